@@ -1,0 +1,127 @@
+/*
+ * silc.h -- the public C API of SILC.
+ *
+ * A program deposits matrices under names, asks for computation as text, and
+ * fetches results by name:
+ *
+ *     silc_envelope_t A, b, u;
+ *     SILC_INIT();
+ *     silc_envelope_csr(&A, n, n, rowptr, colind, values);
+ *     silc_envelope_dense(&b, n, 1, rhs);
+ *     SILC_PUT("A", &A); SILC_PUT("b", &b);
+ *     if (SILC_EXEC("u = A \\ b")) fprintf(stderr, "%s\n", silc_errmsg());
+ *     SILC_GET(&u, "u");
+ *     silc_envelope_to_dense(&u, x);
+ *     silc_envelope_free(&A); silc_envelope_free(&b); silc_envelope_free(&u);
+ *     SILC_FINALIZE();
+ *
+ * The upper-case calls use one default context; the silc_* calls take an
+ * explicit context (several may be open at once; a context is not thread-safe,
+ * use one per thread).  The API does not depend on where computation runs:
+ * embedded in this process today, a server later, behind the same calls.
+ *
+ * Every function returning int returns 0 on success and non-zero on failure; the
+ * message is then available from silc_errmsg() / silc_context_errmsg().
+ *
+ * Ownership: an envelope owns its arrays.  Constructors copy the caller's
+ * arrays; SILC_GET fills an envelope with freshly allocated arrays; release them
+ * all with silc_envelope_free().  Strings returned as const char * belong to
+ * the context and stay valid until the next call on that context.
+ */
+#ifndef SILC_H
+#define SILC_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SILC_VERSION "0.1.0"
+
+/* Storage formats of an envelope (the same codes as the plugin ABI). */
+typedef enum {
+    SILC_DENSE = 0, /* column-major m*n */
+    SILC_CSR = 1,   /* 0-based compressed sparse rows */
+    SILC_BAND = 2   /* LAPACK band storage, ld = kl+ku+1, A(i,j) = values[(ku+i-j) + j*ld] */
+} silc_format_t;
+
+/* A matrix in transit between the program and SILC.  Fields are readable; build
+ * envelopes with the constructors below.  rowptr/colind are int64 whatever width
+ * the caller gave. */
+typedef struct silc_envelope_t {
+    int64_t m, n;
+    silc_format_t format;
+    double *values;     /* dense: m*n; csr: nnz; band: (kl+ku+1)*n */
+    int64_t *rowptr;    /* csr: m+1 entries, else NULL */
+    int64_t *colind;    /* csr: nnz entries, else NULL */
+    int64_t nnz;        /* csr: stored entries; dense: m*n; band: (kl+ku+1)*n */
+    int64_t kl, ku;     /* band only */
+} silc_envelope_t;
+
+/* ---- envelopes ------------------------------------------------------------- */
+/* Dense, column-major; a vector is n x 1, a scalar 1 x 1.  colmajor may be NULL
+ * for zeros.  Copies. */
+int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor);
+int silc_envelope_scalar(silc_envelope_t *e, double x);
+int silc_envelope_vector(silc_envelope_t *e, int64_t n, const double *x);
+/* CSR, 0-based, copies.  Rows need not be sorted: columns are sorted on copy and
+ * duplicates are an error (use sparse(i,j,v,m,n) in the language to sum them). */
+int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
+                      const int64_t *colind, const double *values);
+int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t *rowptr,
+                        const int32_t *colind, const double *values);
+/* Band, LAPACK layout with ld = kl+ku+1.  Copies. */
+int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
+                       const double *band);
+int64_t silc_envelope_rows(const silc_envelope_t *e);
+int64_t silc_envelope_cols(const silc_envelope_t *e);
+/* Writes all m*n entries column-major into colmajor_out (caller's array). */
+int silc_envelope_to_dense(const silc_envelope_t *e, double *colmajor_out);
+/* Frees the arrays and zeroes the envelope; NULL and zeroed envelopes are fine. */
+void silc_envelope_free(silc_envelope_t *e);
+
+/* Matrix Market: read coordinate (real, integer, pattern; general, symmetric,
+ * skew-symmetric) into CSR, or array into dense.  Complex files are refused with
+ * a message.  Write: dense as array, CSR/band as coordinate general, %.17g. */
+int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
+int silc_mm_write(const silc_envelope_t *e, FILE *out);
+
+/* ---- contexts -------------------------------------------------------------- */
+typedef struct silc_context silc_context;
+
+/* Opens an embedded context.  config_path may be NULL: then SILC_CONFIG, else
+ * ./silc.conf if it exists, else built-in defaults.  On failure returns non-zero
+ * and, if *out was set, silc_context_errmsg(*out) says why (else the message is
+ * in silc_errmsg()). */
+int silc_open(silc_context **out, const char *config_path);
+void silc_close(silc_context **ctx);
+int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
+int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
+int silc_exec(silc_context *ctx, const char *statements);
+const char *silc_context_errmsg(const silc_context *ctx);
+/* Warnings of the last silc_exec (one per line, "" if none): results that were
+ * computed but deserve distrust, e.g. "matrix is singular to working precision
+ * (1-norm condition estimate 3.2e+17)".  Valid until the next call. */
+const char *silc_context_warnings(const silc_context *ctx);
+/* Where `who`, `info` and `explain` print (default: stdout).  The callback gets
+ * one complete piece of text at a time; NULL restores stdout. */
+typedef void (*silc_output_fn)(void *user, const char *text);
+void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
+
+/* ---- the default context (the seeds' calls) -------------------------------- */
+int SILC_INIT(void);
+int SILC_FINALIZE(void);
+int SILC_PUT(const char *name, const silc_envelope_t *e);
+int SILC_GET(silc_envelope_t *e, const char *name);
+int SILC_EXEC(const char *statements);
+const char *silc_errmsg(void);        /* message of the last failure on the default context */
+const char *silc_warnings(void);      /* warnings of the last SILC_EXEC on the default context */
+silc_context *silc_default_context(void); /* NULL before SILC_INIT */
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SILC_H */

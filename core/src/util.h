@@ -1,0 +1,39 @@
+/*
+ * util.h -- small shared helpers of the core: a growable string buffer, the
+ * closest-name suggestion used by every "did you mean" message, and a
+ * monotonic clock.  One implementation serves the parser, the config reader
+ * and the dispatcher so their messages read alike.
+ */
+#ifndef SILC_UTIL_H
+#define SILC_UTIL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+typedef struct strbuf {
+    char *s;
+    size_t len, cap;
+} strbuf;
+
+void sb_init(strbuf *b);
+void sb_free(strbuf *b);
+int sb_puts(strbuf *b, const char *s);
+int sb_printf(strbuf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+int sb_vprintf(strbuf *b, const char *fmt, va_list ap);
+const char *sb_str(const strbuf *b);   /* "" when empty */
+
+/* Closest candidate by edit distance, or NULL if none is close enough (distance
+ * at most max(1, strlen(name)/3)). */
+const char *util_closest(const char *name, const char *const *cands, size_t ncands);
+
+double util_now(void);                 /* monotonic seconds */
+char *util_strdup(const char *s);
+/* Formats a double the way the language prints values: %.17g, but shortest
+ * round-trip form (tries %.15g, %.16g first). */
+void util_fmt_double(char *out, size_t outlen, double x);
+
+#endif

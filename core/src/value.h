@@ -1,0 +1,87 @@
+/*
+ * value.h -- values and the store: the engine's data model.
+ *
+ * A value is an immutable m x n real matrix in one storage format (dense
+ * column-major, sorted 0-based CSR, LAPACK band), reference counted, with a
+ * process-unique id, lazily computed structural properties, and attachments
+ * (derived data with a destructor: factorizations, converted copies) that die
+ * with it.  Immutability is what makes attachments safe: `A` keeps its id and
+ * its factorization until the name is rebound.  Values are built mutable by the
+ * constructors below, filled, and then frozen by being handed to the store or
+ * returned from an operation; nothing writes to a value after that.
+ *
+ * The store maps names to values for one context.  Binding retains, rebinding
+ * or clearing releases.
+ */
+#ifndef SILC_VALUE_H
+#define SILC_VALUE_H
+
+#include "silc_plugin.h"
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct val_attachment {
+    char *key;
+    void *data;
+    void (*destroy)(void *);
+    struct val_attachment *next;
+} val_attachment;
+
+struct silc_value {
+    int64_t refcount;
+    uint64_t id;
+    int64_t m, n;
+    int format;              /* enum silc_format */
+    double *val;
+    silc_index *rowptr, *colind;
+    int64_t nnz;             /* csr: entries in use; dense m*n; band ld*n */
+    int64_t cap;             /* csr: capacity of colind/val */
+    int64_t kl, ku, ld;
+    int props_ready;
+    silc_props props;
+    val_attachment *attach;
+};
+
+/* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
+silc_value *val_dense_new(int64_t m, int64_t n);
+silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity);
+silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku);
+silc_value *val_scalar_new(double x);
+int val_csr_set_nnz(silc_value *v, int64_t nnz);
+
+silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
+void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */
+
+void val_view(const silc_value *v, silc_view *out);
+const silc_props *val_props(const silc_value *v); /* computes and caches on first call */
+int val_is_scalar(const silc_value *v);   /* 1x1 */
+double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
+double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
+size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
+const char *val_format_name(int format);  /* "dense", "csr", "band" */
+
+void *val_attach_get(const silc_value *v, const char *key);
+int val_attach_set(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
+
+/* ---- the store ------------------------------------------------------------- */
+typedef struct store_entry {
+    char *name;
+    silc_value *value;
+    struct store_entry *next;
+} store_entry;
+
+typedef struct silc_store {
+    store_entry **buckets;
+    size_t nbuckets, count;
+} silc_store;
+
+int store_init(silc_store *s);
+void store_free(silc_store *s);
+silc_value *store_get(const silc_store *s, const char *name);     /* borrowed, NULL if absent */
+int store_set(silc_store *s, const char *name, silc_value *v);    /* retains v; releases the old */
+int store_remove(silc_store *s, const char *name);                /* 0 removed, 1 absent */
+void store_clear(silc_store *s);
+/* Names in sorted order; *names is malloc'd array of borrowed strings. */
+size_t store_names(const silc_store *s, const char ***names);
+
+#endif

@@ -1,0 +1,270 @@
+/*
+ * silc_plugin.h -- the SILC plugin ABI: the only header a backend plugin includes.
+ *
+ * A plugin is a shared object exporting one symbol, silc_plugin_init().  The
+ * host passes it a table of services (silc_host_api: allocator, errors, options,
+ * value constructors and accessors, attachments, timers) so the plugin never
+ * links against libsilc; the plugin answers with a silc_plugin table naming its
+ * backends, each with an ops table indexed by SILC_OP_*.  Both tables start with
+ * abi_major / abi_minor / struct_size / index_bytes and only ever grow at the
+ * end (as SQLite's versioned vtables do), so an older plugin keeps working with
+ * a newer host.  A wrong major version or index width is refused by the loader.
+ *
+ * Rules (see plugins/README.md): no longjmp, exit or abort across the boundary;
+ * every failure returns a SILC_E* status after calling host->error() with a
+ * message that names the failing library call and its native code; numeric
+ * outcomes (singular, not positive definite, not converged) are statuses, never
+ * crashes.  Input values are immutable: read them through host->view(); a new
+ * value is created by host->*_new(), filled through its view, and handed back in
+ * call->out, after which the host owns it.
+ */
+#ifndef SILC_PLUGIN_H
+#define SILC_PLUGIN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SILC_ABI_MAJOR 1
+#define SILC_ABI_MINOR 0
+
+/* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
+typedef int64_t silc_index;
+
+#if defined(_WIN32)
+#define SILC_PLUGIN_EXPORT __declspec(dllexport)
+#else
+#define SILC_PLUGIN_EXPORT __attribute__((visibility("default")))
+#endif
+
+/* ---- statuses (0 = ok) ---------------------------------------------------- */
+enum silc_status {
+    SILC_OK = 0,
+    SILC_EARG = 1,        /* operands wrong for this operation (shape, format) */
+    SILC_ENOMEM = 2,      /* allocation failed */
+    SILC_ESINGULAR = 3,   /* matrix exactly singular (zero pivot) */
+    SILC_ENOTSPD = 4,     /* Cholesky found a non-positive pivot: dispatcher falls back to LU */
+    SILC_ENOTCONV = 5,    /* iterative method hit its iteration limit */
+    SILC_EBREAKDOWN = 6,  /* iterative method broke down (division by ~0, NaN) */
+    SILC_EDECLINE = 7,    /* plugin declines after all (e.g. structure test failed late): try next */
+    SILC_ELIB = 8,        /* third-party library failure */
+    SILC_EUNSUP = 9,      /* operation or option not supported */
+    SILC_EINTERNAL = 10
+};
+
+/* ---- values ---------------------------------------------------------------- */
+typedef struct silc_value silc_value; /* opaque, owned by the host */
+
+enum silc_format {
+    SILC_FMT_DENSE = 0, /* column-major, leading dimension m */
+    SILC_FMT_CSR = 1,   /* rowptr[m+1], colind[nnz] sorted ascending per row, 0-based; explicit zeros allowed */
+    SILC_FMT_BAND = 2   /* LAPACK general band storage: ld = kl+ku+1, A(i,j) = val[(ku+i-j) + j*ld] */
+};
+
+/* A borrowed view of a value's arrays.  For inputs, treat every array as const.
+ * For a value the plugin just created (not yet returned), the arrays are writable. */
+typedef struct silc_view {
+    int64_t m, n;
+    int format;             /* enum silc_format */
+    double *val;            /* dense: m*n; csr: nnz; band: ld*n */
+    silc_index *rowptr;     /* csr only */
+    silc_index *colind;     /* csr only */
+    int64_t nnz;            /* csr: stored entries; dense: m*n; band: ld*n */
+    int64_t kl, ku, ld;     /* band only (ld = kl+ku+1) */
+} silc_view;
+
+/* Structural properties, computed by the host on first use and cached. */
+typedef struct silc_props {
+    int square;
+    int symmetric;          /* exactly symmetric values (pattern and value) */
+    int pos_diag;           /* every diagonal entry > 0 (square only) */
+    int diagonal;           /* no off-diagonal nonzero */
+    int lower, upper;       /* lower / upper triangular (diagonal counts as both) */
+    int64_t kl, ku;         /* lower / upper bandwidth of the nonzeros */
+    int64_t nnz;            /* numerically nonzero entries */
+    int has_nonfinite;      /* a NaN or Inf is stored */
+    double norm1, norminf, normfro, maxabs; /* computed with scaling: no overflow */
+} silc_props;
+
+/* ---- operations ------------------------------------------------------------ */
+/* Ops are numbered for ever; new ones are appended.  in[] are the operands; shapes
+ * have been checked by the host, except where noted.  A 1x1 operand of ADD and
+ * EWISE broadcasts against the other operand. */
+enum silc_op {
+    SILC_OP_ADD = 0,       /* out = alpha*in[0] + beta*in[1]                                  */
+    SILC_OP_SCALE = 1,     /* out = alpha*in[0]                                               */
+    SILC_OP_MATMUL = 2,    /* out = in[0] * in[1] (neither is 1x1: host turns that into SCALE) */
+    SILC_OP_EWISE = 3,     /* out = in[0] (sub) in[1] element-wise; sub = enum silc_ewise     */
+    SILC_OP_MAP = 4,       /* out = f(in[0]) element-wise; sub = enum silc_map                */
+    SILC_OP_TRANSPOSE = 5, /* out = in[0]'                                                    */
+    SILC_OP_SOLVE = 6,     /* out = in[0] \ in[1]; fills call->report; options in call->options */
+    SILC_OP_REDUCE = 7,    /* sub = enum silc_reduce; see there                               */
+    SILC_OP_CONVERT = 8,   /* out = in[0] stored as format sub (band: kl = ival[0], ku = ival[1]) */
+    SILC_OP_DIAG = 9,      /* sub 0: diag(v) -> CSR diagonal matrix; sub 1: diagvec(A) -> column */
+    SILC_OP_COUNT = 10
+};
+
+enum silc_ewise {
+    SILC_EW_MUL = 0, SILC_EW_DIV, SILC_EW_POW, SILC_EW_MAX, SILC_EW_MIN,
+    SILC_EW_EQ, SILC_EW_NE, SILC_EW_LT, SILC_EW_LE, SILC_EW_GT, SILC_EW_GE,
+    SILC_EW_AND, SILC_EW_OR  /* comparisons and logic give 1.0 / 0.0 */
+};
+
+enum silc_map {
+    SILC_MAP_NEG = 0, SILC_MAP_ABS, SILC_MAP_SQRT, SILC_MAP_EXP, SILC_MAP_LOG,
+    SILC_MAP_SIN, SILC_MAP_COS, SILC_MAP_NOT
+};
+
+/* REDUCE: for a vector (m==1 or n==1) the result is 1x1; for a matrix it is the
+ * 1xn row of per-column results (as MATLAB), except NORM, NORM1, NORMINF,
+ * NORMFRO and DOT, which always give 1x1.  NORM of a vector is the 2-norm, of a
+ * matrix the 2-norm (largest singular value).  DOT takes in[0], in[1] of the
+ * same shape and returns sum(in0 .* in1). */
+enum silc_reduce {
+    SILC_RED_SUM = 0, SILC_RED_MAX, SILC_RED_MIN, SILC_RED_DOT,
+    SILC_RED_NORM, SILC_RED_NORM1, SILC_RED_NORMINF, SILC_RED_NORMFRO
+};
+
+/* What a solver tells about its result.  The host fills backend, wall time and the
+ * backward error itself; a plugin fills what it knows and leaves the rest alone
+ * (the host zeroes the report and sets cond_est = -1 before the call). */
+typedef struct silc_report {
+    char method[64];        /* e.g. "LU (partial pivoting, COLAMD order)" */
+    double cond_est;        /* 1-norm condition estimate, -1 = unknown */
+    double rcond;           /* reciprocal condition estimate as the library reports it, -1 = unknown */
+    int64_t iterations;     /* iterative solvers; 0 for direct */
+    double resid;           /* final relative residual of an iterative solver */
+    int reused_factor;      /* 1 if an attached factorization was reused */
+    double factor_seconds, solve_seconds;
+    char note[256];         /* anything else worth showing in `info` */
+    /* host-filled */
+    char backend[64];
+    double seconds;
+    double backward_error;
+} silc_report;
+
+typedef struct silc_call {
+    int op;                     /* enum silc_op */
+    int sub;                    /* op-specific selector */
+    int nin;
+    const silc_value *in[3];
+    double alpha, beta;         /* ADD / SCALE coefficients */
+    int64_t ival[2];            /* CONVERT band widths */
+    const char *options;        /* SOLVE: per-call option text, may be NULL */
+    silc_value *out;            /* set by the plugin on success */
+    silc_report *report;        /* SOLVE only, never NULL then */
+    void *host_private;         /* host bookkeeping (error buffer, option scope) */
+    const char *op_class;       /* class being tried, e.g. "solve.sparse.spd": a SOLVE under a
+                                   ".spd" class should try Cholesky and return SILC_ENOTSPD on
+                                   failure; under the general class it should use LU */
+} silc_call;
+
+typedef int (*silc_op_fn)(silc_call *call);
+/* Returns 1 if the backend takes these operands, else 0 with *why set to a short
+ * static reason ("needs a symmetric matrix").  Must be cheap: it may use
+ * host->props(). */
+typedef int (*silc_accepts_fn)(const silc_call *call, const char **why);
+
+typedef struct silc_op_entry {
+    silc_op_fn run;             /* NULL = not provided */
+    silc_accepts_fn accepts;    /* NULL = accepts anything run is given */
+} silc_op_entry;
+
+/* ---- options --------------------------------------------------------------- */
+enum silc_opt_type { SILC_OPT_INT = 0, SILC_OPT_DOUBLE, SILC_OPT_STRING, SILC_OPT_BOOL };
+
+typedef struct silc_option_spec {
+    const char *key;            /* without the plugin prefix: "icntl_7" */
+    int type;                   /* enum silc_opt_type */
+    const char *default_value;  /* as text */
+    const char *help;
+} silc_option_spec;
+
+/* ---- the host's services --------------------------------------------------- */
+typedef struct silc_host_api {
+    int abi_major, abi_minor;
+    size_t struct_size;
+    int index_bytes;            /* sizeof(silc_index) on the host */
+
+    void *(*alloc)(size_t bytes);
+    void *(*calloc)(size_t count, size_t size);
+    void *(*realloc)(void *p, size_t bytes);
+    void (*free)(void *p);
+
+    /* Record the failure message of this call and return status, so a plugin
+     * writes `return host->error(call, SILC_ESINGULAR, "umfpack_dl_numeric: ...")`. */
+    int (*error)(silc_call *call, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+        __attribute__((format(printf, 3, 4)))
+#endif
+        ;
+    void (*log)(int level, const char *fmt, ...); /* 0 error, 1 warn, 2 info, 3 debug */
+
+    /* Typed options of this plugin, looked up in the per-call options, the
+     * session's `set`, then the config file.  key is without the plugin prefix.
+     * Return 0 and the default when absent; non-zero (after host->error) when
+     * present but not of the type. */
+    int (*option_int)(silc_call *call, const char *key, int64_t def, int64_t *out);
+    int (*option_double)(silc_call *call, const char *key, double def, double *out);
+    const char *(*option_string)(silc_call *call, const char *key, const char *def);
+
+    /* New values, zero-filled, NULL on allocation failure.  Fill through view(). */
+    silc_value *(*dense_new)(int64_t m, int64_t n);
+    silc_value *(*csr_new)(int64_t m, int64_t n, int64_t nnz_capacity);
+    silc_value *(*band_new)(int64_t m, int64_t n, int64_t kl, int64_t ku);
+    /* Set the final entry count of a CSR value built with a larger capacity. */
+    int (*csr_set_nnz)(silc_value *v, int64_t nnz);
+    void (*release)(silc_value *v);     /* drop a value the plugin created and will not return */
+
+    void (*view)(const silc_value *v, silc_view *out);
+    const silc_props *(*props)(const silc_value *v);
+    uint64_t (*id)(const silc_value *v); /* unique per value for the process lifetime */
+
+    /* Attachments: derived data (a factorization, a converted copy) hung on an
+     * immutable value and destroyed with it.  key should start with the backend
+     * name.  set replaces (destroying) an existing attachment of the same key. */
+    void *(*attach_get)(const silc_value *v, const char *key);
+    int (*attach_set)(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
+
+    double (*now)(void);        /* monotonic seconds */
+    int (*threads)(void);       /* thread budget the tuner grants right now */
+} silc_host_api;
+
+/* ---- what a plugin provides ------------------------------------------------ */
+typedef struct silc_backend {
+    const char *name;           /* "umfpack"; full name is "<plugin>.<name>"; NULL = plugin name alone */
+    const char *description;
+    int n_ops;                  /* entries in ops (ops past n_ops are "not provided") */
+    const silc_op_entry *ops;   /* indexed by enum silc_op */
+} silc_backend;
+
+typedef struct silc_plugin {
+    int abi_major, abi_minor;
+    size_t struct_size;
+    int index_bytes;            /* sizeof(silc_index) the plugin was built with */
+
+    const char *name;           /* "suitesparse", "reference" */
+    const char *version;        /* of the plugin and, after a space, of the library */
+    int n_backends;
+    const silc_backend *backends;
+
+    int n_options;              /* typed options the plugin reads; others are errors */
+    const silc_option_spec *options;
+
+    void (*set_threads)(int nthreads); /* NULL if the plugin is single-threaded */
+    void (*shutdown)(void);            /* NULL if nothing to release; called once at unload */
+} silc_plugin;
+
+/* The one exported symbol.  Returns 0 and *out on success; on failure returns
+ * non-zero and may set *errmsg to a static message. */
+typedef int (*silc_plugin_init_fn)(const silc_host_api *host, const silc_plugin **out,
+                                   const char **errmsg);
+#define SILC_PLUGIN_INIT_SYMBOL "silc_plugin_init"
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SILC_PLUGIN_H */
