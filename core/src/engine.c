@@ -1,0 +1,193 @@
+/*
+ * engine.c -- the embedded engine behind a context: its creation (store,
+ * options, plugins, configuration file, in that order so that the file can
+ * name options of any loaded plugin), destruction, the error buffer, output,
+ * warnings and the per-name records that `info` shows.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "engine.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef SILC_PLUGIN_BUILD_DIR
+#define SILC_PLUGIN_BUILD_DIR "./plugins"
+#endif
+#ifndef SILC_PLUGIN_INSTALL_DIR
+#define SILC_PLUGIN_INSTALL_DIR "/usr/local/lib/silc"
+#endif
+
+/* Seed of rand(): fixed so that scripts are reproducible run to run. */
+#define ENG_RAND_SEED 0x9E3779B97F4A7C15ull
+
+/* The configuration file to read, or NULL for built-in defaults. */
+static const char *config_file(const char *config_path)
+{
+    const char *env;
+    if (config_path) return config_path;
+    env = getenv("SILC_CONFIG");
+    if (env && *env) return env;
+    if (access("./silc.conf", F_OK) == 0) return "./silc.conf";
+    return NULL;
+}
+
+/* Thread budget from core.threads; anything but a positive integer means 1
+ * (the tuner raises it later). */
+static int config_threads(const silc_engine *E)
+{
+    const char *t = cfg_get(E, "core.threads");
+    char *end;
+    long n;
+    if (!t) return 1;
+    n = strtol(t, &end, 10);
+    if (end == t || *end != '\0' || n < 1 || n > 4096) return 1;
+    return (int)n;
+}
+
+static int eng_setup(silc_engine *E, const char *config_path)
+{
+    const char *path;
+    if (store_init(&E->store)) return eng_error(E, "out of memory creating the store");
+    if (cfg_create(E)) return -1;
+    if (ld_create(E)) return -1;
+    /* The built-in directories may legitimately be absent (not installed, or
+     * run from elsewhere); a directory the user named must work. */
+    ld_load_path(E, SILC_PLUGIN_BUILD_DIR ":" SILC_PLUGIN_INSTALL_DIR);
+    E->err[0] = '\0';
+    path = getenv("SILC_PLUGIN_PATH");
+    if (path && *path && ld_load_path(E, path)) return -1;
+    path = config_file(config_path);
+    if (path && cfg_load_file(E, path)) return -1;
+    path = cfg_get(E, "core.plugin_path");
+    if (path && *path && ld_load_path(E, path)) return -1;
+    E->threads = config_threads(E);
+    ld_set_threads(E, E->threads);
+    return 0;
+}
+
+int eng_create(silc_engine **out, const char *config_path, char *err, size_t errlen)
+{
+    silc_engine *E;
+    if (!out) return -1;
+    *out = NULL;
+    E = calloc(1, sizeof *E);
+    if (!E) {
+        if (err && errlen) snprintf(err, errlen, "out of memory creating the engine");
+        return -1;
+    }
+    sb_init(&E->warnings);
+    E->threads = 1;
+    E->rand_state = ENG_RAND_SEED;
+    if (eng_setup(E, config_path)) {
+        if (err && errlen)
+            snprintf(err, errlen, "%s", E->err[0] ? E->err : "engine initialisation failed");
+        eng_destroy(&E);
+        return -1;
+    }
+    *out = E;
+    return 0;
+}
+
+static void info_entry_free(eng_info_entry *e)
+{
+    free(e->name);
+    free(e->info.statement);
+    free(e);
+}
+
+void eng_destroy(silc_engine **pE)
+{
+    silc_engine *E;
+    eng_info_entry *e, *next;
+    if (!pE || !*pE) return;
+    E = *pE;
+    /* Values first: their attachments may belong to plugins still loaded. */
+    store_free(&E->store);
+    if (E->lang_cache_free && E->lang_cache) E->lang_cache_free(E->lang_cache);
+    for (e = E->infos; e; e = next) {
+        next = e->next;
+        info_entry_free(e);
+    }
+    cfg_destroy(E);
+    ld_destroy(E);
+    sb_free(&E->warnings);
+    free(E);
+    *pE = NULL;
+}
+
+int eng_error(silc_engine *E, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(E->err, sizeof E->err, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+void eng_print(silc_engine *E, const char *text)
+{
+    if (!text) return;
+    if (E && E->output) E->output(E->output_user, text);
+    else fputs(text, stdout);
+}
+
+void eng_warn(silc_engine *E, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    sb_vprintf(&E->warnings, fmt, ap);
+    va_end(ap);
+    sb_puts(&E->warnings, "\n");
+}
+
+int eng_info_set(silc_engine *E, const char *name, const eng_info *info)
+{
+    eng_info_entry *e;
+    char *stmt = NULL;
+    if (!E || !name || !info) return -1;
+    if (info->statement && !(stmt = util_strdup(info->statement)))
+        return eng_error(E, "out of memory recording info for '%s'", name);
+    for (e = E->infos; e; e = e->next)
+        if (strcmp(e->name, name) == 0) break;
+    if (!e) {
+        e = calloc(1, sizeof *e);
+        if (!e || !(e->name = util_strdup(name))) {
+            free(e);
+            free(stmt);
+            return eng_error(E, "out of memory recording info for '%s'", name);
+        }
+        e->next = E->infos;
+        E->infos = e;
+    } else {
+        free(e->info.statement);
+    }
+    e->info = *info;
+    e->info.statement = stmt;
+    return 0;
+}
+
+const eng_info *eng_info_get(const silc_engine *E, const char *name)
+{
+    const eng_info_entry *e;
+    if (!E || !name) return NULL;
+    for (e = E->infos; e; e = e->next)
+        if (strcmp(e->name, name) == 0) return &e->info;
+    return NULL;
+}
+
+void eng_info_remove(silc_engine *E, const char *name)
+{
+    eng_info_entry **pe, *e;
+    if (!E || !name) return;
+    for (pe = &E->infos; *pe; pe = &(*pe)->next) {
+        if (strcmp((*pe)->name, name) == 0) {
+            e = *pe;
+            *pe = e->next;
+            info_entry_free(e);
+            return;
+        }
+    }
+}

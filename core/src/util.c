@@ -1,0 +1,160 @@
+/*
+ * util.c -- small shared helpers of the core: the growable string buffer,
+ * the "did you mean" suggestion, the monotonic clock and the shortest
+ * round-trip formatting of doubles.  Kept in one place so that every module's
+ * messages read alike.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+void sb_init(strbuf *b)
+{
+    b->s = NULL;
+    b->len = b->cap = 0;
+}
+
+void sb_free(strbuf *b)
+{
+    free(b->s);
+    sb_init(b);
+}
+
+/* Makes room for extra more characters plus the terminator. */
+static int sb_reserve(strbuf *b, size_t extra)
+{
+    size_t need = b->len + extra + 1, cap;
+    char *s;
+    if (need <= b->cap) return 0;
+    cap = b->cap ? b->cap : 64;
+    while (cap < need) cap *= 2;
+    s = realloc(b->s, cap);
+    if (!s) return -1;
+    b->s = s;
+    b->cap = cap;
+    return 0;
+}
+
+int sb_puts(strbuf *b, const char *s)
+{
+    size_t n = strlen(s);
+    if (sb_reserve(b, n)) return -1;
+    memcpy(b->s + b->len, s, n + 1);
+    b->len += n;
+    return 0;
+}
+
+int sb_vprintf(strbuf *b, const char *fmt, va_list ap)
+{
+    va_list ap2;
+    int n;
+    va_copy(ap2, ap);
+    n = vsnprintf(NULL, 0, fmt, ap2);
+    va_end(ap2);
+    if (n < 0 || sb_reserve(b, (size_t)n)) return -1;
+    vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap);
+    b->len += (size_t)n;
+    return 0;
+}
+
+int sb_printf(strbuf *b, const char *fmt, ...)
+{
+    va_list ap;
+    int rc;
+    va_start(ap, fmt);
+    rc = sb_vprintf(b, fmt, ap);
+    va_end(ap);
+    return rc;
+}
+
+const char *sb_str(const strbuf *b)
+{
+    return b->s ? b->s : "";
+}
+
+/* Levenshtein distance with two rolling rows; names are short, so the rows
+ * live on the stack unless a name is unusually long. */
+static size_t edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b), i, j, d;
+    size_t stack[2][64], *prev, *cur, *heap = NULL;
+    if (lb + 1 <= 64) {
+        prev = stack[0];
+        cur = stack[1];
+    } else {
+        heap = malloc(2 * (lb + 1) * sizeof *heap);
+        if (!heap) return (size_t)-1;
+        prev = heap;
+        cur = heap + lb + 1;
+    }
+    for (j = 0; j <= lb; j++) prev[j] = j;
+    for (i = 1; i <= la; i++) {
+        size_t *t;
+        cur[0] = i;
+        for (j = 1; j <= lb; j++) {
+            size_t sub = prev[j - 1] + (a[i - 1] != b[j - 1]);
+            size_t del = prev[j] + 1, ins = cur[j - 1] + 1;
+            d = sub < del ? sub : del;
+            cur[j] = d < ins ? d : ins;
+        }
+        t = prev;
+        prev = cur;
+        cur = t;
+    }
+    d = prev[lb];
+    free(heap);
+    return d;
+}
+
+const char *util_closest(const char *name, const char *const *cands, size_t ncands)
+{
+    size_t limit, best_d = (size_t)-1, i;
+    const char *best = NULL;
+    if (!name || !cands) return NULL;
+    limit = strlen(name) / 3;
+    if (limit < 1) limit = 1;
+    for (i = 0; i < ncands; i++) {
+        size_t d;
+        if (!cands[i] || strcmp(cands[i], name) == 0) continue;
+        d = edit_distance(name, cands[i]);
+        if (d <= limit && d < best_d) {
+            best_d = d;
+            best = cands[i];
+        }
+    }
+    return best;
+}
+
+double util_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+char *util_strdup(const char *s)
+{
+    size_t n;
+    char *p;
+    if (!s) return NULL;
+    n = strlen(s) + 1;
+    p = malloc(n);
+    if (p) memcpy(p, s, n);
+    return p;
+}
+
+void util_fmt_double(char *out, size_t outlen, double x)
+{
+    static const char *const fmts[] = {"%.15g", "%.16g", "%.17g"};
+    size_t k;
+    if (!out || outlen == 0) return;
+    for (k = 0; k < 3; k++) {
+        snprintf(out, outlen, fmts[k], x);
+        /* NaN never compares equal to itself; %.15g already prints it exactly. */
+        if (x != x || strtod(out, NULL) == x) return;
+    }
+}

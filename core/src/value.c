@@ -1,0 +1,609 @@
+/*
+ * value.c -- values and the store.
+ *
+ * A value is created mutable by one of the constructors, filled by its
+ * creator, and frozen from then on (see value.h).  What lives here is the
+ * bookkeeping around that: unique ids, reference counts, attachments, the
+ * structural properties the dispatcher asks about (computed once, on demand,
+ * with scaled norms so that entries near the overflow threshold give finite
+ * answers), and the per-context store mapping names to values.
+ */
+#include "value.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util.h"
+
+/* Ids are unique for the process lifetime, across every context and thread. */
+static _Atomic uint64_t next_id = 1;
+
+/* a*b as a non-negative element count, or -1 on overflow or negative input. */
+static int64_t count_mul(int64_t a, int64_t b)
+{
+    if (a < 0 || b < 0) return -1;
+    if (a != 0 && b > (INT64_MAX / (int64_t)sizeof(double)) / a) return -1;
+    return a * b;
+}
+
+/* malloc/calloc of count doubles or indices; never asks for zero bytes, so a
+ * NULL result always means failure. */
+static void *alloc_zeroed(int64_t count, size_t size)
+{
+    return calloc(count > 0 ? (size_t)count : 1, size);
+}
+
+static silc_value *val_alloc(int64_t m, int64_t n, int format)
+{
+    silc_value *v;
+    if (m < 0 || n < 0) return NULL;
+    v = calloc(1, sizeof *v);
+    if (!v) return NULL;
+    v->refcount = 1;
+    v->id = atomic_fetch_add(&next_id, 1);
+    v->m = m;
+    v->n = n;
+    v->format = format;
+    return v;
+}
+
+/* Frees the arrays and the struct of a value that has no attachments yet. */
+static void val_free_arrays(silc_value *v)
+{
+    free(v->val);
+    free(v->rowptr);
+    free(v->colind);
+    free(v);
+}
+
+silc_value *val_dense_new(int64_t m, int64_t n)
+{
+    int64_t count = count_mul(m, n);
+    silc_value *v;
+    if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
+    v->val = alloc_zeroed(count, sizeof(double));
+    if (!v->val) {
+        val_free_arrays(v);
+        return NULL;
+    }
+    v->nnz = v->cap = count;
+    return v;
+}
+
+silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity)
+{
+    silc_value *v;
+    if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
+    if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
+    v->rowptr = alloc_zeroed(m + 1, sizeof(silc_index));
+    v->colind = alloc_zeroed(nnz_capacity, sizeof(silc_index));
+    v->val = alloc_zeroed(nnz_capacity, sizeof(double));
+    if (!v->rowptr || !v->colind || !v->val) {
+        val_free_arrays(v);
+        return NULL;
+    }
+    v->cap = nnz_capacity;
+    return v;
+}
+
+silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
+{
+    int64_t ld, count;
+    silc_value *v;
+    if (kl < 0 || ku < 0 || kl > INT64_MAX / 4 || ku > INT64_MAX / 4) return NULL;
+    ld = kl + ku + 1;
+    count = count_mul(ld, n);
+    if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_BAND))) return NULL;
+    v->val = alloc_zeroed(count, sizeof(double));
+    if (!v->val) {
+        val_free_arrays(v);
+        return NULL;
+    }
+    v->kl = kl;
+    v->ku = ku;
+    v->ld = ld;
+    v->nnz = v->cap = count;
+    return v;
+}
+
+silc_value *val_scalar_new(double x)
+{
+    silc_value *v = val_dense_new(1, 1);
+    if (v) v->val[0] = x;
+    return v;
+}
+
+int val_csr_set_nnz(silc_value *v, int64_t nnz)
+{
+    if (!v || v->format != SILC_FMT_CSR || nnz < 0 || nnz > v->cap) return -1;
+    v->nnz = nnz;
+    return 0;
+}
+
+silc_value *val_retain(silc_value *v)
+{
+    if (v) v->refcount++;
+    return v;
+}
+
+void val_release(silc_value *v)
+{
+    val_attachment *a, *next;
+    if (!v || --v->refcount > 0) return;
+    /* Attachments first: a factorization may still point into the arrays. */
+    for (a = v->attach; a; a = next) {
+        next = a->next;
+        if (a->destroy) a->destroy(a->data);
+        free(a->key);
+        free(a);
+    }
+    v->attach = NULL;
+    val_free_arrays(v);
+}
+
+void val_view(const silc_value *v, silc_view *out)
+{
+    out->m = v->m;
+    out->n = v->n;
+    out->format = v->format;
+    out->val = v->val;
+    out->rowptr = v->rowptr;
+    out->colind = v->colind;
+    out->nnz = v->nnz;
+    out->kl = v->kl;
+    out->ku = v->ku;
+    out->ld = v->ld;
+}
+
+int val_is_scalar(const silc_value *v)
+{
+    return v && v->m == 1 && v->n == 1;
+}
+
+double val_scalar(const silc_value *v)
+{
+    return val_get(v, 0, 0);
+}
+
+double val_get(const silc_value *v, int64_t i, int64_t j)
+{
+    if (!v || i < 0 || j < 0 || i >= v->m || j >= v->n) return 0.0;
+    switch (v->format) {
+    case SILC_FMT_DENSE:
+        return v->val[i + j * v->m];
+    case SILC_FMT_CSR: {
+        int64_t lo = v->rowptr[i], hi = v->rowptr[i + 1] - 1;
+        while (lo <= hi) {
+            int64_t mid = lo + (hi - lo) / 2;
+            if (v->colind[mid] == j) return v->val[mid];
+            if (v->colind[mid] < j) lo = mid + 1;
+            else hi = mid - 1;
+        }
+        return 0.0;
+    }
+    case SILC_FMT_BAND:
+        if (i - j > v->kl || j - i > v->ku) return 0.0;
+        return v->val[(v->ku + i - j) + j * v->ld];
+    default:
+        return 0.0;
+    }
+}
+
+size_t val_bytes(const silc_value *v)
+{
+    size_t b;
+    if (!v) return 0;
+    b = (size_t)v->cap * sizeof(double);
+    if (v->format == SILC_FMT_CSR)
+        b += (size_t)(v->m + 1) * sizeof(silc_index) + (size_t)v->cap * sizeof(silc_index);
+    return b;
+}
+
+const char *val_format_name(int format)
+{
+    switch (format) {
+    case SILC_FMT_DENSE: return "dense";
+    case SILC_FMT_CSR: return "csr";
+    case SILC_FMT_BAND: return "band";
+    default: return "unknown";
+    }
+}
+
+/* ---- attachments --------------------------------------------------------- */
+
+void *val_attach_get(const silc_value *v, const char *key)
+{
+    const val_attachment *a;
+    if (!v || !key) return NULL;
+    for (a = v->attach; a; a = a->next)
+        if (strcmp(a->key, key) == 0) return a->data;
+    return NULL;
+}
+
+/* Attachments are derived data, not part of the value's contents, so hanging
+ * one on a frozen value is allowed (hence the cast).  On failure the caller
+ * keeps ownership of data. */
+int val_attach_set(const silc_value *cv, const char *key, void *data, void (*destroy)(void *))
+{
+    silc_value *v = (silc_value *)cv;
+    val_attachment *a;
+    if (!v || !key) return -1;
+    for (a = v->attach; a; a = a->next) {
+        if (strcmp(a->key, key) == 0) {
+            if (a->data != data && a->destroy) a->destroy(a->data);
+            a->data = data;
+            a->destroy = destroy;
+            return 0;
+        }
+    }
+    a = malloc(sizeof *a);
+    if (!a) return -1;
+    a->key = util_strdup(key);
+    if (!a->key) {
+        free(a);
+        return -1;
+    }
+    a->data = data;
+    a->destroy = destroy;
+    a->next = v->attach;
+    v->attach = a;
+    return 0;
+}
+
+/* ---- structural properties ------------------------------------------------ */
+
+typedef void (*entry_fn)(void *acc, int64_t i, int64_t j, double a);
+
+/* Calls fn for every stored entry (explicit zeros included). */
+static void for_each_entry(const silc_value *v, entry_fn fn, void *acc)
+{
+    int64_t i, j, k;
+    switch (v->format) {
+    case SILC_FMT_DENSE:
+        for (j = 0; j < v->n; j++)
+            for (i = 0; i < v->m; i++) fn(acc, i, j, v->val[i + j * v->m]);
+        break;
+    case SILC_FMT_CSR:
+        for (i = 0; i < v->m; i++)
+            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) fn(acc, i, v->colind[k], v->val[k]);
+        break;
+    case SILC_FMT_BAND:
+        for (j = 0; j < v->n; j++) {
+            int64_t lo = j - v->ku > 0 ? j - v->ku : 0;
+            int64_t hi = j + v->kl < v->m - 1 ? j + v->kl : v->m - 1;
+            for (i = lo; i <= hi; i++) fn(acc, i, j, v->val[(v->ku + i - j) + j * v->ld]);
+        }
+        break;
+    default:
+        break;
+    }
+}
+
+/* First pass: everything that needs no scale. */
+typedef struct structure_acc {
+    silc_props *p;
+    int64_t pos_diag_count;
+} structure_acc;
+
+static void structure_entry(void *accp, int64_t i, int64_t j, double a)
+{
+    structure_acc *acc = accp;
+    silc_props *p = acc->p;
+    double x = fabs(a);
+    if (!isfinite(a)) p->has_nonfinite = 1;
+    if (x != x) p->maxabs = x; /* NaN is sticky: x > NaN is false from then on */
+    else if (x > p->maxabs) p->maxabs = x;
+    if (i == j && a > 0) acc->pos_diag_count++;
+    if (a == 0) return;
+    p->nnz++;
+    if (i != j) p->diagonal = 0;
+    if (j > i) {
+        p->lower = 0;
+        if (j - i > p->ku) p->ku = j - i;
+    }
+    if (i > j) {
+        p->upper = 0;
+        if (i - j > p->kl) p->kl = i - j;
+    }
+}
+
+/* Second pass: norms, on entries multiplied by a power of two chosen from
+ * maxabs so that no partial sum or square can overflow (the idea of LAPACK's
+ * dlassq; a power of two keeps the scaling itself exact). */
+typedef struct norm_acc {
+    double scale;
+    double *colsum, *rowsum; /* NULL if they could not be allocated */
+    double total, sumsq;
+} norm_acc;
+
+static void norm_entry(void *accp, int64_t i, int64_t j, double a)
+{
+    norm_acc *acc = accp;
+    double x = fabs(a) * acc->scale;
+    acc->total += x;
+    acc->sumsq += x * x;
+    if (acc->colsum) acc->colsum[j] += x;
+    if (acc->rowsum) acc->rowsum[i] += x;
+}
+
+static double max_of(const double *x, int64_t n)
+{
+    double best = 0.0;
+    int64_t k;
+    for (k = 0; k < n; k++) {
+        if (x[k] != x[k]) return x[k];
+        if (x[k] > best) best = x[k];
+    }
+    return best;
+}
+
+/* Exact value symmetry of a CSR matrix: the numerically nonzero entries of A
+ * and of A' must coincide.  Builds A' of the nonzeros by a counting sort,
+ * which leaves its rows sorted, and compares row by row.  Returns -1 when out
+ * of memory. */
+static int csr_symmetric(const silc_value *v)
+{
+    int64_t n = v->n, i, k, t, nz = 0;
+    int64_t *tp, *ti, *next;
+    double *tx;
+    int sym = 1;
+    for (k = 0; k < v->nnz; k++) nz += v->val[k] != 0;
+    tp = calloc((size_t)n + 1, sizeof *tp);
+    next = calloc((size_t)n + 1, sizeof *next);
+    ti = malloc((size_t)(nz ? nz : 1) * sizeof *ti);
+    tx = malloc((size_t)(nz ? nz : 1) * sizeof *tx);
+    if (!tp || !next || !ti || !tx) {
+        free(tp), free(next), free(ti), free(tx);
+        return -1;
+    }
+    for (k = 0; k < v->nnz; k++)
+        if (v->val[k] != 0) tp[v->colind[k] + 1]++;
+    for (i = 0; i < n; i++) tp[i + 1] += tp[i];
+    memcpy(next, tp, (size_t)(n + 1) * sizeof *tp);
+    for (i = 0; i < v->m; i++)
+        for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++)
+            if (v->val[k] != 0) {
+                int64_t c = v->colind[k];
+                ti[next[c]] = i;
+                tx[next[c]++] = v->val[k];
+            }
+    for (i = 0; i < v->m && sym; i++) {
+        t = tp[i];
+        for (k = v->rowptr[i]; k < v->rowptr[i + 1] && sym; k++) {
+            if (v->val[k] == 0) continue;
+            if (t >= tp[i + 1] || ti[t] != v->colind[k] || tx[t] != v->val[k]) sym = 0;
+            t++;
+        }
+        if (t != tp[i + 1]) sym = 0;
+    }
+    free(tp), free(next), free(ti), free(tx);
+    return sym;
+}
+
+/* Symmetry of dense and band values through element access; -1 if unknown. */
+static int value_symmetric(const silc_value *v)
+{
+    int64_t i, j;
+    if (v->m != v->n) return 0;
+    switch (v->format) {
+    case SILC_FMT_CSR:
+        return csr_symmetric(v);
+    case SILC_FMT_DENSE:
+        for (j = 0; j < v->n; j++)
+            for (i = j + 1; i < v->m; i++)
+                if (v->val[i + j * v->m] != v->val[j + i * v->m]) return 0;
+        return 1;
+    case SILC_FMT_BAND:
+        for (j = 0; j < v->n; j++) {
+            int64_t hi = j + v->kl < v->m - 1 ? j + v->kl : v->m - 1;
+            for (i = j + 1; i <= hi; i++)
+                if (val_get(v, i, j) != val_get(v, j, i)) return 0;
+            hi = j + v->ku < v->m - 1 ? j + v->ku : v->m - 1;
+            for (i = j + 1; i <= hi; i++)
+                if (val_get(v, j, i) != val_get(v, i, j)) return 0;
+        }
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* Fills *p.  Returns 0, or -1 when memory ran short: then the answers are
+ * conservative (not symmetric; both operator norms replaced by the upper
+ * bound sum|a_ij|) and the caller does not cache them. */
+static int compute_props(const silc_value *v, silc_props *p)
+{
+    structure_acc sacc;
+    norm_acc nacc;
+    int exp2 = 0, sym, rc = 0;
+    memset(p, 0, sizeof *p);
+    p->square = v->m == v->n;
+    p->diagonal = p->lower = p->upper = 1;
+    sacc.p = p;
+    sacc.pos_diag_count = 0;
+    for_each_entry(v, structure_entry, &sacc);
+    p->pos_diag = p->square && v->n > 0 && sacc.pos_diag_count == v->n;
+
+    memset(&nacc, 0, sizeof nacc);
+    if (isfinite(p->maxabs) && p->maxabs > 0) {
+        frexp(p->maxabs, &exp2);
+        /* Clamped so that the scale itself and its inverse are finite normals. */
+        if (exp2 > 1021) exp2 = 1021;
+        if (exp2 < -1021) exp2 = -1021;
+    }
+    nacc.scale = ldexp(1.0, -exp2);
+    nacc.colsum = calloc((size_t)(v->n ? v->n : 1), sizeof(double));
+    nacc.rowsum = calloc((size_t)(v->m ? v->m : 1), sizeof(double));
+    for_each_entry(v, norm_entry, &nacc);
+    if (nacc.colsum && nacc.rowsum) {
+        p->norm1 = ldexp(max_of(nacc.colsum, v->n), exp2);
+        p->norminf = ldexp(max_of(nacc.rowsum, v->m), exp2);
+    } else {
+        p->norm1 = p->norminf = ldexp(nacc.total, exp2);
+        rc = -1;
+    }
+    p->normfro = ldexp(sqrt(nacc.sumsq), exp2);
+    free(nacc.colsum);
+    free(nacc.rowsum);
+
+    sym = value_symmetric(v);
+    if (sym < 0) rc = -1;
+    p->symmetric = sym > 0;
+    return rc;
+}
+
+const silc_props *val_props(const silc_value *cv)
+{
+    /* The cache is not part of the value's contents (see val_attach_set). */
+    silc_value *v = (silc_value *)cv;
+    if (!v) return NULL;
+    if (!v->props_ready && compute_props(v, &v->props) == 0) v->props_ready = 1;
+    return &v->props;
+}
+
+/* ---- the store ------------------------------------------------------------ */
+
+static size_t hash_name(const char *s)
+{
+    /* FNV-1a: short keys, good spread, no table. */
+    uint64_t h = 1469598103934665603ull;
+    while (*s) {
+        h ^= (unsigned char)*s++;
+        h *= 1099511628211ull;
+    }
+    return (size_t)h;
+}
+
+int store_init(silc_store *s)
+{
+    s->nbuckets = 16;
+    s->count = 0;
+    s->buckets = calloc(s->nbuckets, sizeof *s->buckets);
+    return s->buckets ? 0 : -1;
+}
+
+void store_clear(silc_store *s)
+{
+    size_t b;
+    if (!s->buckets) return;
+    for (b = 0; b < s->nbuckets; b++) {
+        store_entry *e = s->buckets[b], *next;
+        for (; e; e = next) {
+            next = e->next;
+            val_release(e->value);
+            free(e->name);
+            free(e);
+        }
+        s->buckets[b] = NULL;
+    }
+    s->count = 0;
+}
+
+void store_free(silc_store *s)
+{
+    if (!s) return;
+    store_clear(s);
+    free(s->buckets);
+    s->buckets = NULL;
+    s->nbuckets = 0;
+}
+
+static store_entry **store_slot(const silc_store *s, const char *name)
+{
+    store_entry **pe = &s->buckets[hash_name(name) % s->nbuckets];
+    while (*pe && strcmp((*pe)->name, name) != 0) pe = &(*pe)->next;
+    return pe;
+}
+
+silc_value *store_get(const silc_store *s, const char *name)
+{
+    store_entry **pe;
+    if (!s || !s->buckets || !name) return NULL;
+    pe = store_slot(s, name);
+    return *pe ? (*pe)->value : NULL;
+}
+
+/* Doubles the bucket array; on allocation failure the store keeps working
+ * with longer chains. */
+static void store_grow(silc_store *s)
+{
+    size_t nb = s->nbuckets * 2, b;
+    store_entry **nbk = calloc(nb, sizeof *nbk);
+    if (!nbk) return;
+    for (b = 0; b < s->nbuckets; b++) {
+        store_entry *e = s->buckets[b], *next;
+        for (; e; e = next) {
+            size_t h = hash_name(e->name) % nb;
+            next = e->next;
+            e->next = nbk[h];
+            nbk[h] = e;
+        }
+    }
+    free(s->buckets);
+    s->buckets = nbk;
+    s->nbuckets = nb;
+}
+
+int store_set(silc_store *s, const char *name, silc_value *v)
+{
+    store_entry **pe, *e;
+    if (!s || !s->buckets || !name || !v) return -1;
+    pe = store_slot(s, name);
+    if (*pe) {
+        silc_value *old = (*pe)->value;
+        (*pe)->value = val_retain(v);
+        val_release(old);
+        return 0;
+    }
+    e = malloc(sizeof *e);
+    if (!e) return -1;
+    e->name = util_strdup(name);
+    if (!e->name) {
+        free(e);
+        return -1;
+    }
+    e->value = val_retain(v);
+    e->next = NULL;
+    *pe = e;
+    if (++s->count > s->nbuckets) store_grow(s);
+    return 0;
+}
+
+int store_remove(silc_store *s, const char *name)
+{
+    store_entry **pe, *e;
+    if (!s || !s->buckets || !name) return 1;
+    pe = store_slot(s, name);
+    if (!*pe) return 1;
+    e = *pe;
+    *pe = e->next;
+    val_release(e->value);
+    free(e->name);
+    free(e);
+    s->count--;
+    return 0;
+}
+
+static int cmp_names(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+size_t store_names(const silc_store *s, const char ***names)
+{
+    size_t b, k = 0;
+    const char **out;
+    *names = NULL;
+    if (!s || !s->buckets || s->count == 0) return 0;
+    out = malloc(s->count * sizeof *out);
+    if (!out) return 0;
+    for (b = 0; b < s->nbuckets; b++) {
+        const store_entry *e;
+        for (e = s->buckets[b]; e; e = e->next) out[k++] = e->name;
+    }
+    qsort(out, k, sizeof *out, cmp_names);
+    *names = out;
+    return k;
+}
