@@ -11,7 +11,7 @@
  *   host.c      the silc_host_api table handed to plugins
  *   dispatch.c  operation class -> ordered backend list -> first that accepts;
  *               fallbacks; accuracy report of every solve; `explain` text
- *   lang/*.c    lexer, parser, AST cache, evaluator (see lang.h)
+ *   lang: lexer.c, parser.c, eval.c -- lexer, parser, AST cache, evaluator (lang.h)
  * The evaluator never calls a plugin directly: it fills a silc_call and hands it
  * to disp_run().
  */
@@ -133,6 +133,8 @@ extern const char *const ld_known_backends[];
 
 /* ---- host.c ---------------------------------------------------------------- */
 const silc_host_api *host_api(void);
+/* The thread budget host->threads() reports; set by ld_set_threads. */
+void host_set_threads(int nthreads);
 /* Per-call bookkeeping behind call->host_private. */
 typedef struct host_call_ctx {
     silc_engine *E;

@@ -1,0 +1,515 @@
+/*
+ * dispatch.c -- from an operation to the backend that runs it.
+ *
+ * Every call gets a chain of operation classes, most specific first (a solve
+ * with a symmetric, positive-diagonal sparse matrix is "solve.sparse.spd",
+ * then "solve.sparse").  The class chain picks an ordered list of backends:
+ * a per-call "backend = X", else the first class of the chain that the
+ * configuration names (so a config that only sets solve.sparse governs SPD
+ * systems too), else the built-in default, which follows the structure rules
+ * users know from MATLAB's `\`.  The list is walked: a backend that is not
+ * installed, does not provide the operation, or declines the operands is
+ * skipped; a Cholesky that finds the matrix not positive definite sends the
+ * same list round again under the general class (LU); any other failure stops
+ * with the backend's message.  The reference plugin ends every list, so an
+ * operation always has somewhere to go.
+ *
+ * Every solve gets the same accuracy report whoever ran it: the backward error
+ * is computed here with the reference plugin's operations, so backends are
+ * judged by one yardstick.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "engine.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const disp_class_names[] = {
+    "solve.diag", "solve.triangular", "solve.band", "solve.dense", "solve.dense.spd",
+    "solve.sparse", "solve.sparse.spd", "solve.rect", "matmul.sparse_sparse",
+    "matmul.sparse_dense", "matmul.dense", "add", "elementwise", "transpose", "reduce",
+    "convert", "diag", NULL};
+
+static const char *const op_names[SILC_OP_COUNT] = {
+    "add", "scale", "matmul", "elementwise", "map", "transpose", "solve", "reduce", "convert",
+    "diag"};
+
+/* Built-in backend lists; a class not listed uses the reference alone. */
+static const struct {
+    const char *cls;
+    const char *list;
+} default_lists[] = {
+    {"solve.diag", "reference"},
+    {"solve.triangular", "lapack, reference"},
+    {"solve.band", "lapack, reference"},
+    {"solve.dense", "lapack, reference"},
+    {"solve.dense.spd", "lapack, reference"},
+    {"solve.sparse", "suitesparse.umfpack, mumps, reference"},
+    {"solve.sparse.spd", "suitesparse.cholmod, suitesparse.umfpack, reference"},
+    {"solve.rect", "suitesparse.spqr, lapack, reference"},
+};
+
+#define DISP_MAX_LIST 33 /* the config's 32 plus the appended reference */
+
+/* The backends to try for one call, and where the list came from. */
+typedef struct blist {
+    char buf[1024];
+    const char *names[DISP_MAX_LIST];
+    int n;
+    int forced;             /* per-call backend = X: no fallback */
+    char source[192];
+} blist;
+
+/* ---- classes --------------------------------------------------------------- */
+
+/* The class chain of call, with a readable reason in why (may be NULL). */
+static int classify(const silc_call *call, const char *out[4], char *why, size_t whylen)
+{
+    const silc_value *A, *B;
+    const silc_props *p;
+    const char *reason;
+    char band_reason[96];
+    int sparse, n = 0;
+    if (why && whylen) why[0] = '\0';
+    if (!call || call->op < 0 || call->op >= SILC_OP_COUNT || call->nin < 1 || !call->in[0])
+        return 0;
+    A = call->in[0];
+    B = call->nin > 1 ? call->in[1] : NULL;
+    switch (call->op) {
+    case SILC_OP_SOLVE:
+        p = val_props(A);
+        if (!p) return 0;
+        sparse = A->format == SILC_FMT_CSR;
+        if (A->m != A->n) {
+            out[n++] = "solve.rect";
+            reason = "not square (least squares)";
+        } else if (p->diagonal) {
+            out[n++] = "solve.diag";
+            reason = "diagonal";
+        } else if (p->lower || p->upper) {
+            out[n++] = "solve.triangular";
+            reason = p->lower ? "lower triangular" : "upper triangular";
+        } else if (A->format == SILC_FMT_BAND ||
+                   ((double)p->nnz >= 0.5 * (double)(p->kl + p->ku + 1) * (double)A->n &&
+                    2 * (p->kl + p->ku + 1) < A->n)) {
+            out[n++] = "solve.band";
+            snprintf(band_reason, sizeof band_reason, "banded (kl=%lld, ku=%lld)",
+                     (long long)p->kl, (long long)p->ku);
+            reason = band_reason;
+        } else if (p->symmetric && p->pos_diag) {
+            out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
+            out[n++] = sparse ? "solve.sparse" : "solve.dense";
+            reason = "symmetric with positive diagonal";
+        } else {
+            out[n++] = sparse ? "solve.sparse" : "solve.dense";
+            reason = p->symmetric ? "symmetric, some diagonal entry <= 0" : "general";
+        }
+        if (why && whylen) {
+            int k = snprintf(why, whylen, "A is %lldx%lld %s, %s -> %s", (long long)A->m,
+                             (long long)A->n, val_format_name(A->format), reason, out[0]);
+            if (n > 1 && k > 0 && (size_t)k < whylen)
+                snprintf(why + k, whylen - (size_t)k, ", then %s", out[1]);
+        }
+        return n;
+    case SILC_OP_MATMUL:
+        if (!B) return 0;
+        if (A->format == SILC_FMT_CSR && B->format == SILC_FMT_CSR) out[n++] = "matmul.sparse_sparse";
+        else if (A->format == SILC_FMT_CSR || B->format == SILC_FMT_CSR) out[n++] = "matmul.sparse_dense";
+        else out[n++] = "matmul.dense";
+        break;
+    case SILC_OP_ADD:
+    case SILC_OP_SCALE: out[n++] = "add"; break;
+    case SILC_OP_EWISE:
+    case SILC_OP_MAP: out[n++] = "elementwise"; break;
+    case SILC_OP_TRANSPOSE: out[n++] = "transpose"; break;
+    case SILC_OP_REDUCE: out[n++] = "reduce"; break;
+    case SILC_OP_CONVERT: out[n++] = "convert"; break;
+    case SILC_OP_DIAG: out[n++] = "diag"; break;
+    default: return 0;
+    }
+    if (why && whylen) snprintf(why, whylen, "%s -> %s", op_names[call->op], out[0]);
+    return n;
+}
+
+int disp_classes(silc_engine *E, const silc_call *call, const char *out[4])
+{
+    (void)E;
+    return classify(call, out, NULL, 0);
+}
+
+/* ---- backend lists --------------------------------------------------------- */
+
+static void split_list(blist *L, const char *text)
+{
+    char *p;
+    snprintf(L->buf, sizeof L->buf, "%s", text);
+    L->n = 0;
+    for (p = L->buf; p && L->n < DISP_MAX_LIST - 1;) {
+        char *comma = strchr(p, ','), *end;
+        if (comma) *comma = '\0';
+        while (*p == ' ' || *p == '\t') p++;
+        end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t')) *--end = '\0';
+        if (*p) L->names[L->n++] = p;
+        p = comma ? comma + 1 : NULL;
+    }
+}
+
+static void resolve_list(const silc_engine *E, const char *const *chain, int nchain, blist *L)
+{
+    const char *forced = cfg_get(E, "backend"), *text = NULL;
+    char key[160];
+    size_t i;
+    int c;
+    memset(L, 0, sizeof *L);
+    if (forced) {
+        split_list(L, forced);
+        L->forced = 1;
+        snprintf(L->source, sizeof L->source, "per-call option backend = %s", forced);
+        return;
+    }
+    for (c = 0; c < nchain && !text; c++) {
+        snprintf(key, sizeof key, "dispatch.%s", chain[c]);
+        text = cfg_get(E, key);
+        if (text) snprintf(L->source, sizeof L->source, "config key %s", key);
+    }
+    if (!text) {
+        text = "reference";
+        for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
+            if (strcmp(default_lists[i].cls, chain[0]) == 0) text = default_lists[i].list;
+        snprintf(L->source, sizeof L->source, "built-in default for %s", chain[0]);
+    }
+    split_list(L, text);
+    for (c = 0; c < L->n; c++)
+        if (strcmp(L->names[c], "reference") == 0) return;
+    L->names[L->n++] = "reference";
+}
+
+static int provides(const ld_backend *b, int op)
+{
+    return op < b->backend->n_ops && b->backend->ops[op].run != NULL;
+}
+
+static const char *status_text(int status)
+{
+    switch (status) {
+    case SILC_EARG: return "invalid operands";
+    case SILC_ENOMEM: return "out of memory";
+    case SILC_ESINGULAR: return "singular matrix";
+    case SILC_ENOTSPD: return "not positive definite";
+    case SILC_ENOTCONV: return "did not converge";
+    case SILC_EBREAKDOWN: return "iterative method broke down";
+    case SILC_EDECLINE: return "declined";
+    case SILC_ELIB: return "library failure";
+    case SILC_EUNSUP: return "not supported";
+    case SILC_EINTERNAL: return "internal error";
+    default: return "failed";
+    }
+}
+
+/* ---- the accuracy report --------------------------------------------------- */
+
+/* Runs one reference operation for the report; NULL if it cannot. */
+static silc_value *ref_run(silc_engine *E, const ld_backend *ref, silc_call *c)
+{
+    host_call_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.E = E;
+    ctx.backend = ref;
+    c->host_private = &ctx;
+    c->op_class = NULL;
+    c->out = NULL;
+    if (!provides(ref, c->op)) return NULL;
+    if (ref->backend->ops[c->op].run(c) != SILC_OK) {
+        val_release(c->out);
+        return NULL;
+    }
+    return c->out;
+}
+
+static silc_value *ref_op(silc_engine *E, const ld_backend *ref, int op, int sub,
+                          const silc_value *a, const silc_value *b, double alpha, double beta)
+{
+    silc_call c;
+    memset(&c, 0, sizeof c);
+    c.op = op;
+    c.sub = sub;
+    c.in[0] = a;
+    c.in[1] = b;
+    c.nin = b ? 2 : 1;
+    c.alpha = alpha;
+    c.beta = beta;
+    return ref_run(E, ref, &c);
+}
+
+/* a*b, where MATMUL takes no 1x1 operand (the language turns that into SCALE). */
+static silc_value *ref_mul(silc_engine *E, const ld_backend *ref, const silc_value *a,
+                           const silc_value *b)
+{
+    if (val_is_scalar(a)) return ref_op(E, ref, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0);
+    if (val_is_scalar(b)) return ref_op(E, ref, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0);
+    return ref_op(E, ref, SILC_OP_MATMUL, 0, a, b, 1, 0);
+}
+
+static double ref_norminf(silc_engine *E, const ld_backend *ref, const silc_value *v)
+{
+    silc_value *r = ref_op(E, ref, SILC_OP_REDUCE, SILC_RED_NORMINF, v, NULL, 1, 0);
+    double x = r && val_is_scalar(r) ? val_scalar(r) : NAN;
+    val_release(r);
+    return x;
+}
+
+/*
+ * Normwise backward error of X as a solution of A X = B, in the infinity norm:
+ *
+ *   square A:        ||B - A X|| / (||A|| ||X|| + ||B||)
+ *   rectangular A:   ||A'(B - A X)|| / (||A|| (||A|| ||X|| + ||B||))
+ *
+ * The first is the Rigal-Gaches backward error of a linear system.  A least
+ * squares solution does not make B - A X small, only orthogonal to the range
+ * of A, so the second measures the normal equations' residual A'R, scaled so
+ * that it is invariant under scaling A and B, as the first is.  Returns -1 when
+ * it cannot be computed (the reference plugin lacks an operation).
+ */
+static double backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
+                             const silc_value *X)
+{
+    const ld_backend *ref = ld_find(E, "reference");
+    silc_value *AX = NULL, *R = NULL, *At = NULL, *G = NULL;
+    double nA, nX, nB, nR, be = -1;
+    if (!ref) return -1;
+    nA = val_props(A)->norminf;
+    nB = val_props(B)->norminf;
+    nX = ref_norminf(E, ref, X);
+    AX = ref_mul(E, ref, A, X);
+    if (AX) R = ref_op(E, ref, SILC_OP_ADD, 0, B, AX, 1, -1);
+    if (R && A->m == A->n) {
+        nR = ref_norminf(E, ref, R);
+        be = nR / (nA * nX + nB);
+    } else if (R) {
+        At = ref_op(E, ref, SILC_OP_TRANSPOSE, 0, A, NULL, 1, 0);
+        if (At) G = ref_mul(E, ref, At, R);
+        if (G) {
+            nR = ref_norminf(E, ref, G);
+            be = nR / (nA * (nA * nX + nB));
+        }
+    }
+    /* 0/0: X = 0 solves B = 0 exactly. */
+    if (R && isnan(be) && !isnan(nX)) be = 0;
+    val_release(AX);
+    val_release(R);
+    val_release(At);
+    val_release(G);
+    return be;
+}
+
+static int has_nonfinite(const silc_value *v)
+{
+    silc_view w;
+    int64_t i;
+    val_view(v, &w);
+    for (i = 0; i < w.nnz; i++)
+        if (!isfinite(w.val[i])) return 1;
+    return 0;
+}
+
+/* Completes the report of a solve that succeeded and warns about a result that
+ * deserves distrust. */
+static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed)
+{
+    silc_report *r = call->report;
+    double eps_cond;
+    if (cholesky_failed) {
+        char note[sizeof r->note];
+        snprintf(note, sizeof note, "Cholesky failed (not positive definite); used LU%s%.200s",
+                 r->note[0] ? "; " : "", r->note);
+        memcpy(r->note, note, sizeof note);
+    }
+    r->backward_error = backward_error(E, call->in[0], call->in[1], call->out);
+    eps_cond = r->cond_est * DBL_EPSILON;
+    if (r->cond_est > 0 && eps_cond >= 1)
+        eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
+                 r->cond_est);
+    else if (r->cond_est > 0 && eps_cond > 1e-4)
+        eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
+                 r->cond_est);
+    if (has_nonfinite(call->out))
+        eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
+}
+
+/* ---- running --------------------------------------------------------------- */
+
+/* One attempt of backend b; the report is reset for every attempt so nothing
+ * of a failed backend leaks into the one that succeeds. */
+static int run_one(silc_call *call, const ld_backend *b)
+{
+    double t0;
+    int rc;
+    call->out = NULL;
+    if (call->op == SILC_OP_SOLVE) {
+        memset(call->report, 0, sizeof *call->report);
+        call->report->cond_est = -1;
+        call->report->rcond = -1;
+    }
+    t0 = util_now();
+    rc = b->backend->ops[call->op].run(call);
+    if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
+        call->report->seconds = util_now() - t0;
+        snprintf(call->report->backend, sizeof call->report->backend, "%s", b->full_name);
+    }
+    if (rc != SILC_OK) {
+        val_release(call->out);
+        call->out = NULL;
+    }
+    return rc;
+}
+
+static int walk(silc_engine *E, silc_call *call, const char *const *chain, int nchain,
+                const blist *L)
+{
+    strbuf skipped;
+    int ci, i, rc, cholesky_failed = 0;
+    sb_init(&skipped);
+    for (ci = 0; ci < nchain; ci++) {
+        int next_class = 0;
+        for (i = 0; i < L->n && !next_class; i++) {
+            const ld_backend *b = ld_find(E, L->names[i]);
+            const char *why = NULL;
+            host_call_ctx ctx;
+            if (ci > 0 && i == 0) sb_printf(&skipped, "[%s] ", chain[ci]);
+            if (!b) {
+                sb_printf(&skipped, "%s not installed; ", L->names[i]);
+                continue;
+            }
+            if (!provides(b, call->op)) {
+                sb_printf(&skipped, "%s does not provide %s; ", b->full_name, op_names[call->op]);
+                continue;
+            }
+            memset(&ctx, 0, sizeof ctx);
+            ctx.E = E;
+            ctx.backend = b;
+            call->host_private = &ctx;
+            call->op_class = chain[ci];
+            if (b->backend->ops[call->op].accepts && !b->backend->ops[call->op].accepts(call, &why)) {
+                sb_printf(&skipped, "%s declines: %s; ", b->full_name, why ? why : "no reason given");
+                continue;
+            }
+            rc = run_one(call, b);
+            if (rc == SILC_OK && !call->out) {
+                rc = SILC_EINTERNAL;
+                snprintf(ctx.err, sizeof ctx.err, "reported success but returned no result");
+            }
+            if (rc == SILC_OK) {
+                if (call->op == SILC_OP_SOLVE) finish_solve(E, call, cholesky_failed);
+                call->host_private = NULL;
+                sb_free(&skipped);
+                return 0;
+            }
+            if (rc == SILC_ENOTSPD && ci + 1 < nchain) {
+                cholesky_failed = 1;
+                next_class = 1;
+            } else if (rc == SILC_EDECLINE) {
+                sb_printf(&skipped, "%s declines: %s; ", b->full_name,
+                          ctx.err[0] ? ctx.err : "no reason given");
+            } else {
+                eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
+                call->host_private = NULL;
+                sb_free(&skipped);
+                return rc;
+            }
+        }
+        if (!next_class) break;
+    }
+    call->host_private = NULL;
+    /* Drop the trailing "; " of the last reason. */
+    if (skipped.len >= 2) skipped.s[skipped.len -= 2] = '\0';
+    eng_error(E, "no backend can run %s (%s): %s", op_names[call->op], chain[0], sb_str(&skipped));
+    sb_free(&skipped);
+    return SILC_EUNSUP;
+}
+
+int disp_run(silc_engine *E, silc_call *call)
+{
+    const char *chain[4];
+    silc_report local;
+    blist L;
+    int n, rc, own_options;
+    if (!E || !call) return SILC_EARG;
+    call->out = NULL;
+    own_options = call->options != NULL;
+    if (own_options && cfg_set_call_options(E, call->options)) return SILC_EARG;
+    n = classify(call, chain, NULL, 0);
+    if (n == 0) {
+        eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
+        rc = SILC_EARG;
+    } else if (call->op == SILC_OP_SOLVE && (call->nin < 2 || !call->in[1])) {
+        eng_error(E, "solve needs a right-hand side");
+        rc = SILC_EARG;
+    } else {
+        silc_report *saved = call->report;
+        if (call->op == SILC_OP_SOLVE && !call->report) call->report = &local;
+        resolve_list(E, chain, n, &L);
+        rc = walk(E, call, chain, n, &L);
+        call->report = saved;
+    }
+    if (own_options) cfg_clear_call_options(E);
+    return rc;
+}
+
+/* ---- explain --------------------------------------------------------------- */
+
+int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
+{
+    const char *chain[4];
+    char why[256];
+    silc_call c;
+    blist L;
+    int n, i, chosen = 0;
+    if (!E || !call || !b) return -1;
+    if (call->options && cfg_set_call_options(E, call->options)) return -1;
+    n = classify(call, chain, why, sizeof why);
+    if (n == 0) {
+        if (call->options) cfg_clear_call_options(E);
+        return eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
+    }
+    resolve_list(E, chain, n, &L);
+    sb_printf(b, "%s\n", why);
+    sb_printf(b, "backends (%s):", L.source);
+    for (i = 0; i < L.n; i++) sb_printf(b, "%s %s", i ? "," : "", L.names[i]);
+    sb_puts(b, "\n");
+    c = *call;
+    c.op_class = chain[0];
+    c.out = NULL;
+    for (i = 0; i < L.n && !chosen; i++) {
+        const ld_backend *be = ld_find(E, L.names[i]);
+        const char *reason = NULL;
+        host_call_ctx ctx;
+        if (!be) {
+            sb_printf(b, "  %s: not installed\n", L.names[i]);
+            continue;
+        }
+        if (!provides(be, call->op)) {
+            sb_printf(b, "  %s: does not provide %s\n", be->full_name, op_names[call->op]);
+            continue;
+        }
+        memset(&ctx, 0, sizeof ctx);
+        ctx.E = E;
+        ctx.backend = be;
+        c.host_private = &ctx;
+        if (be->backend->ops[call->op].accepts && !be->backend->ops[call->op].accepts(&c, &reason)) {
+            sb_printf(b, "  %s: declines: %s\n", be->full_name, reason ? reason : "no reason given");
+            continue;
+        }
+        sb_printf(b, "  %s -> would run\n", be->full_name);
+        chosen = 1;
+    }
+    if (!chosen) sb_printf(b, "  no backend can run this\n");
+    else if (n > 1)
+        sb_printf(b, "  (if Cholesky finds A not positive definite, the list is tried again "
+                     "under %s)\n", chain[1]);
+    if (call->options) cfg_clear_call_options(E);
+    return 0;
+}
