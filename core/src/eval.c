@@ -1,0 +1,913 @@
+/*
+ * eval.c -- runs parsed statements: the AST cache, expression evaluation,
+ * assignment, control flow and the keyword statements (clear, who, set, info,
+ * explain).
+ *
+ * Every arithmetic operation becomes a silc_call handed to disp_run(); the
+ * core only builds values that are pure structure (literals, zeros, sparse
+ * triplets, subscripts).  A statement computes its new value completely
+ * before binding it, so a failing statement leaves the store untouched while
+ * the earlier statements of the same text stay done.
+ *
+ * Operands in messages are quoted as the user wrote them when short ("'A'",
+ * "'x + y'"), else called "the left operand" / "the right operand".
+ */
+#include "lang.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- AST cache ------------------------------------------------------------ */
+/* Keyed by the exact text, so a time loop EXECing the same strings parses each
+ * once.  Bounded: when full it is emptied and refills with what is in use. */
+#define CACHE_BUCKETS 1024
+#define CACHE_MAX 512
+
+typedef struct cache_entry {
+    lang_program *prog;
+    struct cache_entry *next;
+} cache_entry;
+
+typedef struct lang_cache {
+    cache_entry *b[CACHE_BUCKETS];
+    size_t count;
+} lang_cache;
+
+static size_t text_hash(const char *s)
+{
+    size_t h = 2166136261u;
+    while (*s) h = (h ^ (unsigned char)*s++) * 16777619u;
+    return h % CACHE_BUCKETS;
+}
+
+static void cache_empty(lang_cache *c)
+{
+    size_t i;
+    for (i = 0; i < CACHE_BUCKETS; i++) {
+        while (c->b[i]) {
+            cache_entry *e = c->b[i];
+            c->b[i] = e->next;
+            ps_free(e->prog);
+            free(e);
+        }
+    }
+    c->count = 0;
+}
+
+static void cache_free(void *p)
+{
+    if (!p) return;
+    cache_empty(p);
+    free(p);
+}
+
+/* Parsed program for text, from the cache or freshly parsed (and cached). */
+static int program_for(silc_engine *E, const char *text, lang_program **out)
+{
+    lang_cache *c = E->lang_cache;
+    cache_entry *e;
+    size_t h = text_hash(text);
+    char err[512];
+    if (!c) {
+        c = calloc(1, sizeof *c);
+        if (!c) return eng_error(E, "out of memory");
+        E->lang_cache = c;
+        E->lang_cache_free = cache_free;
+    }
+    for (e = c->b[h]; e; e = e->next) {
+        if (!strcmp(e->prog->text, text)) {
+            *out = e->prog;
+            return 0;
+        }
+    }
+    if (ps_parse(text, out, err, sizeof err)) return eng_error(E, "%s", err);
+    if (c->count >= CACHE_MAX) cache_empty(c);
+    e = malloc(sizeof *e);
+    if (!e) {
+        ps_free(*out);
+        *out = NULL;
+        return eng_error(E, "out of memory");
+    }
+    e->prog = *out;
+    e->next = c->b[h];
+    c->b[h] = e;
+    c->count++;
+    return 0;
+}
+
+/* ---- helpers shared with builtins.c and index.c ---------------------------- */
+
+void ev_shape(const silc_value *v, char *out, size_t outlen)
+{
+    snprintf(out, outlen, "%lldx%lld", (long long)v->m, (long long)v->n);
+}
+
+void ev_operand_name(const lang_ev *V, const ast_node *n, int side, char *out, size_t outlen)
+{
+    size_t len = n->end - n->start;
+    if (len < 24)
+        snprintf(out, outlen, "'%.*s'", (int)len, V->src + n->start);
+    else
+        snprintf(out, outlen, "%s", side == 0 ? "the left operand" : side == 1 ? "the right operand"
+                                                                                : "the argument");
+}
+
+static void add_backend(lang_ev *V, const char *name)
+{
+    size_t len = strlen(name), have = strlen(V->backends);
+    const char *p = V->backends;
+    if (!name[0]) return;
+    while ((p = strstr(p, name)) != NULL) {
+        if ((p == V->backends || p[-1] == ' ') && (p[len] == ',' || p[len] == 0)) return;
+        p += len;
+    }
+    if (have + len + 3 > sizeof V->backends) return;
+    if (have) strcat(V->backends, ", ");
+    strcat(V->backends, name);
+}
+
+/* Appends text indented under an explain step. */
+static void indent_into(strbuf *b, const char *text)
+{
+    while (*text) {
+        const char *nl = strchr(text, '\n');
+        size_t len = nl ? (size_t)(nl - text) : strlen(text);
+        sb_printf(b, "     %.*s\n", (int)len, text);
+        text += len + (nl ? 1 : 0);
+    }
+}
+
+int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
+{
+    silc_engine *E = V->E;
+    silc_report rep;
+    int i, rc;
+    *out = NULL;
+    call->out = NULL;
+    if (call->op == SILC_OP_SOLVE) {
+        memset(&rep, 0, sizeof rep);
+        rep.cond_est = -1;
+        rep.rcond = -1;
+        call->report = &rep;
+    }
+    if (V->explain) {
+        strbuf d;
+        char shape[48];
+        sb_printf(V->explain_out, "  %d. %s:", ++V->explain_step, what);
+        for (i = 0; i < call->nin; i++) {
+            ev_shape(call->in[i], shape, sizeof shape);
+            sb_printf(V->explain_out, "%s %s %s", i ? "," : "", shape,
+                      val_format_name(call->in[i]->format));
+        }
+        sb_puts(V->explain_out, "\n");
+        sb_init(&d);
+        rc = disp_explain(E, call, &d);
+        indent_into(V->explain_out, rc ? E->err : sb_str(&d));
+        sb_free(&d);
+        if (call->op == SILC_OP_SOLVE) {
+            /* explain runs no solve: later steps see a placeholder of the right shape */
+            *out = val_dense_new(call->in[0]->n, call->in[1]->n);
+            return *out ? 0 : eng_error(E, "out of memory");
+        }
+    }
+    rc = disp_run(E, call);
+    if (rc || !call->out) {
+        if (call->out) val_release(call->out);
+        call->out = NULL;
+        if (!E->err[0]) eng_error(E, "%s failed (status %d)", what, rc);
+        return -1;
+    }
+    if (call->op == SILC_OP_SOLVE) {
+        V->has_solve = 1;
+        V->report = rep;
+        add_backend(V, rep.backend);
+    }
+    call->report = NULL;
+    *out = call->out;
+    return 0;
+}
+
+/* Shorthand for the common one- and two-operand calls. */
+static int run2(lang_ev *V, int op, int sub, const silc_value *a, const silc_value *b,
+                double alpha, double beta, const char *what, silc_value **out)
+{
+    silc_call c;
+    memset(&c, 0, sizeof c);
+    c.op = op;
+    c.sub = sub;
+    c.nin = b ? 2 : 1;
+    c.in[0] = a;
+    c.in[1] = b;
+    c.alpha = alpha;
+    c.beta = beta;
+    return ev_run(V, &c, what, out);
+}
+
+/* ---- names ------------------------------------------------------------------ */
+
+static int undefined_name(lang_ev *V, const char *name)
+{
+    const char **names = NULL, **cands;
+    size_t n = store_names(&V->E->store, &names), nb = 0, i;
+    const char *best;
+    while (bi_names[nb]) nb++;
+    cands = malloc((n + nb + 1) * sizeof *cands);
+    if (!cands) {
+        free(names);
+        return eng_error(V->E, "undefined name '%s'", name);
+    }
+    for (i = 0; i < n; i++) cands[i] = names[i];
+    for (i = 0; i < nb; i++) cands[n + i] = bi_names[i];
+    best = util_closest(name, cands, n + nb);
+    if (best)
+        eng_error(V->E, "undefined name '%s' (did you mean '%s'?)", name, best);
+    else
+        eng_error(V->E, "undefined name '%s'", name);
+    free(cands);
+    free(names);
+    return -1;
+}
+
+static int eval_name(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *v = store_get(&V->E->store, n->name);
+    double x;
+    if (v) {
+        *out = val_retain(v);
+        return 0;
+    }
+    if (bi_constant(n->name, &x)) {
+        *out = val_scalar_new(x);
+        return *out ? 0 : eng_error(V->E, "out of memory");
+    }
+    return undefined_name(V, n->name);
+}
+
+/* ---- operators ---------------------------------------------------------------- */
+
+static const char *op_text(int op)
+{
+    switch (op) {
+    case TK_PLUS: case TK_PLUSEQ: return "+";
+    case TK_MINUS: case TK_MINUSEQ: return "-";
+    case TK_STAR: case TK_STAREQ: return "*";
+    case TK_SLASH: case TK_SLASHEQ: return "/";
+    case TK_BACKSLASH: return "\\";
+    case TK_EMUL: return "*@";
+    case TK_EDIV: return "/@";
+    case TK_CARET: return "^";
+    case TK_EPOW: return "^@";
+    case TK_EQ: return "==";
+    case TK_NE: return "!=";
+    case TK_LT: return "<";
+    case TK_LE: return "<=";
+    case TK_GT: return ">";
+    case TK_GE: return ">=";
+    case TK_AND: return "&&";
+    case TK_OR: return "||";
+    default: return "?";
+    }
+}
+
+static int ewise_sub(int op)
+{
+    switch (op) {
+    case TK_EMUL: return SILC_EW_MUL;
+    case TK_EDIV: return SILC_EW_DIV;
+    case TK_EPOW: case TK_CARET: return SILC_EW_POW;
+    case TK_EQ: return SILC_EW_EQ;
+    case TK_NE: return SILC_EW_NE;
+    case TK_LT: return SILC_EW_LT;
+    case TK_LE: return SILC_EW_LE;
+    case TK_GT: return SILC_EW_GT;
+    case TK_GE: return SILC_EW_GE;
+    case TK_AND: return SILC_EW_AND;
+    default: return SILC_EW_OR;
+    }
+}
+
+typedef struct operands {
+    const char *lname, *rname;   /* as quoted in messages */
+    const char *what;            /* the operation's source text, for explain */
+} operands;
+
+static int shape_error(lang_ev *V, const char *fmt_head, int op, const operands *o,
+                       const silc_value *a, const silc_value *b)
+{
+    char sa[48], sb[48];
+    ev_shape(a, sa, sizeof sa);
+    ev_shape(b, sb, sizeof sb);
+    return eng_error(V->E, "'%s' %s: %s is %s, %s is %s", op_text(op), fmt_head, o->lname, sa,
+                     o->rname, sb);
+}
+
+static int same_or_scalar(const silc_value *a, const silc_value *b)
+{
+    return val_is_scalar(a) || val_is_scalar(b) || (a->m == b->m && a->n == b->n);
+}
+
+static silc_value *identity_like(const silc_value *a)
+{
+    int64_t i, n = a->m;
+    silc_value *r;
+    if (a->format == SILC_FMT_DENSE) {
+        r = val_dense_new(n, n);
+        if (r)
+            for (i = 0; i < n; i++) r->val[i + i * n] = 1.0;
+        return r;
+    }
+    r = val_csr_new(n, n, n);
+    if (!r) return NULL;
+    for (i = 0; i < n; i++) {
+        r->rowptr[i] = i;
+        r->colind[i] = i;
+        r->val[i] = 1.0;
+    }
+    r->rowptr[n] = n;
+    val_csr_set_nnz(r, n);
+    return r;
+}
+
+/* A^k for square A and integer k >= 0 by repeated squaring. */
+static int matrix_power(lang_ev *V, const silc_value *a, double k, const char *what,
+                        silc_value **out)
+{
+    silc_value *result = NULL, *base = val_retain((silc_value *)a), *t;
+    unsigned long long e = (unsigned long long)k;
+    if (e == 0) {
+        val_release(base);
+        *out = identity_like(a);
+        return *out ? 0 : eng_error(V->E, "out of memory");
+    }
+    while (e) {
+        if (e & 1) {
+            if (!result) {
+                result = val_retain(base);
+            } else {
+                if (run2(V, SILC_OP_MATMUL, 0, result, base, 1, 0, what, &t)) goto fail;
+                val_release(result);
+                result = t;
+            }
+        }
+        e >>= 1;
+        if (e) {
+            if (run2(V, SILC_OP_MATMUL, 0, base, base, 1, 0, what, &t)) goto fail;
+            val_release(base);
+            base = t;
+        }
+    }
+    val_release(base);
+    *out = result;
+    return 0;
+fail:
+    val_release(base);
+    val_release(result);
+    return -1;
+}
+
+/* a op b for every binary operator. */
+static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value *a,
+                        const silc_value *b, silc_value **out)
+{
+    silc_engine *E = V->E;
+    char sa[48];
+    switch (op) {
+    case TK_PLUS: case TK_PLUSEQ: case TK_MINUS: case TK_MINUSEQ:
+        if (!same_or_scalar(a, b))
+            return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
+        return run2(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
+                    o->what, out);
+    case TK_STAR: case TK_STAREQ:
+        if (val_is_scalar(a)) return run2(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
+        if (val_is_scalar(b)) return run2(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
+        if (a->n != b->m) return shape_error(V, "inner dimensions differ", op, o, a, b);
+        return run2(V, SILC_OP_MATMUL, 0, a, b, 1, 0, o->what, out);
+    case TK_SLASH: case TK_SLASHEQ: {
+        silc_value *at, *bt, *x;
+        int rc;
+        if (val_is_scalar(b))
+            return run2(V, SILC_OP_SCALE, 0, a, NULL, 1.0 / val_scalar(b), 0, o->what, out);
+        if (a->n != b->n)
+            return shape_error(V, "needs operands with the same number of columns", op, o, a, b);
+        /* a / B = (B' \ a')' */
+        if (run2(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, o->what, &at)) return -1;
+        if (run2(V, SILC_OP_TRANSPOSE, 0, b, NULL, 0, 0, o->what, &bt)) {
+            val_release(at);
+            return -1;
+        }
+        rc = run2(V, SILC_OP_SOLVE, 0, bt, at, 0, 0, o->what, &x);
+        val_release(at);
+        val_release(bt);
+        if (rc) return -1;
+        rc = run2(V, SILC_OP_TRANSPOSE, 0, x, NULL, 0, 0, o->what, out);
+        val_release(x);
+        return rc;
+    }
+    case TK_BACKSLASH:
+        if (val_is_scalar(a))
+            return run2(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
+        if (a->m != b->m)
+            return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
+        return run2(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
+    case TK_CARET:
+        if (val_is_scalar(a) && val_is_scalar(b))
+            return run2(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);
+        if (a->m != a->n) {
+            ev_shape(a, sa, sizeof sa);
+            return eng_error(E, "%s is %s but '^' needs a square matrix", o->lname, sa);
+        }
+        if (!val_is_scalar(b)) {
+            ev_shape(b, sa, sizeof sa);
+            return eng_error(E, "'^' needs a scalar exponent: %s is %s (use '^@' for element-wise powers)",
+                             o->rname, sa);
+        }
+        {
+            double k = val_scalar(b);
+            if (!(k >= 0 && k == floor(k) && k < 9.0e15)) {
+                char kt[40];
+                util_fmt_double(kt, sizeof kt, k);
+                return eng_error(E, "'^' of a matrix needs a nonnegative integer exponent, got %s "
+                                    "(use '^@' for element-wise powers)", kt);
+            }
+            return matrix_power(V, a, k, o->what, out);
+        }
+    default:
+        if (!same_or_scalar(a, b))
+            return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
+        return run2(V, SILC_OP_EWISE, ewise_sub(op), a, b, 0, 0, o->what, out);
+    }
+}
+
+static void node_text(const lang_ev *V, const ast_node *n, char *out, size_t outlen)
+{
+    size_t len = n->end - n->start;
+    if (len >= outlen) len = outlen - 1;
+    memcpy(out, V->src + n->start, len);
+    out[len] = 0;
+}
+
+static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a, *b;
+    char ln[64], rn[64], what[256];
+    operands o;
+    int rc;
+    if (ev_expr(V, n->kids[0], &a)) return -1;
+    /* && and || short-circuit on a scalar left side, so `k <= n && v[k] > 0` is safe */
+    if ((n->op == TK_AND || n->op == TK_OR) && val_is_scalar(a)) {
+        int truth = val_scalar(a) != 0;
+        if (truth == (n->op == TK_OR)) {
+            val_release(a);
+            *out = val_scalar_new(truth ? 1.0 : 0.0);
+            return *out ? 0 : eng_error(V->E, "out of memory");
+        }
+    }
+    if (ev_expr(V, n->kids[1], &b)) {
+        val_release(a);
+        return -1;
+    }
+    ev_operand_name(V, n->kids[0], 0, ln, sizeof ln);
+    ev_operand_name(V, n->kids[1], 1, rn, sizeof rn);
+    node_text(V, n, what, sizeof what);
+    o.lname = ln;
+    o.rname = rn;
+    o.what = what;
+    rc = apply_binary(V, n->op, &o, a, b, out);
+    val_release(a);
+    val_release(b);
+    return rc;
+}
+
+static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a;
+    char what[256];
+    int rc;
+    if (ev_expr(V, n->kids[0], &a)) return -1;
+    if (n->op == TK_PLUS) {
+        *out = a;
+        return 0;
+    }
+    node_text(V, n, what, sizeof what);
+    if (n->kind == AST_TRANSPOSE)
+        rc = run2(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
+    else
+        rc = run2(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
+                  what, out);
+    val_release(a);
+    return rc;
+}
+
+int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_engine *E = V->E;
+    *out = NULL;
+    switch (n->kind) {
+    case AST_NUM:
+        *out = val_scalar_new(n->num);
+        return *out ? 0 : eng_error(E, "out of memory");
+    case AST_NAME:
+        return eval_name(V, n, out);
+    case AST_END:
+        *out = val_scalar_new((double)V->end_value);
+        return *out ? 0 : eng_error(E, "out of memory");
+    case AST_STRING:
+        return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
+    case AST_COLON_ALL:
+    case AST_RANGE:
+        return eng_error(E, "a range is only allowed inside a subscript");
+    case AST_BINARY:
+        return eval_binary(V, n, out);
+    case AST_UNARY:
+    case AST_TRANSPOSE:
+        return eval_unary(V, n, out);
+    case AST_INDEX: {
+        silc_value *base;
+        char what[64];
+        int rc;
+        if (ev_expr(V, n->kids[0], &base)) return -1;
+        ev_operand_name(V, n->kids[0], 2, what, sizeof what);
+        rc = ix_extract(V, n->kids + 1, n->nkids - 1, what, base, out);
+        val_release(base);
+        return rc;
+    }
+    case AST_CALL:
+        return bi_call(V, n, out);
+    default:
+        return eng_error(E, "internal error: statement where an expression was expected");
+    }
+}
+
+/* ---- statements ---------------------------------------------------------------- */
+
+enum { FLOW_NEXT = 0, FLOW_BREAK, FLOW_CONTINUE };
+
+static char *stmt_text(const lang_ev *V, const ast_node *n)
+{
+    size_t len = n->end - n->start;
+    char *s = malloc(len + 1);
+    if (s) {
+        memcpy(s, V->src + n->start, len);
+        s[len] = 0;
+    }
+    return s;
+}
+
+/* Binds name to v (taking over the caller's reference) and records how it was computed. */
+static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *v, double t0)
+{
+    eng_info info;
+    int rc;
+    if (V->explain) {
+        char shape[48];
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(V->explain_out, "  result: %s would be bound to a %s %s value (not run)\n", name,
+                  shape, val_format_name(v->format));
+        val_release(v);
+        return 0;
+    }
+    rc = store_set(&V->E->store, name, v);
+    val_release(v);
+    if (rc) return eng_error(V->E, "out of memory binding '%s'", name);
+    memset(&info, 0, sizeof info);
+    info.statement = stmt_text(V, stmt);
+    info.has_solve = V->has_solve;
+    if (V->has_solve) info.report = V->report;
+    info.seconds = util_now() - t0;
+    snprintf(info.backends, sizeof info.backends, "%s", V->backends);
+    eng_info_set(V->E, name, &info);
+    free(info.statement);
+    return 0;
+}
+
+static int opassign_token(int op)
+{
+    switch (op) {
+    case TK_PLUSEQ: return TK_PLUS;
+    case TK_MINUSEQ: return TK_MINUS;
+    case TK_STAREQ: return TK_STAR;
+    default: return TK_SLASH;
+    }
+}
+
+static int exec_assign(lang_ev *V, const ast_node *s, double t0)
+{
+    silc_value *v = NULL, *cur, *r;
+    char ln[64], rn[64], what[256];
+    operands o;
+    int rc;
+    if (s->kind == ST_ASSIGN) {
+        if (ev_expr(V, s->kids[0], &v)) return -1;
+        return bind(V, s, s->name, v, t0);
+    }
+    cur = store_get(&V->E->store, s->name);
+    if (!cur) return undefined_name(V, s->name);
+    val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
+    if (ev_expr(V, s->kids[0], &r)) {
+        val_release(cur);
+        return -1;
+    }
+    snprintf(ln, sizeof ln, "'%s'", s->name);
+    ev_operand_name(V, s->kids[0], 1, rn, sizeof rn);
+    node_text(V, s, what, sizeof what);
+    o.lname = ln;
+    o.rname = rn;
+    o.what = what;
+    if (s->kind == ST_OPASSIGN) {
+        rc = apply_binary(V, opassign_token(s->op), &o, cur, r, &v);
+    } else {
+        snprintf(ln, sizeof ln, "'%s'", s->name);
+        rc = ix_assign(V, s->kids + 1, s->nkids - 1, ln, cur, r, &v);
+    }
+    val_release(cur);
+    val_release(r);
+    if (rc) return -1;
+    return bind(V, s, s->name, v, t0);
+}
+
+static int exec_who(lang_ev *V)
+{
+    const char **names = NULL;
+    size_t n = store_names(&V->E->store, &names), i, w = 4, sw = 4;
+    strbuf b;
+    char shape[48];
+    sb_init(&b);
+    if (n == 0) {
+        eng_print(V->E, "no variables\n");
+        free(names);
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        silc_value *v = store_get(&V->E->store, names[i]);
+        ev_shape(v, shape, sizeof shape);
+        if (strlen(names[i]) > w) w = strlen(names[i]);
+        if (strlen(shape) > sw) sw = strlen(shape);
+    }
+    sb_printf(&b, "%-*s  %-*s  %-6s  %s\n", (int)w, "name", (int)sw, "size", "format", "nnz");
+    for (i = 0; i < n; i++) {
+        silc_value *v = store_get(&V->E->store, names[i]);
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(&b, "%-*s  %-*s  %-6s  nnz %lld\n", (int)w, names[i], (int)sw, shape,
+                  val_format_name(v->format), (long long)val_props(v)->nnz);
+    }
+    eng_print(V->E, sb_str(&b));
+    sb_free(&b);
+    free(names);
+    return 0;
+}
+
+static void clear_name(silc_engine *E, const char *name)
+{
+    store_remove(&E->store, name);
+    eng_info_remove(E, name);
+}
+
+static int exec_clear(lang_ev *V, const ast_node *s)
+{
+    size_t i;
+    if (s->nkids == 0) {
+        const char **names = NULL;
+        size_t n = store_names(&V->E->store, &names);
+        for (i = 0; i < n; i++) eng_info_remove(V->E, names[i]);
+        free(names);
+        store_clear(&V->E->store);
+        return 0;
+    }
+    for (i = 0; i < s->nkids; i++) clear_name(V->E, s->kids[i]->name);
+    return 0;
+}
+
+static char *trimmed(const char *s, size_t len)
+{
+    char *r;
+    while (len && (*s == ' ' || *s == '\t')) s++, len--;
+    while (len && (s[len - 1] == ' ' || s[len - 1] == '\t' || s[len - 1] == '\r')) len--;
+    r = malloc(len + 1);
+    if (r) {
+        memcpy(r, s, len);
+        r[len] = 0;
+    }
+    return r;
+}
+
+static int exec_set(lang_ev *V, const ast_node *s)
+{
+    silc_engine *E = V->E;
+    const char *eq;
+    char *key, *value;
+    int rc;
+    if (!s->name) {
+        strbuf b;
+        sb_init(&b);
+        cfg_list(E, &b);
+        eng_print(E, b.len ? sb_str(&b) : "no settings\n");
+        sb_free(&b);
+        return 0;
+    }
+    eq = strchr(s->name, '=');
+    key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
+    if (!key) return eng_error(E, "out of memory");
+    if (!eq) {
+        const char *v = cfg_get(E, key);
+        strbuf b;
+        sb_init(&b);
+        if (v) sb_printf(&b, "%s = %s\n", key, v);
+        else sb_printf(&b, "%s is not set\n", key);
+        eng_print(E, sb_str(&b));
+        sb_free(&b);
+        free(key);
+        return 0;
+    }
+    value = trimmed(eq + 1, strlen(eq + 1));
+    if (!value) {
+        free(key);
+        return eng_error(E, "out of memory");
+    }
+    if (!key[0]) rc = eng_error(E, "set needs a key before '=', as in 'set dispatch.solve.dense = lapack'");
+    else rc = cfg_set(E, CFG_SCOPE_SESSION, key, value);
+    free(key);
+    free(value);
+    return rc ? -1 : 0;
+}
+
+static int exec_info(lang_ev *V, const ast_node *s)
+{
+    silc_engine *E = V->E;
+    silc_value *v = store_get(&E->store, s->name);
+    const eng_info *in;
+    strbuf b;
+    char shape[48], num[40];
+    if (!v) return undefined_name(V, s->name);
+    in = eng_info_get(E, s->name);
+    sb_init(&b);
+    ev_shape(v, shape, sizeof shape);
+    sb_printf(&b, "%s: %s %s, nnz %lld\n", s->name, shape, val_format_name(v->format),
+              (long long)val_props(v)->nnz);
+    if (!in) {
+        sb_puts(&b, "  deposited by PUT (no statement of this session computed it)\n");
+    } else {
+        const silc_report *r = &in->report;
+        sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
+        sb_printf(&b, "  wall time: %.3g s\n", in->seconds);
+        if (!in->has_solve) {
+            sb_puts(&b, "  no solve in this statement\n");
+        } else {
+            sb_printf(&b, "  solve: %s\n", r->method[0] ? r->method : "(method not reported)");
+            sb_printf(&b, "  backend: %s\n", in->backends[0] ? in->backends : r->backend);
+            sb_printf(&b, "  backward error: %.3g\n", r->backward_error);
+            if (r->cond_est >= 0) {
+                sb_printf(&b, "  condition estimate: %.3g\n", r->cond_est);
+            } else {
+                sb_puts(&b, "  condition estimate: not available\n");
+            }
+            sb_printf(&b, "  iterations: %lld\n", (long long)r->iterations);
+            if (r->iterations > 0) {
+                util_fmt_double(num, sizeof num, r->resid);
+                sb_printf(&b, "  final relative residual: %s\n", num);
+            }
+            sb_printf(&b, "  reused factorization: %s\n", r->reused_factor ? "yes" : "no");
+            sb_printf(&b, "  solve time: %.3g s\n", r->seconds);
+            if (r->note[0]) sb_printf(&b, "  note: %s\n", r->note);
+        }
+    }
+    eng_print(E, sb_str(&b));
+    sb_free(&b);
+    return 0;
+}
+
+static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
+
+static int exec_explain(lang_ev *V, const ast_node *s)
+{
+    strbuf b;
+    int flow = FLOW_NEXT, rc;
+    char *text = stmt_text(V, s->kids[0]);
+    sb_init(&b);
+    sb_printf(&b, "explain: %s\n", text ? text : "");
+    free(text);
+    V->explain = 1;
+    V->explain_out = &b;
+    V->explain_step = 0;
+    rc = exec_stmt(V, s->kids[0], &flow);
+    V->explain = 0;
+    V->explain_out = NULL;
+    if (!rc) {
+        if (V->explain_step == 0) sb_puts(&b, "  no operation runs: values are built by the core\n");
+        eng_print(V->E, sb_str(&b));
+    }
+    sb_free(&b);
+    return rc;
+}
+
+static int condition(lang_ev *V, const ast_node *c, int *truth)
+{
+    silc_value *v;
+    char shape[48];
+    if (ev_expr(V, c, &v)) return -1;
+    if (!val_is_scalar(v)) {
+        ev_shape(v, shape, sizeof shape);
+        val_release(v);
+        return eng_error(V->E, "condition must be a scalar, got %s", shape);
+    }
+    *truth = val_scalar(v) != 0;
+    val_release(v);
+    return 0;
+}
+
+static int exec_block(lang_ev *V, const ast_node *b, int *flow)
+{
+    size_t i;
+    for (i = 0; i < b->nkids; i++) {
+        if (exec_stmt(V, b->kids[i], flow)) return -1;
+        if (*flow != FLOW_NEXT) return 0;
+    }
+    return 0;
+}
+
+static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
+{
+    double t0 = util_now();
+    int truth;
+    *flow = FLOW_NEXT;
+    V->has_solve = 0;
+    V->backends[0] = 0;
+    switch (s->kind) {
+    case ST_EXPR: {
+        silc_value *v;
+        if (ev_expr(V, s->kids[0], &v)) return -1;
+        if (V->explain) {
+            char shape[48];
+            ev_shape(v, shape, sizeof shape);
+            sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
+                      val_format_name(v->format));
+        }
+        val_release(v);
+        return 0;
+    }
+    case ST_ASSIGN:
+    case ST_OPASSIGN:
+    case ST_INDEX_ASSIGN:
+        return exec_assign(V, s, t0);
+    case ST_CLEAR:
+        return exec_clear(V, s);
+    case ST_WHO:
+        return exec_who(V);
+    case ST_SET:
+        return exec_set(V, s);
+    case ST_INFO:
+        return exec_info(V, s);
+    case ST_EXPLAIN:
+        return exec_explain(V, s);
+    case ST_BREAK:
+        *flow = FLOW_BREAK;
+        return 0;
+    case ST_CONTINUE:
+        *flow = FLOW_CONTINUE;
+        return 0;
+    case ST_BLOCK:
+        return exec_block(V, s, flow);
+    case ST_IF:
+        if (condition(V, s->cond, &truth)) return -1;
+        if (truth) return exec_block(V, s->kids[0], flow);
+        return s->els ? exec_stmt(V, s->els, flow) : 0;
+    case ST_WHILE:
+        for (;;) {
+            if (condition(V, s->cond, &truth)) return -1;
+            if (!truth) return 0;
+            if (exec_block(V, s->kids[0], flow)) return -1;
+            if (*flow == FLOW_BREAK) break;
+        }
+        *flow = FLOW_NEXT;
+        return 0;
+    default:
+        return eng_error(V->E, "internal error: expression where a statement was expected");
+    }
+}
+
+int lang_exec(silc_engine *E, const char *text)
+{
+    lang_program *prog;
+    lang_ev V;
+    size_t i;
+    if (!text) return eng_error(E, "no statement text");
+    E->err[0] = 0;
+    if (program_for(E, text, &prog)) return -1;
+    memset(&V, 0, sizeof V);
+    V.E = E;
+    V.src = prog->text;
+    for (i = 0; i < prog->nstmts; i++) {
+        int flow;
+        E->err[0] = 0;
+        if (exec_stmt(&V, prog->stmts[i], &flow)) {
+            if (prog->nstmts > 1) {
+                char msg[sizeof E->err];
+                memcpy(msg, E->err, sizeof msg);
+                eng_error(E, "statement %zu: %s", i + 1, msg);
+            }
+            return -1;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,354 @@
+/*
+ * index.c -- subscripts: A[i, j], v[k] (linear, column-major, on any matrix),
+ * ranges a:b, ':' alone, `end`, and index vectors; extraction and assignment
+ * into a block.
+ *
+ * Subscripts are 1-based in the language and 0-based here once resolved.
+ * Extraction keeps the storage family: dense gives dense, CSR gives CSR (with
+ * a row-wise fast path), band gives dense (a block of a band matrix is rarely
+ * banded about its own diagonal); a 1x1 result is always a dense scalar.
+ * Assignment builds a new value and never touches the old one, which may be
+ * shared: dense stays dense, CSR is rebuilt as CSR (assigned zeros are not
+ * stored), band stays band while the new entries fit, else becomes CSR.
+ */
+#include "lang.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct ix_list {
+    int64_t *ix;           /* 0-based */
+    int64_t n;
+} ix_list;
+
+static int oom(lang_ev *V)
+{
+    return eng_error(V->E, "out of memory");
+}
+
+static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, const char *what,
+                      const silc_value *base)
+{
+    char num[40], shape[48];
+    if (x != floor(x)) {
+        util_fmt_double(num, sizeof num, x);
+        return eng_error(V->E, "index %s into %s is not an integer", num, what);
+    }
+    if (!(x >= 1 && x <= (double)extent)) {
+        util_fmt_double(num, sizeof num, x);
+        ev_shape(base, shape, sizeof shape);
+        return eng_error(V->E, "index %s is out of range for %s (%s)", num, what, shape);
+    }
+    l->ix[l->n++] = (int64_t)x - 1;
+    return 0;
+}
+
+static int range_end(lang_ev *V, const ast_node *n, double *x)
+{
+    silc_value *v;
+    char shape[48];
+    if (ev_expr(V, n, &v)) return -1;
+    if (!val_is_scalar(v)) {
+        ev_shape(v, shape, sizeof shape);
+        val_release(v);
+        return eng_error(V->E, "a range a:b needs scalar ends, got %s", shape);
+    }
+    *x = val_scalar(v);
+    val_release(v);
+    if (!isfinite(*x)) return eng_error(V->E, "a range a:b needs finite ends");
+    return 0;
+}
+
+/* Resolves one subscript against a dimension of the given extent. */
+static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *what,
+                   const silc_value *base, ix_list *out)
+{
+    int64_t saved_end = V->end_value, k;
+    int rc = 0;
+    out->ix = NULL;
+    out->n = 0;
+    V->end_value = extent;
+    if (sub->kind == AST_COLON_ALL) {
+        out->ix = malloc((size_t)(extent ? extent : 1) * sizeof *out->ix);
+        if (!out->ix) rc = oom(V);
+        for (k = 0; !rc && k < extent; k++) out->ix[out->n++] = k;
+    } else if (sub->kind == AST_RANGE) {
+        double a, b, x;
+        if (range_end(V, sub->kids[0], &a) || range_end(V, sub->kids[1], &b)) {
+            rc = -1;
+        } else {
+            int64_t cnt = b >= a ? (int64_t)floor(b - a) + 1 : 0;
+            if (cnt > extent) {
+                /* some index must be out of range: report the first without
+                 * allocating for a range that may be huge */
+                double bad = a < 1 || a != floor(a) || a > (double)extent ? a : (double)extent + 1;
+                int64_t one;
+                out->ix = &one;
+                rc = push_index(V, out, bad, extent, what, base);
+                out->ix = NULL;
+            } else {
+                out->ix = malloc((size_t)(cnt ? cnt : 1) * sizeof *out->ix);
+                if (!out->ix) rc = oom(V);
+                for (x = a, k = 0; !rc && k < cnt; k++, x += 1.0)
+                    rc = push_index(V, out, x, extent, what, base);
+            }
+        }
+    } else {
+        silc_value *v;
+        if (ev_expr(V, sub, &v)) {
+            rc = -1;
+        } else {
+            int64_t cnt = v->m * v->n;
+            out->ix = malloc((size_t)(cnt ? cnt : 1) * sizeof *out->ix);
+            if (!out->ix) rc = oom(V);
+            for (k = 0; !rc && k < cnt; k++)
+                rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, what, base);
+            val_release(v);
+        }
+    }
+    V->end_value = saved_end;
+    if (rc) {
+        free(out->ix);
+        out->ix = NULL;
+    }
+    return rc;
+}
+
+/* Resolves the subscripts: one (linear) or two (row, column). */
+static int resolve_all(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+                       const silc_value *base, ix_list *I, ix_list *J)
+{
+    I->ix = J->ix = NULL;
+    I->n = J->n = 0;
+    if (nsubs == 0 || nsubs > 2)
+        return eng_error(V->E, "%s takes 1 or 2 subscripts, got %zu", what, nsubs);
+    if (nsubs == 1) return resolve(V, subs[0], base->m * base->n, what, base, I);
+    if (resolve(V, subs[0], base->m, what, base, I)) return -1;
+    if (resolve(V, subs[1], base->n, what, base, J)) {
+        free(I->ix);
+        I->ix = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+/* Position of column j in CSR row i, or -1. */
+static int64_t csr_find(const silc_value *a, int64_t i, int64_t j)
+{
+    int64_t lo = a->rowptr[i], hi = a->rowptr[i + 1] - 1;
+    while (lo <= hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (a->colind[mid] == j) return mid;
+        if (a->colind[mid] < j) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+static silc_value *extract_csr(const silc_value *a, const ix_list *I, const ix_list *J)
+{
+    int64_t r, k, nnz = 0, cap = 0;
+    int all = J->n == a->n;
+    silc_value *out;
+    for (k = 0; all && k < J->n; k++) all = J->ix[k] == k;
+    for (r = 0; r < I->n; r++) {
+        int64_t i = I->ix[r], len = a->rowptr[i + 1] - a->rowptr[i];
+        cap += all ? len : (len < J->n ? len : J->n);
+    }
+    out = val_csr_new(I->n, J->n, cap);
+    if (!out) return NULL;
+    for (r = 0; r < I->n; r++) {
+        int64_t i = I->ix[r], p;
+        out->rowptr[r] = nnz;
+        if (all) {
+            for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) {
+                out->colind[nnz] = a->colind[p];
+                out->val[nnz++] = a->val[p];
+            }
+        } else {
+            for (k = 0; k < J->n && nnz < cap; k++) {
+                p = csr_find(a, i, J->ix[k]);
+                if (p >= 0) {
+                    out->colind[nnz] = k;
+                    out->val[nnz++] = a->val[p];
+                }
+            }
+        }
+    }
+    out->rowptr[I->n] = nnz;
+    val_csr_set_nnz(out, nnz);
+    return out;
+}
+
+int ix_extract(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+               const silc_value *base, silc_value **out)
+{
+    ix_list I, J;
+    silc_value *r = NULL;
+    int64_t a, b, m = base->m;
+    *out = NULL;
+    if (resolve_all(V, subs, nsubs, what, base, &I, &J)) return -1;
+    if (nsubs == 1) {
+        /* linear: a vector keeps its orientation, anything else gives a column */
+        int row = base->m == 1 && base->n != 1;
+        r = val_dense_new(row ? 1 : I.n, row ? I.n : 1);
+        if (r)
+            for (a = 0; a < I.n; a++) r->val[a] = val_get(base, I.ix[a] % m, I.ix[a] / m);
+        if (r && base->format == SILC_FMT_CSR && r->m * r->n != 1) {
+            silc_value *c = bi_to_csr(r);
+            val_release(r);
+            r = c;
+        }
+    } else if (base->format == SILC_FMT_CSR && !(I.n == 1 && J.n == 1)) {
+        r = extract_csr(base, &I, &J);
+    } else {
+        r = val_dense_new(I.n, J.n);
+        if (r && base->format == SILC_FMT_DENSE) {
+            for (b = 0; b < J.n; b++) {
+                const double *col = base->val + J.ix[b] * m;
+                for (a = 0; a < I.n; a++) r->val[a + b * I.n] = col[I.ix[a]];
+            }
+        } else if (r) {
+            for (b = 0; b < J.n; b++)
+                for (a = 0; a < I.n; a++) r->val[a + b * I.n] = val_get(base, I.ix[a], J.ix[b]);
+        }
+    }
+    free(I.ix);
+    free(J.ix);
+    if (!r) return oom(V);
+    *out = r;
+    return 0;
+}
+
+/* ---- assignment ----------------------------------------------------------------- */
+
+typedef struct ix_entry {
+    int64_t i, j, order;
+    double v;
+} ix_entry;
+
+static int cmp_entry(const void *pa, const void *pb)
+{
+    const ix_entry *a = pa, *b = pb;
+    if (a->i != b->i) return a->i < b->i ? -1 : 1;
+    if (a->j != b->j) return a->j < b->j ? -1 : 1;
+    return a->order < b->order ? -1 : a->order > b->order;
+}
+
+/* Merges sorted, deduplicated entries into a CSR copy of c. */
+static silc_value *csr_merge(const silc_value *c, const ix_entry *e, int64_t ne)
+{
+    int64_t i, q = 0, nnz = 0, cap = c->rowptr[c->m] + ne;
+    silc_value *r = val_csr_new(c->m, c->n, cap);
+    if (!r) return NULL;
+    for (i = 0; i < c->m; i++) {
+        int64_t p = c->rowptr[i], pe = c->rowptr[i + 1];
+        r->rowptr[i] = nnz;
+        while (p < pe || (q < ne && e[q].i == i)) {
+            int take_new = q < ne && e[q].i == i && (p >= pe || e[q].j <= c->colind[p]);
+            if (take_new) {
+                if (p < pe && c->colind[p] == e[q].j) p++;   /* replaced */
+                if (e[q].v != 0) {
+                    r->colind[nnz] = e[q].j;
+                    r->val[nnz++] = e[q].v;
+                }
+                q++;
+            } else {
+                r->colind[nnz] = c->colind[p];
+                r->val[nnz++] = c->val[p++];
+            }
+        }
+    }
+    r->rowptr[c->m] = nnz;
+    val_csr_set_nnz(r, nnz);
+    return r;
+}
+
+static silc_value *copy_value(const silc_value *t)
+{
+    silc_value *r;
+    if (t->format == SILC_FMT_DENSE) r = val_dense_new(t->m, t->n);
+    else r = val_band_new(t->m, t->n, t->kl, t->ku);
+    if (r) memcpy(r->val, t->val, (size_t)t->nnz * sizeof *r->val);
+    return r;
+}
+
+int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+              const silc_value *target, const silc_value *rhs, silc_value **out)
+{
+    ix_list I, J;
+    ix_entry *e = NULL;
+    int64_t ne, k, a, b, m = target->m;
+    int scalar = val_is_scalar(rhs), inband = 1;
+    silc_value *r = NULL;
+    char s0[48], s1[48];
+    *out = NULL;
+    if (resolve_all(V, subs, nsubs, what, target, &I, &J)) return -1;
+    ne = nsubs == 1 ? I.n : I.n * J.n;
+    if (!scalar) {
+        int ok = nsubs == 1 ? rhs->m * rhs->n == I.n && (rhs->m == 1 || rhs->n == 1)
+                            : rhs->m == I.n && rhs->n == J.n;
+        if (!ok) {
+            ev_shape(rhs, s0, sizeof s0);
+            if (nsubs == 1)
+                snprintf(s1, sizeof s1, "%lld elements", (long long)I.n);
+            else
+                snprintf(s1, sizeof s1, "a %lldx%lld block", (long long)I.n, (long long)J.n);
+            free(I.ix);
+            free(J.ix);
+            return eng_error(V->E, "cannot assign a %s value to %s of %s", s0, s1, what);
+        }
+    }
+    e = malloc((size_t)(ne ? ne : 1) * sizeof *e);
+    if (!e) goto nomem;
+    for (k = 0; k < ne; k++) {
+        if (nsubs == 1) {
+            a = I.ix[k] % m;
+            b = I.ix[k] / m;
+            e[k].v = scalar ? val_scalar(rhs) : val_get(rhs, rhs->m == 1 ? 0 : k, rhs->m == 1 ? k : 0);
+        } else {
+            int64_t ra = k % I.n, rb = k / I.n;
+            a = I.ix[ra];
+            b = J.ix[rb];
+            e[k].v = scalar ? val_scalar(rhs) : val_get(rhs, ra, rb);
+        }
+        e[k].i = a;
+        e[k].j = b;
+        e[k].order = k;
+        if (b - a > target->ku || a - b > target->kl) inband = 0;
+    }
+    if (target->format == SILC_FMT_DENSE) {
+        r = copy_value(target);
+        if (!r) goto nomem;
+        for (k = 0; k < ne; k++) r->val[e[k].i + e[k].j * m] = e[k].v;
+    } else if (target->format == SILC_FMT_BAND && inband) {
+        r = copy_value(target);
+        if (!r) goto nomem;
+        for (k = 0; k < ne; k++) r->val[(r->ku + e[k].i - e[k].j) + e[k].j * r->ld] = e[k].v;
+    } else {
+        /* CSR, or a band whose new entries leave the band: rebuild as CSR */
+        int64_t w = 0;
+        silc_value *c = target->format == SILC_FMT_CSR ? NULL : bi_to_csr(target);
+        if (target->format != SILC_FMT_CSR && !c) goto nomem;
+        qsort(e, (size_t)ne, sizeof *e, cmp_entry);
+        for (k = 0; k < ne; k++) {   /* the last assignment to a position wins */
+            if (w > 0 && e[w - 1].i == e[k].i && e[w - 1].j == e[k].j) e[w - 1] = e[k];
+            else e[w++] = e[k];
+        }
+        r = csr_merge(c ? c : target, e, w);
+        val_release(c);
+        if (!r) goto nomem;
+    }
+    free(e);
+    free(I.ix);
+    free(J.ix);
+    *out = r;
+    return 0;
+nomem:
+    free(e);
+    free(I.ix);
+    free(J.ix);
+    return oom(V);
+}

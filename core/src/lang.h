@@ -1,0 +1,134 @@
+/*
+ * lang.h -- internal interface of the command language: tokens (lexer.c), the
+ * syntax tree (parser.c), the evaluator's state shared with the built-in
+ * functions (builtins.c) and subscripts (index.c), all driven by lang_exec()
+ * in eval.c.
+ *
+ * A text is lexed and parsed whole before anything runs, so a syntax error
+ * anywhere refuses the text.  The parsed program keeps its own copy of the
+ * text; every node records its source span so error messages and `info` can
+ * quote the code the user wrote.
+ */
+#ifndef SILC_LANG_H
+#define SILC_LANG_H
+
+#include "engine.h"
+
+/* ---- tokens ----------------------------------------------------------------- */
+enum lx_kind {
+    TK_EOF = 0, TK_NEWLINE, TK_NUMBER, TK_NAME, TK_STRING, TK_RAW,
+    TK_PLUS, TK_MINUS, TK_STAR, TK_SLASH, TK_BACKSLASH, TK_EMUL, TK_EDIV,
+    TK_CARET, TK_EPOW, TK_QUOTE,
+    TK_LPAREN, TK_RPAREN, TK_LBRACKET, TK_RBRACKET, TK_LBRACE, TK_RBRACE,
+    TK_COMMA, TK_SEMI, TK_COLON,
+    TK_ASSIGN, TK_PLUSEQ, TK_MINUSEQ, TK_STAREQ, TK_SLASHEQ,
+    TK_EQ, TK_NE, TK_LT, TK_LE, TK_GT, TK_GE, TK_AND, TK_OR, TK_NOT
+};
+
+typedef struct lx_token {
+    int kind;              /* enum lx_kind */
+    int line, col;         /* 1-based */
+    size_t start, len;     /* span in the source text */
+    double num;            /* TK_NUMBER */
+} lx_token;
+
+typedef struct lx_tokens {
+    lx_token *t;
+    size_t n, cap;
+} lx_tokens;
+
+/* Tokenizes text; the `set` keyword's argument becomes one TK_RAW token.
+ * Returns 0, or -1 with "L:C: message" in err. */
+int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen);
+void lx_free(lx_tokens *toks);
+/* Printable form of a token for messages: "'*'", "end of input", "newline". */
+void lx_describe(const char *text, const lx_token *tk, char *out, size_t outlen);
+
+/* ---- syntax tree -------------------------------------------------------------- */
+enum ast_kind {
+    /* expressions */
+    AST_NUM, AST_NAME, AST_STRING, AST_END, AST_COLON_ALL, AST_RANGE,
+    AST_BINARY, AST_UNARY, AST_TRANSPOSE, AST_INDEX, AST_CALL,
+    /* statements */
+    ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
+    ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
+    ST_BLOCK               /* { statements } of IF / WHILE: kids are the statements */
+};
+
+typedef struct ast_node ast_node;
+struct ast_node {
+    int kind;              /* enum ast_kind */
+    int op;                /* operator token kind (BINARY, UNARY, OPASSIGN) */
+    int line, col;
+    size_t start, end;     /* source span [start, end) */
+    double num;            /* AST_NUM */
+    char *name;            /* NAME, CALL, STRING (unquoted text), assignment target, SET raw text */
+    /* kids: BINARY/UNARY/TRANSPOSE operands; INDEX base then subscripts; CALL
+     * arguments; RANGE from, to; EXPR/ASSIGN/OPASSIGN the expression;
+     * INDEX_ASSIGN the value then the subscripts; CLEAR names; EXPLAIN the
+     * statement; IF/WHILE the body block; BLOCK the statements */
+    ast_node **kids;
+    size_t nkids;
+    ast_node *cond;        /* IF, WHILE */
+    ast_node *els;         /* IF: else branch (a block or another IF), may be NULL */
+};
+
+/* A parsed text: the owned copy of the source and its top-level statements. */
+typedef struct lang_program {
+    char *text;
+    ast_node **stmts;
+    size_t nstmts;
+} lang_program;
+
+/* Parses text into *out.  Returns 0, or -1 with "L:C: message" in err. */
+int ps_parse(const char *text, lang_program **out, char *err, size_t errlen);
+void ps_free(lang_program *p);
+
+/* ---- evaluation state --------------------------------------------------------- */
+typedef struct lang_ev {
+    silc_engine *E;
+    const char *src;       /* text of the program being run */
+    int explain;           /* explain mode: describe operations, run no solve */
+    strbuf *explain_out;
+    int explain_step;
+    int64_t end_value;     /* what `end` means in the subscript being evaluated */
+    int in_subscript;
+    int has_solve;         /* the current statement ran a solve */
+    silc_report report;    /* its last solve report */
+    char backends[128];    /* solve backends of the current statement */
+} lang_ev;
+
+/* Operand description for messages: "'A'" when the node is short source text,
+ * else "the left operand" / "the right operand" (side 0 / 1). */
+void ev_operand_name(const lang_ev *V, const ast_node *n, int side, char *out, size_t outlen);
+/* Runs one operation through the dispatcher (or, in explain mode, describes
+ * it and runs it only when it is not a solve).  what names the operation for
+ * explain ("A \ b").  Returns 0 with *out set (owned), or -1 with E->err set. */
+int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out);
+/* "3x4" */
+void ev_shape(const silc_value *v, char *out, size_t outlen);
+
+/* ---- built-in functions (builtins.c) ------------------------------------------ */
+/* Names of every built-in function and constant (for suggestions), NULL-ended. */
+extern const char *const bi_names[];
+int bi_is_function(const char *name);
+/* Constant by name (pi, inf, nan, eps): 1 and *x, or 0. */
+int bi_constant(const char *name, double *x);
+/* Calls function node->name with the call node's arguments.  Returns 0 and
+ * *out, or -1 with E->err set. */
+int bi_call(lang_ev *V, const ast_node *call, silc_value **out);
+/* Shared with index.c: CSR copy of any value (core-side, no dispatch). */
+silc_value *bi_to_csr(const silc_value *a);
+
+/* ---- subscripts (index.c) ----------------------------------------------------- */
+/* base[subs] and target[subs] = rhs.  what names the matrix for messages
+ * ("'v'").  Return 0 with *out set (owned), or -1 with E->err set. */
+int ix_extract(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+               const silc_value *base, silc_value **out);
+int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+              const silc_value *target, const silc_value *rhs, silc_value **out);
+
+/* eval.c entry used by index.c and builtins.c */
+int ev_expr(lang_ev *V, const ast_node *n, silc_value **out);
+
+#endif

@@ -1,0 +1,732 @@
+/*
+ * parser.c -- recursive-descent parser from tokens to the syntax tree.
+ *
+ * Operator levels, loosest first: || ; && ; comparisons (not associative) ;
+ * + - ; * / \ *@ /@ ; unary - + ! ; ^ ^@ (right associative, and the right
+ * operand may carry a sign: 2^-1) ; postfix ' [subscripts] f(args).  So
+ * -2^2 is -(2^2) and -A*B is (-A)*B, as in MATLAB.
+ *
+ * Keywords (clear who set info explain if while else break continue) are
+ * keywords only at the start of a statement and only when not followed by an
+ * assignment, so `info = 3` still binds a variable.  The first syntax error
+ * stops parsing; its message is Lua-style, "L:C: expected ')' (to close '('
+ * at 1:5) near ';'".
+ */
+#include "lang.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct ps_state {
+    const char *src;
+    lx_token *t;
+    size_t pos, n;
+    int loop_depth;
+    int bracket_depth;     /* inside [ ]: `end` and `:` are subscripts */
+    char *err;
+    size_t errlen;
+    int failed;
+} ps_state;
+
+static const lx_token *peek(const ps_state *P)
+{
+    return &P->t[P->pos];
+}
+
+static const lx_token *peek_at(const ps_state *P, size_t k)
+{
+    return &P->t[P->pos + k < P->n ? P->pos + k : P->n - 1];
+}
+
+static int is(const ps_state *P, int kind)
+{
+    return P->t[P->pos].kind == kind;
+}
+
+static const lx_token *next(ps_state *P)
+{
+    const lx_token *tk = &P->t[P->pos];
+    if (P->pos + 1 < P->n) P->pos++;
+    return tk;
+}
+
+/* Records the first error only: later ones are consequences of it. */
+static void *fail(ps_state *P, const lx_token *at, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void *fail(ps_state *P, const lx_token *at, const char *fmt, ...)
+{
+    if (!P->failed) {
+        va_list ap;
+        int k = snprintf(P->err, P->errlen, "%d:%d: ", at->line, at->col);
+        va_start(ap, fmt);
+        if (k > 0 && (size_t)k < P->errlen) vsnprintf(P->err + k, P->errlen - (size_t)k, fmt, ap);
+        va_end(ap);
+        P->failed = 1;
+    }
+    return NULL;
+}
+
+static void *unexpected(ps_state *P, const lx_token *at)
+{
+    char d[64];
+    lx_describe(P->src, at, d, sizeof d);
+    return fail(P, at, "unexpected %s", d);
+}
+
+static int tok_is_text(const ps_state *P, const lx_token *tk, const char *word)
+{
+    return tk->kind == TK_NAME && tk->len == strlen(word) &&
+           !strncmp(P->src + tk->start, word, tk->len);
+}
+
+static char *tok_text(const ps_state *P, const lx_token *tk)
+{
+    char *s = malloc(tk->len + 1);
+    if (s) {
+        memcpy(s, P->src + tk->start, tk->len);
+        s[tk->len] = 0;
+    }
+    return s;
+}
+
+static void node_free(ast_node *n)
+{
+    size_t i;
+    if (!n) return;
+    for (i = 0; i < n->nkids; i++) node_free(n->kids[i]);
+    free(n->kids);
+    free(n->name);
+    node_free(n->cond);
+    node_free(n->els);
+    free(n);
+}
+
+static ast_node *node_new(ps_state *P, int kind, const lx_token *at)
+{
+    ast_node *n = calloc(1, sizeof *n);
+    if (!n) return fail(P, at, "out of memory while parsing");
+    n->kind = kind;
+    n->line = at->line;
+    n->col = at->col;
+    n->start = at->start;
+    n->end = at->start + at->len;
+    return n;
+}
+
+static int add_kid(ps_state *P, ast_node *n, ast_node *kid)
+{
+    ast_node **k;
+    if (!kid) return -1;
+    k = realloc(n->kids, (n->nkids + 1) * sizeof *k);
+    if (!k) {
+        node_free(kid);
+        fail(P, peek(P), "out of memory while parsing");
+        return -1;
+    }
+    n->kids = k;
+    n->kids[n->nkids++] = kid;
+    if (kid->end > n->end) n->end = kid->end;
+    if (kid->start < n->start) n->start = kid->start;
+    return 0;
+}
+
+/* Consumes the closing token of a bracket pair or fails Lua-style. */
+static int close_with(ps_state *P, int kind, const char *what, const lx_token *opener, ast_node *n)
+{
+    char d[64];
+    if (is(P, kind)) {
+        const lx_token *tk = next(P);
+        if (n) n->end = tk->start + tk->len;
+        return 0;
+    }
+    lx_describe(P->src, peek(P), d, sizeof d);
+    fail(P, peek(P), "expected '%s' (to close '%.*s' at %d:%d) near %s", what, (int)opener->len,
+         P->src + opener->start, opener->line, opener->col, d);
+    return -1;
+}
+
+static ast_node *parse_expr(ps_state *P);
+
+static ast_node *binary(ps_state *P, const lx_token *optk, ast_node *l, ast_node *r)
+{
+    ast_node *n;
+    if (!r) {
+        node_free(l);
+        return NULL;
+    }
+    n = node_new(P, AST_BINARY, optk);
+    if (!n) {
+        node_free(l);
+        node_free(r);
+        return NULL;
+    }
+    n->op = optk->kind;
+    if (add_kid(P, n, l) || add_kid(P, n, r)) {
+        if (n->nkids == 0) node_free(r);
+        node_free(n);
+        return NULL;
+    }
+    return n;
+}
+
+/* Subscript item: ':' alone, a:b, or an expression. */
+static ast_node *parse_subscript(ps_state *P)
+{
+    ast_node *a, *r;
+    const lx_token *tk;
+    if (is(P, TK_COLON) && (peek_at(P, 1)->kind == TK_COMMA || peek_at(P, 1)->kind == TK_RBRACKET))
+        return node_new(P, AST_COLON_ALL, next(P));
+    a = parse_expr(P);
+    if (!a || !is(P, TK_COLON)) return a;
+    tk = next(P);
+    r = node_new(P, AST_RANGE, tk);
+    if (!r || add_kid(P, r, a)) {
+        if (!r) node_free(a);
+        node_free(r);
+        return NULL;
+    }
+    if (add_kid(P, r, parse_expr(P))) {
+        node_free(r);
+        return NULL;
+    }
+    return r;
+}
+
+/* Comma-separated items up to the closer; items go to n->kids. */
+static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetext,
+                      const lx_token *opener, int subscripts)
+{
+    if (is(P, closer) && !subscripts) return close_with(P, closer, closetext, opener, n);
+    for (;;) {
+        ast_node *item;
+        if (subscripts) {
+            item = parse_subscript(P);
+        } else if (is(P, TK_STRING)) {
+            const lx_token *tk = next(P);
+            item = node_new(P, AST_STRING, tk);
+            if (item) {
+                item->name = malloc(tk->len - 1);
+                if (item->name) {
+                    memcpy(item->name, P->src + tk->start + 1, tk->len - 2);
+                    item->name[tk->len - 2] = 0;
+                }
+            }
+        } else {
+            item = parse_expr(P);
+        }
+        if (add_kid(P, n, item)) return -1;
+        if (!is(P, TK_COMMA)) break;
+        next(P);
+    }
+    return close_with(P, closer, closetext, opener, n);
+}
+
+static ast_node *parse_primary(ps_state *P)
+{
+    const lx_token *tk = peek(P);
+    ast_node *n;
+    switch (tk->kind) {
+    case TK_NUMBER:
+        n = node_new(P, AST_NUM, next(P));
+        if (n) n->num = tk->num;
+        return n;
+    case TK_NAME:
+        if (P->bracket_depth > 0 && tok_is_text(P, tk, "end")) return node_new(P, AST_END, next(P));
+        n = node_new(P, AST_NAME, next(P));
+        if (n && !(n->name = tok_text(P, tk))) {
+            node_free(n);
+            return fail(P, tk, "out of memory while parsing");
+        }
+        return n;
+    case TK_LPAREN: {
+        next(P);
+        n = parse_expr(P);
+        if (!n) return NULL;
+        if (close_with(P, TK_RPAREN, ")", tk, NULL)) {
+            node_free(n);
+            return NULL;
+        }
+        /* the span covers the parentheses, so quoted operands read as written */
+        n->start = tk->start;
+        n->end = P->t[P->pos - 1].start + 1;
+        return n;
+    }
+    default:
+        return unexpected(P, tk);
+    }
+}
+
+static ast_node *parse_postfix(ps_state *P)
+{
+    ast_node *n = parse_primary(P);
+    while (n) {
+        const lx_token *tk = peek(P);
+        ast_node *w;
+        if (tk->kind == TK_QUOTE) {
+            next(P);
+            w = node_new(P, AST_TRANSPOSE, tk);
+            if (!w || add_kid(P, w, n)) {
+                if (!w) node_free(n);
+                node_free(w);
+                return NULL;
+            }
+            n = w;
+        } else if (tk->kind == TK_LBRACKET) {
+            next(P);
+            w = node_new(P, AST_INDEX, tk);
+            if (!w || add_kid(P, w, n)) {
+                if (!w) node_free(n);
+                node_free(w);
+                return NULL;
+            }
+            P->bracket_depth++;
+            n = w;
+            if (parse_list(P, n, TK_RBRACKET, "]", tk, 1)) {
+                P->bracket_depth--;
+                node_free(n);
+                return NULL;
+            }
+            P->bracket_depth--;
+        } else if (tk->kind == TK_LPAREN && n->kind == AST_NAME) {
+            next(P);
+            n->kind = AST_CALL;
+            if (parse_list(P, n, TK_RPAREN, ")", tk, 0)) {
+                node_free(n);
+                return NULL;
+            }
+        } else {
+            break;
+        }
+    }
+    return n;
+}
+
+static ast_node *parse_signed_power(ps_state *P);
+
+static ast_node *parse_power(ps_state *P)
+{
+    ast_node *l = parse_postfix(P);
+    if (l && (is(P, TK_CARET) || is(P, TK_EPOW))) {
+        const lx_token *op = next(P);
+        return binary(P, op, l, parse_signed_power(P));
+    }
+    return l;
+}
+
+static ast_node *unary(ps_state *P, ast_node *(*operand)(ps_state *))
+{
+    const lx_token *tk = peek(P);
+    if (tk->kind == TK_MINUS || tk->kind == TK_PLUS || tk->kind == TK_NOT) {
+        ast_node *n, *k;
+        next(P);
+        k = unary(P, operand);
+        if (!k) return NULL;
+        n = node_new(P, AST_UNARY, tk);
+        if (!n || add_kid(P, n, k)) {
+            if (!n) node_free(k);
+            node_free(n);
+            return NULL;
+        }
+        n->op = tk->kind;
+        return n;
+    }
+    return operand(P);
+}
+
+/* Right operand of ^: may be signed (2^-1), binds tighter than anything but postfix. */
+static ast_node *parse_signed_power(ps_state *P)
+{
+    return unary(P, parse_power);
+}
+
+static ast_node *parse_unary(ps_state *P)
+{
+    return unary(P, parse_power);
+}
+
+static ast_node *parse_mul(ps_state *P)
+{
+    ast_node *l = parse_unary(P);
+    while (l && (is(P, TK_STAR) || is(P, TK_SLASH) || is(P, TK_BACKSLASH) || is(P, TK_EMUL) ||
+                 is(P, TK_EDIV))) {
+        const lx_token *op = next(P);
+        l = binary(P, op, l, parse_unary(P));
+    }
+    return l;
+}
+
+static ast_node *parse_add(ps_state *P)
+{
+    ast_node *l = parse_mul(P);
+    while (l && (is(P, TK_PLUS) || is(P, TK_MINUS))) {
+        const lx_token *op = next(P);
+        l = binary(P, op, l, parse_mul(P));
+    }
+    return l;
+}
+
+static int is_comparison(int k)
+{
+    return k == TK_EQ || k == TK_NE || k == TK_LT || k == TK_LE || k == TK_GT || k == TK_GE;
+}
+
+static ast_node *parse_cmp(ps_state *P)
+{
+    ast_node *l = parse_add(P);
+    if (l && is_comparison(peek(P)->kind)) {
+        const lx_token *op = next(P);
+        l = binary(P, op, l, parse_add(P));
+        if (l && is_comparison(peek(P)->kind)) {
+            node_free(l);
+            return fail(P, peek(P), "comparisons do not chain: use '&&' near '%.*s'",
+                        (int)peek(P)->len, P->src + peek(P)->start);
+        }
+    }
+    return l;
+}
+
+static ast_node *parse_and(ps_state *P)
+{
+    ast_node *l = parse_cmp(P);
+    while (l && is(P, TK_AND)) {
+        const lx_token *op = next(P);
+        l = binary(P, op, l, parse_cmp(P));
+    }
+    return l;
+}
+
+static ast_node *parse_expr(ps_state *P)
+{
+    ast_node *l = parse_and(P);
+    while (l && is(P, TK_OR)) {
+        const lx_token *op = next(P);
+        l = binary(P, op, l, parse_and(P));
+    }
+    return l;
+}
+
+/* ---- statements ---------------------------------------------------------- */
+
+static ast_node *parse_statement(ps_state *P);
+
+static int is_separator(int k)
+{
+    return k == TK_SEMI || k == TK_NEWLINE;
+}
+
+static void skip_separators(ps_state *P)
+{
+    while (is_separator(peek(P)->kind)) next(P);
+}
+
+/* Statements until closer (TK_RBRACE or TK_EOF), into n->kids. */
+static int parse_statements(ps_state *P, ast_node *n, int closer)
+{
+    skip_separators(P);
+    while (!is(P, closer) && !is(P, TK_EOF)) {
+        ast_node *s = parse_statement(P);
+        int k;
+        if (!s || add_kid(P, n, s)) return -1;
+        k = peek(P)->kind;
+        /* a block ends a statement by itself: `if (c) { } x = 1` */
+        if (!is_separator(k) && k != closer && k != TK_EOF &&
+            s->kind != ST_IF && s->kind != ST_WHILE) {
+            unexpected(P, peek(P));
+            return -1;
+        }
+        skip_separators(P);
+    }
+    return 0;
+}
+
+static ast_node *parse_block(ps_state *P, ast_node *owner)
+{
+    const lx_token *open;
+    ast_node *b;
+    while (is(P, TK_NEWLINE)) next(P);    /* allow the brace on the next line */
+    open = peek(P);
+    if (!is(P, TK_LBRACE)) {
+        char d[64];
+        lx_describe(P->src, open, d, sizeof d);
+        return fail(P, open, "expected '{' near %s", d);
+    }
+    next(P);
+    b = node_new(P, ST_BLOCK, open);
+    if (!b) return NULL;
+    if (parse_statements(P, b, TK_RBRACE) || close_with(P, TK_RBRACE, "}", open, b)) {
+        node_free(b);
+        return NULL;
+    }
+    if (b->end > owner->end) owner->end = b->end;
+    return b;
+}
+
+static ast_node *parse_condition(ps_state *P)
+{
+    const lx_token *open = peek(P);
+    ast_node *c;
+    if (!is(P, TK_LPAREN)) {
+        char d[64];
+        lx_describe(P->src, open, d, sizeof d);
+        return fail(P, open, "expected '(' near %s", d);
+    }
+    next(P);
+    c = parse_expr(P);
+    if (c && close_with(P, TK_RPAREN, ")", open, NULL)) {
+        node_free(c);
+        return NULL;
+    }
+    return c;
+}
+
+static ast_node *parse_if(ps_state *P, const lx_token *kw)
+{
+    ast_node *n = node_new(P, ST_IF, kw), *b;
+    size_t save;
+    if (!n) return NULL;
+    if (!(n->cond = parse_condition(P)) || !(b = parse_block(P, n)) || add_kid(P, n, b)) {
+        node_free(n);
+        return NULL;
+    }
+    save = P->pos;
+    while (is(P, TK_NEWLINE)) next(P);
+    if (tok_is_text(P, peek(P), "else")) {
+        next(P);
+        if (tok_is_text(P, peek(P), "if")) {
+            const lx_token *kw2 = next(P);
+            n->els = parse_if(P, kw2);
+        } else {
+            n->els = parse_block(P, n);
+        }
+        if (!n->els) {
+            node_free(n);
+            return NULL;
+        }
+        if (n->els->end > n->end) n->end = n->els->end;
+    } else {
+        P->pos = save;
+    }
+    return n;
+}
+
+static ast_node *parse_while(ps_state *P, const lx_token *kw)
+{
+    ast_node *n = node_new(P, ST_WHILE, kw), *b;
+    if (!n) return NULL;
+    if (!(n->cond = parse_condition(P))) {
+        node_free(n);
+        return NULL;
+    }
+    P->loop_depth++;
+    b = parse_block(P, n);
+    P->loop_depth--;
+    if (!b || add_kid(P, n, b)) {
+        node_free(n);
+        return NULL;
+    }
+    return n;
+}
+
+static ast_node *name_node(ps_state *P, int kind)
+{
+    const lx_token *tk = peek(P);
+    ast_node *n;
+    if (tk->kind != TK_NAME) {
+        char d[64];
+        lx_describe(P->src, tk, d, sizeof d);
+        return fail(P, tk, "expected a name near %s", d);
+    }
+    n = node_new(P, kind, next(P));
+    if (n && !(n->name = tok_text(P, tk))) {
+        node_free(n);
+        return fail(P, tk, "out of memory while parsing");
+    }
+    return n;
+}
+
+static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
+{
+    ast_node *n;
+    if (tok_is_text(P, kw, "if")) return parse_if(P, kw);
+    if (tok_is_text(P, kw, "while")) return parse_while(P, kw);
+    if (tok_is_text(P, kw, "break") || tok_is_text(P, kw, "continue")) {
+        if (P->loop_depth == 0)
+            return fail(P, kw, "'%.*s' outside a loop", (int)kw->len, P->src + kw->start);
+        return node_new(P, tok_is_text(P, kw, "break") ? ST_BREAK : ST_CONTINUE, kw);
+    }
+    if (tok_is_text(P, kw, "who")) return node_new(P, ST_WHO, kw);
+    if (tok_is_text(P, kw, "clear")) {
+        n = node_new(P, ST_CLEAR, kw);
+        while (n && peek(P)->kind == TK_NAME)
+            if (add_kid(P, n, name_node(P, AST_NAME))) {
+                node_free(n);
+                return NULL;
+            }
+        return n;
+    }
+    if (tok_is_text(P, kw, "info")) {
+        ast_node *x = name_node(P, ST_INFO);
+        if (x) x->start = kw->start;
+        return x;
+    }
+    if (tok_is_text(P, kw, "set")) {
+        n = node_new(P, ST_SET, kw);
+        if (n && is(P, TK_RAW)) {
+            const lx_token *raw = next(P);
+            if (!(n->name = tok_text(P, raw))) {
+                node_free(n);
+                return fail(P, raw, "out of memory while parsing");
+            }
+            n->end = raw->start + raw->len;
+        }
+        return n;
+    }
+    /* explain */
+    n = node_new(P, ST_EXPLAIN, kw);
+    if (n) {
+        const lx_token *at = peek(P);
+        ast_node *s;
+        if (at->kind == TK_EOF || is_separator(at->kind)) {
+            node_free(n);
+            return fail(P, at, "explain needs a statement, as in 'explain x = A \\ b'");
+        }
+        s = parse_statement(P);
+        if (s && s->kind != ST_EXPR && s->kind != ST_ASSIGN && s->kind != ST_OPASSIGN &&
+            s->kind != ST_INDEX_ASSIGN) {
+            node_free(s);
+            node_free(n);
+            return fail(P, at, "explain takes an assignment or an expression");
+        }
+        if (add_kid(P, n, s)) {
+            node_free(n);
+            return NULL;
+        }
+    }
+    return n;
+}
+
+static int is_assign_op(int k)
+{
+    return k == TK_ASSIGN || k == TK_PLUSEQ || k == TK_MINUSEQ || k == TK_STAREQ || k == TK_SLASHEQ;
+}
+
+static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
+                                       "info", "set", "explain"};
+
+static ast_node *parse_statement(ps_state *P)
+{
+    const lx_token *tk = peek(P);
+    ast_node *n, *e;
+    if (tk->kind == TK_NAME) {
+        int nk = peek_at(P, 1)->kind;
+        size_t i;
+        if (!is_assign_op(nk) && nk != TK_LBRACKET)
+            for (i = 0; i < sizeof keywords / sizeof keywords[0]; i++)
+                if (tok_is_text(P, tk, keywords[i])) return parse_keyword(P, next(P));
+        if (is_assign_op(nk)) {
+            const lx_token *op;
+            n = node_new(P, nk == TK_ASSIGN ? ST_ASSIGN : ST_OPASSIGN, tk);
+            if (!n || !(n->name = tok_text(P, tk))) {
+                node_free(n);
+                return fail(P, tk, "out of memory while parsing");
+            }
+            next(P);
+            op = next(P);
+            n->op = op->kind;
+            if (add_kid(P, n, parse_expr(P))) {
+                node_free(n);
+                return NULL;
+            }
+            return n;
+        }
+    }
+    e = parse_expr(P);
+    if (!e) return NULL;
+    if (is(P, TK_ASSIGN) && e->kind == AST_INDEX && e->kids[0]->kind == AST_NAME) {
+        /* x[...] = value: kids are the value, then the subscripts */
+        size_t i;
+        next(P);
+        n = node_new(P, ST_INDEX_ASSIGN, tk);
+        if (!n || !(n->name = util_strdup(e->kids[0]->name)) || add_kid(P, n, parse_expr(P))) {
+            node_free(n);
+            node_free(e);
+            return n ? NULL : fail(P, tk, "out of memory while parsing");
+        }
+        for (i = 1; i < e->nkids; i++) {
+            ast_node *sub = e->kids[i];
+            e->kids[i] = NULL;          /* moved: add_kid frees it on failure */
+            if (add_kid(P, n, sub)) {
+                node_free(e);
+                node_free(n);
+                return NULL;
+            }
+        }
+        node_free(e);
+        return n;
+    }
+    if (is_assign_op(peek(P)->kind)) {
+        node_free(e);
+        return fail(P, peek(P), "cannot assign to this expression near '%.*s'", (int)peek(P)->len,
+                    P->src + peek(P)->start);
+    }
+    n = node_new(P, ST_EXPR, tk);
+    if (!n || add_kid(P, n, e)) {
+        if (!n) node_free(e);
+        node_free(n);
+        return NULL;
+    }
+    return n;
+}
+
+int ps_parse(const char *text, lang_program **out, char *err, size_t errlen)
+{
+    lx_tokens toks;
+    ps_state P;
+    ast_node root;
+    lang_program *prog;
+    *out = NULL;
+    if (lx_tokenize(text, &toks, err, errlen)) return -1;
+    memset(&P, 0, sizeof P);
+    memset(&root, 0, sizeof root);
+    P.src = text;
+    P.t = toks.t;
+    P.n = toks.n;
+    P.err = err;
+    P.errlen = errlen;
+    if (parse_statements(&P, &root, TK_EOF) || P.failed) {
+        size_t i;
+        for (i = 0; i < root.nkids; i++) node_free(root.kids[i]);
+        free(root.kids);
+        lx_free(&toks);
+        if (!P.failed) snprintf(err, errlen, "out of memory while parsing");
+        return -1;
+    }
+    lx_free(&toks);
+    prog = calloc(1, sizeof *prog);
+    if (!prog || !(prog->text = util_strdup(text))) {
+        size_t i;
+        for (i = 0; i < root.nkids; i++) node_free(root.kids[i]);
+        free(root.kids);
+        free(prog);
+        snprintf(err, errlen, "out of memory while parsing");
+        return -1;
+    }
+    prog->stmts = root.kids;
+    prog->nstmts = root.nkids;
+    *out = prog;
+    return 0;
+}
+
+void ps_free(lang_program *p)
+{
+    size_t i;
+    if (!p) return;
+    for (i = 0; i < p->nstmts; i++) node_free(p->stmts[i]);
+    free(p->stmts);
+    free(p->text);
+    free(p);
+}

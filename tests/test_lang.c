@@ -1,0 +1,766 @@
+/*
+ * test_lang.c -- table-driven tests of the command language through the public
+ * API: literals, precedence and associativity, every operator and built-in,
+ * subscripts and assignment into blocks, compound assignment, control flow,
+ * keyword statements, and every error message verbatim.
+ *
+ * Each case runs in a fresh context holding the same small operands (below);
+ * expected numbers are worked out by hand from those operands, never taken
+ * from an earlier run.  Solves use diagonal, triangular and tiny systems with
+ * exact answers.
+ *
+ *   v = [1;2;3]  w = [4;5;6]  r = [1 2 3]  idx = [1;3]  s = 5
+ *   M = [1 2; 3 4]           A = [1 4 7 10; 2 5 8 11; 3 6 9 12]   (dense)
+ *   S = [4 1 0; 1 4 1; 0 1 4] (CSR)   B = [2 -1 0; -1 2 -1; 0 -1 2] (band 1,1)
+ *   D = diag(2, 4, 8) (dense)         L = [2 0 0; 1 1 0; 0 1 4] (dense)
+ */
+#include "check.h"
+
+#include <math.h>
+#include <silc.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct lang_case {
+    const char *src;
+    const char *name;      /* result to fetch, NULL for an error case */
+    int m, n;
+    double v[12];          /* expected values, column-major */
+    const char *err;       /* expected message, exactly */
+} lang_case;
+
+#define OK(src, name, m, n, ...) {src, name, m, n, {__VA_ARGS__}, NULL}
+#define ERR(src, msg) {src, NULL, 0, 0, {0}, msg}
+
+static const lang_case cases[] = {
+    /* literals */
+    OK("x = 42", "x", 1, 1, 42),
+    OK("x = 1.5", "x", 1, 1, 1.5),
+    OK("x = .5", "x", 1, 1, 0.5),
+    OK("x = 1e-3", "x", 1, 1, 0.001),
+    OK("x = 2.5E2", "x", 1, 1, 250),
+    OK("x = 1e+2", "x", 1, 1, 100),
+    OK("x = 0", "x", 1, 1, 0),
+    OK("x = 007", "x", 1, 1, 7),
+    /* precedence and associativity */
+    OK("x = 1 + 2 * 3", "x", 1, 1, 7),
+    OK("x = (1 + 2) * 3", "x", 1, 1, 9),
+    OK("x = 10 - 4 - 3", "x", 1, 1, 3),
+    OK("x = 64 / 4 / 2", "x", 1, 1, 8),
+    OK("x = 2 ^ 3 ^ 2", "x", 1, 1, 512),
+    OK("x = -2 ^ 2", "x", 1, 1, -4),
+    OK("x = 2 ^ -1", "x", 1, 1, 0.5),
+    OK("x = -2 ^ -2", "x", 1, 1, -0.25),
+    OK("x = (-2) ^ 2", "x", 1, 1, 4),
+    OK("x = 2 * -3", "x", 1, 1, -6),
+    OK("x = - - 3", "x", 1, 1, 3),
+    OK("x = +3", "x", 1, 1, 3),
+    OK("x = 1 - -1", "x", 1, 1, 2),
+    OK("x = 2 + 3 * 4 ^ 2", "x", 1, 1, 50),
+    OK("x = 12 / 2 * 3", "x", 1, 1, 18),
+    OK("x = 2 \\ 8", "x", 1, 1, 4),
+    OK("x = 3 *@ 4", "x", 1, 1, 12),
+    OK("x = 3 .* 4", "x", 1, 1, 12),
+    OK("x = 8 /@ 2", "x", 1, 1, 4),
+    OK("x = 8 ./ 2", "x", 1, 1, 4),
+    OK("x = 2 ^@ 3", "x", 1, 1, 8),
+    OK("x = 2 .^ 3", "x", 1, 1, 8),
+    OK("x = 1.*2", "x", 1, 1, 2),
+    OK("x = 3 - 2 * 2 ^ 2", "x", 1, 1, -5),
+    OK("x = 2 ^ 2 * 3", "x", 1, 1, 12),
+    OK("x = -v", "x", 3, 1, -1, -2, -3),
+    OK("x = -v[2]^2", "x", 1, 1, -4),
+    OK("x = 2 * v + 1", "x", 3, 1, 3, 5, 7),
+    OK("x = v + w", "x", 3, 1, 5, 7, 9),
+    OK("x = w - v", "x", 3, 1, 3, 3, 3),
+    OK("x = v - w - v", "x", 3, 1, -4, -5, -6),
+    OK("x = v *@ w", "x", 3, 1, 4, 10, 18),
+    OK("x = w /@ v", "x", 3, 1, 4, 2.5, 2),
+    OK("x = v ^@ 2", "x", 3, 1, 1, 4, 9),
+    OK("x = 2 ^@ v", "x", 3, 1, 2, 4, 8),
+    OK("x = v' * w", "x", 1, 1, 32),
+    OK("x = v * r", "x", 3, 3, 1, 2, 3, 2, 4, 6, 3, 6, 9),
+    OK("x = r * v", "x", 1, 1, 14),
+    OK("x = -M * M", "x", 2, 2, -7, -15, -10, -22),
+    OK("x = M * M", "x", 2, 2, 7, 15, 10, 22),
+    OK("x = M ^ 2", "x", 2, 2, 7, 15, 10, 22),
+    OK("x = M ^ 3", "x", 2, 2, 37, 81, 54, 118),
+    OK("x = M ^ 0", "x", 2, 2, 1, 0, 0, 1),
+    OK("x = M ^ 1", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = S ^ 2", "x", 3, 3, 17, 8, 1, 8, 18, 8, 1, 8, 17),
+    /* transposes */
+    OK("x = M'", "x", 2, 2, 1, 2, 3, 4),
+    OK("x = r'", "x", 3, 1, 1, 2, 3),
+    OK("x = v''", "x", 3, 1, 1, 2, 3),
+    OK("x = A'", "x", 4, 3, 1, 4, 7, 10, 2, 5, 8, 11, 3, 6, 9, 12),
+    OK("x = M' * v[1:2]", "x", 2, 1, 7, 10),
+    OK("x = (M * M)'", "x", 2, 2, 7, 10, 15, 22),
+    OK("x = M * v[1:2]", "x", 2, 1, 5, 11),
+    OK("x = S'", "x", 3, 3, 4, 1, 0, 1, 4, 1, 0, 1, 4),
+    OK("x = 2'", "x", 1, 1, 2),
+    /* scalars with matrices */
+    OK("x = 2 * M - M", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = M + 1", "x", 2, 2, 2, 4, 3, 5),
+    OK("x = 1 - M", "x", 2, 2, 0, -2, -1, -3),
+    OK("x = M / 2", "x", 2, 2, 0.5, 1.5, 1, 2),
+    OK("x = M * 2", "x", 2, 2, 2, 6, 4, 8),
+    OK("x = s * v", "x", 3, 1, 5, 10, 15),
+    /* solves */
+    OK("x = D \\ v", "x", 3, 1, 0.5, 0.5, 0.375),
+    OK("x = L \\ (L * ones(3, 1))", "x", 3, 1, 1, 1, 1),
+    OK("x = L \\ v", "x", 3, 1, 0.5, 1.5, 0.375),
+    OK("x = S \\ (S * v)", "x", 3, 1, 1, 2, 3),
+    OK("x = B \\ (B * v)", "x", 3, 1, 1, 2, 3),
+    OK("x = B \\ ones(3, 1)", "x", 3, 1, 1.5, 2, 1.5),
+    OK("x = M \\ (M * v[1:2])", "x", 2, 1, 1, 2),
+    OK("x = M \\ v[1:2]", "x", 2, 1, 0, 0.5),
+    OK("x = r / D", "x", 1, 3, 0.5, 0.5, 0.375),
+    OK("x = v' / D", "x", 1, 3, 0.5, 0.5, 0.375),
+    OK("x = 6 / 3", "x", 1, 1, 2),
+    OK("x = solve(D, v)", "x", 3, 1, 0.5, 0.5, 0.375),
+    OK("x = solve(D, v, \"backend = reference\")", "x", 3, 1, 0.5, 0.5, 0.375),
+    OK("x = D \\ (v * r)", "x", 3, 3, 0.5, 0.5, 0.375, 1, 1, 0.75, 1.5, 1.5, 1.125),
+    OK("x = sqrt(v' * v)", "x", 1, 1, 3.7416573867739413),
+    /* comparisons and logic */
+    OK("x = 1 < 2", "x", 1, 1, 1),
+    OK("x = 2 <= 1", "x", 1, 1, 0),
+    OK("x = 3 == 3", "x", 1, 1, 1),
+    OK("x = 3 != 3", "x", 1, 1, 0),
+    OK("x = 2 > 1", "x", 1, 1, 1),
+    OK("x = 2 >= 3", "x", 1, 1, 0),
+    OK("x = v > 1", "x", 3, 1, 0, 1, 1),
+    OK("x = v == 2", "x", 3, 1, 0, 1, 0),
+    OK("x = v == w - 3", "x", 3, 1, 1, 1, 1),
+    OK("x = 1 < 2 && 2 < 3", "x", 1, 1, 1),
+    OK("x = 1 > 2 || 3 > 2", "x", 1, 1, 1),
+    OK("x = !0", "x", 1, 1, 1),
+    OK("x = !v", "x", 3, 1, 0, 0, 0),
+    OK("x = 1 + 1 == 2", "x", 1, 1, 1),
+    OK("x = 0 && v[5]", "x", 1, 1, 0),
+    OK("x = 1 || v[5]", "x", 1, 1, 1),
+    OK("x = 0 || 0", "x", 1, 1, 0),
+    OK("x = !(1 < 2)", "x", 1, 1, 0),
+    OK("x = -1 < 0", "x", 1, 1, 1),
+    OK("x = 1 || 0 && 0", "x", 1, 1, 1),
+    /* built-ins */
+    OK("x = zeros(2, 3)", "x", 2, 3, 0, 0, 0, 0, 0, 0),
+    OK("x = zeros(2)", "x", 2, 2, 0, 0, 0, 0),
+    OK("x = ones(2, 1)", "x", 2, 1, 1, 1),
+    OK("x = ones(1, 3)", "x", 1, 3, 1, 1, 1),
+    OK("x = zeros(0, 1)", "x", 0, 1, 0),
+    OK("x = eye(2)", "x", 2, 2, 1, 0, 0, 1),
+    OK("x = eye(2, 3)", "x", 2, 3, 1, 0, 0, 1, 0, 0),
+    OK("x = nnz(eye(4))", "x", 1, 1, 4),
+    OK("x = size(A)", "x", 1, 2, 3, 4),
+    OK("x = size(A, 1)", "x", 1, 1, 3),
+    OK("x = size(A, 2)", "x", 1, 1, 4),
+    OK("x = rows(A)", "x", 1, 1, 3),
+    OK("x = cols(A)", "x", 1, 1, 4),
+    OK("x = nnz(S)", "x", 1, 1, 7),
+    OK("x = nnz(v - v)", "x", 1, 1, 0),
+    OK("x = nnz(B)", "x", 1, 1, 7),
+    OK("x = sum(v)", "x", 1, 1, 6),
+    OK("x = sum(r)", "x", 1, 1, 6),
+    OK("x = sum(M)", "x", 1, 2, 4, 6),
+    OK("x = sum(S)", "x", 1, 3, 5, 6, 5),
+    OK("x = sum(eye(3))", "x", 1, 3, 1, 1, 1),
+    OK("x = max(v)", "x", 1, 1, 3),
+    OK("x = min(w)", "x", 1, 1, 4),
+    OK("x = max(M)", "x", 1, 2, 3, 4),
+    OK("x = min(M)", "x", 1, 2, 1, 2),
+    OK("x = max(v, 2)", "x", 3, 1, 2, 2, 3),
+    OK("x = min(v, w)", "x", 3, 1, 1, 2, 3),
+    OK("x = dot(v, w)", "x", 1, 1, 32),
+    OK("x = norm(ones(4, 1))", "x", 1, 1, 2),
+    OK("x = norm(v, 1)", "x", 1, 1, 6),
+    OK("x = norm(v, inf)", "x", 1, 1, 3),
+    OK("x = norm(v, 2)", "x", 1, 1, 3.7416573867739413),
+    OK("x = norm(M, \"fro\")", "x", 1, 1, 5.477225575051661),
+    OK("x = norm(M, 1)", "x", 1, 1, 6),
+    OK("x = norm(M, inf)", "x", 1, 1, 7),
+    OK("x = norm(M, \"inf\")", "x", 1, 1, 7),
+    OK("x = norm(D)", "x", 1, 1, 8),
+    OK("x = abs(-v)", "x", 3, 1, 1, 2, 3),
+    OK("x = sqrt(v *@ v)", "x", 3, 1, 1, 2, 3),
+    OK("x = sqrt(4)", "x", 1, 1, 2),
+    OK("x = exp(0)", "x", 1, 1, 1),
+    OK("x = log(1)", "x", 1, 1, 0),
+    OK("x = sin(0)", "x", 1, 1, 0),
+    OK("x = cos(0)", "x", 1, 1, 1),
+    OK("x = exp(log(v))", "x", 3, 1, 1, 2, 3),
+    OK("x = sin(pi / 2)", "x", 1, 1, 1),
+    OK("x = cos(pi)", "x", 1, 1, -1),
+    OK("x = trans(r)", "x", 3, 1, 1, 2, 3),
+    OK("x = trans(M)", "x", 2, 2, 1, 2, 3, 4),
+    OK("x = diag(v)", "x", 3, 3, 1, 0, 0, 0, 2, 0, 0, 0, 3),
+    OK("x = diag(r)", "x", 3, 3, 1, 0, 0, 0, 2, 0, 0, 0, 3),
+    OK("x = diagvec(M)", "x", 2, 1, 1, 4),
+    OK("x = diagvec(S)", "x", 3, 1, 4, 4, 4),
+    OK("x = diagvec(B)", "x", 3, 1, 2, 2, 2),
+    OK("x = dense(S)", "x", 3, 3, 4, 1, 0, 1, 4, 1, 0, 1, 4),
+    OK("x = sparse(M)", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = band(M, 1, 1)", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = dense(band(S, 1, 1))", "x", 3, 3, 4, 1, 0, 1, 4, 1, 0, 1, 4),
+    OK("x = dense(B)", "x", 3, 3, 2, -1, 0, -1, 2, -1, 0, -1, 2),
+    OK("x = sparse(idx, idx, 5, 3, 3)", "x", 3, 3, 5, 0, 0, 0, 0, 0, 0, 0, 5),
+    OK("x = sparse(v, v, w, 3, 3)", "x", 3, 3, 4, 0, 0, 0, 5, 0, 0, 0, 6),
+    OK("x = sparse(ones(2, 1), ones(2, 1), idx, 2, 2)", "x", 2, 2, 4, 0, 0, 0),
+    OK("x = sparse(idx', idx', idx, 3, 3)", "x", 3, 3, 1, 0, 0, 0, 0, 0, 0, 0, 3),
+    OK("x = pi", "x", 1, 1, 3.141592653589793),
+    OK("x = eps", "x", 1, 1, 2.220446049250313e-16),
+    OK("x = inf", "x", 1, 1, INFINITY),
+    OK("x = -inf < 0", "x", 1, 1, 1),
+    OK("x = nan == nan", "x", 1, 1, 0),
+    OK("pi = 3; x = pi", "x", 1, 1, 3),
+    OK("x = rand(2, 3); y = size(x)", "y", 1, 2, 2, 3),
+    OK("x = rand(3); y = size(x)", "y", 1, 2, 3, 3),
+    OK("x = rand(100, 1); y = (max(x) < 1) && (min(x) >= 0)", "y", 1, 1, 1),
+    OK("x = rand(1); y = rand(1); z = x != y", "z", 1, 1, 1),
+    OK("x = size(S')", "x", 1, 2, 3, 3),
+    /* subscripts */
+    OK("x = v[2]", "x", 1, 1, 2),
+    OK("x = v[end]", "x", 1, 1, 3),
+    OK("x = v[end - 1]", "x", 1, 1, 2),
+    OK("x = v[2:3]", "x", 2, 1, 2, 3),
+    OK("x = v[:]", "x", 3, 1, 1, 2, 3),
+    OK("x = r[2:3]", "x", 1, 2, 2, 3),
+    OK("x = A[2, 3]", "x", 1, 1, 8),
+    OK("x = A[:, 2]", "x", 3, 1, 4, 5, 6),
+    OK("x = A[1, :]", "x", 1, 4, 1, 4, 7, 10),
+    OK("x = A[2:3, 3:4]", "x", 2, 2, 8, 9, 11, 12),
+    OK("x = A[end, end]", "x", 1, 1, 12),
+    OK("x = A[5]", "x", 1, 1, 5),
+    OK("x = A[end]", "x", 1, 1, 12),
+    OK("x = A[idx, 1]", "x", 2, 1, 1, 3),
+    OK("x = A[idx, idx]", "x", 2, 2, 1, 3, 7, 9),
+    OK("x = v[idx]", "x", 2, 1, 1, 3),
+    OK("x = S[2, :]", "x", 1, 3, 1, 4, 1),
+    OK("x = S[1:2, 2:3]", "x", 2, 2, 1, 4, 0, 1),
+    OK("x = S[3, 3]", "x", 1, 1, 4),
+    OK("x = S[1, 3]", "x", 1, 1, 0),
+    OK("x = S[:, 1]", "x", 3, 1, 4, 1, 0),
+    OK("x = S[5]", "x", 1, 1, 4),
+    OK("x = B[2, 1]", "x", 1, 1, -1),
+    OK("x = B[:, 2]", "x", 3, 1, -1, 2, -1),
+    OK("x = A[1:2, end]", "x", 2, 1, 10, 11),
+    OK("x = v[3:2]", "x", 0, 1, 0),
+    OK("x = v[v]", "x", 3, 1, 1, 2, 3),
+    OK("x = v[2:3][1]", "x", 1, 1, 2),
+    OK("x = A'[4, 1]", "x", 1, 1, 10),
+    OK("x = (v + w)[2]", "x", 1, 1, 7),
+    OK("x = A[end - 1, end - 2]", "x", 1, 1, 5),
+    OK("x = v[min(end, 5)]", "x", 1, 1, 3),
+    OK("x = v[w[1] - 3]", "x", 1, 1, 1),
+    OK("x = v[v[end]]", "x", 1, 1, 3),
+    OK("x = A[:, end][2]", "x", 1, 1, 11),
+    /* assignment into blocks */
+    OK("x = v; x[2] = 9", "x", 3, 1, 1, 9, 3),
+    OK("x = v; x[2:3] = 0", "x", 3, 1, 1, 0, 0),
+    OK("x = v; x[idx] = w[1:2]", "x", 3, 1, 4, 2, 5),
+    OK("x = zeros(2, 2); x[1, :] = r[1:2]", "x", 2, 2, 1, 0, 2, 0),
+    OK("x = zeros(2, 2); x[:, 2] = ones(2, 1)", "x", 2, 2, 0, 0, 1, 1),
+    OK("x = M; x[2, 2] = -1", "x", 2, 2, 1, 3, 2, -1),
+    OK("x = M; x[3] = 7", "x", 2, 2, 1, 3, 7, 4),
+    OK("x = S; x[1, 3] = 7; y = dense(x)", "y", 3, 3, 4, 1, 0, 1, 4, 1, 7, 1, 4),
+    OK("x = S; x[2, 2] = 0; y = nnz(x)", "y", 1, 1, 6),
+    OK("x = S; x[1, 3] = 7; y = x[1, 3]", "y", 1, 1, 7),
+    OK("x = S; x[2, :] = 0; y = dense(x)", "y", 3, 3, 4, 0, 0, 1, 0, 1, 0, 0, 4),
+    OK("x = S; x[1:2, 1:2] = M; y = dense(x)", "y", 3, 3, 1, 3, 0, 2, 4, 1, 0, 1, 4),
+    OK("x = S; x[3] = 9; y = dense(x)", "y", 3, 3, 4, 1, 9, 1, 4, 1, 0, 1, 4),
+    OK("x = B; x[1, 2] = 5; y = dense(x)", "y", 3, 3, 2, -1, 0, 5, 2, -1, 0, -1, 2),
+    OK("x = B; x[1, 3] = 5; y = dense(x)", "y", 3, 3, 2, -1, 0, -1, 2, -1, 5, -1, 2),
+    OK("x = v; x[end] = 10", "x", 3, 1, 1, 2, 10),
+    OK("x = A; x[:, :] = 1; y = sum(sum(x))", "y", 1, 1, 12),
+    OK("x = v; x[2] = x[2] + 1", "x", 3, 1, 1, 3, 3),
+    OK("x = s; x[1] = 2", "x", 1, 1, 2),
+    OK("x = r; x[2:3] = v[1:2]", "x", 1, 3, 1, 1, 2),
+    OK("x = v; x[idx] = 0; x[idx] = 8", "x", 3, 1, 8, 2, 8),
+    /* compound assignment */
+    OK("x = v; x += w", "x", 3, 1, 5, 7, 9),
+    OK("x = w; x -= v", "x", 3, 1, 3, 3, 3),
+    OK("x = M; x *= M", "x", 2, 2, 7, 15, 10, 22),
+    OK("x = v; x *= 2", "x", 3, 1, 2, 4, 6),
+    OK("x = v; x /= 2", "x", 3, 1, 0.5, 1, 1.5),
+    OK("x = r; x /= D", "x", 1, 3, 0.5, 0.5, 0.375),
+    OK("x = 1; x += 2 * 3", "x", 1, 1, 7),
+    OK("x = v; x += 1; x += 1", "x", 3, 1, 3, 4, 5),
+    OK("x = 10; x -= 2 - 1", "x", 1, 1, 9),
+    /* control flow and layout */
+    OK("x = 0; k = 0; while (k < 10) { k += 1; x += k }", "x", 1, 1, 55),
+    OK("x = 0; while (1) { x += 1; if (x >= 7) { break } }", "x", 1, 1, 7),
+    OK("x = 0; k = 0; while (k < 5) { k += 1; if (k == 3) { continue }; x += k }", "x", 1, 1, 12),
+    OK("if (1) { x = 1 } else { x = 2 }", "x", 1, 1, 1),
+    OK("if (0) { x = 1 } else { x = 2 }", "x", 1, 1, 2),
+    OK("x = 5; if (x > 10) { y = 1 } else if (x > 3) { y = 2 } else { y = 3 }", "y", 1, 1, 2),
+    OK("x = 1; if (x > 10) { y = 1 } else if (x > 3) { y = 2 } else { y = 3 }", "y", 1, 1, 3),
+    OK("x = 0; if (x) { x = 9 }", "x", 1, 1, 0),
+    OK("x = 0\nif (v[1] == 1)\n{\n  x = 1\n}\nelse\n{\n  x = 2\n}", "x", 1, 1, 1),
+    OK("x = 1\ny = x + 1\n# comment\nz = y * 2  # trailing", "z", 1, 1, 4),
+    OK("x = 0; i = 0; while (i < 3) { i += 1; j = 0; while (j < 3) { j += 1; if (j == 2) { break }; "
+       "x += 1 } }", "x", 1, 1, 3),
+    OK("x = 0\nwhile (x < 3) {\n  x += 1\n}\n", "x", 1, 1, 3),
+    OK("x = (1 +\n 2)", "x", 1, 1, 3),
+    OK("x = v[1 +\n 1]", "x", 1, 1, 2),
+    OK("x = 1; if (x == 1) { y = 2 } z = 3", "z", 1, 1, 3),
+    OK(";; x = 1;;\n\n; y = 2;", "y", 1, 1, 2),
+    OK("x = 2; while (x < 100) { x *= x }", "x", 1, 1, 256),
+    OK("x = 0; k = 0; while (k < 3 && v[k + 1] < 3) { k += 1; x += v[k] }", "x", 1, 1, 3),
+    /* keywords are names when assigned */
+    OK("info = 3; x = info", "x", 1, 1, 3),
+    OK("who = 2; x = who + 1", "x", 1, 1, 3),
+    OK("set = 4; x = set", "x", 1, 1, 4),
+    OK("clear = 1; clear += 1; x = clear", "x", 1, 1, 2),
+    OK("x = 1; clear x; x = 2", "x", 1, 1, 2),
+    OK("end = 5; x = end", "x", 1, 1, 5),
+    OK("x = 1; y = 2; clear x y; x = 3", "x", 1, 1, 3),
+    /* the seeds' cloth statements, on a tiny mesh */
+    OK("z = sqrt(diagvec(diag(v) * diag(v)))", "z", 3, 1, 1, 2, 3),
+    OK("fij = diag(v) * (w *@ (v - 1) /@ v)", "fij", 3, 1, 0, 5, 12),
+    OK("zhat = ones(3, 1) /@ v; P = zhat *@ v", "P", 3, 1, 1, 1, 1),
+    OK("C1 = diag(D * sqrt(v *@ v)); T1 = -C1 * C1'", "T1", 3, 3, -4, 0, 0, 0, -64, 0, 0, 0, -576),
+    OK("x = v; dt = 0.5; x += dt * w", "x", 3, 1, 3, 4.5, 6),
+    OK("vv = v; dv = D \\ (D * w); vv += dv *@ idx[1]", "vv", 3, 1, 5, 7, 9),
+
+    /* syntax errors: nothing runs */
+    ERR("x = (1 + 2;", "1:11: expected ')' (to close '(' at 1:5) near ';'"),
+    ERR("x = foo(1, 2;", "1:13: expected ')' (to close '(' at 1:8) near ';'"),
+    ERR("x = 1 * * 2", "1:9: unexpected '*'"),
+    ERR("x = (1 + 2", "1:11: expected ')' (to close '(' at 1:5) near end of input"),
+    ERR("x = 1 $ 2", "1:7: unexpected character '$'"),
+    ERR("x = v[1", "1:8: expected ']' (to close '[' at 1:6) near end of input"),
+    ERR("x = ", "1:5: unexpected end of input"),
+    ERR("x = 1 +", "1:8: unexpected end of input"),
+    ERR("= 3", "1:1: unexpected '='"),
+    ERR("x = 1 2", "1:7: unexpected '2'"),
+    ERR("x = 1\ny = (2 *\n3", "3:2: expected ')' (to close '(' at 2:5) near end of input"),
+    ERR("x = 1; y = 2)", "1:13: unexpected ')'"),
+    ERR("break", "1:1: 'break' outside a loop"),
+    ERR("if (1) { continue }", "1:10: 'continue' outside a loop"),
+    ERR("x = \"abc\"", "1:5: unexpected '\"abc\"'"),
+    ERR("x = 1 < 2 < 3", "1:11: comparisons do not chain: use '&&' near '<'"),
+    ERR("if (1) x = 2", "1:8: expected '{' near 'x'"),
+    ERR("x = 1.5e", "1:5: malformed number near '1.5e'"),
+    ERR("x = \"abc", "1:5: unfinished string"),
+    ERR("v + 1 = 3", "1:7: cannot assign to this expression near '='"),
+    ERR("x = 1\ny = 2 +\n", "2:8: unexpected end of line"),
+    ERR("while (1) { x = 1", "1:18: expected '}' (to close '{' at 1:11) near end of input"),
+    ERR("if 1 { x = 1 }", "1:4: expected '(' near '1'"),
+    ERR("x = v[1, ]", "1:10: unexpected ']'"),
+    ERR("x = a b c", "1:7: unexpected 'b'"),
+    ERR("x = 1 @ 2", "1:7: unexpected character '@'"),
+    ERR("explain", "1:8: explain needs a statement, as in 'explain x = A \\ b'"),
+    ERR("explain who", "1:9: explain takes an assignment or an expression"),
+    ERR("info", "1:5: expected a name near end of input"),
+
+    /* runtime errors */
+    ERR("x = vv + 1", "undefined name 'vv' (did you mean 'v'?)"),
+    ERR("x = qqqqq", "undefined name 'qqqqq'"),
+    ERR("x = sqr(2)", "unknown function 'sqr' (did you mean 'sqrt'?)"),
+    ERR("x = v + w[1:2]", "'+' needs operands of the same shape or a scalar: 'v' is 3x1, 'w[1:2]' is 2x1"),
+    ERR("x = v - r", "'-' needs operands of the same shape or a scalar: 'v' is 3x1, 'r' is 1x3"),
+    ERR("x = A * v", "'*' inner dimensions differ: 'A' is 3x4, 'v' is 3x1"),
+    ERR("x = M \\ v", "'\\' needs as many rows in the right-hand side: 'M' is 2x2, 'v' is 3x1"),
+    ERR("x = A ^ 2", "'A' is 3x4 but '^' needs a square matrix"),
+    ERR("x = M ^ 0.5", "'^' of a matrix needs a nonnegative integer exponent, got 0.5 (use '^@' for "
+                       "element-wise powers)"),
+    ERR("x = M ^ -1", "'^' of a matrix needs a nonnegative integer exponent, got -1 (use '^@' for "
+                      "element-wise powers)"),
+    ERR("x = M ^ v", "'^' needs a scalar exponent: 'v' is 3x1 (use '^@' for element-wise powers)"),
+    ERR("x = zero(3)", "unknown function 'zero' (did you mean 'zeros'?)"),
+    ERR("x = foo(3)", "unknown function 'foo'"),
+    ERR("x = zeros(1, 2, 3)", "zeros takes 1 or 2 arguments, got 3"),
+    ERR("x = dot(v)", "dot takes 2 arguments, got 1"),
+    ERR("x = abs(v, w)", "abs takes 1 argument, got 2"),
+    ERR("x = band(S)", "band takes 3 arguments, got 1"),
+    ERR("x = sparse(v, v, v)", "sparse takes 1 or 5 arguments, got 3"),
+    ERR("x = v[5]", "index 5 is out of range for 'v' (3x1)"),
+    ERR("x = v[0]", "index 0 is out of range for 'v' (3x1)"),
+    ERR("x = v[1.5]", "index 1.5 into 'v' is not an integer"),
+    ERR("x = A[4, 1]", "index 4 is out of range for 'A' (3x4)"),
+    ERR("x = A[1, 5]", "index 5 is out of range for 'A' (3x4)"),
+    ERR("x = A[13]", "index 13 is out of range for 'A' (3x4)"),
+    ERR("x = v[1:5]", "index 4 is out of range for 'v' (3x1)"),
+    ERR("x = v[1:1000000000000]", "index 4 is out of range for 'v' (3x1)"),
+    ERR("x = v[end + 1]", "index 4 is out of range for 'v' (3x1)"),
+    ERR("x = band(S, 0, 0)", "band(S, 0, 0): entry (1,2) lies outside the band"),
+    ERR("x = band(A, 1, 1)", "band(A, 1, 1): entry (1,3) lies outside the band"),
+    ERR("x = band(B, 1, 0)", "band(B, 1, 0): entry (1,2) lies outside the band"),
+    ERR("if (v) { x = 1 }", "condition must be a scalar, got 3x1"),
+    ERR("while (r) { x = 1 }", "condition must be a scalar, got 1x3"),
+    ERR("x = v *@ w[1:2]", "'*@' needs operands of the same shape or a scalar: 'v' is 3x1, 'w[1:2]' is 2x1"),
+    ERR("x = v ./ r", "'/@' needs operands of the same shape or a scalar: 'v' is 3x1, 'r' is 1x3"),
+    ERR("x = v < r", "'<' needs operands of the same shape or a scalar: 'v' is 3x1, 'r' is 1x3"),
+    ERR("x = max(v, w[1:2])", "max needs operands of the same shape or a scalar: 'v' is 3x1, 'w[1:2]' is 2x1"),
+    ERR("x = dot(v, r)", "dot needs operands of the same shape: 'v' is 3x1, 'r' is 1x3"),
+    ERR("x = norm(v, 3)", "norm: p must be 1, 2, inf or \"fro\""),
+    ERR("x = norm(v, \"max\")", "norm: p must be 1, 2, inf or \"fro\""),
+    ERR("x = diag(M)", "diag needs a vector, got 2x2 (diagvec(A) gives the diagonal of a matrix)"),
+    ERR("x = zeros(-1)", "zeros: argument 1 must be an integer >= 0, got -1"),
+    ERR("x = ones(2, 1.5)", "ones: argument 2 must be an integer >= 0, got 1.5"),
+    ERR("x = zeros(v)", "zeros: argument 1 must be a scalar, got 3x1"),
+    ERR("x = sparse(idx, idx, 1, 2, 3)", "sparse: row index 3 (entry 2) is out of range 1..2"),
+    ERR("x = sparse(idx, idx, 1, 3, 2)", "sparse: column index 3 (entry 2) is out of range 1..2"),
+    ERR("x = sparse(idx, v, 1, 3, 3)", "sparse: i has 2 entries but j has 3"),
+    ERR("x = sparse(idx, idx, v, 3, 3)", "sparse: i has 2 entries but v has 3 (v may also be a scalar)"),
+    ERR("x = sparse(M, idx, 1, 3, 3)", "sparse: argument 1 must be a vector, got 2x2"),
+    ERR("yyy[2] = 1", "undefined name 'yyy'"),
+    ERR("x = v; x[1:2] = w", "statement 2: cannot assign a 3x1 value to 2 elements of 'x'"),
+    ERR("x = M; x[1:2, 1] = M", "statement 2: cannot assign a 2x2 value to a 2x1 block of 'x'"),
+    ERR("x = v; x[4] = 1", "statement 2: index 4 is out of range for 'x' (3x1)"),
+    ERR("qq += 1", "undefined name 'qq'"),
+    ERR("x = 1; y = vv; z = 3", "statement 2: undefined name 'vv' (did you mean 'v'?)"),
+    ERR("x = M / v'", "'/' needs operands with the same number of columns: 'M' is 2x2, 'v'' is 1x3"),
+    ERR("x = v(1)", "unknown function 'v' ('v' is a variable: subscripts use v[...])"),
+    ERR("x = abs(\"fro\")", "abs: argument 1 must be a matrix, not a string"),
+    ERR("x = v[1:v]", "a range a:b needs scalar ends, got 3x1"),
+    ERR("x = solve(M, v)", "solve needs as many rows in the right-hand side: 'M' is 2x2, 'v' is 3x1"),
+    ERR("x = size(A, 3)", "size: dimension must be 1 or 2, got 3"),
+    ERR("x = A[1, 2, 3]", "'A' takes 1 or 2 subscripts, got 3"),
+    ERR("x = (v + v + v + v + v + v + v) + w[1:2]",
+        "'+' needs operands of the same shape or a scalar: the left operand is 3x1, 'w[1:2]' is 2x1"),
+    ERR("x = w[1:2] - (v + v + v + v + v + v + v)",
+        "'-' needs operands of the same shape or a scalar: 'w[1:2]' is 2x1, the right operand is 3x1"),
+    ERR("x = 0; while (x < 3) { x += 1; y = vv }", "statement 2: undefined name 'vv' (did you mean 'v'?)"),
+    ERR("x = (v + w)[4]", "index 4 is out of range for '(v + w)' (3x1)"),
+};
+
+/* ---- fixtures --------------------------------------------------------------- */
+
+static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
+{
+    silc_envelope_t e;
+    silc_envelope_dense(&e, m, n, x);
+    CHECK(silc_put(c, name, &e) == 0, "put %s: %s", name, silc_context_errmsg(c));
+    silc_envelope_free(&e);
+}
+
+static silc_context *fixture(void)
+{
+    static const double v[] = {1, 2, 3}, w[] = {4, 5, 6}, idx[] = {1, 3}, s = 5;
+    static const double M[] = {1, 3, 2, 4};
+    static const double A[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+    static const double D[] = {2, 0, 0, 0, 4, 0, 0, 0, 8};
+    static const double L[] = {2, 1, 0, 0, 1, 1, 0, 0, 4};
+    static const int64_t Sp[] = {0, 2, 5, 7}, Si[] = {0, 1, 0, 1, 2, 1, 2};
+    static const double Sv[] = {4, 1, 1, 4, 1, 1, 4};
+    /* band storage, ld = 3: rows are superdiagonal, diagonal, subdiagonal */
+    static const double Bb[] = {0, 2, -1, -1, 2, -1, -1, 2, 0};
+    silc_context *c = NULL;
+    silc_envelope_t e;
+    if (silc_open(&c, NULL)) {
+        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
+        return NULL;
+    }
+    put_dense(c, "v", 3, 1, v);
+    put_dense(c, "w", 3, 1, w);
+    put_dense(c, "r", 1, 3, v);
+    put_dense(c, "idx", 2, 1, idx);
+    put_dense(c, "s", 1, 1, &s);
+    put_dense(c, "M", 2, 2, M);
+    put_dense(c, "A", 3, 4, A);
+    put_dense(c, "D", 3, 3, D);
+    put_dense(c, "L", 3, 3, L);
+    silc_envelope_csr(&e, 3, 3, Sp, Si, Sv);
+    CHECK(silc_put(c, "S", &e) == 0, "put S: %s", silc_context_errmsg(c));
+    silc_envelope_free(&e);
+    silc_envelope_band(&e, 3, 3, 1, 1, Bb);
+    CHECK(silc_put(c, "B", &e) == 0, "put B: %s", silc_context_errmsg(c));
+    silc_envelope_free(&e);
+    return c;
+}
+
+/* Fetches name as dense values; returns the count or -1. */
+static int64_t fetch(silc_context *c, const char *name, int64_t *m, int64_t *n, double **x)
+{
+    silc_envelope_t e;
+    *x = NULL;
+    if (silc_get(c, &e, name)) return -1;
+    *m = e.m;
+    *n = e.n;
+    *x = malloc((size_t)(e.m * e.n + 1) * sizeof **x);
+    if (*x) silc_envelope_to_dense(&e, *x);
+    silc_envelope_free(&e);
+    return *m * *n;
+}
+
+static int is_defined(silc_context *c, const char *name)
+{
+    silc_envelope_t e;
+    if (silc_get(c, &e, name)) return 0;
+    silc_envelope_free(&e);
+    return 1;
+}
+
+static void run_case(const lang_case *t)
+{
+    silc_context *c = fixture();
+    int rc;
+    if (!c) return;
+    rc = silc_exec(c, t->src);
+    if (t->err) {
+        CHECK(rc != 0, "[%s] should fail with \"%s\"", t->src, t->err);
+        if (rc) CHECK(!strcmp(silc_context_errmsg(c), t->err), "[%s]\n   got  \"%s\"\n   want \"%s\"",
+                      t->src, silc_context_errmsg(c), t->err);
+    } else {
+        int64_t m = 0, n = 0, k, cnt;
+        double *x;
+        CHECK(rc == 0, "[%s] failed: %s", t->src, silc_context_errmsg(c));
+        cnt = rc ? -1 : fetch(c, t->name, &m, &n, &x);
+        if (cnt >= 0) {
+            int ok = m == t->m && n == t->n;
+            CHECK(ok, "[%s] %s is %lldx%lld, want %dx%d", t->src, t->name, (long long)m,
+                  (long long)n, t->m, t->n);
+            for (k = 0; ok && k < cnt && k < 12; k++) {
+                double want = t->v[k], tol = 1e-13 * (fabs(want) > 1 ? fabs(want) : 1);
+                CHECK(x[k] == want || fabs(x[k] - want) <= tol, "[%s] %s[%lld] = %.17g, want %.17g",
+                      t->src, t->name, (long long)k + 1, x[k], want);
+            }
+            free(x);
+        } else if (rc == 0) {
+            CHECK(0, "[%s] cannot fetch %s: %s", t->src, t->name, silc_context_errmsg(c));
+        }
+    }
+    silc_close(&c);
+}
+
+/* ---- keyword statements and engine behaviour ---------------------------------- */
+
+static char captured[8192];
+
+static void capture(void *user, const char *text)
+{
+    (void)user;
+    strncat(captured, text, sizeof captured - strlen(captured) - 1);
+}
+
+static void test_who(void)
+{
+    silc_context *c = fixture();
+    if (!c) return;
+    silc_exec(c, "clear");
+    silc_set_output(c, capture, NULL);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "who") == 0, "who on empty store");
+    CHECK(!strcmp(captured, "no variables\n"), "who empty: \"%s\"", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "x = ones(3, 1); long_name = eye(2); who") == 0, "who: %s", silc_context_errmsg(c));
+    CHECK(!strcmp(captured, "name       size  format  nnz\n"
+                            "long_name  2x2   csr     nnz 2\n"
+                            "x          3x1   dense   nnz 3\n"),
+          "who output:\n%s", captured);
+    silc_close(&c);
+}
+
+static void test_info(void)
+{
+    silc_context *c = fixture();
+    if (!c) return;
+    silc_set_output(c, capture, NULL);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = D \\ v; info y") == 0, "info: %s", silc_context_errmsg(c));
+    CHECK(!strncmp(captured, "y: 3x1 dense, nnz 3\n", 20), "info head: %s", captured);
+    CHECK(strstr(captured, "  statement: y = D \\ v\n") != NULL, "info statement: %s", captured);
+    CHECK(strstr(captured, "  backward error: ") != NULL, "info backward error: %s", captured);
+    CHECK(strstr(captured, "  backend: reference\n") != NULL, "info backend: %s", captured);
+    CHECK(strstr(captured, "  condition estimate: ") != NULL, "info cond: %s", captured);
+    CHECK(strstr(captured, "  iterations: 0\n") != NULL, "info iterations: %s", captured);
+    CHECK(strstr(captured, "  reused factorization: ") != NULL, "info reuse: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "info v") == 0, "info v");
+    CHECK(!strcmp(captured, "v: 3x1 dense, nnz 3\n"
+                            "  deposited by PUT (no statement of this session computed it)\n"),
+          "info of a PUT value: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "z = v + 1\ninfo z") == 0, "info z");
+    CHECK(strstr(captured, "  statement: z = v + 1\n") && strstr(captured, "  no solve in this statement\n"),
+          "info without solve: %s", captured);
+    CHECK(silc_exec(c, "info vv") != 0 &&
+              !strcmp(silc_context_errmsg(c), "undefined name 'vv' (did you mean 'v'?)"),
+          "info of a missing name: %s", silc_context_errmsg(c));
+    silc_close(&c);
+}
+
+static void test_explain(void)
+{
+    silc_context *c = fixture();
+    if (!c) return;
+    silc_set_output(c, capture, NULL);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "explain x = D \\ v + 1") == 0, "explain: %s", silc_context_errmsg(c));
+    CHECK(!strncmp(captured, "explain: x = D \\ v + 1\n  1. D \\ v: 3x3 dense, 3x1 dense\n", 52),
+          "explain head: %s", captured);
+    CHECK(strstr(captured, "  2. D \\ v + 1: 3x1 dense, 1x1 dense\n") != NULL, "explain step 2: %s", captured);
+    CHECK(strstr(captured, "  result: x would be bound to a 3x1 dense value (not run)\n") != NULL,
+          "explain result: %s", captured);
+    CHECK(!is_defined(c, "x"), "explain must not bind x");
+    captured[0] = 0;
+    CHECK(silc_exec(c, "explain v[2] = 7") == 0, "explain index assign: %s", silc_context_errmsg(c));
+    {
+        int64_t m, n;
+        double *x;
+        if (fetch(c, "v", &m, &n, &x) == 3) {
+            CHECK(x[1] == 2, "explain changed v[2] to %g", x[1]);
+            free(x);
+        }
+    }
+    captured[0] = 0;
+    CHECK(silc_exec(c, "explain y = zeros(2, 1)") == 0, "explain core: %s", silc_context_errmsg(c));
+    CHECK(strstr(captured, "  1. zeros(2, 1): built by the core -> 2x1 dense\n") != NULL,
+          "explain core step: %s", captured);
+    CHECK(silc_exec(c, "explain y = M \\ v") != 0 &&
+              !strcmp(silc_context_errmsg(c),
+                      "'\\' needs as many rows in the right-hand side: 'M' is 2x2, 'v' is 3x1"),
+          "explain of a bad statement: %s", silc_context_errmsg(c));
+    silc_close(&c);
+}
+
+static void test_set(void)
+{
+    silc_context *c = fixture();
+    if (!c) return;
+    silc_set_output(c, capture, NULL);
+    CHECK(silc_exec(c, "set tune.accuracy = 1e-8") == 0, "set: %s", silc_context_errmsg(c));
+    captured[0] = 0;
+    CHECK(silc_exec(c, "set tune.accuracy") == 0, "set key: %s", silc_context_errmsg(c));
+    CHECK(!strcmp(captured, "tune.accuracy = 1e-8\n"), "set key output: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "set") == 0 && strstr(captured, "tune.accuracy") != NULL, "set list: %s", captured);
+    CHECK(silc_exec(c, "set x = 1") != 0, "set of an unknown key must fail");
+    CHECK(silc_exec(c, "x = 1; set tune.accuracy = 1e-9; y = 2") == 0, "set between statements: %s",
+          silc_context_errmsg(c));
+    CHECK(is_defined(c, "y"), "statement after set ran");
+    silc_close(&c);
+}
+
+static void test_atomicity(void)
+{
+    silc_context *c = fixture();
+    int64_t m, n;
+    double *x;
+    if (!c) return;
+    /* a syntax error anywhere runs nothing */
+    CHECK(silc_exec(c, "x = 1; y = (") != 0, "syntax error");
+    CHECK(!is_defined(c, "x"), "x bound despite a syntax error later in the text");
+    /* a failing statement keeps the earlier ones and changes nothing itself */
+    CHECK(silc_exec(c, "x = 1; v = v + w[1:2]; z = 3") != 0, "runtime error");
+    CHECK(is_defined(c, "x"), "statement 1 should stay done");
+    CHECK(!is_defined(c, "z"), "statement 3 must not run");
+    if (fetch(c, "v", &m, &n, &x) == 3) {
+        CHECK(x[0] == 1 && x[1] == 2 && x[2] == 3, "v changed by a failing statement");
+        free(x);
+    }
+    CHECK(silc_exec(c, "v[2] = 9; v[7] = 1") != 0, "index error");
+    if (fetch(c, "v", &m, &n, &x) == 3) {
+        CHECK(x[1] == 9 && x[2] == 3 && m == 3, "v after partial run: %g %g", x[1], x[2]);
+        free(x);
+    }
+    CHECK(silc_exec(c, "w += vv") != 0, "compound error");
+    if (fetch(c, "w", &m, &n, &x) == 3) {
+        CHECK(x[0] == 4, "w changed by a failing +=");
+        free(x);
+    }
+    silc_close(&c);
+}
+
+static void test_cache(void)
+{
+    silc_context *c = fixture();
+    int i, ok = 1;
+    int64_t m, n;
+    double *x;
+    char text[64];
+    if (!c) return;
+    CHECK(silc_exec(c, "k = 0") == 0, "k = 0");
+    for (i = 0; i < 1000; i++) ok &= silc_exec(c, "k += 1") == 0;
+    CHECK(ok, "repeated exec");
+    if (fetch(c, "k", &m, &n, &x) == 1) {
+        CHECK(x[0] == 1000, "k = %g after 1000 cached runs", x[0]);
+        free(x);
+    }
+    /* more distinct texts than the cache holds: it empties and keeps working */
+    for (i = 0; i < 1200; i++) {
+        snprintf(text, sizeof text, "t%d = %d", i % 7, i);
+        ok &= silc_exec(c, text) == 0;
+    }
+    CHECK(ok && silc_exec(c, "k += 1") == 0, "exec after cache overflow");
+    if (fetch(c, "k", &m, &n, &x) == 1) {
+        CHECK(x[0] == 1001, "k = %g", x[0]);
+        free(x);
+    }
+    /* a cached text that failed keeps failing the same way */
+    CHECK(silc_exec(c, "x = (1") != 0 && silc_exec(c, "x = (1") != 0 &&
+              !strcmp(silc_context_errmsg(c), "1:7: expected ')' (to close '(' at 1:5) near end of input"),
+          "cached syntax error: %s", silc_context_errmsg(c));
+    silc_close(&c);
+}
+
+static void test_clear(void)
+{
+    silc_context *c = fixture();
+    if (!c) return;
+    CHECK(silc_exec(c, "clear v w") == 0, "clear v w");
+    CHECK(!is_defined(c, "v") && !is_defined(c, "w") && is_defined(c, "M"), "clear names");
+    CHECK(silc_exec(c, "clear") == 0 && !is_defined(c, "M"), "clear all");
+    CHECK(silc_exec(c, "x = pi") == 0, "constants after clear");
+    silc_close(&c);
+}
+
+static void test_rand_reproducible(void)
+{
+    silc_context *a = fixture(), *b = fixture();
+    int64_t m, n;
+    double *x, *y;
+    if (!a || !b) return;
+    silc_exec(a, "q = rand(5, 1)");
+    silc_exec(b, "q = rand(5, 1)");
+    if (fetch(a, "q", &m, &n, &x) == 5) {
+        if (fetch(b, "q", &m, &n, &y) == 5) {
+            CHECK(!memcmp(x, y, 5 * sizeof *x), "rand differs between fresh contexts");
+            free(y);
+        }
+        free(x);
+    }
+    silc_close(&a);
+    silc_close(&b);
+}
+
+static void test_formats(void)
+{
+    silc_context *c = fixture();
+    silc_envelope_t e;
+    static const struct { const char *src, *name; int format; } f[] = {
+        {"x = eye(3)", "x", SILC_CSR},          {"x = S[1:2, :]", "x", SILC_CSR},
+        {"x = A[1:2, :]", "x", SILC_DENSE},     {"x = B[1:2, :]", "x", SILC_DENSE},
+        {"x = S; x[1, 1] = 2", "x", SILC_CSR},  {"x = B; x[1, 2] = 2", "x", SILC_BAND},
+        {"x = B; x[1, 3] = 2", "x", SILC_CSR},  {"x = sparse(idx, idx, 1, 3, 3)", "x", SILC_CSR},
+        {"x = S[1, 1]", "x", SILC_DENSE},       {"x = zeros(2)", "x", SILC_DENSE},
+        {"x = M; x[1] = 0", "x", SILC_DENSE},   {"x = band(S, 1, 1)", "x", SILC_BAND},
+    };
+    size_t i;
+    if (!c) return;
+    for (i = 0; i < sizeof f / sizeof f[0]; i++) {
+        CHECK(silc_exec(c, f[i].src) == 0, "[%s]: %s", f[i].src, silc_context_errmsg(c));
+        if (silc_get(c, &e, f[i].name) == 0) {
+            CHECK((int)e.format == f[i].format, "[%s] format %d, want %d", f[i].src, (int)e.format,
+                  f[i].format);
+            silc_envelope_free(&e);
+        }
+    }
+    silc_close(&c);
+}
+
+int main(void)
+{
+    size_t i;
+    for (i = 0; i < sizeof cases / sizeof cases[0]; i++) run_case(&cases[i]);
+    test_who();
+    test_info();
+    test_explain();
+    test_set();
+    test_atomicity();
+    test_cache();
+    test_clear();
+    test_rand_reproducible();
+    test_formats();
+    return check_done();
+}
