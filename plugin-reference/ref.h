@@ -1,0 +1,130 @@
+/*
+ * ref.h -- internal interface of the reference plugin (the oracle backend).
+ *
+ * The reference plugin implements every operation of silc_plugin.h in plain
+ * C11 with no external library.  Its modules share a few things declared here:
+ * the host table (every allocation, error and value goes through it), a
+ * compressed-column sparse matrix used by all sparse kernels, format
+ * conversions, and the "factorization" object every direct solver produces so
+ * the solve driver can attach it to A, reuse it, and estimate the condition
+ * number through it.
+ *
+ *   reference.c        tables, init, accepts predicates, shared helpers
+ *   ref_elementwise.c  ADD SCALE EWISE MAP TRANSPOSE CONVERT DIAG REDUCE
+ *   ref_matmul.c       MATMUL
+ *   ref_solve.c        SOLVE: algorithm choice, factor reuse, report
+ *   ref_dense.c        dense LU, Cholesky, triangular, Householder QR
+ *   ref_band.c         band LU with partial pivoting
+ *   ref_sparse.c       sparse triangular, Cholesky, LU
+ *   ref_order.c        approximate minimum degree ordering
+ *   ref_qr.c           sparse (Q-less) QR least squares
+ *   ref_cond.c         Hager/Higham 1-norm condition estimator
+ */
+#ifndef REF_H
+#define REF_H
+
+#include "silc_plugin.h"
+#include <stddef.h>
+#include <stdint.h>
+
+extern const silc_host_api *ref_host;
+
+/* Compressed-column sparse matrix (m x n).  A CSR value of A read without
+ * copying is the compressed-column form of A' (owned = 0). */
+typedef struct ref_sp {
+    int64_t m, n;
+    int64_t *p, *i; /* p[n+1], i[nnz] */
+    double *x;      /* may be NULL for a pattern */
+    int owned;
+} ref_sp;
+
+/* ---- reference.c: memory and conversions --------------------------------- */
+void *ref_alloc(size_t count, size_t size);   /* NULL on overflow or failure */
+void *ref_calloc(size_t count, size_t size);
+void ref_free(void *p);
+int ref_nomem(silc_call *call);               /* host->error(ENOMEM) */
+int ref_sp_alloc(ref_sp *A, int64_t m, int64_t n, int64_t nnz, int values);
+void ref_sp_free(ref_sp *A);
+int64_t ref_sp_nnz(const ref_sp *A);
+/* Compressed-column form of the matrix in v (any format; dense and band skip
+ * zeros, CSR keeps explicit zeros).  Always an owned copy. */
+int ref_sp_from_view(const silc_view *v, ref_sp *A);
+/* Compressed-column form of v' : borrowed from a CSR value, copied otherwise. */
+int ref_spt_from_view(const silc_view *v, ref_sp *At);
+int ref_sp_transpose(const ref_sp *A, ref_sp *T);
+/* Dense column-major copy of any format. */
+double *ref_dense_from_view(const silc_view *v);
+double ref_view_get(const silc_view *v, int64_t i, int64_t j);
+/* A CSR value from the compressed-column form of its transpose (rows of A). */
+silc_value *ref_value_from_rows(const ref_sp *R);
+silc_value *ref_value_from_dense(int64_t m, int64_t n, const double *x);
+
+/* ---- ref_elementwise.c, ref_matmul.c, ref_solve.c ------------------------ */
+int ref_op_add(silc_call *call);
+int ref_op_scale(silc_call *call);
+int ref_op_ewise(silc_call *call);
+int ref_op_map(silc_call *call);
+int ref_op_transpose(silc_call *call);
+int ref_op_convert(silc_call *call);
+int ref_op_diag(silc_call *call);
+int ref_op_reduce(silc_call *call);
+int ref_op_matmul(silc_call *call);
+int ref_op_solve(silc_call *call);
+double ref_nrm2(int64_t n, const double *x, int64_t inc); /* scaled 2-norm */
+
+/* ---- factorizations ------------------------------------------------------ */
+/* solve(): x holds b (length m) on entry and the solution (length n) on exit;
+ * its length is max(m, n).  trans = 1 solves with A' (square factors only; the
+ * condition estimator uses it).  Kernels report failures as a status plus a
+ * message written into msg. */
+typedef struct ref_factor {
+    int64_t m, n;
+    void *data;
+    int (*solve)(void *data, double *x, int trans, double *work);
+    void (*destroy)(void *data);
+    int64_t work_len;       /* doubles of scratch solve() needs */
+    double cond, rcond;     /* 1-norm estimate, computed once at factor time */
+    char method[64];
+    char note[256];
+} ref_factor;
+
+void ref_factor_free(void *f);  /* attachment destructor */
+
+/* ref_cond.c: estimate of ||M^{-1}||_1 for an n x n operator given by its
+ * inverse applied in place (trans selects M^{-T}).  Returns -1 on failure. */
+double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                         void *ctx, double *work);
+double ref_cond_from(double anorm, double inv_est); /* guards 0 and non-finite */
+
+/* ref_dense.c: factor an n x n (or m x n for QR) column-major matrix.  On
+ * failure return a SILC_E* status with the message in msg.  *F gets solve,
+ * destroy, method; the driver fills the condition estimate. */
+int ref_dense_lu(int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_chol(int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_tri(int64_t n, const double *A, int lower, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_qr(int64_t m, int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+/* ref_band.c: A given in any format; kl, ku its bandwidths. */
+int ref_band_lu(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, char *msg, size_t msglen);
+/* ref_sparse.c: A square, compressed column (owned copies are taken as needed). */
+int ref_sparse_tri(const ref_sp *A, int lower, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_chol(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_lu(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+/* Symbolic Cholesky of a symmetric pattern (upper part of C is used): the
+ * column pattern of L, rows ascending with the diagonal first. */
+int ref_symbolic_chol(const ref_sp *C, ref_sp *L);
+/* ref_qr.c: least squares / minimum norm for a sparse m x n A. */
+int ref_sparse_qr(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+
+/* ---- ref_order.c --------------------------------------------------------- */
+/* Approximate minimum degree order of the symmetric pattern S (both triangles,
+ * diagonal ignored): perm[k] = the k-th vertex eliminated. */
+int ref_amd(const ref_sp *S, int64_t *perm);
+/* Symmetric patterns (no diagonal, both triangles) of A + A' (A square) and of
+ * A'A; for ordering, skip_dense leaves out rows denser than 10 sqrt(n), which
+ * would make A'A full. */
+int ref_pattern_aplusat(const ref_sp *A, ref_sp *S);
+int ref_pattern_ata(const ref_sp *A, int skip_dense, ref_sp *S);
+/* Elimination tree of the upper part of symmetric C (parent[-1 = root]). */
+int ref_etree(const ref_sp *C, int64_t *parent);
+
+#endif
