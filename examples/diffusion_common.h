@@ -1,0 +1,44 @@
+/*
+ * diffusion_common.h -- the parts of the diffusion examples that the examples
+ * and their test share: assembly of the Crank-Nicolson matrices in C, the
+ * initial fields, and the PUT/EXEC/GET time loops.  Keeping them here means the
+ * test (tests/test_examples.c) checks exactly the code the examples run.
+ *
+ * The model problem is u_t = Laplacian(u) with zero Dirichlet boundary values on
+ * a uniform grid of n interior points per side (spacing h).  Crank-Nicolson
+ * advances u by solving (I - dt/2 L) u_new = (I + dt/2 L) u_old, with L the
+ * second-difference Laplacian (3-point in 1-D, 5-point in 2-D).
+ *
+ * Every function returns 0 on success; on failure the message is in
+ * silc_errmsg() (SILC failures) or names the problem on stderr (allocation).
+ * The run functions use the default context: call SILC_INIT() first.
+ */
+#ifndef DIFFUSION_COMMON_H
+#define DIFFUSION_COMMON_H
+
+#include <stdint.h>
+
+#include "silc.h"
+
+/* Builds the CSR matrix I + c*L for the Laplacian L in `dim` (1 or 2)
+ * dimensions on n points per side with spacing h; the unknown (i, j) is
+ * i + j*n.  With c = -dt/2 this is Crank-Nicolson's A, with c = +dt/2 its B. */
+int diff_shifted_laplacian(int dim, int64_t n, double h, double c, silc_envelope_t *out);
+
+/* Advances u (n^dim entries, in/out) by `steps` Crank-Nicolson steps of size dt
+ * inside SILC: the matrices are PUT once, u stays in SILC between steps, and is
+ * fetched once at the end. */
+int diff_run(int dim, int64_t n, int steps, double dt, double *u);
+
+/* 1-D problem on [0, pi]: u(x, 0) = sin x, exact solution e^{-t} sin x. */
+double diff1d_h(int64_t n);
+void diff1d_initial(int64_t n, double *u);
+double diff1d_max_error(int64_t n, double t, const double *u);
+
+/* 2-D problem on the unit square: 1 on the block (0.4, 0.6)^2, 0 elsewhere. */
+double diff2d_h(int64_t n);
+void diff2d_initial(int64_t n, double *u);
+/* Total heat sum(u) * h^2 (the midpoint rule for the integral of u). */
+double diff2d_heat(int64_t n, const double *u);
+
+#endif

@@ -1,0 +1,147 @@
+#!/bin/sh
+# test_cli.sh -- end-to-end tests of the silc command: -e, run, the REPL on a
+# pipe, --put/--get Matrix Market round trips (values compared numerically),
+# exit statuses and error text on stderr.
+#
+#     sh tests/test_cli.sh path/to/silc
+#
+# Prints "N passed, N failed" last, like the C tests, and exits 1 on a failure.
+SILC=${1:?usage: test_cli.sh path/to/silc}
+case $SILC in /*) ;; *) SILC=$(pwd)/$SILC ;; esac
+T=$(mktemp -d) || exit 1
+trap 'rm -rf "$T"' EXIT
+cd "$T" || exit 1   # no stray ./silc.conf from the caller's directory
+
+passed=0
+failed=0
+check() { # check DESCRIPTION COMMAND...: one test case
+    desc=$1
+    shift
+    if "$@"; then
+        passed=$((passed + 1))
+    else
+        failed=$((failed + 1))
+        echo "FAIL: $desc (status $st)" >&2
+        sed 's/^/  stdout: /' out >&2
+        sed 's/^/  stderr: /' err >&2
+    fi
+}
+run() { "$@" >out 2>err; st=$?; }         # stdout -> out, stderr -> err, status -> $st
+status_is() { [ "$st" -eq "$1" ]; }
+has() { grep -q -F -- "$2" "$1"; }        # has FILE TEXT
+starts() { head -n 1 "$1" | grep -q -F -x -- "$2"; }
+empty() { [ ! -s "$1" ]; }
+# values FILE: the data lines of Matrix Market files (after banner, comments, size)
+values() { awk '/^%%MatrixMarket/ { size = 0 } /^%/ { next } !size { size = 1; next } { print }' "$1"; }
+# same_numbers FILE "n1 n2 ...": the data lines of FILE are exactly these
+# numbers (compared as doubles, so 0.1 == 0.10000000000000001)
+same_numbers() {
+    values "$1" | awk -v want="$2" 'BEGIN { n = split(want, w, " ") }
+        { for (f = 1; f <= NF; f++) { k++; if (k > n || $f + 0 != w[k] + 0) bad = 1 } }
+        END { exit (bad || k != n) }'
+}
+
+# ---- -e and --get ----------------------------------------------------------------
+run "$SILC" -e 'x = 2 + 3' --get x
+check "-e exit status" status_is 0
+check "-e --get banner" starts out "%%MatrixMarket matrix array real general"
+check "-e --get value" same_numbers out "5"
+check "-e nothing on stderr" empty err
+
+run "$SILC" -e 'a = 1; b = 2' --get b --get a
+check "two --get in order" same_numbers out "2 1"
+
+run "$SILC" -e 'x = 1; who'
+check "who goes to stdout" has out "x"
+check "who: nothing on stderr" empty err
+
+# ---- --put / --get round trips ---------------------------------------------------
+cat >a.mtx <<'MTX'
+%%MatrixMarket matrix coordinate real general
+% a small sparse matrix with awkward values
+3 3 4
+1 1 0.1
+2 1 -2.5
+3 2 1e-300
+3 3 3.141592653589793
+MTX
+run "$SILC" --put A=a.mtx -e 'B = A' --get B
+check "sparse round trip status" status_is 0
+check "sparse comes back as coordinate" starts out "%%MatrixMarket matrix coordinate real general"
+check "sparse round trip values" same_numbers out "1 1 0.1  2 1 -2.5  3 2 1e-300  3 3 3.141592653589793"
+
+cat >d.mtx <<'MTX'
+%%MatrixMarket matrix array real general
+2 2
+1
+2
+3
+4.5
+MTX
+run "$SILC" --put=D=d.mtx -e 'E = 2 * D' --get=E
+check "dense put, compute, get" same_numbers out "2 4 6 9"
+
+# ---- run FILE: control flow across lines -------------------------------------------
+cat >loop.silc <<'SILC'
+# sum 1..5 with a loop
+i = 0
+s = 0
+while (i < 5) {
+  i = i + 1
+  s = s + i
+}
+SILC
+run "$SILC" run loop.silc --get s
+check "run FILE with while" same_numbers out "15"
+
+run "$SILC" run no-such-file.silc
+check "run missing file status" status_is 1
+check "run missing file message" has err "silc: cannot open 'no-such-file.silc'"
+
+# ---- the REPL on a pipe (no readline, no prompts) ------------------------------------
+printf 'a = (1 +\n2)\nb = a * 2\n' >in
+run "$SILC" --get b <in
+check "REPL continues unclosed brackets" same_numbers out "6"
+printf 'y = nosuch\nz = 7\nwho\n' >in
+run "$SILC" <in
+check "REPL goes on after an error" has out "z"
+check "REPL reports the error" has err "silc: "
+check "REPL on a pipe fails if a statement failed" status_is 1
+
+# ---- errors --------------------------------------------------------------------------
+run "$SILC" -e 'x = (1 + 2'
+check "syntax error status" status_is 1
+check "syntax error text" has err "expected ')'"
+check "syntax error prefix" grep -q '^silc: ' err
+check "syntax error: nothing on stdout" empty out
+
+run "$SILC" -e 'a = 1; b = u + 1' --get a
+check "undefined name status" status_is 1
+check "undefined name text" has err "undefined name 'u'"
+
+run "$SILC" -e 'x = 1' --get nosuch
+check "--get of an unknown name fails" status_is 1
+check "--get error names the option" has err "silc: --get nosuch"
+
+run "$SILC" --put A=missing.mtx -e 'x = 1'
+check "--put of a missing file fails" status_is 1
+check "--put error names the option" has err "silc: --put A=missing.mtx"
+
+# ---- usage -----------------------------------------------------------------------------
+run "$SILC" --bogus
+check "unknown option is a usage error" status_is 2
+check "unknown option message" has err "silc: unknown option '--bogus'"
+run "$SILC" --put nonsense
+check "--put without NAME=FILE" status_is 2
+run "$SILC" run
+check "run without a file" status_is 2
+run "$SILC" -e 'x = 1' run loop.silc
+check "-e and run together" status_is 2
+run "$SILC" --help
+check "--help status" status_is 0
+check "--help text" has out "usage: silc"
+run "$SILC" --version
+check "--version" grep -q '^silc [0-9]' out
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,378 @@
+/*
+ * silc.c -- the `silc` command: run a script, run statements given on the
+ * command line, or talk to SILC interactively.
+ *
+ *     silc [options] run FILE        the whole file is one silc_exec, so control
+ *                                    flow (if/while/break/continue) spans lines
+ *     silc [options] -e STATEMENTS
+ *     silc [options]                 REPL (readline line editing and history in
+ *                                    ~/.silc_history when stdin is a terminal)
+ *
+ * --put NAME=FILE.mtx loads Matrix Market files before running, --get NAME
+ * prints values in Matrix Market format afterwards, so the command composes with
+ * other tools through files and pipes.  Uses only the public API (silc.h), as
+ * any other client would.  Exit status: 0 success, 1 failure (message on stderr
+ * as "silc: ..."), 2 usage error.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifdef SILC_HAVE_READLINE
+#include <readline/history.h>
+#include <readline/readline.h>
+#endif
+
+#include "silc.h"
+
+static const char usage_text[] =
+    "usage: silc [options] run FILE      run a script (\"-\" reads standard input)\n"
+    "       silc [options] -e STATEMENTS run statements given as text\n"
+    "       silc [options]               interactive session\n"
+    "options:\n"
+    "  --put NAME=FILE.mtx  load a Matrix Market file as NAME before running (repeatable)\n"
+    "  --get NAME           after running, print NAME to standard output in Matrix\n"
+    "                       Market format (repeatable, in the order given)\n"
+    "  --config FILE        configuration file (default: $SILC_CONFIG, else ./silc.conf)\n"
+    "  -h, --help           show this text\n"
+    "  --version            show the version\n"
+    "In the interactive session a line that ends inside an unclosed ( [ or { continues\n"
+    "on the next line; 'quit', 'exit' or end of input leaves.  Warnings go to standard\n"
+    "error as \"warning: ...\"; who, info and explain print to standard output.\n";
+
+typedef struct {
+    const char *config;
+    const char *script;     /* run FILE */
+    const char *statements; /* -e */
+    const char **put_args;  /* NAME=FILE, as given */
+    int nput;
+    const char **get_names;
+    int nget;
+} cli_options;
+
+static void fail(const char *fmt, ...)
+{
+    va_list ap;
+    fflush(stdout); /* keep the order of output and messages on a terminal */
+    fputs("silc: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+/* Matches "--opt VALUE" and "--opt=VALUE"; advances *i past what it used.
+ * Returns 1 on a match with *value set (NULL if the value is missing). */
+static int take_option(int argc, char **argv, int *i, const char *opt, const char **value)
+{
+    size_t len = strlen(opt);
+    if (strncmp(argv[*i], opt, len)) return 0;
+    if (argv[*i][len] == '=') {
+        *value = argv[*i] + len + 1;
+        return 1;
+    }
+    if (argv[*i][len]) return 0;
+    *value = *i + 1 < argc ? argv[++*i] : NULL;
+    return 1;
+}
+
+/* Returns 0 to go on, 1 after printing --help/--version, 2 on a usage error. */
+static int parse_args(int argc, char **argv, cli_options *o)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage_text, stdout);
+            return 1;
+        } else if (!strcmp(a, "--version")) {
+            printf("silc %s\n", SILC_VERSION);
+            return 1;
+        } else if (take_option(argc, argv, &i, "--config", &v)) {
+            if (!v || !*v) return fail("--config needs a file name"), 2;
+            o->config = v;
+        } else if (take_option(argc, argv, &i, "--put", &v)) {
+            const char *eq = v ? strchr(v, '=') : NULL;
+            if (!eq || eq == v || !eq[1])
+                return fail("--put needs NAME=FILE.mtx, got '%s'", v ? v : ""), 2;
+            o->put_args[o->nput++] = v;
+        } else if (take_option(argc, argv, &i, "--get", &v)) {
+            if (!v || !*v) return fail("--get needs a name"), 2;
+            o->get_names[o->nget++] = v;
+        } else if (take_option(argc, argv, &i, "-e", &v)) {
+            if (!v) return fail("-e needs statements"), 2;
+            if (o->statements || o->script) return fail("give only one of 'run FILE' and -e"), 2;
+            o->statements = v;
+        } else if (!strcmp(a, "run")) {
+            if (i + 1 >= argc) return fail("run needs a file name"), 2;
+            if (o->statements || o->script) return fail("give only one of 'run FILE' and -e"), 2;
+            o->script = argv[++i];
+        } else {
+            fail("%s '%s' (see silc --help)", a[0] == '-' ? "unknown option" : "unknown command", a);
+            return 2;
+        }
+    }
+    return 0;
+}
+
+/* Reads a whole file ("-" = standard input) into a NUL-terminated buffer. */
+static char *read_file(const char *path)
+{
+    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
+    if (!f) {
+        fail("cannot open '%s': %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t len = 0, cap = 4096;
+    char *buf = malloc(cap);
+    while (buf) {
+        len += fread(buf + len, 1, cap - 1 - len, f);
+        if (len < cap - 1) break;
+        char *grown = realloc(buf, cap *= 2);
+        if (!grown) free(buf);
+        buf = grown;
+    }
+    int err = ferror(f);
+    if (f != stdin) fclose(f);
+    if (!buf || err) {
+        fail(buf ? "cannot read '%s'" : "out of memory reading '%s'", path);
+        free(buf);
+        return NULL;
+    }
+    buf[len] = '\0';
+    if (memchr(buf, '\0', len)) {
+        fail("'%s' is not a text file (it contains NUL bytes)", path);
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
+
+static void print_warnings(const silc_context *ctx)
+{
+    const char *w = silc_context_warnings(ctx);
+    fflush(stdout);
+    while (w && *w) {
+        size_t len = strcspn(w, "\n");
+        if (len) fprintf(stderr, "warning: %.*s\n", (int)len, w);
+        w += len + (w[len] == '\n');
+    }
+}
+
+/* Runs statements and reports warnings and any error; returns 0 on success. */
+static int run_text(silc_context *ctx, const char *text)
+{
+    int rc = silc_exec(ctx, text);
+    print_warnings(ctx);
+    if (rc) fail("%s", silc_context_errmsg(ctx));
+    return rc;
+}
+
+static int load_puts(silc_context *ctx, const cli_options *o)
+{
+    for (int k = 0; k < o->nput; k++) {
+        const char *eq = strchr(o->put_args[k], '=');
+        int namelen = (int)(eq - o->put_args[k]);
+        char *name = malloc((size_t)namelen + 1);
+        if (!name) return fail("out of memory"), 1;
+        memcpy(name, o->put_args[k], (size_t)namelen);
+        name[namelen] = '\0';
+        char err[512] = "";
+        silc_envelope_t e = {0};
+        int rc = silc_mm_read(&e, eq + 1, err, sizeof err);
+        if (rc)
+            fail("--put %s: %s", o->put_args[k], *err ? err : "cannot read the file");
+        else if ((rc = silc_put(ctx, name, &e)))
+            fail("--put %s: %s", o->put_args[k], silc_context_errmsg(ctx));
+        silc_envelope_free(&e);
+        free(name);
+        if (rc) return 1;
+    }
+    return 0;
+}
+
+static int print_gets(silc_context *ctx, const cli_options *o)
+{
+    for (int k = 0; k < o->nget; k++) {
+        silc_envelope_t e = {0};
+        if (silc_get(ctx, &e, o->get_names[k])) {
+            fail("--get %s: %s", o->get_names[k], silc_context_errmsg(ctx));
+            return 1;
+        }
+        int rc = silc_mm_write(&e, stdout);
+        silc_envelope_free(&e);
+        if (rc) return fail("--get %s: error writing standard output", o->get_names[k]), 1;
+    }
+    return 0;
+}
+
+/* ---- the interactive session ------------------------------------------------ */
+
+/* Net number of ( [ { left open in text, ignoring strings and comments: a line
+ * that ends with brackets open continues on the next. */
+static int open_brackets(const char *s)
+{
+    int depth = 0, in_string = 0;
+    for (; *s; s++) {
+        if (in_string) {
+            if (*s == '\\' && s[1] && s[1] != '\n') s++;
+            else if (*s == '"' || *s == '\n') in_string = 0;
+        } else if (*s == '"') {
+            in_string = 1;
+        } else if (*s == '#') {
+            s += strcspn(s, "\n");
+            if (!*s) break;
+        } else if (*s == '(' || *s == '[' || *s == '{') {
+            depth++;
+        } else if (*s == ')' || *s == ']' || *s == '}') {
+            depth--;
+        }
+    }
+    return depth;
+}
+
+static int is_command(const char *line, const char *word)
+{
+    line += strspn(line, " \t");
+    size_t len = strlen(word);
+    return !strncmp(line, word, len) && line[len + strspn(line + len, " \t;")] == '\0';
+}
+
+/* One line without its newline, malloc'd; NULL at end of input. */
+static char *read_line(int interactive, const char *prompt)
+{
+#ifdef SILC_HAVE_READLINE
+    if (interactive) return readline(prompt);
+#endif
+    if (interactive) {
+        fputs(prompt, stdout);
+        fflush(stdout);
+    }
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t len = getline(&line, &cap, stdin);
+    if (len < 0) {
+        free(line);
+        return NULL;
+    }
+    if (len > 0 && line[len - 1] == '\n') line[len - 1] = '\0';
+    return line;
+}
+
+#ifdef SILC_HAVE_READLINE
+static char *history_path(void)
+{
+    const char *home = getenv("HOME");
+    if (!home || !*home) return NULL;
+    size_t len = strlen(home) + sizeof "/.silc_history";
+    char *path = malloc(len);
+    if (path) snprintf(path, len, "%s/.silc_history", home);
+    return path;
+}
+#endif
+
+/* Statements are run as soon as their brackets close; a failing one is reported
+ * and the session goes on.  Returns 1 if input was not a terminal and some
+ * statement failed, so scripted sessions can be checked. */
+static int repl(silc_context *ctx)
+{
+    int interactive = isatty(STDIN_FILENO), failed = 0;
+    size_t len = 0, cap = 0;
+    char *buf = NULL;
+#ifdef SILC_HAVE_READLINE
+    char *hist = interactive ? history_path() : NULL;
+    if (interactive) {
+        using_history();
+        stifle_history(1000);
+        if (hist) read_history(hist); /* a missing file is a first session */
+    }
+#endif
+    if (interactive) printf("silc %s -- 'quit' or Ctrl-D to leave, silc --help for usage\n", SILC_VERSION);
+    for (;;) {
+        char *line = read_line(interactive, len ? "...> " : "silc> ");
+        if (!line) {
+            if (interactive) putchar('\n');
+            break;
+        }
+        if (!len && (is_command(line, "quit") || is_command(line, "exit"))) {
+            free(line);
+            break;
+        }
+#ifdef SILC_HAVE_READLINE
+        if (interactive && line[strspn(line, " \t")]) add_history(line);
+#endif
+        size_t add = strlen(line);
+        if (len + add + 2 > cap) {
+            size_t ncap = (len + add + 2) * 2;
+            char *grown = realloc(buf, ncap);
+            if (!grown) {
+                free(line);
+                fail("out of memory");
+                failed = 1;
+                break;
+            }
+            buf = grown, cap = ncap;
+        }
+        memcpy(buf + len, line, add);
+        len += add;
+        buf[len++] = '\n';
+        buf[len] = '\0';
+        free(line);
+        if (open_brackets(buf) > 0) continue;
+        if (buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
+        len = 0;
+    }
+    /* Input ended inside open brackets: run it anyway so the parser says what
+     * is unclosed. */
+    if (len && buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
+    free(buf);
+#ifdef SILC_HAVE_READLINE
+    if (hist) write_history(hist);
+    free(hist);
+#endif
+    return interactive ? 0 : failed;
+}
+
+int main(int argc, char **argv)
+{
+    cli_options o = {0};
+    o.put_args = calloc((size_t)argc, sizeof *o.put_args);
+    o.get_names = calloc((size_t)argc, sizeof *o.get_names);
+    if (!o.put_args || !o.get_names) {
+        fail("out of memory");
+        return 1;
+    }
+    int status = parse_args(argc, argv, &o);
+    if (status) {
+        free(o.put_args), free(o.get_names);
+        return status == 1 ? 0 : 2;
+    }
+
+    silc_context *ctx = NULL;
+    if (silc_open(&ctx, o.config)) {
+        fail("%s", ctx ? silc_context_errmsg(ctx) : silc_errmsg());
+        status = 1;
+    } else {
+        status = load_puts(ctx, &o);
+        if (!status && o.script) {
+            char *text = read_file(o.script);
+            status = !text || run_text(ctx, text);
+            free(text);
+        } else if (!status && o.statements) {
+            status = run_text(ctx, o.statements);
+        } else if (!status) {
+            status = repl(ctx);
+        }
+        if (!status) status = print_gets(ctx, &o);
+    }
+    silc_close(&ctx);
+    free(o.put_args), free(o.get_names);
+    if (fflush(stdout) || ferror(stdout)) {
+        fail("error writing standard output");
+        status = 1;
+    }
+    return status ? 1 : 0;
+}
