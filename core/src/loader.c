@@ -10,6 +10,12 @@
  * checked before the plugin is accepted (ABI major, index width, table size,
  * at least one operation) and a refused plugin is closed again, so nothing of
  * it stays in the process.
+ *
+ * An accepted plugin belongs to the process, not to the engine that loaded it:
+ * it is opened and initialised once, shared by every context, and shut down at
+ * exit, never dlclose'd.  Libraries behind plugins (MPI, PETSc, the Fortran
+ * runtime under MUMPS, OpenMP) keep process-wide state and are not safe to
+ * unload or to shut down while another context still uses them.
  */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "engine.h"
@@ -18,6 +24,7 @@
 #include <dlfcn.h>
 #include <errno.h>
 #include <limits.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,8 +37,16 @@ const char *const ld_known_backends[] = {
     "reference", "lapack", "suitesparse.umfpack", "suitesparse.cholmod", "suitesparse.klu",
     "suitesparse.spqr", "mumps", "petsc", "lis-style", "template", NULL};
 
+/* Every plugin the process has accepted, in load order. */
+static struct {
+    ld_plugin **items;
+    size_t n;
+    int exit_hook;
+} g_loaded;
+static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
+
 struct ld_set {
-    ld_plugin **plugins;        /* each allocated once: backends point into them */
+    ld_plugin **plugins;        /* borrowed from g_loaded: backends point into them */
     size_t nplugins;
     ld_backend **backends;
     size_t nbackends;
@@ -95,27 +110,69 @@ static int check_table(silc_engine *E, const silc_plugin *pl, const char *path)
     return 0;
 }
 
-/* Adds a checked plugin and its backends.  handle is dlclose'd by the caller
- * on failure. */
-static int add_plugin(silc_engine *E, const silc_plugin *pl, void *handle, const char *path)
+/* Shuts every plugin down at exit, last loaded first, like destructors. */
+static void shutdown_all(void)
 {
-    ld_set *S = E->plugins;
-    ld_plugin *p, **np;
-    ld_backend **nb;
-    int i, added = 0;
-    np = realloc(S->plugins, (S->nplugins + 1) * sizeof *np);
-    if (!np) return eng_error(E, "out of memory loading plugin %s", path);
-    S->plugins = np;
-    nb = realloc(S->backends, (S->nbackends + (size_t)pl->n_backends) * sizeof *nb);
-    if (!nb && pl->n_backends > 0) return eng_error(E, "out of memory loading plugin %s", path);
-    if (nb) S->backends = nb;
+    size_t i;
+    pthread_mutex_lock(&g_lock);
+    for (i = g_loaded.n; i-- > 0;) {
+        ld_plugin *p = g_loaded.items[i];
+        if (p->table->shutdown) p->table->shutdown();
+        free(p->path);
+        free(p);
+    }
+    free(g_loaded.items);
+    g_loaded.items = NULL;
+    g_loaded.n = 0;
+    pthread_mutex_unlock(&g_lock);
+}
+
+/* The process-wide entry of an accepted plugin (caller holds g_lock). */
+static ld_plugin *register_plugin(const silc_plugin *pl, void *handle, const char *path)
+{
+    ld_plugin *p, **np = realloc(g_loaded.items, (g_loaded.n + 1) * sizeof *np);
+    if (!np) return NULL;
+    g_loaded.items = np;
     p = calloc(1, sizeof *p);
     if (!p || !(p->path = util_strdup(path))) {
         free(p);
-        return eng_error(E, "out of memory loading plugin %s", path);
+        return NULL;
     }
     p->table = pl;
     p->handle = handle;
+    g_loaded.items[g_loaded.n++] = p;
+    if (!g_loaded.exit_hook) g_loaded.exit_hook = atexit(shutdown_all) == 0;
+    return p;
+}
+
+/* The accepted plugin loaded from this file or, for path NULL, the built-in
+ * one (caller holds g_lock). */
+static ld_plugin *registered(const char *path)
+{
+    size_t i;
+    for (i = 0; i < g_loaded.n; i++) {
+        ld_plugin *p = g_loaded.items[i];
+        char other[PATH_MAX];
+        if (!path ? !p->handle : p->handle && realpath(p->path, other) && strcmp(path, other) == 0)
+            return p;
+    }
+    return NULL;
+}
+
+/* Makes an accepted plugin and its backends usable by this engine. */
+static int add_plugin(silc_engine *E, ld_plugin *p)
+{
+    ld_set *S = E->plugins;
+    const silc_plugin *pl = p->table;
+    ld_plugin **np;
+    ld_backend **nb;
+    int i, added = 0;
+    np = realloc(S->plugins, (S->nplugins + 1) * sizeof *np);
+    if (!np) return eng_error(E, "out of memory loading plugin %s", p->path);
+    S->plugins = np;
+    nb = realloc(S->backends, (S->nbackends + (size_t)pl->n_backends) * sizeof *nb);
+    if (!nb && pl->n_backends > 0) return eng_error(E, "out of memory loading plugin %s", p->path);
+    if (nb) S->backends = nb;
     for (i = 0; i < pl->n_backends; i++) {
         ld_backend *b;
         if (!backend_has_ops(&pl->backends[i])) continue;
@@ -127,9 +184,7 @@ static int add_plugin(silc_engine *E, const silc_plugin *pl, void *handle, const
                 free(last->full_name);
                 free(last);
             }
-            free(p->path);
-            free(p);
-            return eng_error(E, "out of memory loading plugin %s", path);
+            return eng_error(E, "out of memory loading plugin %s", p->path);
         }
         b->backend = &pl->backends[i];
         b->plugin = p;
@@ -145,15 +200,27 @@ int ld_create(silc_engine *E)
 {
     const silc_plugin *pl = NULL;
     const char *msg = NULL;
+    ld_plugin *p;
     E->plugins = calloc(1, sizeof *E->plugins);
     if (!E->plugins) return eng_error(E, "out of memory creating the plugin set");
-    if (silc_reference_plugin_init(host_api(), &pl, &msg))
-        return eng_error(E, "built-in reference plugin failed to start: %s",
-                         msg ? msg : "no reason given");
-    if (check_table(E, pl, "built-in")) return -1;
-    return add_plugin(E, pl, NULL, "built-in");
+    pthread_mutex_lock(&g_lock);
+    p = registered(NULL);
+    if (!p) {
+        if (silc_reference_plugin_init(host_api(), &pl, &msg)) {
+            pthread_mutex_unlock(&g_lock);
+            return eng_error(E, "built-in reference plugin failed to start: %s",
+                             msg ? msg : "no reason given");
+        }
+        if (check_table(E, pl, "built-in") || !(p = register_plugin(pl, NULL, "built-in"))) {
+            pthread_mutex_unlock(&g_lock);
+            return E->err[0] ? -1 : eng_error(E, "out of memory registering the reference plugin");
+        }
+    }
+    pthread_mutex_unlock(&g_lock);
+    return add_plugin(E, p);
 }
 
+/* Frees this engine's view of the plugins; the plugins stay loaded (see top). */
 void ld_destroy(silc_engine *E)
 {
     ld_set *S;
@@ -164,45 +231,27 @@ void ld_destroy(silc_engine *E)
         free(S->backends[i]->full_name);
         free(S->backends[i]);
     }
-    /* Unload in reverse order of loading, like destructors. */
-    for (i = S->nplugins; i-- > 0;) {
-        ld_plugin *p = S->plugins[i];
-        if (p->table->shutdown) p->table->shutdown();
-        if (p->handle) dlclose(p->handle);
-        free(p->path);
-        free(p);
-    }
     free(S->plugins);
     free(S->backends);
     free(S);
     E->plugins = NULL;
 }
 
-int ld_load_file(silc_engine *E, const char *path)
+/* Opens, initialises and checks a plugin file not loaded before (caller holds
+ * g_lock); real is its canonical path. */
+static ld_plugin *open_plugin(silc_engine *E, const char *path, const char *real)
 {
     void *handle, *sym;
     silc_plugin_init_fn init;
     const silc_plugin *pl = NULL;
     const char *msg = NULL;
-    const ld_plugin *other;
-    char real[PATH_MAX];
-    size_t i;
-    if (!E || !E->plugins || !path) return -1;
-    /* The same file reached twice (a directory listed twice, a config naming
-     * the build directory again) is not a conflict. */
-    if (realpath(path, real)) {
-        for (i = 0; i < E->plugins->nplugins; i++) {
-            char other_real[PATH_MAX];
-            const ld_plugin *p = E->plugins->plugins[i];
-            if (p->handle && realpath(p->path, other_real) && strcmp(real, other_real) == 0)
-                return 0;
-        }
-    }
+    ld_plugin *p;
     dlerror();
     handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
         const char *why = dlerror();
-        return eng_error(E, "cannot load plugin %s: %s", path, why ? why : "dlopen failed");
+        eng_error(E, "cannot load plugin %s: %s", path, why ? why : "dlopen failed");
+        return NULL;
     }
     dlerror();
     sym = dlsym(handle, SILC_PLUGIN_INIT_SYMBOL);
@@ -211,7 +260,7 @@ int ld_load_file(silc_engine *E, const char *path)
         eng_error(E, "cannot load plugin %s: no %s symbol (%s)", path, SILC_PLUGIN_INIT_SYMBOL,
                   why ? why : "not exported");
         dlclose(handle);
-        return -1;
+        return NULL;
     }
     /* POSIX guarantees a dlsym'd function pointer round-trips through void *;
      * memcpy keeps -Wpedantic quiet about the object-to-function conversion. */
@@ -220,27 +269,48 @@ int ld_load_file(silc_engine *E, const char *path)
         eng_error(E, "cannot load plugin %s: %s failed: %s", path, SILC_PLUGIN_INIT_SYMBOL,
                   msg ? msg : "no reason given");
         dlclose(handle);
-        return -1;
+        return NULL;
     }
     if (check_table(E, pl, path)) {
         if (pl && pl->abi_major == SILC_ABI_MAJOR && pl->shutdown) pl->shutdown();
         dlclose(handle);
-        return -1;
+        return NULL;
     }
-    other = ld_find_plugin(E, pl->name);
-    if (other) {
-        eng_error(E, "plugin '%s' (%s) not loaded: a plugin of that name is already loaded from %s",
-                  pl->name, path, other->path);
+    if (!(p = register_plugin(pl, handle, real))) {
+        eng_error(E, "out of memory loading plugin %s", path);
         if (pl->shutdown) pl->shutdown();
         dlclose(handle);
-        return -1;
     }
-    if (add_plugin(E, pl, handle, path)) {
-        if (pl->shutdown) pl->shutdown();
-        dlclose(handle);
-        return -1;
+    return p;
+}
+
+int ld_load_file(silc_engine *E, const char *path)
+{
+    ld_plugin *p;
+    const ld_plugin *other;
+    char real[PATH_MAX];
+    size_t i;
+    if (!E || !E->plugins || !path) return -1;
+    if (!realpath(path, real))
+        return eng_error(E, "cannot load plugin %s: %s", path, strerror(errno));
+    /* The same file reached twice (a directory listed twice, a config naming
+     * the build directory again) is not a conflict. */
+    for (i = 0; i < E->plugins->nplugins; i++) {
+        char other_real[PATH_MAX];
+        const ld_plugin *q = E->plugins->plugins[i];
+        if (q->handle && realpath(q->path, other_real) && strcmp(real, other_real) == 0) return 0;
     }
-    return 0;
+    pthread_mutex_lock(&g_lock);
+    p = registered(real);
+    if (!p) p = open_plugin(E, path, real);
+    pthread_mutex_unlock(&g_lock);
+    if (!p) return -1;
+    other = ld_find_plugin(E, p->table->name);
+    if (other)
+        return eng_error(E,
+                         "plugin '%s' (%s) not loaded: a plugin of that name is already loaded from %s",
+                         p->table->name, path, other->path);
+    return add_plugin(E, p);
 }
 
 static int plugin_file_name(const char *name)
