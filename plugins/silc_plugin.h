@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 0
+#define SILC_ABI_MINOR 1
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -231,6 +231,15 @@ typedef struct silc_host_api {
 
     double (*now)(void);        /* monotonic seconds */
     int (*threads)(void);       /* thread budget the tuner grants right now */
+
+    /* ABI 1.1: Hager-Higham estimate of ||A^{-1}||_1 (LAPACK dlacon's method)
+     * for a backend whose library gives no condition estimate or only a crude
+     * one: apply(ctx, x, trans, work) overwrites x (length n) with A^{-1} x, or
+     * A^{-T} x when trans is 1, using the backend's factorization; work is
+     * passed through.  A handful of solves; returns -1 if a solve failed.
+     * cond_1(A) ~ props(A)->norm1 * estimate. */
+    double (*inv_norm1_est)(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                            void *ctx, double *work);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

@@ -184,6 +184,12 @@ static int h_attach_set(const silc_value *v, const char *key, void *data, void (
     return val_attach_set(v, key, data, destroy);
 }
 
+/* The estimator lives in the built-in reference plugin (plugin-reference/
+ * ref_cond.c); lending it through the host keeps one implementation for every
+ * backend that needs it. */
+extern double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                                void *ctx, double *work);
+
 static const silc_host_api host_table = {
     SILC_ABI_MAJOR,
     SILC_ABI_MINOR,
@@ -210,6 +216,7 @@ static const silc_host_api host_table = {
     h_attach_set,
     util_now,
     h_threads,
+    ref_inv_norm1_est,
 };
 
 const silc_host_api *host_api(void)
