@@ -1,0 +1,395 @@
+/*
+ * lapack.c -- the lapack plugin: dense and band operations on OpenBLAS + LAPACKE.
+ *
+ * One backend, "lapack", with two operations:
+ *   MATMUL  dense * dense by cblas_dgemm (cblas_dgemv when one side is a vector);
+ *   SOLVE   the solve classes the dispatcher sends it, each mapped to the
+ *           LAPACK driver users would pick by hand:
+ *             solve.dense        dgetrf (dsytrf when A is symmetric: the
+ *                                dispatcher sends a symmetric A here when its
+ *                                diagonal is not positive or Cholesky failed)
+ *             solve.dense.spd    dpotrf, SILC_ENOTSPD when it fails
+ *             solve.triangular   dtrtrs
+ *             solve.band         dgbtrf / dpbtrf / dgttrf / dpttrf (lapack_band.c)
+ *             solve.rect         QR / LQ as dgels, dgelsy when rank deficient
+ *           solve.diag and the sparse classes are left to other backends.
+ *
+ * The factorization is attached to A ("lapack.<kind>"), so repeated solves
+ * with an unchanged A factor once.  The thread count is OpenBLAS's.
+ */
+#include "lapack.h"
+
+#include <cblas.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+const silc_host_api *lp_host;
+
+/* ---- memory and small helpers ---------------------------------------------- */
+
+void *lp_alloc(size_t count, size_t size)
+{
+    if (count == 0 || size == 0) return lp_host->alloc(1);
+    if (count > SIZE_MAX / size) return NULL;
+    return lp_host->alloc(count * size);
+}
+
+void lp_free(void *p)
+{
+    if (p) lp_host->free(p);
+}
+
+lp_factor *lp_factor_new(int kind, lapack_int m, lapack_int n)
+{
+    lp_factor *F = lp_host->calloc(1, sizeof *F);
+    if (!F) return NULL;
+    F->kind = kind;
+    F->m = m;
+    F->n = n;
+    F->rcond = -1;
+    return F;
+}
+
+void lp_factor_free(void *p)
+{
+    lp_factor *F = p;
+    if (!F) return;
+    lp_free(F->a);
+    lp_free(F->tau);
+    lp_free(F->ipiv);
+    lp_free(F);
+}
+
+int lp_nomem(silc_call *call)
+{
+    return lp_host->error(call, SILC_ENOMEM, "lapack: out of memory");
+}
+
+int lp_illegal(silc_call *call, const char *fn, lapack_int info)
+{
+    return lp_host->error(call, SILC_ELIB, "%s: illegal argument %d (status %d)", fn, (int)-info, (int)info);
+}
+
+double lp_get(const silc_view *A, int64_t i, int64_t j)
+{
+    if (A->format == SILC_FMT_DENSE) return A->val[i + j * A->m];
+    if (i - j > A->kl || j - i > A->ku) return 0.0;
+    return A->val[(A->ku + i - j) + j * A->ld];
+}
+
+static int is_class(const silc_call *call, const char *cls)
+{
+    return call->op_class && strcmp(call->op_class, cls) == 0;
+}
+
+static int spd_class(const silc_call *call)
+{
+    size_t n = call->op_class ? strlen(call->op_class) : 0;
+    return n >= 4 && strcmp(call->op_class + n - 4, ".spd") == 0;
+}
+
+static int fits(int64_t k)
+{
+    return k >= 0 && k <= INT_MAX;
+}
+
+/* ---- accepts ------------------------------------------------------------------- */
+
+static int accepts_matmul(const silc_call *call, const char **why)
+{
+    silc_view a, b;
+    lp_host->view(call->in[0], &a);
+    lp_host->view(call->in[1], &b);
+    if (a.format != SILC_FMT_DENSE || b.format != SILC_FMT_DENSE) {
+        *why = "needs dense operands";
+        return 0;
+    }
+    if (!fits(a.m) || !fits(a.n) || !fits(b.n)) {
+        *why = "dimensions exceed 32-bit BLAS indices";
+        return 0;
+    }
+    return 1;
+}
+
+static int accepts_solve(const silc_call *call, const char **why)
+{
+    silc_view a, b;
+    const silc_props *P;
+    if (call->nin < 2) {
+        *why = "needs a right-hand side";
+        return 0;
+    }
+    lp_host->view(call->in[0], &a);
+    lp_host->view(call->in[1], &b);
+    if (a.format != SILC_FMT_DENSE && a.format != SILC_FMT_BAND) {
+        *why = "needs dense or band storage";
+        return 0;
+    }
+    if (!fits(a.m) || !fits(a.n) || !fits(b.n)) {
+        *why = "dimensions exceed 32-bit LAPACK indices";
+        return 0;
+    }
+    if (is_class(call, "solve.diag")) {
+        *why = "solve.diag is not provided";
+        return 0;
+    }
+    if (a.format == SILC_FMT_BAND && call->op_class && !is_class(call, "solve.band")) {
+        *why = "band storage is solved under solve.band only";
+        return 0;
+    }
+    P = lp_host->props(call->in[0]);
+    if (P->has_nonfinite) {
+        *why = "matrix has NaN or Inf entries";
+        return 0;
+    }
+    if (a.m != a.n && call->op_class && !is_class(call, "solve.rect")) {
+        *why = "needs a square matrix";
+        return 0;
+    }
+    if (is_class(call, "solve.triangular") && !P->lower && !P->upper) {
+        *why = "needs a triangular matrix";
+        return 0;
+    }
+    if (spd_class(call) && !P->symmetric) {
+        *why = "needs a symmetric matrix";
+        return 0;
+    }
+    return 1;
+}
+
+/* ---- MATMUL -------------------------------------------------------------------- */
+
+static int op_matmul(silc_call *call)
+{
+    silc_view a, b, c;
+    silc_value *out;
+    int m, k, n;
+    lp_host->view(call->in[0], &a);
+    lp_host->view(call->in[1], &b);
+    if (a.format != SILC_FMT_DENSE || b.format != SILC_FMT_DENSE)
+        return lp_host->error(call, SILC_EDECLINE, "lapack: needs dense operands");
+    if (a.n != b.m)
+        return lp_host->error(call, SILC_EARG, "lapack: inner dimensions differ (%lldx%lld * %lldx%lld)",
+                              (long long)a.m, (long long)a.n, (long long)b.m, (long long)b.n);
+    m = (int)a.m;
+    k = (int)a.n;
+    n = (int)b.n;
+    out = lp_host->dense_new(m, n);
+    if (!out) return lp_nomem(call);
+    lp_host->view(out, &c);
+    /* Empty inner dimension: the zero-filled result is already right, and BLAS
+     * would reject the leading dimensions of empty arrays. */
+    if (m > 0 && n > 0 && k > 0) {
+        if (n == 1)
+            cblas_dgemv(CblasColMajor, CblasNoTrans, m, k, 1.0, a.val, m, b.val, 1, 0.0, c.val, 1);
+        else if (m == 1) /* row vector times matrix: c' = B' a' */
+            cblas_dgemv(CblasColMajor, CblasTrans, k, n, 1.0, b.val, k, a.val, 1, 0.0, c.val, 1);
+        else
+            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, m, n, k, 1.0, a.val, m, b.val, k, 0.0,
+                        c.val, m);
+    }
+    call->out = out;
+    return SILC_OK;
+}
+
+/* ---- SOLVE --------------------------------------------------------------------- */
+
+enum lp_route { R_LU, R_CHOL, R_LDLT, R_TRI, R_BAND, R_RECT };
+static const char *const route_key[] = {"lapack.lu", "lapack.chol", "lapack.ldlt",
+                                        "lapack.tri", "lapack.band", "lapack.qr"};
+
+/* Which LAPACK path serves this call.  Without a class (a direct call) the
+ * structure decides, as the dispatcher would. */
+static int route_of(const silc_call *call, const silc_view *A, const silc_props *P)
+{
+    if (A->m != A->n) return R_RECT;
+    if (A->format == SILC_FMT_BAND || is_class(call, "solve.band")) return R_BAND;
+    if (is_class(call, "solve.triangular") || (!call->op_class && (P->lower || P->upper))) return R_TRI;
+    if (spd_class(call)) return R_CHOL;
+    return P->symmetric ? R_LDLT : R_LU;
+}
+
+static int factor(silc_call *call, int route, const silc_view *A, const silc_props *P, double rank_tol,
+                  lp_factor **F)
+{
+    switch (route) {
+    case R_LU: return lp_dense_lu(call, A, P->norm1, F);
+    case R_CHOL: return lp_dense_chol(call, A, P->norm1, F);
+    case R_LDLT: return lp_dense_ldlt(call, A, P->norm1, F);
+    case R_TRI: return lp_dense_tri(call, A, P->lower ? 'L' : 'U', F);
+    case R_BAND: return lp_band(call, A, P->kl, P->ku, P->symmetric && P->pos_diag, P->norm1, F);
+    default: return lp_dense_qr(call, A, rank_tol, F);
+    }
+}
+
+/* Copies the m x k right-hand side b (any format) into X with leading dimension ldx. */
+static void rhs_copy(const silc_view *b, double *X, int64_t ldx)
+{
+    int64_t i, j, p;
+    if (b->format == SILC_FMT_CSR) {
+        for (j = 0; j < b->n; j++) memset(X + j * ldx, 0, (size_t)b->m * sizeof(double));
+        for (i = 0; i < b->m; i++)
+            for (p = b->rowptr[i]; p < b->rowptr[i + 1]; p++) X[i + b->colind[p] * ldx] += b->val[p];
+    } else if (b->format == SILC_FMT_BAND) {
+        for (j = 0; j < b->n; j++)
+            for (i = 0; i < b->m; i++) X[i + j * ldx] = lp_get(b, i, j);
+    } else {
+        for (j = 0; j < b->n; j++) memcpy(X + j * ldx, b->val + j * b->m, (size_t)b->m * sizeof(double));
+    }
+}
+
+static void fill_report(silc_report *r, const lp_factor *F)
+{
+    snprintf(r->method, sizeof r->method, "%s", F->method);
+    if (F->rcond > 0) {
+        r->rcond = F->rcond;
+        r->cond_est = 1.0 / F->rcond;
+    } else if (F->rcond == 0) {
+        r->rcond = 0;
+        r->cond_est = INFINITY;
+    }
+    snprintf(r->note, sizeof r->note, "%s", F->note);
+}
+
+static int op_solve(silc_call *call)
+{
+    silc_view A, B, X;
+    const silc_props *P;
+    lp_factor *F, *owned = NULL;
+    silc_value *out;
+    double rank_tol = 0, t0, t1, *work;
+    int64_t ldw;
+    int route, rc, fresh = 0;
+    lp_host->view(call->in[0], &A);
+    lp_host->view(call->in[1], &B);
+    if (A.format != SILC_FMT_DENSE && A.format != SILC_FMT_BAND)
+        return lp_host->error(call, SILC_EDECLINE, "lapack: needs dense or band storage");
+    if (A.m != A.n && A.format != SILC_FMT_DENSE)
+        return lp_host->error(call, SILC_EDECLINE, "lapack: least squares needs dense storage");
+    if (B.m != A.m)
+        return lp_host->error(call, SILC_EARG, "lapack: A is %lldx%lld but b has %lld rows",
+                              (long long)A.m, (long long)A.n, (long long)B.m);
+    if (A.m == 0 || A.n == 0 || B.n == 0) { /* nothing to factor: the zero-filled x is the answer */
+        if (!(call->out = lp_host->dense_new(A.n, B.n))) return lp_nomem(call);
+        snprintf(call->report->method, sizeof call->report->method, "empty system");
+        return SILC_OK;
+    }
+    P = lp_host->props(call->in[0]);
+    route = route_of(call, &A, P);
+    if (route == R_RECT) {
+        if ((rc = lp_host->option_double(call, "rank_tol", 0.0, &rank_tol))) return rc;
+        if (!(rank_tol > 0)) rank_tol = (double)(A.m > A.n ? A.m : A.n) * DBL_EPSILON;
+    }
+
+    t0 = lp_host->now();
+    F = lp_host->attach_get(call->in[0], route_key[route]);
+    /* A least-squares factor made with another rank threshold is redone. */
+    if (F && route == R_RECT && F->rank_tol != rank_tol) F = NULL;
+    if (F && route == R_CHOL && F->bad > 0)
+        return lp_host->error(call, SILC_ENOTSPD,
+                              "dpotrf: matrix is not positive definite (leading minor %d, found by an "
+                              "earlier solve)", (int)F->bad);
+    if (!F) {
+        rc = factor(call, route, &A, P, rank_tol, &F);
+        if (rc != SILC_OK && !(rc == SILC_ENOTSPD && F)) return rc;
+        if (lp_host->attach_set(call->in[0], route_key[route], F, lp_factor_free)) owned = F;
+        if (rc != SILC_OK) { /* the failed Cholesky is remembered as an attachment */
+            lp_factor_free(owned);
+            return rc;
+        }
+        fresh = 1;
+    }
+    t1 = lp_host->now();
+
+    out = lp_host->dense_new(A.n, B.n);
+    if (!out) {
+        lp_factor_free(owned);
+        return lp_nomem(call);
+    }
+    lp_host->view(out, &X);
+    /* Square systems are solved in place in the result; least squares needs
+     * max(m, n) rows of room. */
+    ldw = A.m > A.n ? A.m : A.n;
+    work = A.m == A.n ? X.val : lp_host->calloc((size_t)ldw * (size_t)B.n, sizeof(double));
+    if (!work) {
+        lp_host->release(out);
+        lp_factor_free(owned);
+        return lp_nomem(call);
+    }
+    rhs_copy(&B, work, ldw);
+    if (route == R_BAND) rc = lp_band_solve(call, F, work, (lapack_int)ldw, (lapack_int)B.n);
+    else rc = lp_dense_solve(call, F, &A, work, (lapack_int)ldw, (lapack_int)B.n);
+    if (rc == SILC_OK && work != X.val) {
+        int64_t j;
+        for (j = 0; j < B.n; j++) memcpy(X.val + j * A.n, work + j * ldw, (size_t)A.n * sizeof(double));
+    }
+    if (work != X.val) lp_free(work);
+    if (rc != SILC_OK) {
+        lp_host->release(out);
+        lp_factor_free(owned);
+        return rc;
+    }
+    fill_report(call->report, F);
+    call->report->reused_factor = !fresh && F->kind != LP_TRI && F->kind != LP_LSY;
+    call->report->factor_seconds = fresh ? t1 - t0 : 0.0;
+    call->report->solve_seconds = lp_host->now() - t1;
+    lp_factor_free(owned);
+    call->out = out;
+    return SILC_OK;
+}
+
+/* ---- tables and init ----------------------------------------------------------- */
+
+static void set_threads(int nthreads)
+{
+    openblas_set_num_threads(nthreads > 0 ? nthreads : 1);
+}
+
+static const silc_op_entry lp_ops[SILC_OP_COUNT] = {
+    [SILC_OP_MATMUL] = {op_matmul, accepts_matmul},
+    [SILC_OP_SOLVE] = {op_solve, accepts_solve},
+};
+
+static const silc_backend lp_backends[1] = {
+    {NULL, "OpenBLAS + LAPACKE: dense products; dense, SPD, symmetric indefinite, triangular, "
+           "band, tridiagonal and least-squares solves",
+     SILC_OP_COUNT, lp_ops}};
+
+static const silc_option_spec lp_options[] = {
+    {"rank_tol", SILC_OPT_DOUBLE, "0",
+     "least squares: rcond below which A counts as rank deficient and dgelsy is used "
+     "(0 = max(m,n) * eps)"},
+};
+
+static char lp_version[192];
+
+static silc_plugin lp_plugin = {
+    SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
+    "lapack", lp_version, 1, lp_backends,
+    (int)(sizeof lp_options / sizeof lp_options[0]), lp_options,
+    set_threads, NULL};
+
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
+                                        const char **errmsg);
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
+                                        const char **errmsg)
+{
+    const char *config;
+    if (!host || !out) {
+        if (errmsg) *errmsg = "lapack: no host table";
+        return 1;
+    }
+    if (host->abi_major != SILC_ABI_MAJOR || host->index_bytes != (int)sizeof(silc_index) ||
+        host->struct_size < offsetof(silc_host_api, threads) + sizeof(host->threads)) {
+        if (errmsg) *errmsg = "lapack: host ABI does not match the one this plugin was built for";
+        return 1;
+    }
+    lp_host = host;
+    config = openblas_get_config();
+    snprintf(lp_version, sizeof lp_version, "1.0 %s", config ? config : "OpenBLAS (unknown version)");
+    *out = &lp_plugin;
+    return 0;
+}

@@ -1,0 +1,660 @@
+/*
+ * test_plugin_lapack.c -- the lapack backend (OpenBLAS + LAPACKE) against exact
+ * solutions and against the reference backend.
+ *
+ * Two contexts are opened: L sends every solve class it serves, and dense
+ * products, to "lapack"; R sends them to "reference".  Generated systems have
+ * exact solutions x = 1..n (b = A x computed here): general dense (dgetrf),
+ * SPD A = M'M + nI (dpotrf), symmetric indefinite with negative and with
+ * positive diagonal (dsytrf, the second after Cholesky fails), triangular
+ * (dtrtrs), band, SPD band, tridiagonal (dgbtrf, dpbtrf, dgttrf, dpttrf),
+ * tall least squares against the normal-equation solution computed here,
+ * wide minimum-norm against A'(AA')^{-1}b, and a rank-deficient tall system
+ * (dgelsy).  The forward error must be below 10 n eps cond, with cond the
+ * backend's own 1-norm estimate, and `info` must name lapack and the LAPACK
+ * routine.  A second solve with the same A must reuse the factorization; an
+ * exactly singular matrix must fail with a message naming dgetrf; a CSR
+ * matrix must be declined.  Then every real matrix of ../shared/matrices with
+ * at most 2000 rows, converted with A = dense(A), is solved by both backends,
+ * which must agree within the same condition-scaled bound (singular ones must
+ * fail or warn); the timings of both are printed.
+ */
+#include <ctype.h>
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "silc.h"
+
+#ifndef SILC_SHARED_MATRICES
+#define SILC_SHARED_MATRICES "../shared/matrices"
+#endif
+
+static const char *const classes[] = {"solve.dense", "solve.dense.spd", "solve.triangular",
+                                      "solve.band", "solve.rect", "matmul.dense"};
+
+/* ---- output capture and helpers ------------------------------------------------ */
+
+static char out_buf[16384];
+
+static void capture(void *user, const char *text)
+{
+    size_t have = strlen(out_buf);
+    (void)user;
+    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
+}
+
+static silc_context *open_ctx(const char *backend)
+{
+    silc_context *c = NULL;
+    char cmd[128];
+    if (silc_open(&c, NULL)) {
+        fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
+        return NULL;
+    }
+    silc_set_output(c, capture, NULL);
+    for (size_t i = 0; i < sizeof classes / sizeof classes[0]; i++) {
+        snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", classes[i], backend);
+        CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
+    }
+    return c;
+}
+
+static int contains(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; hay && *hay; hay++) {
+        size_t i = 0;
+        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i])) i++;
+        if (i == n) return 1;
+    }
+    return 0;
+}
+
+/* Runs `info name` (or any statement) and returns its output. */
+static const char *run_out(silc_context *c, const char *stmt)
+{
+    out_buf[0] = '\0';
+    if (silc_exec(c, stmt)) snprintf(out_buf, sizeof out_buf, "error: %s", silc_context_errmsg(c));
+    return out_buf;
+}
+
+static const char *info(silc_context *c, const char *name)
+{
+    char cmd[64];
+    snprintf(cmd, sizeof cmd, "info %s", name);
+    return run_out(c, cmd);
+}
+
+/* The "condition estimate: X" of an info text, -1 if absent. */
+static double info_cond(const char *text)
+{
+    const char *p = strstr(text, "condition estimate: ");
+    if (!p || strncmp(p + 20, "not", 3) == 0) return -1;
+    return strtod(p + 20, NULL);
+}
+
+static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *a)
+{
+    silc_envelope_t e;
+    CHECK(silc_envelope_dense(&e, m, n, a) == 0, "envelope %s", name);
+    CHECK(silc_put(c, name, &e) == 0, "put %s: %s", name, silc_context_errmsg(c));
+    silc_envelope_free(&e);
+}
+
+/* Fetches an m x n value into a new array (NULL on failure). */
+static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
+{
+    silc_envelope_t e;
+    double *x;
+    memset(&e, 0, sizeof e);
+    if (silc_get(c, &e, name)) {
+        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
+        return NULL;
+    }
+    if (e.m != m || e.n != n) {
+        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
+              (long long)m, (long long)n);
+        silc_envelope_free(&e);
+        return NULL;
+    }
+    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof(double));
+    if (x) silc_envelope_to_dense(&e, x);
+    silc_envelope_free(&e);
+    return x;
+}
+
+static double rel_err(const double *x, const double *y, int64_t n)
+{
+    double d = 0, s = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (fabs(x[i] - y[i]) > d) d = fabs(x[i] - y[i]);
+        if (fabs(y[i]) > s) s = fabs(y[i]);
+    }
+    return s > 0 ? d / s : d;
+}
+
+/* Forward-error bound: 10 n eps cond (cond >= 1). */
+static double bound(int64_t n, double cond)
+{
+    return 10.0 * (double)n * DBL_EPSILON * (cond > 1 ? cond : 1);
+}
+
+static unsigned long long rng_state = 12345;
+static double urand(void) /* uniform in [-1, 1) */
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(rng_state >> 11) / 4503599627370496.0 - 1.0;
+}
+
+static void matvec(int64_t m, int64_t n, const double *A, const double *x, double *y)
+{
+    for (int64_t i = 0; i < m; i++) y[i] = 0;
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = 0; i < m; i++) y[i] += A[i + j * m] * x[j];
+}
+
+/* Solves the n x n system G y = r in place (partial pivoting; test-side truth). */
+static void gauss(int64_t n, double *G, double *r)
+{
+    for (int64_t k = 0; k < n; k++) {
+        int64_t p = k;
+        for (int64_t i = k + 1; i < n; i++)
+            if (fabs(G[i + k * n]) > fabs(G[p + k * n])) p = i;
+        for (int64_t j = 0; j < n; j++) {
+            double t = G[k + j * n];
+            G[k + j * n] = G[p + j * n];
+            G[p + j * n] = t;
+        }
+        double t = r[k];
+        r[k] = r[p];
+        r[p] = t;
+        for (int64_t i = k + 1; i < n; i++) {
+            double l = G[i + k * n] / G[k + k * n];
+            for (int64_t j = k; j < n; j++) G[i + j * n] -= l * G[k + j * n];
+            r[i] -= l * r[k];
+        }
+    }
+    for (int64_t k = n - 1; k >= 0; k--) {
+        for (int64_t j = k + 1; j < n; j++) r[k] -= G[k + j * n] * r[j];
+        r[k] /= G[k + k * n];
+    }
+}
+
+/* ---- square systems with x = 1..n ------------------------------------------------ */
+
+/* PUTs A (dense n x n) and b = A (1..n) in both contexts, solves, checks the
+ * result against the exact solution and the reference, `info` naming lapack
+ * and routine, and factor reuse on a second solve. */
+static void check_square(silc_context *L, silc_context *R, const char *label, int64_t n, const double *A,
+                         const char *routine)
+{
+    double *xt = malloc((size_t)n * sizeof(double)), *b = malloc((size_t)n * sizeof(double));
+    double *xl, *xr, cond;
+    const char *text;
+    if (!xt || !b) {
+        free(xt);
+        free(b);
+        CHECK(0, "out of memory");
+        return;
+    }
+    for (int64_t i = 0; i < n; i++) xt[i] = (double)(i + 1);
+    matvec(n, n, A, xt, b);
+    put_dense(L, "A", n, n, A);
+    put_dense(L, "b", n, 1, b);
+    put_dense(R, "A", n, n, A);
+    put_dense(R, "b", n, 1, b);
+    CHECK(silc_exec(L, "x = A \\ b") == 0, "%s: lapack solve: %s", label, silc_context_errmsg(L));
+    CHECK(silc_exec(R, "x = A \\ b") == 0, "%s: reference solve: %s", label, silc_context_errmsg(R));
+    text = info(L, "x");
+    CHECK(contains(text, "backend: lapack"), "%s: info does not name lapack:\n%s", label, text);
+    CHECK(contains(text, routine), "%s: info does not name %s:\n%s", label, routine, text);
+    cond = info_cond(text);
+    CHECK(cond >= 1, "%s: no condition estimate (%g)", label, cond);
+    xl = get_dense(L, "x", n, 1);
+    xr = get_dense(R, "x", n, 1);
+    if (xl && xr) {
+        CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g (cond %.3g)", label,
+              rel_err(xl, xt, n), bound(n, cond), cond);
+        CHECK(rel_err(xl, xr, n) <= bound(n, cond), "%s: lapack and reference differ by %.3g > %.3g",
+              label, rel_err(xl, xr, n), bound(n, cond));
+    }
+    free(xl);
+    free(xr);
+    /* The same A again: the attached factorization is reused. */
+    CHECK(silc_exec(L, "y = A \\ (2 * b)") == 0, "%s: second solve: %s", label, silc_context_errmsg(L));
+    text = info(L, "y");
+    CHECK(contains(text, "reused factorization: yes") || contains(routine, "dtrtrs"),
+          "%s: second solve did not reuse the factorization:\n%s", label, text);
+    free(xt);
+    free(b);
+}
+
+static double *random_matrix(int64_t m, int64_t n)
+{
+    double *A = malloc((size_t)(m * n) * sizeof(double));
+    if (A)
+        for (int64_t k = 0; k < m * n; k++) A[k] = urand();
+    return A;
+}
+
+static void test_dense(silc_context *L, silc_context *R)
+{
+    const int64_t n = 120;
+    double *A = random_matrix(n, n), *M = random_matrix(n, n), *S = malloc((size_t)(n * n) * sizeof(double));
+    if (!A || !M || !S) {
+        CHECK(0, "out of memory");
+        free(A);
+        free(M);
+        free(S);
+        return;
+    }
+    for (int64_t i = 0; i < n; i++) A[i + i * n] += 10.0; /* well conditioned */
+    check_square(L, R, "general dense", n, A, "dgetrf");
+
+    /* SPD: S = M'M + n I. */
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t j = 0; j < n; j++) {
+            double s = i == j ? (double)n : 0.0;
+            for (int64_t k = 0; k < n; k++) s += M[k + i * n] * M[k + j * n];
+            S[i + j * n] = s;
+        }
+    check_square(L, R, "SPD dense", n, S, "dpotrf");
+
+    /* Symmetric indefinite with a negative diagonal: straight to solve.dense. */
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = j; i < n; i++) {
+            double s = i == j ? ((i % 2) ? -12.0 : 12.0) + urand() : urand();
+            S[i + j * n] = S[j + i * n] = s;
+        }
+    check_square(L, R, "symmetric indefinite", n, S, "dsytrf");
+
+    /* Symmetric, positive diagonal, indefinite: Cholesky fails, LDL' answers. */
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = j; i < n; i++) S[i + j * n] = S[j + i * n] = i == j ? 1.0 : urand();
+    check_square(L, R, "symmetric, positive diagonal, indefinite", n, S, "dsytrf");
+
+    /* Triangular, lower and upper. */
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = 0; i < n; i++) A[i + j * n] = i < j ? 0.0 : (i == j ? 2.0 + urand() : urand() / 4);
+    check_square(L, R, "lower triangular", n, A, "dtrtrs");
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = 0; i < n; i++) A[i + j * n] = i > j ? 0.0 : (i == j ? 2.0 + urand() : urand() / 4);
+    check_square(L, R, "upper triangular", n, A, "dtrtrs");
+
+    /* Several right-hand sides at once. */
+    {
+        double B[120 * 3], *X;
+        for (int64_t k = 0; k < n * 3; k++) B[k] = urand();
+        put_dense(L, "B", n, 3, B);
+        CHECK(silc_exec(L, "X = A \\ B; R = A * X - B") == 0, "multiple rhs: %s", silc_context_errmsg(L));
+        X = get_dense(L, "R", n, 3);
+        if (X) {
+            double r = 0;
+            for (int64_t k = 0; k < n * 3; k++) r = fmax(r, fabs(X[k]));
+            CHECK(r < 1e-12, "multiple rhs residual %.3g", r);
+        }
+        free(X);
+    }
+
+    /* Exactly singular: a zero column gives an exactly zero pivot. */
+    for (int64_t k = 0; k < n * n; k++) A[k] = urand();
+    for (int64_t i = 0; i < n; i++) A[i + 7 * n] = 0.0;
+    put_dense(L, "Z", n, n, A);
+    CHECK(silc_exec(L, "z = Z \\ b") != 0, "singular matrix solved");
+    CHECK(contains(silc_context_errmsg(L), "dgetrf") && contains(silc_context_errmsg(L), "singular"),
+          "singular message does not name dgetrf: %s", silc_context_errmsg(L));
+    free(A);
+    free(M);
+    free(S);
+}
+
+/* ---- least squares ------------------------------------------------------------ */
+
+static void test_rect(silc_context *L, silc_context *R)
+{
+    const int64_t m = 80, n = 25;
+    double *A = random_matrix(m, n), *b = random_matrix(m, 1), *G = malloc((size_t)(n * n) * sizeof(double));
+    double r[80], *xl, *xr;
+    const char *text;
+    if (!A || !b || !G) {
+        CHECK(0, "out of memory");
+        free(A);
+        free(b);
+        free(G);
+        return;
+    }
+    /* Tall: x = (A'A) \ (A'b), b not in the range of A. */
+    for (int64_t i = 0; i < n; i++) {
+        r[i] = 0;
+        for (int64_t k = 0; k < m; k++) r[i] += A[k + i * m] * b[k];
+        for (int64_t j = 0; j < n; j++) {
+            double s = 0;
+            for (int64_t k = 0; k < m; k++) s += A[k + i * m] * A[k + j * m];
+            G[i + j * n] = s;
+        }
+    }
+    gauss(n, G, r);
+    put_dense(L, "T", m, n, A);
+    put_dense(L, "c", m, 1, b);
+    put_dense(R, "T", m, n, A);
+    put_dense(R, "c", m, 1, b);
+    CHECK(silc_exec(L, "x = T \\ c") == 0, "tall: %s", silc_context_errmsg(L));
+    CHECK(silc_exec(R, "x = T \\ c") == 0, "tall reference: %s", silc_context_errmsg(R));
+    text = info(L, "x");
+    CHECK(contains(text, "backend: lapack") && contains(text, "dgeqrf"), "tall info:\n%s", text);
+    xl = get_dense(L, "x", n, 1);
+    xr = get_dense(R, "x", n, 1);
+    if (xl && xr) {
+        CHECK(rel_err(xl, r, n) < 1e-11, "tall vs normal equations: %.3g", rel_err(xl, r, n));
+        CHECK(rel_err(xl, xr, n) < 1e-11, "tall vs reference: %.3g", rel_err(xl, xr, n));
+    }
+    free(xl);
+    free(xr);
+    CHECK(silc_exec(L, "y = T \\ c") == 0 && contains(info(L, "y"), "reused factorization: yes"),
+          "tall: factor not reused:\n%s", out_buf);
+
+    /* Wide: the minimum-norm solution x = W' (W W') \ c, W = T' (n x m). */
+    for (int64_t i = 0; i < n; i++) {
+        r[i] = b[i];
+        for (int64_t j = 0; j < n; j++) {
+            double s = 0;
+            for (int64_t k = 0; k < m; k++) s += A[k + i * m] * A[k + j * m];
+            G[i + j * n] = s;
+        }
+    }
+    gauss(n, G, r);
+    {
+        double xw[80];
+        for (int64_t k = 0; k < m; k++) {
+            xw[k] = 0;
+            for (int64_t i = 0; i < n; i++) xw[k] += A[k + i * m] * r[i];
+        }
+        put_dense(L, "d", n, 1, b);
+        CHECK(silc_exec(L, "W = T'; w = W \\ d") == 0, "wide: %s", silc_context_errmsg(L));
+        text = info(L, "w");
+        CHECK(contains(text, "backend: lapack") && contains(text, "dgelqf"), "wide info:\n%s", text);
+        xl = get_dense(L, "w", m, 1);
+        if (xl) CHECK(rel_err(xl, xw, m) < 1e-11, "wide vs minimum norm: %.3g", rel_err(xl, xw, m));
+        free(xl);
+    }
+
+    /* Rank deficient: column 5 repeated as column 6.  The answer must still
+     * satisfy the normal equations A'(c - A x) = 0. */
+    for (int64_t k = 0; k < m; k++) A[k + 6 * m] = A[k + 5 * m];
+    put_dense(L, "D", m, n, A);
+    CHECK(silc_exec(L, "x = D \\ c; g = D' * (c - D * x)") == 0, "rank deficient: %s",
+          silc_context_errmsg(L));
+    text = info(L, "x");
+    CHECK(contains(text, "dgelsy") && contains(text, "rank 24 of 25"), "rank-deficient info:\n%s", text);
+    xl = get_dense(L, "g", n, 1);
+    if (xl) {
+        double g = 0;
+        for (int64_t i = 0; i < n; i++) g = fmax(g, fabs(xl[i]));
+        CHECK(g < 1e-10, "rank deficient: normal-equation residual %.3g", g);
+    }
+    free(xl);
+    free(A);
+    free(b);
+    free(G);
+}
+
+/* ---- band and tridiagonal ------------------------------------------------------ */
+
+/* A band envelope (kl, ku) with the given entry function, solved in both contexts. */
+static void check_band(silc_context *L, silc_context *R, const char *label, int64_t n, int64_t kl,
+                       int64_t ku, double (*entry)(int64_t i, int64_t j), const char *routine)
+{
+    int64_t ld = kl + ku + 1;
+    double *band = calloc((size_t)(ld * n), sizeof(double)), *xt = malloc((size_t)n * sizeof(double));
+    double *b = calloc((size_t)n, sizeof(double)), *xl, *xr, cond;
+    silc_envelope_t e;
+    const char *text;
+    if (!band || !xt || !b) {
+        CHECK(0, "out of memory");
+        free(band);
+        free(xt);
+        free(b);
+        return;
+    }
+    for (int64_t i = 0; i < n; i++) xt[i] = (double)(i + 1);
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = j - ku > 0 ? j - ku : 0; i <= j + kl && i < n; i++) {
+            double a = entry(i, j);
+            band[(ku + i - j) + j * ld] = a;
+            b[i] += a * xt[j];
+        }
+    CHECK(silc_envelope_band(&e, n, n, kl, ku, band) == 0, "%s: band envelope", label);
+    CHECK(silc_put(L, "A", &e) == 0 && silc_put(R, "A", &e) == 0, "%s: put", label);
+    silc_envelope_free(&e);
+    put_dense(L, "b", n, 1, b);
+    put_dense(R, "b", n, 1, b);
+    CHECK(silc_exec(L, "x = A \\ b") == 0, "%s: %s", label, silc_context_errmsg(L));
+    CHECK(silc_exec(R, "x = A \\ b") == 0, "%s reference: %s", label, silc_context_errmsg(R));
+    text = info(L, "x");
+    CHECK(contains(text, "backend: lapack") && contains(text, routine), "%s: info does not name %s:\n%s",
+          label, routine, text);
+    cond = info_cond(text);
+    CHECK(cond >= 1, "%s: no condition estimate", label);
+    xl = get_dense(L, "x", n, 1);
+    xr = get_dense(R, "x", n, 1);
+    if (xl && xr) {
+        CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: error %.3g (cond %.3g)", label,
+              rel_err(xl, xt, n), cond);
+        CHECK(rel_err(xl, xr, n) <= bound(n, cond), "%s: vs reference %.3g", label, rel_err(xl, xr, n));
+    }
+    free(xl);
+    free(xr);
+    CHECK(silc_exec(L, "y = A \\ b") == 0 && contains(info(L, "y"), "reused factorization: yes"),
+          "%s: factor not reused:\n%s", label, out_buf);
+    /* The same matrix stored dense is still banded: the dispatcher sends it to
+     * solve.band and lapack copies the band out of it. */
+    CHECK(silc_exec(L, "F = dense(A); z = F \\ b") == 0, "%s dense-stored: %s", label,
+          silc_context_errmsg(L));
+    text = info(L, "z");
+    CHECK(contains(text, "backend: lapack") && contains(text, routine), "%s dense-stored: info:\n%s", label,
+          text);
+    free(band);
+    free(xt);
+    free(b);
+}
+
+static double gen_band(int64_t i, int64_t j)
+{
+    return i == j ? 8.0 : 1.0 / (double)(1 + i + 2 * j % 7) - 0.3;
+}
+static double spd_band(int64_t i, int64_t j)
+{
+    return i == j ? 6.0 : -1.0 / (double)(1 + (i + j) % 5);
+}
+static double indef_band(int64_t i, int64_t j) /* symmetric, positive diagonal, indefinite */
+{
+    return i == j ? 1.0 : 2.0;
+}
+static double lap1d(int64_t i, int64_t j)
+{
+    return i == j ? 2.0 : -1.0;
+}
+static double gen_tri(int64_t i, int64_t j)
+{
+    return i == j ? 4.0 : (i > j ? -1.0 : 1.5 + 0.01 * (double)i);
+}
+
+static void test_band(silc_context *L, silc_context *R)
+{
+    check_band(L, R, "band", 300, 3, 2, gen_band, "dgbtrf");
+    check_band(L, R, "SPD band", 300, 2, 2, spd_band, "dpbtrf");
+    check_band(L, R, "indefinite symmetric band", 60, 2, 2, indef_band, "dgbtrf");
+    CHECK(contains(info(L, "x"), "dpbtrf: not positive definite"), "no fallback note:\n%s", out_buf);
+    check_band(L, R, "1-D Laplacian", 200, 1, 1, lap1d, "dpttrf");
+    check_band(L, R, "tridiagonal", 200, 1, 1, gen_tri, "dgttrf");
+}
+
+/* ---- products, declines ------------------------------------------------------- */
+
+static void test_matmul_and_declines(silc_context *L)
+{
+    const int64_t m = 30, k = 20, n = 15;
+    double *A = random_matrix(m, k), *B = random_matrix(k, n), C[30 * 15], *got;
+    const char *text;
+    if (!A || !B) {
+        CHECK(0, "out of memory");
+        free(A);
+        free(B);
+        return;
+    }
+    for (int64_t j = 0; j < n; j++) matvec(m, k, A, B + j * k, C + j * m);
+    put_dense(L, "P", m, k, A);
+    put_dense(L, "Q", k, n, B);
+    text = run_out(L, "explain C = P * Q");
+    CHECK(contains(text, "lapack -> would run"), "matmul not sent to lapack:\n%s", text);
+    CHECK(silc_exec(L, "C = P * Q; v = P * Q[:, 1]; u = P[1, :] * Q") == 0, "matmul: %s",
+          silc_context_errmsg(L));
+    got = get_dense(L, "C", m, n);
+    if (got) CHECK(rel_err(got, C, m * n) < 1e-14, "dgemm: %.3g", rel_err(got, C, m * n));
+    free(got);
+    got = get_dense(L, "v", m, 1);
+    if (got) CHECK(rel_err(got, C, m) < 1e-14, "dgemv: %.3g", rel_err(got, C, m));
+    free(got);
+    got = get_dense(L, "u", 1, n);
+    if (got) {
+        double row[15];
+        for (int64_t j = 0; j < n; j++) row[j] = C[j * m];
+        CHECK(rel_err(got, row, n) < 1e-14, "dgemv (transposed): %.3g", rel_err(got, row, n));
+    }
+    free(got);
+
+    /* CSR is declined with the reason. */
+    CHECK(silc_exec(L, "set dispatch.solve.sparse = lapack; S = sparse(P[1:20, 1:20] + 10 * eye(20))") == 0,
+          "sparse setup: %s", silc_context_errmsg(L));
+    text = run_out(L, "explain s = S \\ Q[:, 1]");
+    CHECK(contains(text, "needs dense or band storage"), "CSR not declined:\n%s", text);
+    free(A);
+    free(B);
+}
+
+/* ---- shared matrices ------------------------------------------------------------ */
+
+/* Warnings of the last timed() statement (info would clear the context's). */
+static char warn_buf[1024];
+
+/* Runs stmt and returns the wall time the engine measured for it (-1 on failure). */
+static double timed(silc_context *c, const char *stmt, int *rc)
+{
+    const char *p;
+    *rc = silc_exec(c, stmt);
+    if (*rc) return -1;
+    snprintf(warn_buf, sizeof warn_buf, "%s", silc_context_warnings(c));
+    p = strstr(info(c, "x"), "wall time: ");
+    return p ? strtod(p + 11, NULL) : -1;
+}
+
+/* Normwise backward error ||b - A x||_inf / (||A||_inf ||x||_inf + ||b||_inf), A in CSR. */
+static double backward_error(const silc_envelope_t *A, const double *x, const double *b)
+{
+    double r = 0, an = 0, xn = 0, bn = 0;
+    for (int64_t i = 0; i < A->m; i++) {
+        double s = b[i], rs = 0;
+        for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
+            s -= A->values[p] * x[A->colind[p]];
+            rs += fabs(A->values[p]);
+        }
+        r = fmax(r, fabs(s));
+        an = fmax(an, rs);
+        bn = fmax(bn, fabs(b[i]));
+    }
+    for (int64_t j = 0; j < A->n; j++) xn = fmax(xn, fabs(x[j]));
+    return r / (an * xn + bn);
+}
+
+static void test_shared(silc_context *L, silc_context *R)
+{
+    char path[1024], line[512];
+    FILE *idx;
+    snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
+    idx = fopen(path, "r");
+    CHECK(idx != NULL, "cannot open %s", path);
+    if (!idx) return;
+    printf("%-18s %6s %6s  %-13s %9s %9s %9s %9s %9s\n", "matrix", "rows", "cols", "class", "lapack s",
+           "ref s", "cond", "berr", "|xl-xr|");
+    while (fgets(line, sizeof line, idx)) {
+        char file[128], field[32], sym[32], cls[32], err[256];
+        long long m, n, nnz;
+        silc_envelope_t e;
+        double *b, *xt, *xl = NULL, *xr = NULL, tl, tr, cond, berr = -1, diff = -1;
+        int rcl, rcr;
+        if (sscanf(line, "%127s %lld %lld %lld %31s %31s %31s", file, &m, &n, &nnz, field, sym, cls) != 7 ||
+            strcmp(file, "file") == 0 || m > 2000 || strcmp(field, "complex") == 0)
+            continue;
+        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
+        if (silc_mm_read(&e, path, err, sizeof err)) {
+            CHECK(0, "%s: %s", file, err);
+            continue;
+        }
+        xt = malloc((size_t)n * sizeof(double));
+        b = calloc((size_t)m, sizeof(double));
+        if (!xt || !b) {
+            CHECK(0, "out of memory");
+            goto next;
+        }
+        for (int64_t j = 0; j < n; j++) xt[j] = 1.0 + (double)j / (double)n;
+        for (int64_t i = 0; i < m; i++)
+            for (int64_t p = e.rowptr[i]; p < e.rowptr[i + 1]; p++) b[i] += e.values[p] * xt[e.colind[p]];
+        CHECK(silc_put(L, "A", &e) == 0 && silc_put(R, "A", &e) == 0, "%s: put", file);
+        put_dense(L, "b", m, 1, b);
+        put_dense(R, "b", m, 1, b);
+        CHECK(silc_exec(L, "A = dense(A)") == 0 && silc_exec(R, "A = dense(A)") == 0, "%s: dense()", file);
+        tl = timed(L, "x = A \\ b", &rcl);
+        if (rcl) {
+            /* Only singular matrices may be refused, and the message must say so. */
+            CHECK(strstr(cls, "singular") && contains(silc_context_errmsg(L), "singular"),
+                  "%s (%s): lapack failed: %s", file, cls, silc_context_errmsg(L));
+            printf("%-18s %6lld %6lld  %-13s refused: %s\n", file, m, n, cls, silc_context_errmsg(L));
+            goto next;
+        }
+        cond = info_cond(info(L, "x"));
+        CHECK(contains(out_buf, "backend: lapack"), "%s: not solved by lapack:\n%s", file, out_buf);
+        CHECK(cond * DBL_EPSILON <= 1e-4 || contains(warn_buf, "singular") || contains(warn_buf, "digits"),
+              "%s: cond %.3g and no warning", file, cond);
+        tr = timed(R, "x = A \\ b", &rcr);
+        xl = get_dense(L, "x", n, 1);
+        xr = rcr ? NULL : get_dense(R, "x", n, 1);
+        if (xl) berr = backward_error(&e, xl, b);
+        if (xl && xr) diff = rel_err(xl, xr, n);
+        printf("%-18s %6lld %6lld  %-13s %9.4f %9.4f %9.3g %9.3g %9.3g\n", file, m, n, cls, tl, tr, cond,
+               berr, diff);
+        /* Backward stable whatever the conditioning (LU growth is mild in practice). */
+        CHECK(berr >= 0 && berr < 1e-12, "%s: backward error %.3g", file, berr);
+        if (cond < 0) {
+            CHECK(strcmp(cls, "rect") == 0, "%s: no condition estimate", file);
+        } else if (bound(n, cond) < 1e-2 && xl && xr) {
+            CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g", file,
+                  rel_err(xl, xt, n), bound(n, cond));
+            CHECK(diff <= bound(n, cond), "%s: lapack vs reference %.3g > %.3g", file, diff, bound(n, cond));
+        }
+    next:
+        free(xl);
+        free(xr);
+        free(xt);
+        free(b);
+        silc_envelope_free(&e);
+    }
+    fclose(idx);
+}
+
+int main(void)
+{
+    silc_context *L = open_ctx("lapack"), *R = open_ctx("reference");
+    CHECK(L && R, "cannot open contexts");
+    if (L && R) {
+        test_dense(L, R);
+        test_rect(L, R);
+        test_band(L, R);
+        test_matmul_and_declines(L);
+        test_shared(L, R);
+    }
+    silc_close(&L);
+    silc_close(&R);
+    return check_done();
+}
