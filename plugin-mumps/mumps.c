@@ -1,0 +1,705 @@
+/*
+ * mumps.c -- the "mumps" backend: sparse direct solves with sequential MUMPS.
+ *
+ * One operation, SILC_OP_SOLVE, under "solve.sparse" (unsymmetric LU, SYM=0)
+ * and "solve.sparse.spd" (LDL' without pivoting, SYM=1, on the lower
+ * triangle; a zero or negative pivot returns SILC_ENOTSPD so the dispatcher
+ * falls back to LU).  The matrix goes to MUMPS assembled and centralized
+ * (ICNTL(5)=0, ICNTL(18)=0) as 1-based triplets built once.  Analysis and
+ * factorization (JOB=4) happen once per matrix value: the MUMPS instance, its
+ * triplets and a 1-norm condition estimate are kept as an attachment of A, so
+ * later solves only run JOB=3; the attachment is destroyed with JOB=-2.
+ *
+ * Every ICNTL(1..40) and CNTL(1..15) is a typed option (mumps.icntl_7 = 5).
+ * Defaults differ from MUMPS's in three ways: output is silenced, the ordering
+ * is AMF (ICNTL(7)=2; SCOTCH and PORD were 1.5-3x slower on 2-D grids here),
+ * and MUMPS's error analysis (ICNTL(11)=2: its backward errors; 1 adds
+ * condition numbers) runs once per factorization, on the first single-column
+ * solve, and `info` shows it from then on.  Once, because it is not free:
+ * on the 250,000-unknown Laplacian it added a quarter to a solve with a
+ * reused factorization (0.135 s against 0.11 s of CPU), and the engine
+ * computes the backward error of every solve anyway.  A 1-norm condition
+ * estimate (Hager-Higham, a few extra solves) is made once per factorization
+ * for the engine's "singular to working precision" warning; it added 20% to
+ * the first solve there (1.50 s against 1.26 s), and mumps.condest = false
+ * turns it off.  Workspace errors (the -9 class) double ICNTL(14) and retry
+ * up to four times.
+ *
+ * The module links MUMPS's static archives with -Wl,--exclude-libs,ALL and
+ * -Bsymbolic (see CMakeLists.txt): Debian's sequential MUMPS carries a stub
+ * MPI and the same dmumps_c symbol as the MPI MUMPS inside PETSc, and neither
+ * may leak out of this plugin or bind to the other's.
+ */
+#define _GNU_SOURCE /* dladdr */
+#include "silc_plugin.h"
+
+#include <dlfcn.h>
+#include <stddef.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <dmumps_c.h>
+
+#define MUMPS_JOB_INIT (-1)
+#define MUMPS_JOB_END (-2)
+#define MUMPS_JOB_FACTOR 2
+#define MUMPS_JOB_SOLVE 3
+#define MUMPS_JOB_ANALYSE_FACTOR 4
+#define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's only communicator */
+#define MUMPS_RETRIES 4                /* ICNTL(14) doublings on workspace errors */
+#define N_ICNTL 40
+#define N_CNTL 15
+
+/* Fortran's 1-based ICNTL(i), INFOG(i), ... as C lvalues. */
+#define ICNTL(id, i) ((id)->icntl[(i)-1])
+#define CNTL(id, i) ((id)->cntl[(i)-1])
+#define INFOG(id, i) ((id)->infog[(i)-1])
+#define RINFOG(id, i) ((id)->rinfog[(i)-1])
+
+static const silc_host_api *host;
+
+/* ---- options ----------------------------------------------------------------- */
+
+#define IC(k, def, help) {"icntl_" #k, SILC_OPT_INT, def, "ICNTL(" #k "): " help}
+#define C(k, help) {"cntl_" #k, SILC_OPT_DOUBLE, "", "CNTL(" #k "): " help}
+/* The list order matters: icntl_k is entry k-1, cntl_k is entry N_ICNTL+k-1.
+ * An empty default means "MUMPS's own default". */
+static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 1] = {
+    IC(1, "-1", "output stream for error messages (<= 0: none)"),
+    IC(2, "-1", "output stream for diagnostics (<= 0: none)"),
+    IC(3, "-1", "output stream for global information (<= 0: none)"),
+    IC(4, "0", "print level (0: nothing .. 4: everything)"),
+    IC(5, "0", "matrix input format (the plugin passes assembled triplets: 0)"),
+    IC(6, "", "permutation / scaling to a zero-free diagonal (0-7)"),
+    IC(7, "2", "ordering: 0 AMD, 2 AMF, 3 SCOTCH, 4 PORD, 5 METIS, 6 QAMD, 7 automatic"),
+    IC(8, "", "scaling strategy (77: automatic)"),
+    IC(9, "1", "1 solves A x = b (the only value '\\' can use)"),
+    IC(10, "", "iterative refinement steps (0: none)"),
+    IC(11, "2", "error analysis on the first solve of a factorization: 0 none, 1 full (condition "
+                "numbers), 2 backward errors"),
+    IC(12, "", "ordering strategy for symmetric matrices (SYM=2)"),
+    IC(13, "", "root front: ScaLAPACK use (parallel only)"),
+    IC(14, "", "percentage increase of the estimated workspace"),
+    IC(15, "", "dense-row detection / compression in analysis"),
+    IC(16, "", "number of OpenMP threads (0: as the environment says)"),
+    IC(17, "", "reserved"),
+    IC(18, "0", "matrix distribution (the plugin centralizes: 0)"),
+    IC(19, "0", "Schur complement (not supported: 0)"),
+    IC(20, "0", "right-hand side format (dense: 0)"),
+    IC(21, "0", "solution distribution (centralized: 0)"),
+    IC(22, "", "out-of-core factorization (1: factors on disk)"),
+    IC(23, "", "maximum working memory per process in MB (0: no limit)"),
+    IC(24, "", "null pivot detection (1: on)"),
+    IC(25, "0", "null-space basis computation (not supported: 0)"),
+    IC(26, "0", "Schur reduction / expansion (not supported: 0)"),
+    IC(27, "", "blocking size for multiple right-hand sides"),
+    IC(28, "", "sequential (1) or parallel (2) analysis"),
+    IC(29, "", "parallel ordering tool"),
+    IC(30, "0", "entries of the inverse (not supported: 0)"),
+    IC(31, "0", "factors discarded after factorization (not supported: 0)"),
+    IC(32, "0", "forward elimination during factorization (not supported: 0)"),
+    IC(33, "", "determinant computation (1: on)"),
+    IC(34, "", "out-of-core file deletion"),
+    IC(35, "", "block low-rank factorization (0: off)"),
+    IC(36, "", "block low-rank variant"),
+    IC(37, "", "block low-rank compression of contribution blocks"),
+    IC(38, "", "estimated compression rate of LU factors (per mille)"),
+    IC(39, "", "estimated compression rate of contribution blocks (per mille)"),
+    IC(40, "", "reserved"),
+    C(1, "relative threshold for numerical pivoting"),
+    C(2, "stopping criterion of iterative refinement"),
+    C(3, "absolute threshold for null pivot detection"),
+    C(4, "threshold for static pivoting (< 0: off)"),
+    C(5, "fixation value for null pivots"),
+    C(6, "reserved"),
+    C(7, "block low-rank dropping parameter"),
+    C(8, "reserved"),
+    C(9, "reserved"),
+    C(10, "reserved"),
+    C(11, "reserved"),
+    C(12, "reserved"),
+    C(13, "reserved"),
+    C(14, "reserved"),
+    C(15, "reserved"),
+    {"condest", SILC_OPT_BOOL, "true",
+     "estimate the 1-norm condition number (Hager-Higham, 2-10 extra solves per factorization)"},
+};
+#undef IC
+#undef C
+
+/* ICNTL entries whose value the plugin's data layout fixes. */
+static const struct {
+    int k, value;
+    const char *why;
+} fixed_icntl[] = {
+    {5, 0, "the plugin passes the matrix assembled"},
+    {9, 1, "'\\' solves A x = b"},
+    {18, 0, "the matrix is centralized on the host"},
+    {19, 0, "no Schur complement is returned"},
+    {20, 0, "the right-hand side is dense"},
+    {21, 0, "the solution is returned centralized"},
+    {25, 0, "no null-space basis is returned"},
+    {26, 0, "no Schur complement is returned"},
+    {30, 0, "'\\' computes a solution, not entries of the inverse"},
+    {31, 0, "the factors must be kept for the solves"},
+    {32, 0, "the right-hand side is not known at factorization"},
+};
+
+/* The options of one call.  "Unset" entries keep MUMPS's defaults. */
+#define ICNTL_UNSET INT64_MIN
+typedef struct settings {
+    int64_t icntl[N_ICNTL];
+    double cntl[N_CNTL];
+    int cntl_set[N_CNTL];
+    int64_t condest;
+} settings;
+
+static int read_settings(silc_call *call, settings *s)
+{
+    int k, rc;
+    memset(s, 0, sizeof *s);
+    for (k = 1; k <= N_ICNTL; k++) {
+        const char *d = mumps_options[k - 1].default_value;
+        int64_t def = d[0] ? (int64_t)strtol(d, NULL, 10) : ICNTL_UNSET;
+        if ((rc = host->option_int(call, mumps_options[k - 1].key, def, &s->icntl[k - 1]))) return rc;
+    }
+    for (k = 1; k <= N_CNTL; k++) {
+        double v;
+        if ((rc = host->option_double(call, mumps_options[N_ICNTL + k - 1].key, NAN, &v))) return rc;
+        s->cntl_set[k - 1] = !isnan(v);
+        s->cntl[k - 1] = s->cntl_set[k - 1] ? v : 0.0;
+    }
+    if ((rc = host->option_int(call, "condest", 1, &s->condest))) return rc;
+    for (k = 0; k < (int)(sizeof fixed_icntl / sizeof fixed_icntl[0]); k++) {
+        int64_t v = s->icntl[fixed_icntl[k].k - 1];
+        if (v != fixed_icntl[k].value)
+            return host->error(call, SILC_EARG,
+                               "mumps.icntl_%d = %lld is not supported: %s (ICNTL(%d) must be %d)",
+                               fixed_icntl[k].k, (long long)v, fixed_icntl[k].why, fixed_icntl[k].k,
+                               fixed_icntl[k].value);
+    }
+    for (k = 1; k <= N_ICNTL; k++)
+        if (s->icntl[k - 1] != ICNTL_UNSET &&
+            (s->icntl[k - 1] < INT_MIN || s->icntl[k - 1] > INT_MAX))
+            return host->error(call, SILC_EARG, "mumps.icntl_%d = %lld is out of range", k,
+                               (long long)s->icntl[k - 1]);
+    return SILC_OK;
+}
+
+static int same_settings(const settings *a, const settings *b)
+{
+    int k;
+    for (k = 0; k < N_ICNTL; k++)
+        if (a->icntl[k] != b->icntl[k]) return 0;
+    for (k = 0; k < N_CNTL; k++)
+        if (a->cntl_set[k] != b->cntl_set[k] || a->cntl[k] != b->cntl[k]) return 0;
+    return a->condest == b->condest;
+}
+
+/* ---- error meanings -------------------------------------------------------------- */
+
+/* The common INFO(1)/INFOG(1) codes of the MUMPS 5.5 users' guide. */
+static const char *mumps_meaning(int code)
+{
+    switch (code) {
+    case -1: return "error on another process";
+    case -2: return "number of entries NNZ out of range";
+    case -3: return "invalid JOB for the current state";
+    case -4: return "error in the user-supplied permutation PERM_IN";
+    case -5: return "out of memory: real workspace allocation failed during analysis";
+    case -6: return "structurally singular matrix";
+    case -7: return "out of memory: integer workspace allocation failed during analysis";
+    case -8: return "internal integer workspace too small for factorization";
+    case -9: return "internal real workspace too small for factorization";
+    case -10: return "numerically singular matrix";
+    case -11: return "internal real workspace too small for the solution";
+    case -12: return "internal real workspace too small for iterative refinement";
+    case -13: return "out of memory: workspace allocation failed during factorization or solution";
+    case -14: return "internal integer workspace too small for the solution";
+    case -15: return "integer workspace too small for iterative refinement or error analysis";
+    case -16: return "N out of range";
+    case -17: return "internal send buffer too small";
+    case -18: return "blocking size for multiple right-hand sides too large";
+    case -19: return "working memory limit ICNTL(23) too small";
+    case -20: return "internal reception buffer too small";
+    case -21: return "PAR=0 needs more than one process";
+    case -22: return "a pointer array is missing or has the wrong size";
+    case -23: return "MPI was not initialized";
+    case -24: return "NELT out of range";
+    case -26: return "LRHS out of range";
+    case -27: return "NZ_RHS and IRHS_PTR do not match";
+    case -32: return "incompatible NRHS and ICNTL(25)";
+    case -38: return "parallel analysis not possible with these settings";
+    case -40: return "matrix declared positive definite (SYM=1) but a negative or zero pivot was met";
+    case -44: return "the factors were discarded (ICNTL(31)=1)";
+    case -45: return "NRHS <= 0";
+    case -52: return "the ordering library needs 64-bit integers";
+    case -53: return "internal error: inconsistent input between two consecutive calls";
+    case -90: return "error in out-of-core management";
+    default: return "see the MUMPS users' guide";
+    }
+}
+
+/* Errors that more workspace (a larger ICNTL(14)) can cure. */
+static int workspace_error(int code)
+{
+    return code == -8 || code == -9 || code == -14 || code == -15 || code == -17 || code == -20;
+}
+
+/* ---- the factorization attachment ------------------------------------------------ */
+
+typedef struct mumps_factor {
+    DMUMPS_STRUC_C id;
+    int live;                   /* JOB=-1 succeeded: JOB=-2 must run */
+    MUMPS_INT *irn, *jcn;       /* 1-based triplets; MUMPS reads them again for */
+    double *a;                  /* error analysis and iterative refinement */
+    settings opts;              /* the options it was computed with */
+    double cond_est;            /* 1-norm condition estimate, -1 = not computed */
+    int analysed;               /* the error analysis ran (on the first 1-column solve) */
+    double rinfog[11];          /* its RINFOG(1..11) */
+    double factor_seconds;
+    int retries;                /* ICNTL(14) doublings that were needed */
+} mumps_factor;
+
+static void factor_free(void *p)
+{
+    mumps_factor *F = p;
+    if (!F) return;
+    if (F->live) {
+        F->id.job = MUMPS_JOB_END;
+        dmumps_c(&F->id);
+    }
+    host->free(F->irn);
+    host->free(F->jcn);
+    host->free(F->a);
+    host->free(F);
+}
+
+/* Entry (i, j) of a dense or band view, 0 outside the band. */
+static double full_get(const silc_view *v, int64_t i, int64_t j)
+{
+    if (v->format == SILC_FMT_DENSE) return v->val[i + j * v->m];
+    if (i - j > v->kl || j - i > v->ku) return 0.0;
+    return v->val[(v->ku + i - j) + j * v->ld];
+}
+
+/* 1-based triplets of A (SYM=1: the lower triangle only).  CSR keeps explicit
+ * zeros (they are part of the pattern); dense and band skip zeros. */
+static int build_triplets(const silc_view *v, int lower, mumps_factor *F, int64_t *nnz_out)
+{
+    int64_t n = v->n, cap, nz = 0, i, j, k;
+    cap = v->format == SILC_FMT_CSR ? v->nnz : v->format == SILC_FMT_BAND ? v->ld * n : n * n;
+    if (cap < 1) cap = 1;
+    F->irn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
+    F->jcn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
+    F->a = host->alloc((size_t)cap * sizeof(double));
+    if (!F->irn || !F->jcn || !F->a) return SILC_ENOMEM;
+    if (v->format == SILC_FMT_CSR) {
+        for (i = 0; i < n; i++)
+            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) {
+                if (lower && v->colind[k] > i) break; /* columns are sorted */
+                F->irn[nz] = (MUMPS_INT)(i + 1);
+                F->jcn[nz] = (MUMPS_INT)(v->colind[k] + 1);
+                F->a[nz++] = v->val[k];
+            }
+    } else {
+        for (j = 0; j < n; j++) {
+            int64_t lo = lower ? j : 0, hi = n;
+            if (v->format == SILC_FMT_BAND) {
+                if (j - v->ku > lo) lo = j - v->ku;
+                if (j + v->kl + 1 < hi) hi = j + v->kl + 1;
+            }
+            for (i = lo; i < hi; i++) {
+                double x = full_get(v, i, j);
+                if (x == 0.0) continue;
+                F->irn[nz] = (MUMPS_INT)(i + 1);
+                F->jcn[nz] = (MUMPS_INT)(j + 1);
+                F->a[nz++] = x;
+            }
+        }
+    }
+    *nnz_out = nz;
+    return SILC_OK;
+}
+
+/* The "dmumps_c (JOB=k): meaning (INFOG(1)=c, INFOG(2)=d)" message. */
+static int mumps_fail(silc_call *call, int status, const DMUMPS_STRUC_C *id, int job)
+{
+    return host->error(call, status, "dmumps_c (JOB=%d): %s (INFOG(1)=%d, INFOG(2)=%d)", job,
+                       mumps_meaning((int)INFOG(id, 1)), (int)INFOG(id, 1), (int)INFOG(id, 2));
+}
+
+/* Status of a failed factorization: singular and not-positive-definite are
+ * numerical outcomes, the rest are library failures. */
+static int factor_status(int code, int sym)
+{
+    if (sym == 1 && (code == -10 || code == -40)) return SILC_ENOTSPD;
+    if (code == -6 || code == -10) return SILC_ESINGULAR;
+    if (code == -5 || code == -7 || code == -13) return SILC_ENOMEM;
+    return SILC_ELIB;
+}
+
+/* run_solve's "refactored with more workspace: refill the right-hand side and
+ * call again".  Bounded: every retry spends one of MUMPS_RETRIES. */
+#define SOLVE_AGAIN (-1)
+
+/* JOB=3 on nrhs columns of rhs, overwritten by the solution.  When the solve
+ * runs out of workspace, refactors with twice ICNTL(14) and asks the caller to
+ * refill rhs (the failed solve may have overwritten it). */
+static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs)
+{
+    DMUMPS_STRUC_C *id = &F->id;
+    id->rhs = rhs;
+    id->nrhs = (MUMPS_INT)nrhs;
+    id->lrhs = id->n;
+    id->job = MUMPS_JOB_SOLVE;
+    dmumps_c(id);
+    if (INFOG(id, 1) >= 0) return SILC_OK;
+    if (!workspace_error((int)INFOG(id, 1)) || F->retries >= MUMPS_RETRIES)
+        return mumps_fail(call, factor_status((int)INFOG(id, 1), 0), id, MUMPS_JOB_SOLVE);
+    ICNTL(id, 14) = ICNTL(id, 14) > 0 ? 2 * ICNTL(id, 14) : 40;
+    F->retries++;
+    id->job = MUMPS_JOB_FACTOR;
+    dmumps_c(id);
+    if (INFOG(id, 1) < 0)
+        return mumps_fail(call, factor_status((int)INFOG(id, 1), id->sym), id, MUMPS_JOB_FACTOR);
+    return SOLVE_AGAIN;
+}
+
+/* out = A^-1 in (trans: A^-T in) for one vector. */
+static int solve_vec(silc_call *call, mumps_factor *F, const double *in, double *out, int trans)
+{
+    int rc;
+    do {
+        memcpy(out, in, (size_t)F->id.n * sizeof(double));
+        ICNTL(&F->id, 9) = trans ? 2 : 1;
+        rc = run_solve(call, F, out, 1);
+        ICNTL(&F->id, 9) = 1;
+    } while (rc == SOLVE_AGAIN);
+    return rc;
+}
+
+/* The host's Hager-Higham estimator (ABI 1.1) drives solves with A and A'
+ * through this callback. */
+typedef struct est_ctx {
+    silc_call *call;
+    mumps_factor *F;
+    int rc;
+} est_ctx;
+
+static int apply_inverse(void *ctx, double *x, int trans, double *work)
+{
+    est_ctx *c = ctx;
+    if ((c->rc = solve_vec(c->call, c->F, x, work, trans))) return c->rc;
+    memcpy(x, work, (size_t)c->F->id.n * sizeof *x);
+    return 0;
+}
+
+/* Estimate of ||A^-1||_1 from a few solves with the factors.  The error
+ * analysis is switched off meanwhile (it would run on every solve). */
+static int estimate_inv_norm1(silc_call *call, mumps_factor *F, double *est_out)
+{
+    int icntl11 = (int)ICNTL(&F->id, 11);
+    double *work;
+    est_ctx c = {call, F, 0};
+    *est_out = -1;
+    if (host->struct_size < offsetof(silc_host_api, inv_norm1_est) + sizeof host->inv_norm1_est)
+        return 0; /* an ABI 1.0 host lends no estimator: the estimate stays unknown */
+    work = host->alloc((size_t)F->id.n * sizeof *work);
+    if (!work) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    ICNTL(&F->id, 11) = 0;
+    *est_out = host->inv_norm1_est(F->id.n, apply_inverse, &c, work);
+    ICNTL(&F->id, 11) = icntl11;
+    host->free(work);
+    return c.rc;
+}
+
+/* Initializes MUMPS for A, analyses and factors it (JOB=-1, then JOB=4, then
+ * JOB=2 again with twice the workspace while it runs short). */
+static int factor_new(silc_call *call, const silc_view *v, int sym, const settings *s,
+                      mumps_factor **out)
+{
+    mumps_factor *F = host->calloc(1, sizeof *F);
+    DMUMPS_STRUC_C *id;
+    int64_t nnz = 0;
+    int k, rc;
+    double t0 = host->now();
+    *out = NULL;
+    if (!F) return host->error(call, SILC_ENOMEM, "mumps: out of memory");
+    F->cond_est = -1;
+    F->opts = *s;
+    if (build_triplets(v, sym == 1, F, &nnz)) {
+        factor_free(F);
+        return host->error(call, SILC_ENOMEM, "mumps: out of memory for %lld triplets",
+                           (long long)v->nnz);
+    }
+    id = &F->id;
+    id->job = MUMPS_JOB_INIT;
+    id->par = 1;
+    id->sym = sym;
+    id->comm_fortran = MUMPS_USE_COMM_WORLD;
+    dmumps_c(id);
+    if (INFOG(id, 1) < 0) {
+        rc = mumps_fail(call, SILC_ELIB, id, MUMPS_JOB_INIT);
+        factor_free(F);
+        return rc;
+    }
+    F->live = 1;
+    for (k = 1; k <= N_ICNTL; k++)
+        if (s->icntl[k - 1] != ICNTL_UNSET) ICNTL(id, k) = (MUMPS_INT)s->icntl[k - 1];
+    for (k = 1; k <= N_CNTL; k++)
+        if (s->cntl_set[k - 1]) CNTL(id, k) = s->cntl[k - 1];
+    id->n = (MUMPS_INT)v->n;
+    id->nnz = nnz;
+    id->nz = nnz <= INT_MAX ? (MUMPS_INT)nnz : 0;
+    id->irn = F->irn;
+    id->jcn = F->jcn;
+    id->a = F->a;
+    id->job = MUMPS_JOB_ANALYSE_FACTOR;
+    dmumps_c(id);
+    /* Workspace errors come from the factorization phase, after a complete
+     * analysis: only the factorization (JOB=2) is repeated. */
+    while (INFOG(id, 1) < 0 && workspace_error((int)INFOG(id, 1)) && F->retries < MUMPS_RETRIES) {
+        ICNTL(id, 14) = ICNTL(id, 14) > 0 ? 2 * ICNTL(id, 14) : 40;
+        F->retries++;
+        id->job = MUMPS_JOB_FACTOR;
+        dmumps_c(id);
+    }
+    if (INFOG(id, 1) < 0) {
+        rc = mumps_fail(call, factor_status((int)INFOG(id, 1), sym), id, id->job);
+        factor_free(F);
+        return rc;
+    }
+    /* LDL' of an SPD matrix has only positive pivots; INFOG(12) counts the negative ones. */
+    if (sym == 1 && INFOG(id, 12) > 0) {
+        rc = host->error(call, SILC_ENOTSPD,
+                         "dmumps_c (JOB=4): matrix is not positive definite (INFOG(12)=%d negative "
+                         "pivots)", (int)INFOG(id, 12));
+        factor_free(F);
+        return rc;
+    }
+    if (s->condest) {
+        double inv;
+        rc = estimate_inv_norm1(call, F, &inv);
+        if (rc) {
+            factor_free(F);
+            return rc;
+        }
+        F->cond_est = host->props(call->in[0])->norm1 * inv;
+    }
+    F->factor_seconds = host->now() - t0;
+    *out = F;
+    return SILC_OK;
+}
+
+/* ---- the solve ------------------------------------------------------------------- */
+
+static const char *ordering_name(int k)
+{
+    static const char *names[] = {"AMD", "user", "AMF", "SCOTCH", "PORD", "METIS", "QAMD", "auto"};
+    return k >= 0 && k < 8 ? names[k] : "unknown";
+}
+
+/* Copies B (any format) into the dense n x nrhs array x. */
+static void dense_copy(const silc_view *b, double *x)
+{
+    int64_t i, j, k;
+    if (b->format == SILC_FMT_DENSE) {
+        if (b->m > 0 && b->n > 0) memcpy(x, b->val, (size_t)(b->m * b->n) * sizeof(double));
+    } else if (b->format == SILC_FMT_CSR) {
+        memset(x, 0, (size_t)(b->m * b->n) * sizeof(double));
+        for (i = 0; i < b->m; i++)
+            for (k = b->rowptr[i]; k < b->rowptr[i + 1]; k++) x[i + b->colind[k] * b->m] += b->val[k];
+    } else {
+        for (j = 0; j < b->n; j++)
+            for (i = 0; i < b->m; i++) x[i + j * b->m] = full_get(b, i, j);
+    }
+}
+
+static void fill_report(silc_report *r, const mumps_factor *F)
+{
+    const DMUMPS_STRUC_C *id = &F->id;
+    int len = 0;
+    snprintf(r->method, sizeof r->method, "%s (MUMPS multifrontal, SYM=%d, %s order)",
+             id->sym == 1 ? "LDL' Cholesky" : "LU", (int)id->sym, ordering_name((int)INFOG(id, 7)));
+    r->cond_est = F->cond_est;
+    r->rcond = -1;
+    r->iterations = 0;
+    /* RINFOG(7), (8): backward errors omega1, omega2; (9): forward error
+     * bound; (10), (11): condition numbers cond1, cond2 (ICNTL(11)=1 only). */
+    if (F->analysed)
+        len = snprintf(r->note, sizeof r->note,
+                       "MUMPS error analysis (first solve): omega1 %.2g, omega2 %.2g", F->rinfog[6],
+                       F->rinfog[7]);
+    if (F->analysed && ICNTL(id, 11) == 1 && len < (int)sizeof r->note)
+        len += snprintf(r->note + len, sizeof r->note - (size_t)len,
+                        ", cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9],
+                        F->rinfog[10], F->rinfog[8]);
+    if (F->retries && len < (int)sizeof r->note)
+        len += snprintf(r->note + len, sizeof r->note - (size_t)len,
+                        "%sworkspace raised to ICNTL(14)=%d after %d retr%s", len ? "; " : "",
+                        (int)ICNTL(id, 14), F->retries, F->retries == 1 ? "y" : "ies");
+    if (INFOG(id, 1) > 0 && len < (int)sizeof r->note)
+        snprintf(r->note + len, sizeof r->note - (size_t)len, "%sMUMPS warning INFOG(1)=%d",
+                 len ? "; " : "", (int)INFOG(id, 1));
+}
+
+static int ends_with_spd(const char *cls)
+{
+    size_t n = cls ? strlen(cls) : 0;
+    return n >= 4 && strcmp(cls + n - 4, ".spd") == 0;
+}
+
+static int solve_accepts(const silc_call *call, const char **why)
+{
+    silc_view a;
+    if (call->nin < 2) {
+        *why = "needs a right-hand side";
+        return 0;
+    }
+    host->view(call->in[0], &a);
+    if (a.m != a.n) {
+        *why = "needs a square matrix";
+        return 0;
+    }
+    if (a.n > INT_MAX) {
+        *why = "matrix too large for MUMPS's 32-bit indices";
+        return 0;
+    }
+    if (ends_with_spd(call->op_class) && !host->props(call->in[0])->symmetric) {
+        *why = "SYM=1 needs a symmetric matrix";
+        return 0;
+    }
+    return 1;
+}
+
+static int solve_run(silc_call *call)
+{
+    silc_view a, b, o;
+    silc_report *r = call->report;
+    settings s;
+    mumps_factor *F;
+    silc_value *X;
+    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse;
+    const char *key = sym ? "mumps.ldlt" : "mumps.lu";
+    double t0;
+    const char *why = NULL;
+    if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
+    if ((rc = read_settings(call, &s))) return rc;
+    host->view(call->in[0], &a);
+    host->view(call->in[1], &b);
+    if (b.m != a.n)
+        return host->error(call, SILC_EARG, "mumps: right-hand side has %lld rows, A has %lld",
+                           (long long)b.m, (long long)a.n);
+    if (b.n > INT_MAX)
+        return host->error(call, SILC_EARG, "mumps: too many right-hand sides (%lld)",
+                           (long long)b.n);
+    if (a.n == 0 || b.n == 0) { /* nothing to factor or solve; MUMPS refuses N=0 */
+        call->out = host->dense_new(b.m, b.n);
+        return call->out ? SILC_OK : host->error(call, SILC_ENOMEM, "mumps: out of memory");
+    }
+    F = host->attach_get(call->in[0], key);
+    if (F && same_settings(&F->opts, &s)) {
+        r->reused_factor = 1;
+    } else {
+        if ((rc = factor_new(call, &a, sym, &s, &F))) return rc;
+        if (host->attach_set(call->in[0], key, F, factor_free)) {
+            factor_free(F);
+            return host->error(call, SILC_ENOMEM, "mumps: cannot attach the factorization");
+        }
+        r->factor_seconds = F->factor_seconds;
+    }
+    X = host->dense_new(b.m, b.n);
+    if (!X) return host->error(call, SILC_ENOMEM, "mumps: cannot allocate the %lldx%lld solution",
+                               (long long)b.m, (long long)b.n);
+    host->view(X, &o);
+    t0 = host->now();
+    /* The error analysis runs once per factorization (see the top of the file). */
+    icntl11 = (int)ICNTL(&F->id, 11);
+    analyse = !F->analysed && b.n == 1 && icntl11 > 0;
+    if (!analyse) ICNTL(&F->id, 11) = 0;
+    do dense_copy(&b, o.val);
+    while ((rc = run_solve(call, F, o.val, b.n)) == SOLVE_AGAIN);
+    ICNTL(&F->id, 11) = icntl11;
+    if (!rc && analyse) {
+        F->analysed = 1;
+        memcpy(F->rinfog, F->id.rinfog, sizeof F->rinfog);
+    }
+    if (rc) {
+        host->release(X);
+        return rc;
+    }
+    r->solve_seconds = host->now() - t0;
+    fill_report(r, F);
+    call->out = X;
+    return SILC_OK;
+}
+
+/* ---- tables ----------------------------------------------------------------------- */
+
+static const silc_op_entry mumps_ops[SILC_OP_COUNT] = {
+    [SILC_OP_SOLVE] = {solve_run, solve_accepts},
+};
+
+static const silc_backend mumps_backends[] = {
+    {NULL, "MUMPS " MUMPS_VERSION " sequential multifrontal LU / LDL' (AMF order)", SILC_OP_COUNT,
+     mumps_ops},
+};
+
+/* Sequential MUMPS is threaded only through BLAS: the OpenBLAS it was linked
+ * with, found among this module's own dependencies (RTLD_LOCAL hides it from
+ * a global look-up). */
+static void (*openblas_threads)(int);
+
+static void mumps_set_threads(int n)
+{
+    if (openblas_threads && n > 0) openblas_threads(n);
+}
+
+static silc_plugin mumps_plugin = {
+    SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
+    "mumps", "1.0 MUMPS " MUMPS_VERSION,
+    1, mumps_backends,
+    (int)(sizeof mumps_options / sizeof mumps_options[0]), mumps_options,
+    NULL, /* set_threads: filled in when OpenBLAS is found */
+    NULL,
+};
+
+static void find_openblas(void)
+{
+    Dl_info info;
+    void *self;
+    if (!dladdr(&mumps_plugin, &info) || !info.dli_fname) return;
+    self = dlopen(info.dli_fname, RTLD_NOW | RTLD_LOCAL | RTLD_NOLOAD);
+    if (!self) return;
+    /* dlsym on a handle searches the module and its dependencies. */
+    *(void **)&openblas_threads = dlsym(self, "openblas_set_num_threads");
+    dlclose(self);
+    if (openblas_threads) mumps_plugin.set_threads = mumps_set_threads;
+}
+
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
+                                        const char **errmsg);
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
+                                        const char **errmsg)
+{
+    if (!h || !out) {
+        if (errmsg) *errmsg = "mumps: no host table";
+        return 1;
+    }
+    if (h->abi_major != SILC_ABI_MAJOR || h->struct_size < sizeof(silc_host_api)) {
+        if (errmsg) *errmsg = "mumps: host ABI does not match the one this plugin was built for";
+        return 1;
+    }
+    if (h->index_bytes != (int)sizeof(silc_index)) {
+        if (errmsg) *errmsg = "mumps: host index width differs from the plugin's";
+        return 1;
+    }
+    host = h;
+    find_openblas();
+    *out = &mumps_plugin;
+    return 0;
+}
