@@ -1,0 +1,280 @@
+/*
+ * cholmod.c -- suitesparse.cholmod: symmetric positive definite sparse
+ * systems by CHOLMOD's Cholesky factorization.
+ *
+ *   cholmod_l_analyze    ordering (AMD, METIS when it pays) and the
+ *                        supernodal or simplicial structure of L, chosen by
+ *                        CHOLMOD's default rule; pattern only, so kept in the
+ *                        pattern cache (ss.h) for later values of the pattern;
+ *   cholmod_l_factorize  into a copy of that analysis (or into the factor of
+ *                        a dead value of the same pattern, given back to the
+ *                        cache); the factor is an attachment of A;
+ *   cholmod_l_solve      all right-hand sides at once.
+ * A matrix that is not positive definite (CHOLMOD_NOT_POSDEF) returns
+ * SILC_ENOTSPD and the dispatcher retries the list under the LU class.
+ *
+ * Zero-copy: accepted matrices are symmetric, so the CSR arrays of A (the
+ * compressed columns of A') are the compressed columns of A; stype = 1 tells
+ * CHOLMOD to read the upper triangle and ignore the rest.  All CHOLMOD calls
+ * use the plugin's one cholmod_common, under the plugin lock.
+ */
+#include "ss.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define CH_KEY "suitesparse.cholmod.chol"
+
+typedef struct ch_factor {
+    cholmod_factor *L;
+    ss_symbolic *entry;         /* the analysis L was copied from, or NULL */
+    double rcond, cond;
+    char method[64];
+    char note[160];
+} ch_factor;
+
+static void ch_free_L(void *p)
+{
+    cholmod_factor *L = p;
+    ss_lock();
+    cholmod_l_free_factor(&L, ss_cholmod_common());
+    ss_unlock();
+}
+
+static void ch_factor_free(void *p)
+{
+    ch_factor *F = p;
+    if (!F) return;
+    if (F->L && F->entry) ss_sym_donate(SS_CHOLMOD, F->entry, F->L, ch_free_L);
+    else if (F->L) ch_free_L(F->L);
+    ss_sym_release(F->entry);
+    ss_host->free(F);
+}
+
+int ss_cholmod_accepts(const silc_call *call, const char **why)
+{
+    if (!ss_accepts_csr(call, 1, why)) return 0;
+    if (!ss_ends_with(call->op_class, ".spd")) {
+        *why = "Cholesky only: runs under the solve.*.spd classes";
+        return 0;
+    }
+    if (!ss_host->props(call->in[0])->symmetric) {
+        *why = "needs a symmetric matrix";
+        return 0;
+    }
+    return 1;
+}
+
+/* A's CSR arrays as a symmetric CHOLMOD matrix (no copy). */
+static void ch_sparse(const silc_view *a, cholmod_sparse *A)
+{
+    memset(A, 0, sizeof *A);
+    A->nrow = (size_t)a->n;
+    A->ncol = (size_t)a->m;
+    A->nzmax = (size_t)a->rowptr[a->m];
+    A->p = a->rowptr;
+    A->i = a->colind;
+    A->x = a->val;
+    A->stype = 1;
+    A->itype = CHOLMOD_LONG;
+    A->xtype = CHOLMOD_REAL;
+    A->dtype = CHOLMOD_DOUBLE;
+    A->sorted = 1;
+    A->packed = 1;
+}
+
+static void ch_dense(int64_t n, int64_t k, double *x, cholmod_dense *D)
+{
+    memset(D, 0, sizeof *D);
+    D->nrow = (size_t)n;
+    D->ncol = (size_t)k;
+    D->nzmax = (size_t)(n * k);
+    D->d = (size_t)n;
+    D->x = x;
+    D->xtype = CHOLMOD_REAL;
+    D->dtype = CHOLMOD_DOUBLE;
+}
+
+static int ch_fail(silc_call *call, const char *fn, int status)
+{
+    if (status == CHOLMOD_OUT_OF_MEMORY)
+        return ss_host->error(call, SILC_ENOMEM, "%s: out of memory (status %d)", fn, status);
+    if (status == CHOLMOD_TOO_LARGE)
+        return ss_host->error(call, SILC_ELIB, "%s: integer overflow (status %d)", fn, status);
+    if (status == CHOLMOD_INVALID)
+        return ss_host->error(call, SILC_ELIB, "%s: invalid input (status %d)", fn, status);
+    return ss_host->error(call, SILC_ELIB, "%s: failed (status %d)", fn, status);
+}
+
+/* For the condition estimate (A symmetric: A^{-T} = A^{-1}). */
+static int ch_apply_inv(void *ctx, double *x, int trans)
+{
+    ch_factor *F = ctx;
+    cholmod_common *cc = ss_cholmod_common();
+    cholmod_dense B, *X;
+    int64_t n = (int64_t)F->L->n;
+    int ok;
+    (void)trans;
+    ch_dense(n, 1, x, &B);
+    ss_lock();
+    X = cholmod_l_solve(CHOLMOD_A, F->L, &B, cc);
+    ok = X != NULL;
+    if (ok) memcpy(x, X->x, (size_t)n * sizeof(double));
+    cholmod_l_free_dense(&X, cc);
+    ss_unlock();
+    return ok ? 0 : -1;
+}
+
+static const char *ch_ordering_name(int ordering)
+{
+    switch (ordering) {
+    case CHOLMOD_NATURAL: return "natural";
+    case CHOLMOD_AMD: return "AMD";
+    case CHOLMOD_METIS: return "METIS";
+    case CHOLMOD_NESDIS: return "NESDIS";
+    case CHOLMOD_COLAMD: return "COLAMD";
+    case CHOLMOD_POSTORDERED: return "postordered";
+    default: return "given";
+    }
+}
+
+static int ch_factor_new(silc_call *call, const silc_view *a, int condest, ch_factor **out)
+{
+    cholmod_common *cc = ss_cholmod_common();
+    cholmod_sparse A;
+    cholmod_factor *L = NULL;
+    ch_factor *F;
+    int sym_reused, status, rc, crude = 1;
+    long long minor;
+    *out = NULL;
+    ch_sparse(a, &A);
+    F = ss_host->calloc(1, sizeof *F);
+    if (!F) return ss_nomem(call, "CHOLMOD factor");
+    F->entry = ss_sym_find(SS_CHOLMOD, a, 0);
+    sym_reused = F->entry != NULL;
+    if (F->entry) {
+        L = ss_sym_take_spare(F->entry);
+        if (!L) {
+            ss_lock();
+            L = cholmod_l_copy_factor(F->entry->obj, cc);
+            status = cc->status;
+            ss_unlock();
+            if (!L) {
+                ch_factor_free(F);
+                return ch_fail(call, "cholmod_l_copy_factor", status);
+            }
+        }
+    } else {
+        cholmod_factor *S, *Lc;
+        ss_lock();
+        S = cholmod_l_analyze(&A, cc);
+        status = cc->status;
+        Lc = S ? cholmod_l_copy_factor(S, cc) : NULL;
+        ss_unlock();
+        if (!S) {
+            ch_factor_free(F);
+            return ch_fail(call, "cholmod_l_analyze", status);
+        }
+        F->entry = ss_sym_remember(SS_CHOLMOD, a, 0, S, ch_free_L);
+        if (!F->entry) ch_free_L(S); /* not cached: the copy is all we need */
+        if (!Lc) {
+            ch_factor_free(F);
+            return ch_fail(call, "cholmod_l_copy_factor", CHOLMOD_OUT_OF_MEMORY);
+        }
+        L = Lc;
+    }
+    ss_lock();
+    cholmod_l_factorize(&A, L, cc);
+    status = cc->status;
+    minor = (long long)L->minor;
+    F->L = L;
+    F->rcond = status == CHOLMOD_OK ? cholmod_l_rcond(L, cc) : 0;
+    ss_unlock();
+    if (status == CHOLMOD_NOT_POSDEF) {
+        /* The factor is not donated: only complete factorizations refactor. */
+        ch_free_L(F->L);
+        F->L = NULL;
+        ch_factor_free(F);
+        return ss_host->error(call, SILC_ENOTSPD,
+                              "cholmod_l_factorize: matrix not positive definite (status %d, "
+                              "leading minor of order %lld)",
+                              status, minor + 1);
+    }
+    if (status < CHOLMOD_OK) {
+        rc = ch_fail(call, "cholmod_l_factorize", status);
+        ch_factor_free(F);
+        return rc;
+    }
+    F->cond = F->rcond > 0 ? 1.0 / F->rcond : INFINITY;
+    if (ss_use_condest(condest, F->cond)) {
+        double inv = ss_inv_norm1(a->n, ch_apply_inv, F);
+        if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
+    }
+    snprintf(F->method, sizeof F->method, "sparse Cholesky (CHOLMOD, %s, %s)",
+             L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
+    snprintf(F->note, sizeof F->note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",
+             crude ? "condition estimate is CHOLMOD's crude 1/rcond (diagonal of L)"
+                   : "1-norm condition estimate (Hager/Higham)");
+    *out = F;
+    return SILC_OK;
+}
+
+int ss_cholmod_solve(silc_call *call)
+{
+    cholmod_common *cc = ss_cholmod_common();
+    silc_report *r = call->report;
+    silc_view a, b;
+    ch_factor *F = NULL;
+    cholmod_dense Bh, *X = NULL;
+    double *B, t0;
+    int64_t n, k;
+    int owned, rc, condest, status;
+    ss_host->view(call->in[0], &a);
+    ss_host->view(call->in[1], &b);
+    if (a.format != SILC_FMT_CSR || a.m != a.n) return SILC_EDECLINE;
+    n = a.n;
+    k = b.n;
+    if ((rc = ss_condest_mode(call, &condest))) return rc;
+
+    t0 = ss_host->now();
+    if (n > 0) {
+        F = ss_host->attach_get(call->in[0], CH_KEY);
+        if (F) {
+            r->reused_factor = 1;
+        } else {
+            if ((rc = ch_factor_new(call, &a, condest, &F))) return rc;
+            if (ss_host->attach_set(call->in[0], CH_KEY, F, ch_factor_free)) {
+                ch_factor_free(F);
+                return ss_nomem(call, "attaching the CHOLMOD factor");
+            }
+        }
+    }
+    r->factor_seconds = ss_host->now() - t0;
+
+    t0 = ss_host->now();
+    if (n == 0 || k == 0) {
+        call->out = ss_host->dense_new(n, k);
+        return call->out ? SILC_OK : ss_nomem(call, "CHOLMOD result");
+    }
+    B = ss_rhs_dense(&b, 0, &owned);
+    if (!B) return ss_nomem(call, "CHOLMOD right-hand side");
+    ch_dense(n, k, B, &Bh);
+    ss_lock();
+    X = cholmod_l_solve(CHOLMOD_A, F->L, &Bh, cc);
+    status = cc->status;
+    ss_unlock();
+    if (owned) ss_host->free(B);
+    if (!X) return ch_fail(call, "cholmod_l_solve", status);
+    call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
+    ss_lock();
+    cholmod_l_free_dense(&X, cc);
+    ss_unlock();
+    if (!call->out) return ss_nomem(call, "CHOLMOD result");
+    r->solve_seconds = ss_host->now() - t0;
+    snprintf(r->method, sizeof r->method, "%s", F->method);
+    r->rcond = F->rcond;
+    r->cond_est = F->cond;
+    snprintf(r->note, sizeof r->note, "%s", F->note);
+    return SILC_OK;
+}

@@ -1,0 +1,123 @@
+/*
+ * ss.h -- what the four SuiteSparse backends of the plugin share.
+ *
+ *   suitesparse.c  plugin table, init/shutdown (reference-counted: every
+ *                  context that loads the module calls init once), threads
+ *   ss_common.c    operands (views, right-hand sides, results), the
+ *                  pattern-keyed cache of symbolic analyses, the lock, the
+ *                  one cholmod_common, the Hager/Higham condition estimator
+ *   umfpack.c      UMFPACK: general sparse LU
+ *   cholmod.c      CHOLMOD: sparse Cholesky under the .spd classes
+ *   klu.c          KLU: sparse LU for circuit-like matrices, fast refactor
+ *   spqr.c         SuiteSparseQR: rectangular least squares
+ *
+ * Zero-copy: a CSR value of A is, array for array, the compressed-column form
+ * of A'.  UMFPACK and KLU factor that A' in place and solve with the
+ * transposed system (UMFPACK_At, klu_l_tsolve); CHOLMOD reads a symmetric A,
+ * which is its own transpose.  Only SPQR needs A itself and transposes.
+ */
+#ifndef SS_H
+#define SS_H
+
+#include "silc_plugin.h"
+
+#include <SuiteSparse_config.h>
+#include <cholmod.h>
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* SuiteSparse's 64-bit entry points (umfpack_dl_, klu_l_, cholmod_l_) take
+ * SuiteSparse_long arrays; SILC's CSR arrays are passed to them unchanged. */
+_Static_assert(sizeof(SuiteSparse_long) == sizeof(silc_index),
+               "SuiteSparse_long must be as wide as silc_index");
+
+extern const silc_host_api *ss_host;
+
+/* ---- suitesparse.c: the backends' ops (one accepts + run per library) ------- */
+int ss_umfpack_accepts(const silc_call *call, const char **why);
+int ss_umfpack_solve(silc_call *call);
+int ss_cholmod_accepts(const silc_call *call, const char **why);
+int ss_cholmod_solve(silc_call *call);
+int ss_klu_accepts(const silc_call *call, const char **why);
+int ss_klu_solve(silc_call *call);
+int ss_spqr_accepts(const silc_call *call, const char **why);
+int ss_spqr_solve(silc_call *call);
+
+/* ---- ss_common.c ------------------------------------------------------------ */
+int ss_start(void);                 /* 0 on success; starts the cholmod_common */
+void ss_finish(void);               /* frees caches, finishes the cholmod_common */
+void ss_lock(void);                 /* guards the shared state below */
+void ss_unlock(void);
+cholmod_common *ss_cholmod_common(void); /* use only between ss_lock / ss_unlock */
+
+int ss_nomem(silc_call *call, const char *what);
+int ss_ends_with(const char *s, const char *suffix);
+/* Shared accepts: A must be CSR (and square when square is set). */
+int ss_accepts_csr(const silc_call *call, int square, const char **why);
+
+/* The right-hand side as a dense column-major m x k array.  A dense B is
+ * borrowed (*owned = 0) unless writable is set; anything else is copied. */
+double *ss_rhs_dense(const silc_view *b, int writable, int *owned);
+/* A new dense m x k value filled from x (column-major, leading dimension ld). */
+silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld);
+
+/*
+ * The plugin option "condest" decides when the Hager/Higham 1-norm estimate
+ * (ss_inv_norm1, about ten extra solves) replaces the libraries' cheap pivot
+ * ratio, which can miss ill-conditioning by orders of magnitude:
+ *   auto (default)  when the cheap estimate exceeds SS_CONDEST_AUTO, so a
+ *                   well-conditioned system pays nothing and a suspicious one
+ *                   gets a number SILC's singularity warning can trust;
+ *   true / false    always / never.
+ * ss_condest_mode gives SS_CONDEST_*; ss_use_condest applies it to a cheap cond.
+ */
+enum { SS_CONDEST_AUTO = 0, SS_CONDEST_ALWAYS, SS_CONDEST_NEVER };
+#define SS_CONDEST_AUTO_ABOVE 1e6
+int ss_condest_mode(silc_call *call, int *mode);
+int ss_use_condest(int mode, double cheap_cond);
+
+/* Estimate of ||A^{-1}||_1 for an n x n A given by solves with A (trans = 0)
+ * and A' (trans = 1) in place on x; about 5 pairs of solves.  -1 on failure. */
+double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), void *ctx);
+
+/*
+ * Symbolic analyses keyed by sparsity pattern.  A time loop that builds a new
+ * matrix with the same pattern each step (A = K + dt*M) gets a new value, so
+ * the attachment of the old one is no help; the last symbolic object of each
+ * backend is kept here with an exact copy of the pattern it was made for and
+ * handed to the next value whose pattern matches (hash first, then memcmp).
+ * Entries are reference-counted: the cache holds one reference and every
+ * factorization that needs its symbolic object (KLU's) holds another.  An
+ * entry may also keep one spare numeric object donated by a factorization
+ * whose value died, so KLU can refactor into it without pivoting.
+ */
+enum { SS_UMFPACK = 0, SS_CHOLMOD, SS_KLU, SS_NCACHE };
+
+typedef struct ss_symbolic {
+    int refs;
+    int tag;                    /* backend variant the analysis was made for */
+    int64_t m, n, nnz;
+    uint64_t hash;
+    silc_index *rowptr, *colind;
+    void *obj;                  /* the library's symbolic object */
+    void (*destroy)(void *obj);
+    void *spare;                /* a donated numeric object, or NULL */
+    void (*spare_destroy)(void *spare);
+} ss_symbolic;
+
+/* A retained entry of cache slot whose pattern equals a's and tag matches, or NULL. */
+ss_symbolic *ss_sym_find(int slot, const silc_view *a, int tag);
+/* A new entry (one reference, the caller's) owning obj, remembered in slot
+ * (replacing the previous one).  NULL on allocation failure: obj is then
+ * still the caller's. */
+ss_symbolic *ss_sym_remember(int slot, const silc_view *a, int tag, void *obj,
+                             void (*destroy)(void *obj));
+void ss_sym_release(ss_symbolic *e);
+/* Takes the spare numeric object out of e (NULL if none). */
+void *ss_sym_take_spare(ss_symbolic *e);
+/* Offers a numeric object made from e's analysis to e; destroys it with
+ * spare_destroy when e already has one or is no longer in the cache. */
+void ss_sym_donate(int slot, ss_symbolic *e, void *spare, void (*spare_destroy)(void *));
+
+#endif

@@ -1,0 +1,287 @@
+/*
+ * ss_common.c -- helpers the four SuiteSparse backends share.
+ *
+ * Operands (accept tests, right-hand sides, results), the one cholmod_common
+ * of the plugin and the lock that guards it, the pattern-keyed cache of
+ * symbolic analyses (see ss.h for why it exists), and a Hager/Higham 1-norm
+ * condition estimator for the "condest" option.  The plugin state is per
+ * process, while SILC calls a context from one thread at a time: two
+ * contexts in two threads may call in together, hence the lock.
+ */
+#include "ss.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stddef.h>
+#include <string.h>
+
+static pthread_mutex_t ss_mutex = PTHREAD_MUTEX_INITIALIZER;
+static cholmod_common ss_cc;
+static ss_symbolic *ss_cache[SS_NCACHE];
+
+void ss_lock(void)
+{
+    pthread_mutex_lock(&ss_mutex);
+}
+
+void ss_unlock(void)
+{
+    pthread_mutex_unlock(&ss_mutex);
+}
+
+cholmod_common *ss_cholmod_common(void)
+{
+    return &ss_cc;
+}
+
+int ss_start(void)
+{
+    if (!cholmod_l_start(&ss_cc)) return -1;
+    /* CHOLMOD prints its errors and warnings (print level 3) by default; SILC
+     * reports them as statuses instead, so keep it quiet. */
+    ss_cc.print = 0;
+    ss_cc.error_handler = NULL;
+    /* Keep L in LL' form, also when CHOLMOD picks a simplicial factorization:
+     * its LDL' would go through an indefinite matrix without a complaint,
+     * and the .spd classes rely on Cholesky failing there. */
+    ss_cc.final_ll = 1;
+    return 0;
+}
+
+void ss_finish(void)
+{
+    int s;
+    ss_lock();
+    for (s = 0; s < SS_NCACHE; s++) {
+        ss_symbolic *e = ss_cache[s];
+        ss_cache[s] = NULL;
+        if (e) {
+            ss_unlock();
+            ss_sym_release(e);
+            ss_lock();
+        }
+    }
+    cholmod_l_finish(&ss_cc);
+    ss_unlock();
+}
+
+int ss_nomem(silc_call *call, const char *what)
+{
+    return ss_host->error(call, SILC_ENOMEM, "suitesparse: out of memory (%s)", what);
+}
+
+int ss_ends_with(const char *s, const char *suffix)
+{
+    size_t a, b;
+    if (!s) return 0;
+    a = strlen(s);
+    b = strlen(suffix);
+    return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+int ss_accepts_csr(const silc_call *call, int square, const char **why)
+{
+    silc_view a;
+    if (call->nin < 2) {
+        *why = "needs a matrix and a right-hand side";
+        return 0;
+    }
+    ss_host->view(call->in[0], &a);
+    if (a.format != SILC_FMT_CSR) {
+        *why = "needs a sparse (CSR) matrix";
+        return 0;
+    }
+    if (square && a.m != a.n) {
+        *why = "needs a square matrix";
+        return 0;
+    }
+    return 1;
+}
+
+/* ---- operands --------------------------------------------------------------- */
+
+double *ss_rhs_dense(const silc_view *b, int writable, int *owned)
+{
+    int64_t m = b->m, k = b->n, i, j;
+    size_t len = (size_t)(m > 0 ? m : 1) * (size_t)(k > 0 ? k : 1);
+    double *x;
+    *owned = 0;
+    if (b->format == SILC_FMT_DENSE && !writable) return b->val;
+    x = ss_host->calloc(len, sizeof(double));
+    if (!x) return NULL;
+    *owned = 1;
+    if (b->format == SILC_FMT_DENSE) {
+        if (m > 0 && k > 0) memcpy(x, b->val, (size_t)(m * k) * sizeof(double));
+    } else if (b->format == SILC_FMT_CSR) {
+        for (i = 0; i < m; i++)
+            for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) x[i + b->colind[j] * m] += b->val[j];
+    } else {
+        for (j = 0; j < k; j++) {
+            int64_t lo = j - b->ku > 0 ? j - b->ku : 0;
+            int64_t hi = j + b->kl + 1 < m ? j + b->kl + 1 : m;
+            for (i = lo; i < hi; i++) x[i + j * m] = b->val[(b->ku + i - j) + j * b->ld];
+        }
+    }
+    return x;
+}
+
+silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld)
+{
+    silc_value *out = ss_host->dense_new(m, k);
+    silc_view o;
+    int64_t j;
+    if (!out) return NULL;
+    ss_host->view(out, &o);
+    for (j = 0; j < k && m > 0; j++) memcpy(o.val + j * m, x + j * ld, (size_t)m * sizeof(double));
+    return out;
+}
+
+int ss_condest_mode(silc_call *call, int *mode)
+{
+    const char *v = ss_host->option_string(call, "condest", "auto");
+    if (!strcmp(v, "auto")) *mode = SS_CONDEST_AUTO;
+    else if (!strcmp(v, "true") || !strcmp(v, "on") || !strcmp(v, "yes") || !strcmp(v, "1"))
+        *mode = SS_CONDEST_ALWAYS;
+    else if (!strcmp(v, "false") || !strcmp(v, "off") || !strcmp(v, "no") || !strcmp(v, "0"))
+        *mode = SS_CONDEST_NEVER;
+    else
+        return ss_host->error(call, SILC_EARG,
+                              "option 'suitesparse.condest' expects auto, true or false, got '%s'", v);
+    return SILC_OK;
+}
+
+int ss_use_condest(int mode, double cheap_cond)
+{
+    if (mode == SS_CONDEST_AUTO) return !(cheap_cond <= SS_CONDEST_AUTO_ABOVE); /* NaN, Inf too */
+    return mode == SS_CONDEST_ALWAYS;
+}
+
+/* ---- condition estimate ------------------------------------------------------ */
+
+/* The host lends the Hager-Higham estimator (ABI 1.1); this adapter lets the
+ * backends keep their in-place solve callbacks. */
+typedef struct ss_est {
+    int (*solve)(void *ctx, double *x, int trans);
+    void *ctx;
+} ss_est;
+
+static int ss_apply(void *ctx, double *x, int trans, double *work)
+{
+    const ss_est *e = ctx;
+    (void)work;
+    return e->solve(e->ctx, x, trans);
+}
+
+double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), void *ctx)
+{
+    ss_est e = {solve, ctx};
+    if (ss_host->struct_size < offsetof(silc_host_api, inv_norm1_est) + sizeof ss_host->inv_norm1_est)
+        return -1; /* an ABI 1.0 host lends no estimator */
+    return ss_host->inv_norm1_est(n, ss_apply, &e, NULL);
+}
+
+/* ---- the symbolic cache ------------------------------------------------------ */
+
+static uint64_t pattern_hash(const silc_view *a)
+{
+    /* FNV-1a over the index arrays: a quick reject before the exact compare. */
+    uint64_t h = 1469598103934665603ull;
+    int64_t i;
+    for (i = 0; i <= a->m; i++) h = (h ^ (uint64_t)a->rowptr[i]) * 1099511628211ull;
+    for (i = 0; i < a->rowptr[a->m]; i++) h = (h ^ (uint64_t)a->colind[i]) * 1099511628211ull;
+    return h;
+}
+
+static int same_pattern(const ss_symbolic *e, const silc_view *a, int tag, uint64_t h)
+{
+    int64_t nnz = a->rowptr[a->m];
+    return e->tag == tag && e->m == a->m && e->n == a->n && e->nnz == nnz && e->hash == h &&
+           memcmp(e->rowptr, a->rowptr, (size_t)(a->m + 1) * sizeof(silc_index)) == 0 &&
+           (nnz == 0 || memcmp(e->colind, a->colind, (size_t)nnz * sizeof(silc_index)) == 0);
+}
+
+static void sym_free(ss_symbolic *e)
+{
+    if (e->spare) e->spare_destroy(e->spare);
+    if (e->obj) e->destroy(e->obj);
+    ss_host->free(e->rowptr);
+    ss_host->free(e->colind);
+    ss_host->free(e);
+}
+
+ss_symbolic *ss_sym_find(int slot, const silc_view *a, int tag)
+{
+    uint64_t h = pattern_hash(a);
+    ss_symbolic *e;
+    ss_lock();
+    e = ss_cache[slot];
+    if (e && same_pattern(e, a, tag, h)) e->refs++;
+    else e = NULL;
+    ss_unlock();
+    return e;
+}
+
+ss_symbolic *ss_sym_remember(int slot, const silc_view *a, int tag, void *obj,
+                             void (*destroy)(void *obj))
+{
+    int64_t nnz = a->rowptr[a->m];
+    ss_symbolic *e = ss_host->calloc(1, sizeof *e), *old;
+    if (!e) return NULL;
+    e->rowptr = ss_host->alloc((size_t)(a->m + 1) * sizeof(silc_index));
+    e->colind = ss_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(silc_index));
+    if (!e->rowptr || !e->colind) {
+        ss_host->free(e->rowptr);
+        ss_host->free(e->colind);
+        ss_host->free(e);
+        return NULL;
+    }
+    memcpy(e->rowptr, a->rowptr, (size_t)(a->m + 1) * sizeof(silc_index));
+    if (nnz) memcpy(e->colind, a->colind, (size_t)nnz * sizeof(silc_index));
+    e->tag = tag;
+    e->m = a->m;
+    e->n = a->n;
+    e->nnz = nnz;
+    e->hash = pattern_hash(a);
+    e->obj = obj;
+    e->destroy = destroy;
+    e->refs = 2; /* the cache's and the caller's */
+    ss_lock();
+    old = ss_cache[slot];
+    ss_cache[slot] = e;
+    ss_unlock();
+    if (old) ss_sym_release(old);
+    return e;
+}
+
+void ss_sym_release(ss_symbolic *e)
+{
+    int last;
+    if (!e) return;
+    ss_lock();
+    last = --e->refs == 0;
+    ss_unlock();
+    if (last) sym_free(e);
+}
+
+void *ss_sym_take_spare(ss_symbolic *e)
+{
+    void *s;
+    ss_lock();
+    s = e->spare;
+    e->spare = NULL;
+    ss_unlock();
+    return s;
+}
+
+void ss_sym_donate(int slot, ss_symbolic *e, void *spare, void (*spare_destroy)(void *))
+{
+    int kept = 0;
+    ss_lock();
+    if (ss_cache[slot] == e && !e->spare) {
+        e->spare = spare;
+        e->spare_destroy = spare_destroy;
+        kept = 1;
+    }
+    ss_unlock();
+    if (!kept) spare_destroy(spare);
+}

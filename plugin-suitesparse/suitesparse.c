@@ -1,0 +1,138 @@
+/*
+ * suitesparse.c -- the SuiteSparse plugin: four backends, one per library.
+ *
+ *   suitesparse.umfpack  general sparse LU          solve.sparse (and .spd)
+ *   suitesparse.cholmod  supernodal sparse Cholesky solve.sparse.spd
+ *   suitesparse.klu      LU for circuit matrices    solve.sparse
+ *   suitesparse.spqr     sparse QR, least squares   solve.rect
+ *
+ * SILC runs init once per context that loads the module and shutdown once per
+ * context closed, while dlopen shares one copy of the module: so the library
+ * state (one cholmod_common, the symbolic caches) is started by the first
+ * init and finished by the last shutdown.
+ *
+ * Threads: UMFPACK, CHOLMOD and SPQR spend their time in BLAS, which is
+ * OpenBLAS here (Debian's libblas.so.3 alternative).  set_threads finds
+ * openblas_set_num_threads in the BLAS our libraries already loaded and calls
+ * it; with another BLAS the call is a no-op.  KLU is sequential.
+ */
+#define _GNU_SOURCE /* RTLD_DEFAULT, RTLD_NOLOAD */
+#include "ss.h"
+
+#include <dlfcn.h>
+#include <pthread.h>
+#include <string.h>
+
+const silc_host_api *ss_host;
+
+/* Contexts holding the module (init minus shutdown), under users_mutex. */
+static int ss_users;
+static pthread_mutex_t users_mutex = PTHREAD_MUTEX_INITIALIZER;
+
+#define SS_STR2(x) #x
+#define SS_STR(x) SS_STR2(x)
+#define SS_VERSION                                                                            \
+    "1.0 SuiteSparse " SS_STR(SUITESPARSE_MAIN_VERSION) "." SS_STR(SUITESPARSE_SUB_VERSION) "." \
+        SS_STR(SUITESPARSE_SUBSUB_VERSION)
+
+static const silc_op_entry umfpack_ops[SILC_OP_COUNT] = {
+    [SILC_OP_SOLVE] = {ss_umfpack_solve, ss_umfpack_accepts}};
+static const silc_op_entry cholmod_ops[SILC_OP_COUNT] = {
+    [SILC_OP_SOLVE] = {ss_cholmod_solve, ss_cholmod_accepts}};
+static const silc_op_entry klu_ops[SILC_OP_COUNT] = {
+    [SILC_OP_SOLVE] = {ss_klu_solve, ss_klu_accepts}};
+static const silc_op_entry spqr_ops[SILC_OP_COUNT] = {
+    [SILC_OP_SOLVE] = {ss_spqr_solve, ss_spqr_accepts}};
+
+static const silc_backend ss_backends[] = {
+    {"umfpack", "UMFPACK multifrontal sparse LU (square sparse systems)", SILC_OP_COUNT,
+     umfpack_ops},
+    {"cholmod", "CHOLMOD supernodal sparse Cholesky (symmetric positive definite)",
+     SILC_OP_COUNT, cholmod_ops},
+    {"klu", "KLU sparse LU for circuit-like matrices, fast refactor", SILC_OP_COUNT, klu_ops},
+    {"spqr", "SuiteSparseQR multifrontal sparse QR (least squares, rank-revealing)",
+     SILC_OP_COUNT, spqr_ops},
+};
+
+static const silc_option_spec ss_options[] = {
+    {"condest", SILC_OPT_STRING, "auto",
+     "1-norm condition estimate by Hager/Higham (about 10 extra solves per factorization) "
+     "instead of the libraries' cheap pivot ratio: auto (when the cheap one exceeds 1e6), "
+     "true, false"},
+    {"umfpack_irstep", SILC_OPT_INT, "2", "UMFPACK: maximum steps of iterative refinement"},
+    {"spqr_tol", SILC_OPT_DOUBLE, "-2",
+     "SPQR: columns of 2-norm <= tol count as zero (rank detection); -2 = SPQR's default "
+     "20*(m+n)*eps*max column norm, -1 = none"},
+};
+
+/* openblas_set_num_threads of the BLAS our libraries loaded, or NULL.  The
+ * module is loaded RTLD_LOCAL, so its BLAS is not in the global scope: look
+ * it up by its SONAME with RTLD_NOLOAD (which never loads anything new). */
+static void (*blas_set_threads)(int);
+
+static void find_blas_threads(void)
+{
+    static const char *const sonames[] = {"libblas.so.3", "libopenblas.so.0", NULL};
+    void *sym = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+    int i;
+    for (i = 0; !sym && sonames[i]; i++) {
+        void *h = dlopen(sonames[i], RTLD_LAZY | RTLD_LOCAL | RTLD_NOLOAD);
+        if (!h) continue;
+        sym = dlsym(h, "openblas_set_num_threads");
+        dlclose(h); /* drops only the reference RTLD_NOLOAD added */
+    }
+    if (sym) memcpy(&blas_set_threads, &sym, sizeof blas_set_threads);
+    ss_host->log(3, "suitesparse: openblas_set_num_threads %s", sym ? "found: set_threads controls BLAS"
+                                                               : "not found: set_threads does nothing");
+}
+
+static void ss_set_threads(int nthreads)
+{
+    if (nthreads < 1) return;
+    if (blas_set_threads) blas_set_threads(nthreads);
+}
+
+static void ss_shutdown(void)
+{
+    pthread_mutex_lock(&users_mutex);
+    if (ss_users > 0 && --ss_users == 0) ss_finish();
+    pthread_mutex_unlock(&users_mutex);
+}
+
+static const silc_plugin ss_plugin = {
+    SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
+    "suitesparse", SS_VERSION,
+    (int)(sizeof ss_backends / sizeof ss_backends[0]), ss_backends,
+    (int)(sizeof ss_options / sizeof ss_options[0]), ss_options,
+    ss_set_threads, ss_shutdown,
+};
+
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
+                                        const char **errmsg);
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
+                                        const char **errmsg)
+{
+    if (!h || !out) {
+        if (errmsg) *errmsg = "suitesparse: no host table";
+        return 1;
+    }
+    if (h->abi_major != SILC_ABI_MAJOR || h->index_bytes != (int)sizeof(silc_index) ||
+        h->struct_size < offsetof(silc_host_api, threads) + sizeof h->threads) {
+        if (errmsg) *errmsg = "suitesparse: host ABI does not match the one this plugin was built for";
+        return 1;
+    }
+    pthread_mutex_lock(&users_mutex);
+    if (ss_users == 0) {
+        ss_host = h;
+        if (ss_start()) {
+            pthread_mutex_unlock(&users_mutex);
+            if (errmsg) *errmsg = "suitesparse: cholmod_l_start failed";
+            return 1;
+        }
+        find_blas_threads();
+    }
+    ss_users++;
+    pthread_mutex_unlock(&users_mutex);
+    *out = &ss_plugin;
+    return 0;
+}

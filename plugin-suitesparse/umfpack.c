@@ -1,0 +1,293 @@
+/*
+ * umfpack.c -- suitesparse.umfpack: general square sparse systems by UMFPACK.
+ *
+ * The analyze / factor / solve split of UMFPACK maps onto SILC's reuse rules:
+ *   umfpack_dl_symbolic  ordering and symbolic analysis, pattern only: kept in
+ *                        the pattern cache, so a new value with the same
+ *                        pattern (A = K + dt*M each step) skips it;
+ *   umfpack_dl_numeric   the LU factors: an attachment of the value A, so
+ *                        u = A \ b in a loop factors once;
+ *   umfpack_dl_wsolve    per right-hand side, with UMFPACK's iterative
+ *                        refinement.
+ * Zero-copy: the CSR arrays of A are the compressed columns of A', which is
+ * what UMFPACK factors; umfpack_dl_wsolve(UMFPACK_At) then solves
+ * (A')' x = A x = b, and its refinement reads the same arrays.
+ *
+ * The condition number reported is 1 / Info[UMFPACK_RCOND], UMFPACK's ratio
+ * of the smallest to the largest pivot: free, but crude (it can miss
+ * ill-conditioning by orders of magnitude).  When it is large (or always,
+ * per the option suitesparse.condest) a Hager/Higham 1-norm estimate
+ * replaces it; rcond stays UMFPACK's.
+ */
+#include "ss.h"
+
+#include <umfpack.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define UM_KEY "suitesparse.umfpack.lu"
+
+/* The cached symbolic object with the description of the method it chose. */
+typedef struct um_symbolic {
+    void *symbolic;
+    char method[64];
+} um_symbolic;
+
+typedef struct um_factor {
+    void *numeric;
+    double rcond, cond;
+    int crude;                  /* cond is 1/rcond, not Hager/Higham's estimate */
+    char method[64];
+    char note[128];
+} um_factor;
+
+static void um_symbolic_free(void *p)
+{
+    um_symbolic *s = p;
+    if (!s) return;
+    umfpack_dl_free_symbolic(&s->symbolic);
+    ss_host->free(s);
+}
+
+static void um_factor_free(void *p)
+{
+    um_factor *F = p;
+    if (!F) return;
+    if (F->numeric) umfpack_dl_free_numeric(&F->numeric);
+    ss_host->free(F);
+}
+
+static const char *um_status_text(int status)
+{
+    switch (status) {
+    case UMFPACK_WARNING_singular_matrix: return "singular matrix";
+    case UMFPACK_ERROR_out_of_memory: return "out of memory";
+    case UMFPACK_ERROR_invalid_matrix: return "invalid matrix";
+    case UMFPACK_ERROR_different_pattern: return "pattern differs from the symbolic analysis";
+    case UMFPACK_ERROR_ordering_failed: return "ordering failed";
+    case UMFPACK_ERROR_internal_error: return "internal error";
+    default: return "failed";
+    }
+}
+
+static int um_fail(silc_call *call, const char *fn, int status)
+{
+    int st = status == UMFPACK_WARNING_singular_matrix ? SILC_ESINGULAR
+             : status == UMFPACK_ERROR_out_of_memory  ? SILC_ENOMEM
+                                                      : SILC_ELIB;
+    return ss_host->error(call, st, "%s: %s (status %d)", fn, um_status_text(status), status);
+}
+
+int ss_umfpack_accepts(const silc_call *call, const char **why)
+{
+    return ss_accepts_csr(call, 1, why);
+}
+
+/* For the condition estimate: x := A^{-1} x or A^{-T} x, without refinement. */
+typedef struct um_apply {
+    const silc_view *a;
+    void *numeric;
+    double *y, *w;
+    SuiteSparse_long *wi;
+    double control[UMFPACK_CONTROL];
+} um_apply;
+
+static int um_apply_inv(void *ctx, double *x, int trans)
+{
+    um_apply *u = ctx;
+    double info[UMFPACK_INFO];
+    int64_t n = u->a->n;
+    /* The factors are of A', so A^{-1} is the UMFPACK_At system. */
+    int sys = trans ? UMFPACK_A : UMFPACK_At;
+    int st = (int)umfpack_dl_wsolve(sys, u->a->rowptr, u->a->colind, u->a->val, u->y, x,
+                                    u->numeric, u->control, info, u->wi, u->w);
+    if (st < 0) return -1;
+    memcpy(x, u->y, (size_t)n * sizeof(double));
+    return 0;
+}
+
+static double um_condest(const silc_view *a, void *numeric, double norm1)
+{
+    um_apply u;
+    double inv = -1;
+    int64_t n = a->n;
+    u.a = a;
+    u.numeric = numeric;
+    umfpack_dl_defaults(u.control);
+    u.control[UMFPACK_IRSTEP] = 0;
+    u.y = ss_host->alloc((size_t)n * 2 * sizeof(double));
+    u.wi = ss_host->alloc((size_t)n * sizeof(SuiteSparse_long));
+    if (u.y && u.wi) {
+        u.w = u.y + n;
+        inv = ss_inv_norm1(n, um_apply_inv, &u);
+    }
+    ss_host->free(u.y);
+    ss_host->free(u.wi);
+    return inv < 0 ? -1 : norm1 * inv;
+}
+
+static const char *um_ordering_name(double strategy, double ordering)
+{
+    int sym = (int)strategy == UMFPACK_STRATEGY_SYMMETRIC;
+    switch ((int)ordering) {
+    case UMFPACK_ORDERING_AMD: return sym ? "AMD" : "COLAMD";
+    case UMFPACK_ORDERING_METIS: return "METIS";
+    case UMFPACK_ORDERING_CHOLMOD: return sym ? "AMD/METIS" : "COLAMD/METIS";
+    case UMFPACK_ORDERING_NONE: return "natural";
+    default: return "given";
+    }
+}
+
+/* Symbolic analysis: from the cache, or made and remembered. */
+static int um_analyze(silc_call *call, const silc_view *a, int tag, const double *control,
+                      ss_symbolic **entry, um_symbolic **local, int *reused)
+{
+    double info[UMFPACK_INFO];
+    um_symbolic *s;
+    int st;
+    *entry = ss_sym_find(SS_UMFPACK, a, tag);
+    *local = NULL;
+    *reused = *entry != NULL;
+    if (*entry) return SILC_OK;
+    s = ss_host->calloc(1, sizeof *s);
+    if (!s) return ss_nomem(call, "UMFPACK symbolic");
+    /* Ax = NULL: UMFPACK reads values at this stage only for statistics, and a
+     * pattern-only analysis is what the cache may hand to other values. */
+    st = (int)umfpack_dl_symbolic(a->n, a->m, a->rowptr, a->colind, NULL, &s->symbolic, control,
+                                  info);
+    if (st != UMFPACK_OK) {
+        ss_host->free(s);
+        return um_fail(call, "umfpack_dl_symbolic", st);
+    }
+    snprintf(s->method, sizeof s->method, "sparse LU (UMFPACK, %s strategy, %s)",
+             (int)info[UMFPACK_STRATEGY_USED] == UMFPACK_STRATEGY_SYMMETRIC ? "symmetric"
+                                                                           : "unsymmetric",
+             um_ordering_name(info[UMFPACK_STRATEGY_USED], info[UMFPACK_ORDERING_USED]));
+    *entry = ss_sym_remember(SS_UMFPACK, a, tag, s, um_symbolic_free);
+    if (!*entry) *local = s; /* not cached: used once and freed by the caller */
+    return SILC_OK;
+}
+
+static int um_factor_new(silc_call *call, const silc_view *a, int tag, int condest,
+                         um_factor **out)
+{
+    double control[UMFPACK_CONTROL], info[UMFPACK_INFO];
+    ss_symbolic *entry;
+    um_symbolic *local, *s;
+    um_factor *F;
+    int reused, st, rc;
+    *out = NULL;
+    umfpack_dl_defaults(control);
+    control[UMFPACK_STRATEGY] = tag;
+    rc = um_analyze(call, a, tag, control, &entry, &local, &reused);
+    if (rc) return rc;
+    s = entry ? entry->obj : local;
+    F = ss_host->calloc(1, sizeof *F);
+    if (!F) {
+        rc = ss_nomem(call, "UMFPACK factor");
+        goto done;
+    }
+    st = (int)umfpack_dl_numeric(a->rowptr, a->colind, a->val, s->symbolic, &F->numeric, control,
+                                 info);
+    if (st != UMFPACK_OK) {
+        /* UMFPACK_WARNING_singular_matrix still returns factors (with a zero
+         * pivot); a solve with them divides by zero, so it is an error here. */
+        rc = um_fail(call, "umfpack_dl_numeric", st);
+        um_factor_free(F);
+        goto done;
+    }
+    F->rcond = info[UMFPACK_RCOND];
+    F->cond = F->rcond > 0 ? 1.0 / F->rcond : INFINITY;
+    F->crude = 1;
+    if (ss_use_condest(condest, F->cond)) {
+        double c = um_condest(a, F->numeric, ss_host->props(call->in[0])->norm1);
+        if (c >= 0) F->cond = c, F->crude = 0;
+    }
+    snprintf(F->method, sizeof F->method, "%s", s->method);
+    snprintf(F->note, sizeof F->note, "%s%s",
+             reused ? "symbolic analysis reused (same pattern); " : "",
+             F->crude ? "condition estimate is UMFPACK's crude 1/rcond (pivot ratio)"
+                      : "1-norm condition estimate (Hager/Higham)");
+    *out = F;
+done:
+    if (local) um_symbolic_free(local);
+    ss_sym_release(entry);
+    return rc;
+}
+
+int ss_umfpack_solve(silc_call *call)
+{
+    silc_report *r = call->report;
+    silc_view a, b;
+    um_factor *F;
+    double control[UMFPACK_CONTROL], info[UMFPACK_INFO], *B = NULL, *X = NULL, *W = NULL, t0;
+    SuiteSparse_long *Wi = NULL;
+    int64_t n, k, j, irstep;
+    int owned = 0, rc, condest, st;
+    ss_host->view(call->in[0], &a);
+    ss_host->view(call->in[1], &b);
+    if (a.format != SILC_FMT_CSR || a.m != a.n) return SILC_EDECLINE;
+    n = a.n;
+    k = b.n;
+    if ((rc = ss_condest_mode(call, &condest))) return rc;
+    if ((rc = ss_host->option_int(call, "umfpack_irstep", 2, &irstep))) return rc;
+
+    t0 = ss_host->now();
+    F = n > 0 ? ss_host->attach_get(call->in[0], UM_KEY) : NULL;
+    if (F) {
+        r->reused_factor = 1;
+    } else if (n > 0) {
+        /* Under a .spd class the matrix is symmetric with a positive
+         * diagonal: UMFPACK's symmetric strategy (AMD on A+A', diagonal
+         * pivots preferred) fits it. */
+        int tag = ss_ends_with(call->op_class, ".spd") ? UMFPACK_STRATEGY_SYMMETRIC
+                                                       : UMFPACK_STRATEGY_AUTO;
+        if ((rc = um_factor_new(call, &a, tag, condest, &F))) return rc;
+        if (ss_host->attach_set(call->in[0], UM_KEY, F, um_factor_free)) {
+            um_factor_free(F);
+            return ss_nomem(call, "attaching the UMFPACK factors");
+        }
+    }
+    r->factor_seconds = ss_host->now() - t0;
+
+    t0 = ss_host->now();
+    B = ss_rhs_dense(&b, 0, &owned);
+    X = ss_host->alloc((size_t)(n > 0 ? n : 1) * (size_t)(k > 0 ? k : 1) * sizeof(double));
+    W = ss_host->alloc((size_t)(n > 0 ? n : 1) * 5 * sizeof(double));
+    Wi = ss_host->alloc((size_t)(n > 0 ? n : 1) * sizeof(SuiteSparse_long));
+    if (!B || !X || !W || !Wi) {
+        rc = ss_nomem(call, "UMFPACK solve");
+        goto done;
+    }
+    umfpack_dl_defaults(control);
+    control[UMFPACK_IRSTEP] = (double)(irstep < 0 ? 0 : irstep);
+    for (j = 0; j < k && n > 0; j++) {
+        st = (int)umfpack_dl_wsolve(UMFPACK_At, a.rowptr, a.colind, a.val, X + j * n, B + j * n,
+                                    F->numeric, control, info, Wi, W);
+        if (st != UMFPACK_OK) {
+            rc = um_fail(call, "umfpack_dl_wsolve", st);
+            goto done;
+        }
+    }
+    call->out = ss_dense_value(n, k, X, n);
+    if (!call->out) {
+        rc = ss_nomem(call, "UMFPACK result");
+        goto done;
+    }
+    r->solve_seconds = ss_host->now() - t0;
+    if (F) {
+        snprintf(r->method, sizeof r->method, "%s", F->method);
+        r->rcond = F->rcond;
+        r->cond_est = F->cond;
+        snprintf(r->note, sizeof r->note, "%s", F->note);
+    }
+    rc = SILC_OK;
+done:
+    if (owned) ss_host->free(B);
+    ss_host->free(X);
+    ss_host->free(W);
+    ss_host->free(Wi);
+    return rc;
+}

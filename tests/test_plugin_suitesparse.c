@@ -1,0 +1,590 @@
+/*
+ * test_plugin_suitesparse.c -- the four SuiteSparse backends against exact
+ * solutions and against the reference backend.
+ *
+ * Each backend is forced through its class in a context of its own
+ * (umfpack and klu: solve.sparse; cholmod: solve.sparse.spd; spqr:
+ * solve.rect); a fifth context sends the same classes to "reference".
+ *   - generated systems with exact solutions x_i = 1 + i/n (b = A x computed
+ *     here): the 2-D Laplacian (SPD) and a 2-D convection-diffusion operator
+ *     (unsymmetric); the forward error must be below 1e3 n eps cond;
+ *   - shared matrices (cholmod: bcsstk16, 1138_bus; umfpack and klu: memplus,
+ *     rajat19, west0479, sherman1; spqr: illc1033, ash219) with b = A * ones,
+ *     compared with the reference backend within the same cond-scaled bound
+ *     (cond from the reference's 1-norm estimate), backward error < 1e-10;
+ *   - singular matrices (neumann, mbeacxc): the solve fails naming the library
+ *     function, or succeeds with a "singular to working precision" warning;
+ *   - a symmetric indefinite matrix with positive diagonal under cholmod: the
+ *     dispatcher falls back to LU and `info` says so;
+ *   - factor reuse (second solve with the same A), and a new value with the
+ *     same pattern (A2 = 2 * A): the note says the symbolic analysis was
+ *     reused; KLU refactors into the factors of a value that died (A = 3 * A);
+ *   - several and sparse right-hand sides; least squares (tall, inconsistent)
+ *     and the basic solution of an underdetermined system.
+ * Every `info` must name the backend.  Timings are printed.
+ */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+#include <ctype.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "check.h"
+#include "silc.h"
+
+#ifndef SILC_SHARED_MATRICES
+#define SILC_SHARED_MATRICES "../shared/matrices"
+#endif
+
+/* ---- output capture and helpers ------------------------------------------------ */
+
+static char out_buf[32768];
+
+static void capture(void *user, const char *text)
+{
+    size_t have = strlen(out_buf);
+    (void)user;
+    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
+}
+
+static int contains(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; hay && *hay; hay++) {
+        size_t i = 0;
+        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n) return 1;
+    }
+    return 0;
+}
+
+static silc_context *open_ctx(const char *const *classes, const char *backend)
+{
+    silc_context *c = NULL;
+    char cmd[192];
+    if (silc_open(&c, NULL)) {
+        fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
+        return NULL;
+    }
+    silc_set_output(c, capture, NULL);
+    for (; *classes; classes++) {
+        snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", *classes, backend);
+        CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
+    }
+    return c;
+}
+
+static const char *info(silc_context *c, const char *name)
+{
+    char cmd[64];
+    out_buf[0] = '\0';
+    snprintf(cmd, sizeof cmd, "info %s", name);
+    if (silc_exec(c, cmd)) snprintf(out_buf, sizeof out_buf, "(info failed: %s)", silc_context_errmsg(c));
+    return out_buf;
+}
+
+static double info_number(const char *text, const char *label)
+{
+    const char *p = strstr(text, label);
+    return p ? atof(p + strlen(label)) : -1;
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void put(silc_context *c, const char *name, const silc_envelope_t *e)
+{
+    CHECK(silc_put(c, name, e) == 0, "put %s: %s", name, silc_context_errmsg(c));
+}
+
+static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
+{
+    silc_envelope_t e;
+    CHECK(silc_envelope_dense(&e, m, n, x) == 0, "envelope %s", name);
+    put(c, name, &e);
+    silc_envelope_free(&e);
+}
+
+/* The m x n dense value name, or NULL (with a failed check). */
+static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
+{
+    silc_envelope_t e;
+    double *x;
+    if (silc_get(c, &e, name)) {
+        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
+        return NULL;
+    }
+    if (e.m != m || e.n != n) {
+        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
+              (long long)m, (long long)n);
+        silc_envelope_free(&e);
+        return NULL;
+    }
+    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *x);
+    if (x) silc_envelope_to_dense(&e, x);
+    silc_envelope_free(&e);
+    return x;
+}
+
+static double rel_err(const double *x, const double *y, int64_t n)
+{
+    double d = 0, s = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (fabs(x[i] - y[i]) > d) d = fabs(x[i] - y[i]);
+        if (fabs(y[i]) > s) s = fabs(y[i]);
+    }
+    return s > 0 ? d / s : d;
+}
+
+static double bound(int64_t n, double cond)
+{
+    double b = 1e3 * (double)n * DBL_EPSILON * (cond > 1 ? cond : 1);
+    return b < 1e-1 ? b : 1e-1;
+}
+
+static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
+{
+    for (int64_t i = 0; i < A->m; i++) {
+        double s = 0;
+        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
+        y[i] = s;
+    }
+}
+
+/* ---- generated matrices -------------------------------------------------------- */
+
+/* 5-point operator on a k x k grid: 4 + shift on the diagonal, -1 -/+ beta to
+ * the west/east (beta = 0: the Laplacian, symmetric). */
+static void grid(silc_envelope_t *e, int64_t k, double beta, double shift)
+{
+    int64_t n = k * k, nz = 0;
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
+    double *v = malloc((size_t)(5 * n) * sizeof *v);
+    for (int64_t r = 0; r < n; r++) {
+        int64_t i = r / k, j = r % k;
+        rp[r] = nz;
+        if (i > 0) ci[nz] = r - k, v[nz++] = -1;
+        if (j > 0) ci[nz] = r - 1, v[nz++] = -1 - beta;
+        ci[nz] = r, v[nz++] = 4 + shift;
+        if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1 + beta;
+        if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
+    }
+    rp[n] = nz;
+    CHECK(silc_envelope_csr(e, n, n, rp, ci, v) == 0, "grid envelope");
+    free(rp);
+    free(ci);
+    free(v);
+}
+
+/* x = A \ b in c (A, b already there) with the exact solution xt known. */
+static void check_exact(silc_context *c, const char *backend, const char *label,
+                        const silc_envelope_t *A, const double *xt)
+{
+    int64_t n = A->n;
+    double *x, cond, be, t;
+    const char *in;
+    t = now();
+    if (silc_exec(c, "x = A \\ b")) {
+        CHECK(0, "%s %s: x = A \\ b: %s", backend, label, silc_context_errmsg(c));
+        return;
+    }
+    t = now() - t;
+    in = info(c, "x");
+    CHECK(contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, label, in);
+    cond = info_number(in, "condition estimate: ");
+    be = info_number(in, "backward error: ");
+    CHECK(be >= 0 && be < 1e-12, "%s %s: backward error %g", backend, label, be);
+    x = get_dense(c, "x", n, 1);
+    if (!x) return;
+    CHECK(rel_err(x, xt, n) <= bound(n, cond), "%s %s: forward error %.3g > %.3g (cond %.3g)",
+          backend, label, rel_err(x, xt, n), bound(n, cond), cond);
+    printf("  %-22s %-28s n=%-6lld %.4f s  cond %.3g  backward error %.2g\n", backend, label,
+           (long long)n, t, cond, be);
+    free(x);
+}
+
+/* ---- the four backends on generated systems ----------------------------------- */
+
+static void test_generated(silc_context *c, const char *backend, int symmetric_only)
+{
+    silc_envelope_t A;
+    int64_t k = 60, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt), *b = malloc((size_t)n * sizeof *b);
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0, 0);
+    csr_matvec(&A, xt, b);
+    put(c, "A", &A);
+    put_dense(c, "b", n, 1, b);
+    check_exact(c, backend, "2-D Laplacian 60x60", &A, xt);
+    silc_envelope_free(&A);
+    if (!symmetric_only) {
+        grid(&A, k, 0.4, 0);
+        csr_matvec(&A, xt, b);
+        put(c, "A", &A);
+        put_dense(c, "b", n, 1, b);
+        check_exact(c, backend, "convection-diffusion 60x60", &A, xt);
+        silc_envelope_free(&A);
+    }
+    free(xt);
+    free(b);
+}
+
+/* SPQR: the Laplacian stacked on the identity (tall, full rank, consistent:
+ * the least-squares solution is exact) and, forced per call, square. */
+static void test_generated_qr(silc_context *c)
+{
+    silc_envelope_t L, A;
+    int64_t k = 40, n = k * k, nz;
+    double *xt = malloc((size_t)n * sizeof *xt), *b = malloc((size_t)(2 * n) * sizeof *b), *x;
+    int64_t *rp = malloc((size_t)(2 * n + 1) * sizeof *rp), *ci = malloc((size_t)(6 * n) * sizeof *ci);
+    double *v = malloc((size_t)(6 * n) * sizeof *v);
+    const char *in;
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&L, k, 0, 0);
+    nz = L.rowptr[n];
+    memcpy(rp, L.rowptr, (size_t)(n + 1) * sizeof *rp);
+    memcpy(ci, L.colind, (size_t)nz * sizeof *ci);
+    memcpy(v, L.values, (size_t)nz * sizeof *v);
+    for (int64_t i = 0; i < n; i++) ci[nz + i] = i, v[nz + i] = 1, rp[n + 1 + i] = nz + i + 1;
+    CHECK(silc_envelope_csr(&A, 2 * n, n, rp, ci, v) == 0, "tall envelope");
+    csr_matvec(&A, xt, b);
+    put(c, "A", &A);
+    put_dense(c, "b", 2 * n, 1, b);
+    check_exact(c, "suitesparse.spqr", "[Laplacian; I] 3200x1600", &A, xt);
+    csr_matvec(&L, xt, b);
+    put(c, "A", &L);
+    put_dense(c, "b", n, 1, b);
+    CHECK(silc_exec(c, "x = solve(A, b, \"backend = suitesparse.spqr\")") == 0, "spqr square: %s",
+          silc_context_errmsg(c));
+    in = info(c, "x");
+    CHECK(contains(in, "suitesparse.spqr") && contains(in, "full rank 1600"), "spqr square:\n%s", in);
+    x = get_dense(c, "x", n, 1);
+    if (x) CHECK(rel_err(x, xt, n) < 1e-10, "spqr square: forward error %.3g", rel_err(x, xt, n));
+    free(x);
+    free(xt);
+    free(b);
+    free(rp);
+    free(ci);
+    free(v);
+    silc_envelope_free(&L);
+    silc_envelope_free(&A);
+}
+
+/* Second solve reuses the factors; A2 = 2 * A reuses the symbolic analysis. */
+static void test_reuse(silc_context *c, const char *backend, int symmetric)
+{
+    silc_envelope_t A;
+    int64_t k = 40, n = k * k;
+    double *b = malloc((size_t)n * sizeof *b), *x, *x2;
+    const char *in;
+    for (int64_t i = 0; i < n; i++) b[i] = sin((double)i);
+    grid(&A, k, symmetric ? 0 : 0.3, 0);
+    put(c, "A", &A);
+    put_dense(c, "b", n, 1, b);
+    CHECK(silc_exec(c, "x = A \\ b; y = A \\ (2 * b)") == 0, "%s reuse: %s", backend,
+          silc_context_errmsg(c));
+    in = info(c, "x");
+    CHECK(contains(in, "reused factorization: no"), "%s: first solve reused?\n%s", backend, in);
+    in = info(c, "y");
+    CHECK(contains(in, "reused factorization: yes"), "%s: second solve did not reuse:\n%s", backend, in);
+    CHECK(silc_exec(c, "A2 = 2 * A; x2 = A2 \\ b") == 0, "%s refactor: %s", backend, silc_context_errmsg(c));
+    in = info(c, "x2");
+    CHECK(contains(in, "symbolic analysis reused"), "%s: same pattern, symbolic not reused:\n%s",
+          backend, in);
+    CHECK(contains(in, "reused factorization: no"), "%s: A2 is a new value:\n%s", backend, in);
+    x = get_dense(c, "x", n, 1);
+    x2 = get_dense(c, "x2", n, 1);
+    if (x && x2) {
+        for (int64_t i = 0; i < n; i++) x2[i] *= 2;
+        CHECK(rel_err(x2, x, n) < 1e-12, "%s: 2 * (2A \\ b) != A \\ b (%.3g)", backend, rel_err(x2, x, n));
+    }
+    free(x2);
+    if (strstr(backend, "klu")) {
+        /* A = 3 * A: the old A dies and gives its factors back; the new value
+         * is refactored into them without pivot search. */
+        CHECK(silc_exec(c, "clear A2 x2; A = 3 * A; x3 = A \\ b") == 0, "klu refactor: %s",
+              silc_context_errmsg(c));
+        in = info(c, "x3");
+        CHECK(contains(in, "klu_l_refactor"), "klu: no numeric refactor:\n%s", in);
+        x2 = get_dense(c, "x3", n, 1);
+        if (x && x2) {
+            for (int64_t i = 0; i < n; i++) x2[i] *= 3;
+            CHECK(rel_err(x2, x, n) < 1e-12, "klu: 3 * (3A \\ b) != A \\ b (%.3g)", rel_err(x2, x, n));
+        }
+        free(x2);
+    }
+    free(x);
+    free(b);
+    silc_envelope_free(&A);
+}
+
+/* Several right-hand sides, dense and sparse. */
+static void test_multi_rhs(silc_context *c, const char *backend)
+{
+    silc_envelope_t A;
+    int64_t k = 20, n = k * k;
+    double *B = malloc((size_t)(3 * n) * sizeof *B), *X, *x;
+    for (int64_t i = 0; i < 3 * n; i++) B[i] = cos((double)i);
+    grid(&A, k, 0, 0);
+    put(c, "A", &A);
+    put_dense(c, "B", n, 3, B);
+    CHECK(silc_exec(c, "X = A \\ B; Xs = A \\ sparse(B); x = A \\ B[:, 2]") == 0, "%s multi rhs: %s",
+          backend, silc_context_errmsg(c));
+    X = get_dense(c, "X", n, 3);
+    x = get_dense(c, "x", n, 1);
+    if (X && x) CHECK(rel_err(X + n, x, n) < 1e-13, "%s: column 2 of A\\B differs from A\\b", backend);
+    free(x);
+    x = get_dense(c, "Xs", n, 3);
+    if (X && x) CHECK(rel_err(X, x, 3 * n) < 1e-13, "%s: A\\sparse(B) differs from A\\B", backend);
+    free(x);
+    free(X);
+    free(B);
+    silc_envelope_free(&A);
+}
+
+/* ---- shared matrices ------------------------------------------------------------ */
+
+static int read_shared(const char *file, silc_envelope_t *A)
+{
+    char path[512], err[256];
+    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
+    if (silc_mm_read(A, path, err, sizeof err)) {
+        CHECK(0, "%s: %s", path, err);
+        return -1;
+    }
+    return 0;
+}
+
+/* Solves with the backend in c and the reference in r; they must agree. */
+static void test_shared(silc_context *c, silc_context *r, const char *backend, const char *file)
+{
+    silc_envelope_t A;
+    double *x, *xr, cond, mine, be, t, tr;
+    const char *in;
+    int64_t n;
+    if (read_shared(file, &A)) return;
+    n = A.n;
+    put(c, "A", &A);
+    put(r, "A", &A);
+    t = now();
+    CHECK(silc_exec(c, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "%s %s: %s", backend, file,
+          silc_context_errmsg(c));
+    t = now() - t;
+    tr = now();
+    CHECK(silc_exec(r, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "reference %s: %s", file,
+          silc_context_errmsg(r));
+    tr = now() - tr;
+    in = info(c, "x");
+    CHECK(contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, file, in);
+    be = info_number(in, "backward error: ");
+    mine = info_number(in, "condition estimate: ");
+    CHECK(be >= 0 && be < 1e-10, "%s %s: backward error %g", backend, file, be);
+    cond = info_number(info(r, "x"), "condition estimate: ");
+    /* Above 1e8 the backend's estimate must be a real one, not a pivot ratio. */
+    if (cond > 1e8 && !strstr(backend, "spqr"))
+        CHECK(mine >= cond / 10 && mine <= cond * 10, "%s %s: condition estimate %.3g, reference %.3g",
+              backend, file, mine, cond);
+    x = get_dense(c, "x", n, 1);
+    xr = get_dense(r, "x", n, 1);
+    if (x && xr)
+        CHECK(rel_err(x, xr, n) <= 2 * bound(n, cond),
+              "%s %s: differs from reference by %.3g > %.3g (cond %.3g)", backend, file,
+              rel_err(x, xr, n), 2 * bound(n, cond), cond);
+    printf("  %-22s %-14s %5lldx%-5lld %8.4f s (reference %8.4f s)  cond %.3g (reference %.3g)  "
+           "backward error %.2g\n",
+           backend, file, (long long)A.m, (long long)A.n, t, tr, mine, cond, be);
+    free(x);
+    free(xr);
+    silc_envelope_free(&A);
+}
+
+/* A singular matrix: an error naming the library function, or a warning. */
+static void test_singular(silc_context *c, const char *backend, const char *fn, const char *file)
+{
+    silc_envelope_t A;
+    if (read_shared(file, &A)) return;
+    put(c, "A", &A);
+    if (silc_exec(c, "b = A * ones(cols(A), 1); x = A \\ b")) {
+        const char *msg = silc_context_errmsg(c);
+        CHECK(contains(msg, fn) && contains(msg, "singular"), "%s %s: message should name %s: %s",
+              backend, file, fn, msg);
+        printf("  %-22s %-14s error: %s\n", backend, file, msg);
+    } else {
+        const char *w = silc_context_warnings(c);
+        CHECK(contains(w, "singular to working precision"), "%s %s: singular matrix solved silently",
+              backend, file);
+        printf("  %-22s %-14s warning: %s", backend, file, w);
+    }
+    silc_envelope_free(&A);
+}
+
+/* Symmetric, positive diagonal, indefinite: CHOLMOD fails, LU takes over. */
+static void test_not_spd(void)
+{
+    static const char *const cls[] = {"solve.sparse.spd", NULL};
+    silc_context *c = open_ctx(cls, "suitesparse.cholmod, suitesparse.umfpack");
+    silc_envelope_t A;
+    int64_t k = 20, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt), *b = malloc((size_t)n * sizeof *b), *x;
+    const char *in;
+    if (!c) return;
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0, -3.7); /* diagonal 0.3, eigenvalues in (-3.7, 4.3) */
+    csr_matvec(&A, xt, b);
+    put(c, "A", &A);
+    put_dense(c, "b", n, 1, b);
+    out_buf[0] = '\0';
+    CHECK(silc_exec(c, "explain x = A \\ b") == 0 && contains(out_buf, "suitesparse.cholmod -> would run"),
+          "explain should pick cholmod:\n%s", out_buf);
+    CHECK(silc_exec(c, "x = A \\ b") == 0, "not SPD: %s", silc_context_errmsg(c));
+    in = info(c, "x");
+    CHECK(contains(in, "suitesparse.umfpack") && contains(in, "Cholesky failed"),
+          "not SPD: expected the LU fallback in info:\n%s", in);
+    x = get_dense(c, "x", n, 1);
+    if (x) CHECK(rel_err(x, xt, n) < 1e-8, "not SPD: forward error %.3g", rel_err(x, xt, n));
+    free(x);
+    free(xt);
+    free(b);
+    silc_envelope_free(&A);
+    silc_close(&c);
+}
+
+/* Least squares: tall inconsistent vs reference, wide basic solution. */
+static void test_rect_extra(silc_context *c, silc_context *r)
+{
+    silc_envelope_t A;
+    double *x, *xr, *g, cond;
+    int64_t m, n, nnz = 0;
+    const char *in;
+    if (read_shared("illc1033.mtx", &A)) return;
+    m = A.m;
+    n = A.n;
+    g = malloc((size_t)m * sizeof *g);
+    for (int64_t i = 0; i < m; i++) g[i] = sin(3.0 * (double)i);
+    put(c, "A", &A);
+    put(r, "A", &A);
+    put_dense(c, "g", m, 1, g);
+    put_dense(r, "g", m, 1, g);
+    CHECK(silc_exec(c, "x = A \\ g; y = A \\ g") == 0, "spqr lsq: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(r, "x = A \\ g") == 0, "reference lsq: %s", silc_context_errmsg(r));
+    in = info(c, "y");
+    CHECK(contains(in, "reused factorization: yes") && contains(in, "suitesparse.spqr"),
+          "spqr: second solve did not reuse the QR:\n%s", in);
+    CHECK(contains(in, "least-squares"), "spqr: note should say least squares:\n%s", in);
+    cond = info_number(info(r, "x"), "condition estimate: ");
+    x = get_dense(c, "x", n, 1);
+    xr = get_dense(r, "x", n, 1);
+    if (x && xr)
+        CHECK(rel_err(x, xr, n) <= 1e-6, "spqr lsq illc1033: differs from reference by %.3g (cond %.3g)",
+              rel_err(x, xr, n), cond);
+    free(x);
+    free(xr);
+    free(g);
+    silc_envelope_free(&A);
+
+    /* Underdetermined: A = ash219' is 85 x 219 of full row rank. */
+    if (read_shared("ash219.mtx", &A)) return;
+    put(c, "B", &A);
+    CHECK(silc_exec(c, "A = trans(B); b = A * ones(cols(A), 1); x = A \\ b; r = b - A * x") == 0,
+          "spqr wide: %s", silc_context_errmsg(c));
+    in = info(c, "x");
+    CHECK(contains(in, "basic solution"), "spqr wide: note should say basic solution:\n%s", in);
+    x = get_dense(c, "x", A.m, 1);
+    g = get_dense(c, "r", A.n, 1);
+    if (x && g) {
+        double rn = 0;
+        for (int64_t i = 0; i < A.m; i++) nnz += x[i] != 0;
+        for (int64_t i = 0; i < A.n; i++) rn = fmax(rn, fabs(g[i]));
+        CHECK(rn < 1e-12, "spqr wide: residual %.3g", rn);
+        CHECK(nnz <= A.n, "spqr wide: basic solution has %lld nonzeros > rank %lld", (long long)nnz,
+              (long long)A.n);
+    }
+    free(x);
+    free(g);
+    silc_envelope_free(&A);
+}
+
+/* The condest option replaces the crude estimate by Hager/Higham's. */
+static void test_condest(silc_context *c, silc_context *r, const char *backend)
+{
+    silc_envelope_t A;
+    double cond, cref;
+    const char *in;
+    if (read_shared("sherman1.mtx", &A)) return;
+    put(c, "A", &A);
+    put(r, "A", &A);
+    CHECK(silc_exec(c, "b = A * ones(cols(A), 1); x = solve(A, b, \"suitesparse.condest = true\")") == 0,
+          "%s condest: %s", backend, silc_context_errmsg(c));
+    CHECK(silc_exec(r, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "reference: %s", silc_context_errmsg(r));
+    in = info(c, "x");
+    cond = info_number(in, "condition estimate: ");
+    cref = info_number(info(r, "x"), "condition estimate: ");
+    CHECK(contains(info(c, "x"), "Hager"), "%s: condest note missing:\n%s", backend, out_buf);
+    CHECK(cond > 0 && cref > 0 && cond <= 10 * cref && cref <= 10 * cond,
+          "%s: condest %.3g vs reference %.3g", backend, cond, cref);
+    silc_envelope_free(&A);
+}
+
+int main(void)
+{
+    static const char *const sparse_cls[] = {"solve.sparse", NULL};
+    static const char *const spd_cls[] = {"solve.sparse.spd", NULL};
+    static const char *const rect_cls[] = {"solve.rect", NULL};
+    static const char *const ref_cls[] = {"solve.sparse", "solve.sparse.spd", "solve.rect", NULL};
+    static const char *const unsym[] = {"memplus.mtx", "rajat19.mtx", "west0479.mtx", "sherman1.mtx"};
+    static const char *const spd[] = {"bcsstk16.mtx", "1138_bus.mtx"};
+    static const char *const rect[] = {"illc1033.mtx", "ash219.mtx"};
+    static const char *const singular[] = {"neumann.mtx", "mbeacxc.mtx"};
+    silc_context *um = open_ctx(sparse_cls, "suitesparse.umfpack");
+    silc_context *kl = open_ctx(sparse_cls, "suitesparse.klu");
+    silc_context *ch = open_ctx(spd_cls, "suitesparse.cholmod");
+    silc_context *qr = open_ctx(rect_cls, "suitesparse.spqr");
+    silc_context *ref = open_ctx(ref_cls, "reference");
+    size_t i;
+    if (!um || !kl || !ch || !qr || !ref) return check_done();
+
+    printf("generated systems (exact solutions):\n");
+    test_generated(um, "suitesparse.umfpack", 0);
+    test_generated(kl, "suitesparse.klu", 0);
+    test_generated(ch, "suitesparse.cholmod", 1);
+    test_generated_qr(qr);
+
+    test_reuse(um, "suitesparse.umfpack", 0);
+    test_reuse(kl, "suitesparse.klu", 0);
+    test_reuse(ch, "suitesparse.cholmod", 1);
+    test_multi_rhs(um, "suitesparse.umfpack");
+    test_multi_rhs(kl, "suitesparse.klu");
+    test_multi_rhs(ch, "suitesparse.cholmod");
+
+    printf("shared matrices (against the reference backend):\n");
+    for (i = 0; i < sizeof spd / sizeof spd[0]; i++) test_shared(ch, ref, "suitesparse.cholmod", spd[i]);
+    for (i = 0; i < sizeof unsym / sizeof unsym[0]; i++) {
+        test_shared(um, ref, "suitesparse.umfpack", unsym[i]);
+        test_shared(kl, ref, "suitesparse.klu", unsym[i]);
+    }
+    for (i = 0; i < sizeof rect / sizeof rect[0]; i++) test_shared(qr, ref, "suitesparse.spqr", rect[i]);
+    test_rect_extra(qr, ref);
+
+    printf("singular matrices:\n");
+    for (i = 0; i < sizeof singular / sizeof singular[0]; i++) {
+        test_singular(um, "suitesparse.umfpack", "umfpack_dl_numeric", singular[i]);
+        test_singular(kl, "suitesparse.klu", "klu_l_factor", singular[i]);
+    }
+    test_not_spd();
+    test_condest(um, ref, "suitesparse.umfpack");
+    test_condest(kl, ref, "suitesparse.klu");
+
+    silc_close(&um);
+    silc_close(&kl);
+    silc_close(&ch);
+    silc_close(&qr);
+    silc_close(&ref);
+    return check_done();
+}
