@@ -1,0 +1,140 @@
+! diffusion1d.f90 -- the 1-D diffusion example of examples/diffusion1d.c, in
+! Fortran through the `silc` module: Crank-Nicolson for u_t = u_xx on [0, pi]
+! with u(x, 0) = sin x and u = 0 at both ends, whose exact solution is
+! e^{-t} sin x.
+!
+!     diffusion1d [N [steps [T]]]      defaults: N = 100 interior points,
+!                                      steps = 500 (dt = 1e-3), T = 0.5
+!
+! The tridiagonal matrices A = I - dt/2 L and B = I + dt/2 L are assembled here
+! as 1-based CSR and deposited once; u stays inside SILC between steps, each
+! step being "b = B * u; u = A \ b", and only the final field comes back.  The
+! error against the exact solution is dominated by the spatial error
+! ~ T h^2 e^{-T} / 12 (2.4e-5 at the defaults); the program exits with status 1
+! if it exceeds max(1e-4, 4 x that estimate), i.e. if the scheme went wrong.
+! Set SILC_SERVER=tcp://host:port to run the same program against silcd.
+program diffusion1d
+  use, intrinsic :: iso_c_binding, only: c_double
+  use, intrinsic :: iso_fortran_env, only: error_unit, int64
+  use silc
+  implicit none
+  real(c_double), parameter :: pi = acos(-1.0_c_double)
+  integer :: n, steps, s, i
+  real(c_double) :: t_end, dt, h, err, estimate, tol
+  real(c_double), allocatable :: u(:), x(:)
+  integer(int64) :: clock0, clock1, rate
+
+  n = 100
+  steps = 500
+  t_end = 0.5_c_double
+  if (parse_args() /= 0) then
+    write (error_unit, '(a)') 'usage: diffusion1d [N [steps [T]]]   (N, steps positive integers, T >= 0)'
+    stop 2
+  end if
+  dt = t_end / steps
+  h = pi / (n + 1)
+  allocate(u(n), x(n))
+  x = [(i * h, i = 1, n)]
+  u = sin(x)
+
+  if (silc_init() /= 0) call die('silc_init')
+  call system_clock(clock0, rate)
+  if (put_shifted_laplacian('A', -dt / 2) /= 0) call die('silc_put_csr A')
+  if (put_shifted_laplacian('B', dt / 2) /= 0) call die('silc_put_csr B')
+  if (silc_put('u', u) /= 0) call die('silc_put u')
+  do s = 1, steps
+    if (silc_exec('b = B * u; u = A \ b') /= 0) call die('silc_exec')
+  end do
+  if (silc_get('u', u) /= 0) call die('silc_get u')
+  call system_clock(clock1)
+  if (silc_finalize() /= 0) call die('silc_finalize')
+
+  err = maxval(abs(u - exp(-t_end) * sin(x)))
+  estimate = t_end * h**2 * exp(-t_end) / 12
+  tol = max(1.0e-4_c_double, 4 * estimate)
+  write (*, '(a, i0, a, i0, 7a)') 'N=', n, ' steps=', steps, ' T=', num(t_end), &
+    ' dt=', num(dt), ' time=', num(real(clock1 - clock0, c_double) / rate), 's'
+  write (*, '(a, es10.3, a, es10.3, a)') 'max error=', err, &
+    ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
+  if (.not. (err <= tol)) then   ! written so that a NaN fails too
+    write (error_unit, '(a, es10.3, a)') 'diffusion1d: error above the tolerance ', tol, &
+      ': the scheme did not converge as it should'
+    stop 1
+  end if
+
+contains
+
+  ! Deposits I + c L as 1-based CSR, L the second-difference matrix / h^2 with
+  ! zero Dirichlet ends; columns ascend within each row.
+  integer function put_shifted_laplacian(name, c) result(status)
+    character(len=*), intent(in) :: name
+    real(c_double), intent(in) :: c
+    integer, allocatable :: rowptr(:), colind(:)
+    real(c_double), allocatable :: values(:)
+    real(c_double) :: off
+    integer :: j, k, nz
+    allocate(rowptr(n + 1), colind(3 * n), values(3 * n))
+    off = c / h**2
+    nz = 0
+    do k = 1, n
+      rowptr(k) = nz + 1
+      do j = max(k - 1, 1), min(k + 1, n)
+        nz = nz + 1
+        colind(nz) = j
+        values(nz) = merge(1 - 2 * off, off, j == k)
+      end do
+    end do
+    rowptr(n + 1) = nz + 1
+    status = silc_put_csr(name, n, n, rowptr, colind, values)
+  end function put_shifted_laplacian
+
+  integer function parse_args() result(status)
+    character(len=64) :: arg
+    integer :: nargs
+    status = 0
+    nargs = command_argument_count()
+    if (nargs > 3) status = 1
+    if (nargs >= 1 .and. status == 0) then
+      call get_command_argument(1, arg)
+      read (arg, *, iostat=status) n
+      if (status == 0 .and. n < 1) status = 1
+    end if
+    if (nargs >= 2 .and. status == 0) then
+      call get_command_argument(2, arg)
+      read (arg, *, iostat=status) steps
+      if (status == 0 .and. steps < 1) status = 1
+    end if
+    if (nargs >= 3 .and. status == 0) then
+      call get_command_argument(3, arg)
+      read (arg, *, iostat=status) t_end
+      if (status == 0 .and. .not. (t_end >= 0)) status = 1
+    end if
+  end function parse_args
+
+  ! A number as C's %g would print it: 0.5, 0.001, 2.000E-07.
+  function num(v) result(text)
+    real(c_double), intent(in) :: v
+    character(len=:), allocatable :: text
+    character(len=32) :: buf
+    if (abs(v) < tiny(v) .or. (abs(v) >= 1.0e-3_c_double .and. abs(v) < 1.0e6_c_double)) then
+      write (buf, '(f0.6)') v
+      text = trim(buf)
+      do while (text(len(text):len(text)) == '0')
+        text = text(:len(text) - 1)
+      end do
+      if (text(len(text):len(text)) == '.') text = text(:len(text) - 1)
+      if (text(1:1) == '.') text = '0' // text
+      if (text == '') text = '0'
+    else
+      write (buf, '(es10.3)') v
+      text = trim(adjustl(buf))
+    end if
+  end function num
+
+  subroutine die(what)
+    character(len=*), intent(in) :: what
+    write (error_unit, '(a)') 'diffusion1d: ' // what // ' failed: ' // silc_errmsg()
+    stop 1
+  end subroutine die
+
+end program diffusion1d

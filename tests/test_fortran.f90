@@ -1,0 +1,229 @@
+! test_fortran.f90 -- tests of the Fortran binding (module silc): scalars,
+! vectors, dense 2-D arrays in column-major order, 1-based CSR in both integer
+! kinds, shape checks on silc_get, and error statuses with their messages.
+! Prints "N passed, N failed" as its last line, like the C tests (tests/check.h),
+! and ends with error stop when anything failed.  Runs embedded, or remote when
+! SILC_SERVER is set.
+program test_fortran
+  use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
+  use silc
+  implicit none
+  integer :: passed = 0, failed = 0
+
+  call check_ok(silc_init(), 'silc_init')
+  call test_scalars()
+  call test_vectors()
+  call test_dense()
+  call test_csr()
+  call test_csr_int64()
+  call test_csr_mistakes()
+  call test_errors()
+  call check_ok(silc_finalize(), 'silc_finalize')
+  call check_fails(silc_exec('x = 1'), '', 'exec after silc_finalize')
+
+  print '(i0, a, i0, a)', passed, ' passed, ', failed, ' failed'
+  if (failed > 0) error stop 1
+
+contains
+
+  ! Each status is taken into a variable before anything reads what the call
+  ! defined: Fortran does not fix the order in which operands are evaluated.
+
+  subroutine test_scalars()
+    real(c_double) :: c
+    c = -1
+    call check_ok(silc_put('a', 2.5_c_double), 'put scalar')
+    call check_ok(silc_exec('c = a * 3 + 1'), 'exec on a scalar')
+    call check_ok(silc_get('c', c), 'get scalar')
+    call check_near(c, 8.5_c_double, 0.0_c_double, 'scalar round trip through c = a * 3 + 1')
+  end subroutine test_scalars
+
+  subroutine test_vectors()
+    real(c_double) :: v(4) = [1, -2, 3, 5], w(4), short(3), strided(8)
+    real(c_double), allocatable :: r(:)
+    integer :: m, n
+    call check_ok(silc_put('v', v), 'put vector')
+    call check_ok(silc_get_shape('v', m, n), 'get_shape v')
+    call check(m == 4 .and. n == 1, 'a 1-D array is deposited as a 4x1 vector')
+    call check_ok(silc_exec("w = 2 * v; s = v' * v"), 'exec on vectors')
+    w = 0
+    call check_ok(silc_get('w', w), 'get vector')
+    call check(all(w == 2 * v), 'vector round trip through w = 2 * v')
+
+    ! A row vector fits a 1-D array too; the array is allocated from the shape.
+    call check_ok(silc_exec("r = v'"), 'transpose')
+    call check_ok(silc_get_shape('r', m, n), 'get_shape r')
+    call check(m == 1 .and. n == 4, 'shape of a row vector')
+    allocate(r(m * n))
+    call check_ok(silc_get('r', r), 'get a 1x4 row vector into a 1-D array')
+    call check(all(r == v), 'row vector values')
+
+    ! Non-contiguous sections go in and come out through the same generic.
+    strided = 0
+    strided(1:8:2) = v
+    call check_ok(silc_put('p', strided(1:8:2)), 'put a strided section')
+    strided = 0
+    call check_ok(silc_get('p', strided(2:8:2)), 'get into a strided section')
+    call check(all(strided(2:8:2) == v) .and. all(strided(1:7:2) == 0), 'strided section round trip')
+
+    ! The caller's array must have the value's size, and stays untouched if not.
+    short = 7
+    call check_fails(silc_get('w', short), '4x1', 'get into a too short array')
+    call check_fails(silc_get('w', short), 'size 3', 'get into a too short array')
+    call check(all(short == 7), 'a failed get leaves the array unchanged')
+    call check_fails(silc_get('s', short), '1x1', 'a scalar into a 3-element array')
+  end subroutine test_vectors
+
+  subroutine test_dense()
+    real(c_double) :: x(2, 3), y(2, 3), col(2), xt(3, 2), e2(3) = [0, 1, 0]
+    real(c_double) :: corner
+    integer :: i, j
+    do j = 1, 3
+      do i = 1, 2
+        x(i, j) = 10 * i + j
+      end do
+    end do
+    call check_ok(silc_put('X', x), 'put dense 2x3')
+    call check_ok(silc_put('e2', e2), 'put e2')
+    y = 0
+    call check_ok(silc_get('X', y), 'get dense 2x3')
+    call check(all(y == x), 'dense round trip')
+    ! Column-major with no transposition: X * e2 is Fortran's x(:, 2), and
+    ! X[2, 3] is x(2, 3).
+    call check_ok(silc_exec("c2 = X * e2; x23 = X[2, 3]; Xt = X'"), 'exec on X')
+    call check_ok(silc_get('c2', col), 'get c2')
+    call check(all(col == x(:, 2)), 'X * e2 is column 2')
+    call check_ok(silc_get('x23', corner), 'get x23')
+    call check(corner == x(2, 3), 'X[2, 3] is x(2, 3)')
+    call check_ok(silc_get('Xt', xt), 'get Xt')
+    call check(all(xt == transpose(x)), "X' is transpose(x)")
+    call check_fails(silc_get('X', xt), '3x2', 'a 2x3 value into a 3x2 array')
+  end subroutine test_dense
+
+  ! A = [4 -1 0; -1 4 -1; 0 -1 4] with the columns of row 2 given out of order
+  ! (the library sorts them); x = [1 2 3] solves A x = [2 4 10].
+  subroutine test_csr()
+    integer :: rowptr(4) = [1, 3, 6, 8], colind(7) = [1, 2, 3, 1, 2, 2, 3]
+    real(c_double) :: values(7) = [4, -1, -1, -1, 4, -1, 4], b(3) = [2, 4, 10], x(3), full(3, 3)
+    integer, allocatable :: rp(:), ci(:)
+    real(c_double), allocatable :: vals(:)
+    integer :: m, n
+    call check_ok(silc_put_csr('A', 3, 3, rowptr, colind, values), 'put_csr')
+    call check_ok(silc_put('b', b), 'put b')
+    call check_ok(silc_exec('x = A \ b'), 'solve with 1-based CSR')
+    x = 0
+    call check_ok(silc_get('x', x), 'get x')
+    call check(maxval(abs(x - [1, 2, 3])) < 1e-12_c_double, 'A \ b = [1 2 3]')
+
+    ! Back out as a dense array and as 1-based CSR (rows sorted by the library).
+    call check_ok(silc_get('A', full), 'CSR into a 2-D array')
+    call check(all(full(1, :) == [4, -1, 0]) .and. all(full(2, :) == [-1, 4, -1]) &
+               .and. all(full(3, :) == [0, -1, 4]), 'CSR to dense puts each entry in place')
+    call check_ok(silc_get_csr('A', m, n, rp, ci, vals), 'get_csr')
+    call check(m == 3 .and. n == 3 .and. size(rp) == 4 .and. size(ci) == 7 .and. size(vals) == 7, &
+               'get_csr sizes')
+    if (size(rp) == 4 .and. size(ci) == 7 .and. size(vals) == 7) then
+      call check(all(rp == rowptr) .and. all(ci == [1, 2, 1, 2, 3, 2, 3]) &
+                 .and. all(vals == [4, -1, -1, 4, -1, -1, 4]), 'get_csr gives 1-based sorted CSR')
+    end if
+    call check_fails(silc_get_csr('X', m, n, rp, ci, vals), 'dense', 'get_csr of a dense value')
+
+    ! An empty row is fine.
+    call check_ok(silc_put_csr('E', 2, 2, [1, 1, 2], [2], [5.0_c_double]), 'CSR with an empty row')
+    call check_ok(silc_get('E', full(1:2, 1:2)), 'get E into a section')
+    call check(all(full(1:2, 1:2) == reshape([0, 0, 0, 5], [2, 2])), 'empty row round trip')
+  end subroutine test_csr
+
+  subroutine test_csr_int64()
+    integer(c_int64_t) :: rowptr(3) = [1_c_int64_t, 2_c_int64_t, 4_c_int64_t]
+    integer(c_int64_t) :: colind(3) = [1_c_int64_t, 1_c_int64_t, 2_c_int64_t]
+    integer(c_int64_t) :: m, n
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    real(c_double) :: values(3) = [2, 1, 3], x(2)
+    real(c_double), allocatable :: vals(:)
+    ! [2 0; 1 3] y = [2; 7] gives y = [1; 2].
+    call check_ok(silc_put_csr('L', 2_c_int64_t, 2_c_int64_t, rowptr, colind, values), &
+                  'put_csr int64')
+    call check_ok(silc_put('f', [2.0_c_double, 7.0_c_double]), 'put f')
+    call check_ok(silc_exec('y = L \ f'), 'solve with int64 CSR')
+    call check_ok(silc_get('y', x), 'get y')
+    call check(maxval(abs(x - [1, 2])) < 1e-14_c_double, 'L \ f = [1 2]')
+    call check_ok(silc_get_csr('L', m, n, rp, ci, vals), 'get_csr int64')
+    call check(m == 2 .and. n == 2 .and. all(rp == rowptr) .and. all(ci == colind) &
+               .and. all(vals == values), 'int64 get_csr round trip')
+  end subroutine test_csr_int64
+
+  subroutine test_csr_mistakes()
+    real(c_double) :: v(3) = 1
+    call check_fails(silc_put_csr('Z', 2, 2, [0, 1, 2], [0, 1], v), '1-based', '0-based rowptr')
+    call check_fails(silc_put_csr('Z', 2, 2, [1, 2, 3], [1, 3], v), 'colind(2) = 3', &
+                     'column 3 of 2')
+    call check_fails(silc_put_csr('Z', 2, 2, [1, 3], [1, 2], v), 'm+1', 'short rowptr')
+    call check_fails(silc_put_csr('Z', 2, 2, [1, 3, 2], [1, 2], v), 'decreases', &
+                     'decreasing rowptr')
+    call check_fails(silc_put_csr('Z', 1, 2, [1, 5], [1, 2], v), 'entries', 'rowptr past colind')
+    call check_fails(silc_put_csr('Z', 1, 2, [1, 3], [2, 2], v), 'row 1 has column 2 twice', &
+                     'duplicate column')
+    call check_fails(silc_exec('z = Z'), 'Z', 'no failed put left Z behind')
+  end subroutine test_csr_mistakes
+
+  subroutine test_errors()
+    real(c_double) :: x
+    character(len=:), allocatable :: msg
+    call check_fails(silc_exec('y = nosuchname + 1'), 'nosuchname', 'undefined name')
+    call check_fails(silc_exec('y = (1 + '), '', 'syntax error')
+    msg = silc_errmsg()
+    call check(index(msg, 'nosuchname') == 0, 'a syntax error has its own message: ' // msg)
+    call check_fails(silc_get('nosuchname', x), 'nosuchname', 'get of an undefined name')
+    call check_ok(silc_exec('ok = 1'), 'the context works after errors')
+    ! Names from fixed-length variables lose their trailing blanks.
+    x = 0
+    call check_ok(silc_get('ok' // repeat(' ', 10), x), 'a name with trailing blanks')
+    call check(x > 0.5_c_double, 'value fetched by a blank-padded name')
+  end subroutine test_errors
+
+  ! Passes when status is 0; otherwise shows the library's message.
+  subroutine check_ok(status, what)
+    integer, intent(in) :: status
+    character(len=*), intent(in) :: what
+    if (status == 0) then
+      call check(.true., what)
+    else
+      call check(.false., what // ': ' // silc_errmsg())
+    end if
+  end subroutine check_ok
+
+  ! Passes when status is non-zero with a non-empty message containing part.
+  subroutine check_fails(status, part, what)
+    integer, intent(in) :: status
+    character(len=*), intent(in) :: part, what
+    character(len=:), allocatable :: msg
+    msg = silc_errmsg()
+    if (status == 0) then
+      call check(.false., what // ' should fail but returned 0')
+    else
+      call check(len(msg) > 0 .and. index(msg, part) > 0, what // ' fails with a message containing "' &
+                 // part // '": ' // msg)
+    end if
+  end subroutine check_fails
+
+  subroutine check(ok, what)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    if (ok) then
+      passed = passed + 1
+    else
+      failed = failed + 1
+      print '(a)', 'FAIL: ' // what
+    end if
+  end subroutine check
+
+  subroutine check_near(got, want, tol, what)
+    real(c_double), intent(in) :: got, want, tol
+    character(len=*), intent(in) :: what
+    character(len=80) :: detail
+    write (detail, '(a, es23.16, a, es23.16)') ' (got ', got, ', want ', want
+    call check(abs(got - want) <= tol, what // trim(detail) // ')')
+  end subroutine check_near
+
+end program test_fortran
