@@ -1,0 +1,34 @@
+/*
+ * petsc_plugin.h -- what the two source files of plugin-petsc share.
+ *
+ * petsc.c owns the plugin's life (PETSc and MPI start-up, the tables, the
+ * SOLVE operation); petsc_options.c turns the user's PETSc option string into
+ * a private options database per solver and finds the options PETSc never
+ * read.  Internal to the plugin: nothing here is exported.
+ */
+#ifndef SILC_PETSC_PLUGIN_H
+#define SILC_PETSC_PLUGIN_H
+
+#include "silc_plugin.h"
+
+#include <petscksp.h>
+
+/* The host table handed to silc_plugin_init. */
+extern const silc_host_api *psc_host;
+
+/* Records "petsc <what>: <PETSc's message> (PETSc error <ierr>: <generic text>)"
+ * for a PETSc call that returned ierr, and returns the SILC status for it. */
+int psc_fail(silc_call *call, const char *what, PetscErrorCode ierr);
+
+/* A new options database for one solver: the plugin's defaults for this
+ * class, then the process-wide PETSc options (PETSC_OPTIONS, ~/.petscrc),
+ * then the user's string, later entries overriding earlier ones. */
+int psc_options_create(silc_call *call, const char *user, int spd, PetscOptions *out);
+
+/* After the first solve: SILC_OK when PETSc read every option of the user's
+ * string, else an error naming the first one it ignored, with a suggestion
+ * found among the option names the same KSP/PC configuration understands.
+ * A, the solver's matrix, lets that configuration be rebuilt. */
+int psc_options_check_used(silc_call *call, PetscOptions opts, const char *user, int spd, Mat A);
+
+#endif
