@@ -18,7 +18,8 @@
  * The upper-case calls use one default context; the silc_* calls take an
  * explicit context (several may be open at once; a context is not thread-safe,
  * use one per thread).  The API does not depend on where computation runs:
- * embedded in this process today, a server later, behind the same calls.
+ * embedded in this process, or a silcd server (SILC_SERVER=tcp://host:port or
+ * unix:/path, or silc_open_remote), behind the same calls.
  *
  * Every function returning int returns 0 on success and non-zero on failure; the
  * message is then available from silc_errmsg() / silc_context_errmsg().
@@ -97,6 +98,15 @@ typedef struct silc_context silc_context;
  * and, if *out was set, silc_context_errmsg(*out) says why (else the message is
  * in silc_errmsg()). */
 int silc_open(silc_context **out, const char *config_path);
+/* Opens a remote context on a silcd server: url is tcp://host:port or
+ * unix:/path/to/socket.  The token, when the server wants one, comes from
+ * SILC_TOKEN, else the first line of the file named by SILC_TOKEN_FILE.
+ * silc_open and SILC_INIT do the same with SILC_SERVER when it is set (the
+ * server's configuration then applies, config_path is not used).  Every other
+ * call behaves as on an embedded context: same results, same messages; a lost
+ * connection is reported by the call that meets it.  On failure the message is
+ * in silc_errmsg(). */
+int silc_open_remote(silc_context **out, const char *url);
 void silc_close(silc_context **ctx);
 int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
 int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);

@@ -2,12 +2,17 @@
  * api.c -- the public calls of silc.h: contexts, put/get/exec, and the
  * upper-case calls of the seeds on one default context.
  *
- * A context wraps an embedded engine today; the struct is the seam where a
- * remote transport will be added behind the same calls.  Each failure leaves
- * its message on the context (ctx->err); failures that have no context (a call
- * before SILC_INIT, a NULL context, an envelope constructor) leave it in the
- * per-thread buffer of envelope.c.  silc_errmsg() shows whichever is latest.
+ * A context is embedded (an engine in this process) or remote (a connection
+ * to silcd, remote.c); every call checks its arguments here, once for both,
+ * and then goes to one or the other.  The embedded operations themselves are
+ * the api_* functions of api.h, which silcd runs for its sessions, so both
+ * modes produce the same results and the same messages.  Each failure leaves
+ * its message on the context (ctx->err); failures that have no context (a
+ * call before SILC_INIT, a NULL context, an envelope constructor) leave it in
+ * the per-thread buffer of envelope.c.  silc_errmsg() shows whichever is
+ * latest.
  */
+#define _POSIX_C_SOURCE 200809L
 #include "silc.h"
 
 #include <ctype.h>
@@ -16,11 +21,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api.h"
 #include "engine.h"
 #include "envelope.h"
+#include "remote.h"
 
 struct silc_context {
-    silc_engine *E;
+    silc_engine *E;          /* embedded, or NULL */
+    rem_conn *R;             /* remote, or NULL */
+    silc_output_fn output;   /* remote: where TEXT replies go (NULL = stdout) */
+    void *output_user;
+    strbuf warnings;         /* remote: WARN replies of the last exec */
     char err[4096];
 };
 
@@ -42,10 +53,110 @@ static int ctx_error(silc_context *ctx, const char *fmt, ...)
     return -1;
 }
 
+/* ---- embedded operations (api.h) ---------------------------------------- */
+
+int api_check_name(const char *name, char *err, size_t errlen)
+{
+    const char *s = name;
+    int ok = isalpha((unsigned char)*s) || *s == '_';
+    if (ok)
+        for (s++; *s; s++)
+            if (!(isalnum((unsigned char)*s) || *s == '_')) ok = 0;
+    if (ok) return 0;
+    snprintf(err, errlen, "invalid name '%s': names start with a letter or '_' and contain "
+                          "only letters, digits and '_'", name);
+    return -1;
+}
+
+int api_bind(silc_engine *E, const char *name, silc_value *v, char *err, size_t errlen)
+{
+    if (store_set(&E->store, name, v)) {
+        snprintf(err, errlen, "out of memory storing '%s'", name);
+        return -1;
+    }
+    /* The name now holds data from the program, not a computed result. */
+    eng_info_remove(E, name);
+    return 0;
+}
+
+const silc_value *api_lookup(silc_engine *E, const char *name, char *err, size_t errlen)
+{
+    const char **names = NULL;
+    const silc_value *v = store_get(&E->store, name);
+    size_t n;
+    const char *near;
+    if (v) return v;
+    n = store_names(&E->store, &names);
+    near = util_closest(name, names, n);
+    if (near) snprintf(err, errlen, "undefined name '%s' (did you mean '%s'?)", name, near);
+    else snprintf(err, errlen, "undefined name '%s'", name);
+    free(names);
+    return NULL;
+}
+
+int api_exec(silc_engine *E, const char *statements, char *err, size_t errlen)
+{
+    E->warnings.len = 0;
+    if (E->warnings.s) E->warnings.s[0] = '\0';
+    if (lang_exec(E, statements) == 0) return 0;
+    snprintf(err, errlen, "%s", E->err[0] ? E->err : "statement failed");
+    return -1;
+}
+
+/* ---- contexts ------------------------------------------------------------ */
+
+/* The token for a remote server: SILC_TOKEN, else the first line of
+ * SILC_TOKEN_FILE, else none.  Returns a malloc'd string or NULL. */
+static char *remote_token(char *err, size_t errlen, int *failed)
+{
+    const char *t = getenv("SILC_TOKEN"), *path = getenv("SILC_TOKEN_FILE");
+    char buf[8192];
+    size_t n;
+    FILE *f;
+    *failed = 0;
+    if (t && *t) return util_strdup(t);
+    if (!path || !*path) return NULL;
+    if (!(f = fopen(path, "r"))) {
+        snprintf(err, errlen, "cannot read SILC_TOKEN_FILE '%s'", path);
+        *failed = 1;
+        return NULL;
+    }
+    n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    buf[strcspn(buf, "\r\n")] = '\0';
+    return util_strdup(buf);
+}
+
+int silc_open_remote(silc_context **out, const char *url)
+{
+    silc_context *ctx;
+    char *token;
+    int failed;
+    if (!out) return env_error("silc_open_remote: NULL context pointer");
+    *out = NULL;
+    if (!url || !*url) return env_error("silc_open_remote: no server address");
+    if (!(ctx = calloc(1, sizeof *ctx))) return env_error("silc_open_remote: out of memory");
+    sb_init(&ctx->warnings);
+    token = remote_token(ctx->err, sizeof ctx->err, &failed);
+    if (failed || rem_open(&ctx->R, url, token, ctx->err, sizeof ctx->err)) {
+        free(token);
+        env_error("%s", ctx->err);
+        free(ctx);
+        return -1;
+    }
+    free(token);
+    *out = ctx;
+    return 0;
+}
+
 int silc_open(silc_context **out, const char *config_path)
 {
     silc_context *ctx;
+    const char *server = getenv("SILC_SERVER");
     char err[4096];
+    /* Remote mode: the server's configuration applies, not config_path. */
+    if (server && *server) return silc_open_remote(out, server);
     if (!out) return env_error("silc_open: NULL context pointer");
     *out = NULL;
     ctx = calloc(1, sizeof *ctx);
@@ -62,50 +173,36 @@ void silc_close(silc_context **pctx)
 {
     if (!pctx || !*pctx) return;
     eng_destroy(&(*pctx)->E);
+    rem_close(&(*pctx)->R);
+    sb_free(&(*pctx)->warnings);
     free(*pctx);
     *pctx = NULL;
 }
 
-/* Names follow the language's identifiers, so every put value can be used. */
-static int valid_name(const char *s)
+/* The result of an operation that wrote its message to ctx->err. */
+static int ctx_result(silc_context *ctx, int rc)
 {
-    if (!(isalpha((unsigned char)*s) || *s == '_')) return 0;
-    for (s++; *s; s++)
-        if (!(isalnum((unsigned char)*s) || *s == '_')) return 0;
-    return 1;
+    if (rc && ctx == default_ctx) env_error_forget();
+    return rc ? -1 : 0;
 }
 
 int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e)
 {
     silc_value *v;
     char err[1024];
+    int rc;
     if (!ctx) return env_error("silc_put: NULL context");
     if (!name) return ctx_error(ctx, "silc_put: NULL name");
     if (!e) return ctx_error(ctx, "silc_put: NULL envelope for '%s'", name);
-    if (!valid_name(name))
-        return ctx_error(ctx, "invalid name '%s': names start with a letter or '_' and contain "
-                              "only letters, digits and '_'", name);
-    if (env_to_value(e, &v, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
-    if (store_set(&ctx->E->store, name, v)) {
-        val_release(v);
-        return ctx_error(ctx, "out of memory storing '%s'", name);
+    if (api_check_name(name, ctx->err, sizeof ctx->err)) return ctx_result(ctx, -1);
+    if (ctx->R) {
+        if (env_check(e, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
+        return ctx_result(ctx, rem_put(ctx->R, name, e, ctx->err, sizeof ctx->err));
     }
+    if (env_to_value(e, &v, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
+    rc = api_bind(ctx->E, name, v, ctx->err, sizeof ctx->err);
     val_release(v);
-    /* The name now holds data from the program, not a computed result. */
-    eng_info_remove(ctx->E, name);
-    return 0;
-}
-
-/* "undefined name 'u'" with the closest defined name, if one is close. */
-static int undefined_name(silc_context *ctx, const char *name)
-{
-    const char **names = NULL;
-    size_t n = store_names(&ctx->E->store, &names);
-    const char *near = util_closest(name, names, n);
-    int rc = near ? ctx_error(ctx, "undefined name '%s' (did you mean '%s'?)", name, near)
-                  : ctx_error(ctx, "undefined name '%s'", name);
-    free(names);
-    return rc;
+    return ctx_result(ctx, rc);
 }
 
 int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
@@ -115,8 +212,9 @@ int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
     if (!ctx) return env_error("silc_get: NULL context");
     if (!e) return ctx_error(ctx, "silc_get: NULL envelope");
     if (!name) return ctx_error(ctx, "silc_get: NULL name");
-    v = store_get(&ctx->E->store, name);
-    if (!v) return undefined_name(ctx, name);
+    if (ctx->R) return ctx_result(ctx, rem_get(ctx->R, e, name, ctx->err, sizeof ctx->err));
+    v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err);
+    if (!v) return ctx_result(ctx, -1);
     if (env_from_value(v, e))
         return ctx_error(ctx, "out of memory copying '%s' (%lldx%lld %s)", name, (long long)v->m,
                          (long long)v->n, val_format_name(v->format));
@@ -125,14 +223,19 @@ int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
 
 int silc_exec(silc_context *ctx, const char *statements)
 {
-    silc_engine *E;
     if (!ctx) return env_error("silc_exec: NULL context");
-    E = ctx->E;
-    E->warnings.len = 0;
-    if (E->warnings.s) E->warnings.s[0] = '\0';
+    if (ctx->R) {
+        ctx->warnings.len = 0;
+        if (ctx->warnings.s) ctx->warnings.s[0] = '\0';
+    } else {
+        ctx->E->warnings.len = 0;
+        if (ctx->E->warnings.s) ctx->E->warnings.s[0] = '\0';
+    }
     if (!statements) return ctx_error(ctx, "silc_exec: NULL statements");
-    if (lang_exec(E, statements)) return ctx_error(ctx, "%s", E->err[0] ? E->err : "statement failed");
-    return 0;
+    if (ctx->R)
+        return ctx_result(ctx, rem_exec(ctx->R, statements, ctx->output, ctx->output_user,
+                                        &ctx->warnings, ctx->err, sizeof ctx->err));
+    return ctx_result(ctx, api_exec(ctx->E, statements, ctx->err, sizeof ctx->err));
 }
 
 const char *silc_context_errmsg(const silc_context *ctx)
@@ -146,12 +249,18 @@ const char *silc_context_errmsg(const silc_context *ctx)
 
 const char *silc_context_warnings(const silc_context *ctx)
 {
-    return ctx ? sb_str(&ctx->E->warnings) : "";
+    if (!ctx) return "";
+    return sb_str(ctx->R ? &ctx->warnings : &ctx->E->warnings);
 }
 
 void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user)
 {
     if (!ctx) return;
+    if (ctx->R) {
+        ctx->output = fn;
+        ctx->output_user = fn ? user : NULL;
+        return;
+    }
     ctx->E->output = fn;
     ctx->E->output_user = fn ? user : NULL;
 }

@@ -358,11 +358,9 @@ void silc_envelope_free(silc_envelope_t *e)
 
 /* ---- envelopes <-> values ------------------------------------------------- */
 
-int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
+int env_check(const silc_envelope_t *e, char *err, size_t errlen)
 {
-    silc_value *v = NULL;
     int64_t count, i, k;
-    *out = NULL;
     if (!e) {
         snprintf(err, errlen, "NULL envelope");
         return -1;
@@ -378,9 +376,6 @@ int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t e
             snprintf(err, errlen, "dense envelope has no values (freed or never built?)");
             return -1;
         }
-        if (!(v = val_dense_new(e->m, e->n))) break;
-        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
-        *out = v;
         return 0;
     case SILC_CSR:
         if (csr_check_structure(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
@@ -392,15 +387,6 @@ int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t e
                              e->colind[k - 1] == e->colind[k] ? "duplicated" : "not sorted");
                     return -1;
                 }
-        count = e->rowptr[e->m];
-        if (!(v = val_csr_new(e->m, e->n, count))) break;
-        memcpy(v->rowptr, e->rowptr, (size_t)(e->m + 1) * sizeof(silc_index));
-        if (count > 0) {
-            memcpy(v->colind, e->colind, (size_t)count * sizeof(silc_index));
-            memcpy(v->val, e->values, (size_t)count * sizeof(double));
-        }
-        val_csr_set_nnz(v, count);
-        *out = v;
         return 0;
     case SILC_BAND:
         count = band_count(e->n, e->kl, e->ku);
@@ -413,13 +399,43 @@ int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t e
             snprintf(err, errlen, "band envelope has no values (freed or never built?)");
             return -1;
         }
-        if (!(v = val_band_new(e->m, e->n, e->kl, e->ku))) break;
-        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
-        *out = v;
         return 0;
     default:
         snprintf(err, errlen, "unknown envelope format %d", (int)e->format);
         return -1;
+    }
+}
+
+int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
+{
+    silc_value *v = NULL;
+    int64_t count;
+    *out = NULL;
+    if (env_check(e, err, errlen)) return -1;
+    switch (e->format) {
+    case SILC_DENSE:
+        if (!(v = val_dense_new(e->m, e->n))) break;
+        count = e->m * e->n;
+        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
+        *out = v;
+        return 0;
+    case SILC_CSR:
+        count = e->rowptr[e->m];
+        if (!(v = val_csr_new(e->m, e->n, count))) break;
+        memcpy(v->rowptr, e->rowptr, (size_t)(e->m + 1) * sizeof(silc_index));
+        if (count > 0) {
+            memcpy(v->colind, e->colind, (size_t)count * sizeof(silc_index));
+            memcpy(v->val, e->values, (size_t)count * sizeof(double));
+        }
+        val_csr_set_nnz(v, count);
+        *out = v;
+        return 0;
+    default: /* SILC_BAND: env_check refused every other format */
+        if (!(v = val_band_new(e->m, e->n, e->kl, e->ku))) break;
+        count = band_count(e->n, e->kl, e->ku);
+        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
+        *out = v;
+        return 0;
     }
     snprintf(err, errlen, "out of memory copying a %lldx%lld %s matrix", (long long)e->m,
              (long long)e->n, val_format_name((int)e->format));

@@ -13,6 +13,10 @@
 #include "silc.h"
 #include "value.h"
 
+/* Validates an envelope without copying it (the checks env_to_value makes):
+ * used by the remote client before sending and by silcd on what it received,
+ * so both report exactly the embedded messages. */
+int env_check(const silc_envelope_t *e, char *err, size_t errlen);
 /* Copies an envelope into a new value (refcount 1), validating it first:
  * shapes, array presence, CSR rowptr/colind consistency and sorted,
  * duplicate-free rows.  On failure writes the reason to err. */

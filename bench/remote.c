@@ -1,0 +1,269 @@
+/*
+ * remote.c -- what remote mode costs: PUT/GET throughput against raw loopback
+ * socket throughput measured in the same run, EXEC round-trip latency of a
+ * tiny statement, and the 2-D diffusion loop embedded vs remote.
+ *
+ *     remote [max_mib]          max_mib: largest array (default 512, min 8)
+ *
+ * Starts its own silcd (the one built beside it) on tcp://127.0.0.1 with a
+ * kernel-chosen port and on a Unix socket.  Raw throughput is one direction of
+ * a plain TCP loopback connection between two threads of this process, the
+ * receiver reading into a buffer of the same size as the array (touched
+ * beforehand, so neither side pays page faults); each figure is the best of
+ * 3 runs.  PUT time runs from the call to the server's OK (the server
+ * allocates the value and receives into it); GET time from the call to the
+ * filled envelope (the client allocates it).  Latency is "a = 1" through
+ * silc_exec, 20000 times after 1000 warm-up calls.  Not run by the test suite.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "diffusion_common.h"
+#include "silc.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- raw loopback baseline ----------------------------------------------- */
+typedef struct raw_job {
+    int fd;
+    char *buf;
+    size_t n;
+} raw_job;
+
+static void *raw_sink(void *p)
+{
+    raw_job *j = p;
+    size_t got = 0;
+    while (got < j->n) {
+        ssize_t r = recv(j->fd, j->buf + got, j->n - got, 0);
+        if (r <= 0) break;
+        got += (size_t)r;
+    }
+    if (send(j->fd, "k", 1, 0) != 1) perror("raw ack");
+    return NULL;
+}
+
+/* Seconds to move n bytes one way over TCP loopback, best of 3. */
+static double raw_seconds(size_t n, char *src, char *dst)
+{
+    int ls = socket(AF_INET, SOCK_STREAM, 0), one = 1, a, c;
+    struct sockaddr_in sa;
+    socklen_t sl = sizeof sa;
+    double best = 1e30;
+    int rep;
+    memset(&sa, 0, sizeof sa);
+    sa.sin_family = AF_INET;
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (bind(ls, (struct sockaddr *)&sa, sizeof sa) || listen(ls, 1) ||
+        getsockname(ls, (struct sockaddr *)&sa, &sl))
+        return -1;
+    c = socket(AF_INET, SOCK_STREAM, 0);
+    if (connect(c, (struct sockaddr *)&sa, sizeof sa)) return -1;
+    a = accept(ls, NULL, NULL);
+    setsockopt(c, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    for (rep = 0; rep < 3; rep++) {
+        raw_job j = {a, dst, n};
+        pthread_t th;
+        size_t sent = 0;
+        char ack;
+        double t0 = now();
+        pthread_create(&th, NULL, raw_sink, &j);
+        while (sent < n) {
+            ssize_t w = send(c, src + sent, n - sent, 0);
+            if (w <= 0) break;
+            sent += (size_t)w;
+        }
+        if (recv(c, &ack, 1, 0) != 1) perror("raw ack");
+        pthread_join(th, NULL);
+        if (now() - t0 < best) best = now() - t0;
+    }
+    close(a);
+    close(c);
+    close(ls);
+    return best;
+}
+
+/* ---- silcd ----------------------------------------------------------------- */
+static pid_t start_server(const char *listen, char *url, size_t urllen)
+{
+    char ready[] = "/tmp/silc-bench-ready-XXXXXX";
+    int fd = mkstemp(ready), i;
+    pid_t pid;
+    if (fd < 0) return -1;
+    close(fd);
+    unlink(ready);
+    pid = fork();
+    if (pid == 0) {
+        execl(SILCD_PATH, SILCD_PATH, "--listen", listen, "--ready-file", ready,
+              "--log-level", "error", "--max-value-bytes", "1G", "--max-session-bytes", "0",
+              (char *)NULL);
+        _exit(127);
+    }
+    for (i = 0; i < 400; i++) {
+        FILE *f = fopen(ready, "r");
+        if (f) {
+            int ok = fgets(url, (int)urllen, f) != NULL;
+            fclose(f);
+            if (ok) {
+                url[strcspn(url, "\n")] = '\0';
+                unlink(ready);
+                return pid;
+            }
+        }
+        nanosleep(&(struct timespec){0, 25000000L}, NULL);
+    }
+    kill(pid, SIGKILL);
+    return -1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static void latency(const char *label, silc_context *c)
+{
+    enum { WARM = 1000, N = 20000 };
+    static double t[N];
+    int i;
+    for (i = 0; i < WARM; i++) silc_exec(c, "a = 1");
+    for (i = 0; i < N; i++) {
+        double t0 = now();
+        if (silc_exec(c, "a = 1")) {
+            fprintf(stderr, "exec: %s\n", silc_context_errmsg(c));
+            return;
+        }
+        t[i] = now() - t0;
+    }
+    qsort(t, N, sizeof *t, cmp_double);
+    printf("| %-28s | %8.1f | %8.1f |\n", label, 1e6 * t[N / 2], 1e6 * t[N * 99 / 100]);
+}
+
+static double diffusion(const char *server, int64_t n, int steps)
+{
+    double *u = malloc((size_t)(n * n) * sizeof *u), t0, t;
+    if (server) setenv("SILC_SERVER", server, 1);
+    else unsetenv("SILC_SERVER");
+    diff2d_initial(n, u);
+    if (SILC_INIT()) {
+        fprintf(stderr, "SILC_INIT: %s\n", silc_errmsg());
+        free(u);
+        return -1;
+    }
+    t0 = now();
+    if (diff_run(2, n, steps, 1e-3, u)) fprintf(stderr, "diff_run: %s\n", silc_errmsg());
+    t = now() - t0;
+    SILC_FINALIZE();
+    unsetenv("SILC_SERVER");
+    free(u);
+    return t;
+}
+
+int main(int argc, char **argv)
+{
+    long max_mib = argc > 1 ? atol(argv[1]) : 512;
+    char tcp_url[600], unix_url[600], unix_listen[128];
+    pid_t tcp_pid, unix_pid;
+    silc_context *c = NULL, *cu = NULL;
+    size_t maxn;
+    char *src, *dst;
+    long mib;
+    if (max_mib < 8) max_mib = 8;
+    signal(SIGPIPE, SIG_IGN);
+    unsetenv("SILC_SERVER");
+    snprintf(unix_listen, sizeof unix_listen, "unix:/tmp/silc-bench-%d.sock", (int)getpid());
+    tcp_pid = start_server("tcp://127.0.0.1:0", tcp_url, sizeof tcp_url);
+    unix_pid = start_server(unix_listen, unix_url, sizeof unix_url);
+    if (tcp_pid < 0 || unix_pid < 0) {
+        fprintf(stderr, "remote: silcd did not start\n");
+        return 1;
+    }
+    if (silc_open_remote(&c, tcp_url) || silc_open_remote(&cu, unix_url)) {
+        fprintf(stderr, "remote: %s\n", silc_errmsg());
+        return 1;
+    }
+    maxn = (size_t)max_mib << 20;
+    src = malloc(maxn);
+    dst = malloc(maxn);
+    if (!src || !dst) return 1;
+    memset(src, 1, maxn);
+    memset(dst, 0, maxn);
+
+    printf("PUT/GET over tcp://127.0.0.1 (silcd %s), dense vectors, best of 3\n\n", SILC_VERSION);
+    printf("| size (MiB) | raw TCP (GB/s) | PUT (GB/s) | PUT/raw | GET (GB/s) | GET/raw |\n");
+    printf("|-----------:|---------------:|-----------:|--------:|-----------:|--------:|\n");
+    for (mib = 8; mib <= max_mib; mib *= 4) {
+        size_t bytes = (size_t)mib << 20;
+        int64_t n = (int64_t)(bytes / sizeof(double));
+        double raw = raw_seconds(bytes, src, dst), put = 1e30, get = 1e30;
+        silc_envelope_t e, g;
+        int rep;
+        silc_envelope_vector(&e, n, (const double *)(void *)src);
+        for (rep = 0; rep < 3; rep++) {
+            double t0 = now();
+            if (silc_put(c, "big", &e)) fprintf(stderr, "put: %s\n", silc_context_errmsg(c));
+            if (now() - t0 < put) put = now() - t0;
+            t0 = now();
+            if (silc_get(c, &g, "big")) fprintf(stderr, "get: %s\n", silc_context_errmsg(c));
+            if (now() - t0 < get) get = now() - t0;
+            silc_envelope_free(&g);
+        }
+        silc_exec(c, "clear big");
+        silc_envelope_free(&e);
+        printf("| %10ld | %14.2f | %10.2f | %6.0f%% | %10.2f | %6.0f%% |\n", mib,
+               bytes / raw / 1e9, bytes / put / 1e9, 100 * raw / put, bytes / get / 1e9,
+               100 * raw / get);
+    }
+    free(src);
+    free(dst);
+
+    printf("\nEXEC round trip of \"a = 1\" (20000 calls)\n\n");
+    printf("| %-28s | %8s | %8s |\n", "transport", "median us", "p99 us");
+    printf("|------------------------------|---------:|---------:|\n");
+    {
+        silc_context *emb = NULL;
+        if (silc_open(&emb, NULL) == 0) latency("embedded (no transport)", emb);
+        silc_close(&emb);
+    }
+    latency("tcp://127.0.0.1", c);
+    latency("unix socket", cu);
+    silc_close(&c);
+    silc_close(&cu);
+
+    printf("\n2-D diffusion, Crank-Nicolson on an n x n grid (A \\ (B * u) per step)\n\n");
+    printf("| grid | steps | embedded (s) | remote tcp (s) | remote/embedded |\n");
+    printf("|-----:|------:|-------------:|---------------:|----------------:|\n");
+    {
+        static const int64_t grids[] = {32, 100, 200};
+        static const int steps[] = {500, 100, 20};
+        int k;
+        for (k = 0; k < 3; k++) {
+            double te = diffusion(NULL, grids[k], steps[k]);
+            double tr = diffusion(tcp_url, grids[k], steps[k]);
+            printf("| %4lld | %5d | %12.3f | %14.3f | %15.2f |\n", (long long)grids[k], steps[k],
+                   te, tr, tr / te);
+        }
+    }
+    kill(tcp_pid, SIGTERM);
+    kill(unix_pid, SIGTERM);
+    waitpid(tcp_pid, NULL, 0);
+    waitpid(unix_pid, NULL, 0);
+    return 0;
+}

@@ -1,0 +1,525 @@
+/*
+ * session.c -- one client connection of silcd: the handshake, then requests
+ * until BYE, disconnect or shutdown, each answered on the session's own
+ * engine (its own store: names never leak between sessions).
+ *
+ * I/O happens outside the compute lock and engine calls inside it, so a slow
+ * or hostile client can stall only itself: a PUT's arrays are received into
+ * the new value before the lock is taken, a GET's value is retained under the
+ * lock and sent after it, and the text that `who`, `info` and `explain` print
+ * is collected during the call and sent afterwards.
+ *
+ * Session memory (the val_bytes of every bound value) is kept under
+ * max_session_bytes.  A PUT is checked from its descriptor before its arrays
+ * are read; an EXEC runs against a snapshot of the bindings (names to
+ * retained values, which is cheap because values are immutable) and is rolled
+ * back whole if it leaves the session over the limit.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "server.h"
+
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "api.h"
+#include "engine.h"
+#include "protocol.h"
+
+/* Frames produced while the lock is held, sent once it is released. */
+typedef struct outbuf {
+    uint8_t *p;
+    size_t len, cap;
+    int failed;
+} outbuf;
+
+typedef struct session {
+    int fd;
+    unsigned long id;
+    silc_engine *E;
+    outbuf out;
+    char err[4096];
+} session;
+
+/* The bindings and records an EXEC may change, to restore on rollback. */
+typedef struct snapshot {
+    size_t n;
+    char **names;
+    silc_value **values;
+    eng_info_entry *infos;
+    uint64_t rand_state;
+} snapshot;
+
+static void out_frame(outbuf *o, uint32_t op, const char *text)
+{
+    size_t n = strlen(text), need = o->len + PROTO_HEADER_BYTES + n;
+    if (o->failed) return;
+    if (need > o->cap) {
+        size_t cap = o->cap ? o->cap : 256;
+        uint8_t *p;
+        while (cap < need) cap *= 2;
+        if (!(p = realloc(o->p, cap))) {
+            o->failed = 1;
+            return;
+        }
+        o->p = p;
+        o->cap = cap;
+    }
+    proto_encode_header(o->p + o->len, op, n);
+    memcpy(o->p + o->len + PROTO_HEADER_BYTES, text, n);
+    o->len = need;
+}
+
+static void capture_output(void *user, const char *text)
+{
+    out_frame(&((session *)user)->out, PROTO_TEXT, text);
+}
+
+static uint64_t session_bytes(const silc_engine *E)
+{
+    uint64_t total = 0;
+    size_t b;
+    const store_entry *e;
+    for (b = 0; b < E->store.nbuckets; b++)
+        for (e = E->store.buckets[b]; e; e = e->next) total += val_bytes(e->value);
+    return total;
+}
+
+static void infos_free(eng_info_entry *e)
+{
+    while (e) {
+        eng_info_entry *next = e->next;
+        free(e->name);
+        free(e->info.statement);
+        free(e);
+        e = next;
+    }
+}
+
+static void snapshot_free(snapshot *s)
+{
+    size_t i;
+    for (i = 0; i < s->n; i++) {
+        free(s->names[i]);
+        val_release(s->values[i]);
+    }
+    free(s->names);
+    free(s->values);
+    infos_free(s->infos);
+    memset(s, 0, sizeof *s);
+}
+
+static int snapshot_take(const silc_engine *E, snapshot *s)
+{
+    size_t b;
+    const store_entry *e;
+    const eng_info_entry *ie;
+    eng_info_entry **tail = &s->infos;
+    memset(s, 0, sizeof *s);
+    s->rand_state = E->rand_state;
+    s->names = calloc(E->store.count + 1, sizeof *s->names);
+    s->values = calloc(E->store.count + 1, sizeof *s->values);
+    if (!s->names || !s->values) goto oom;
+    for (b = 0; b < E->store.nbuckets; b++)
+        for (e = E->store.buckets[b]; e; e = e->next) {
+            if (!(s->names[s->n] = util_strdup(e->name))) goto oom;
+            s->values[s->n++] = val_retain(e->value);
+        }
+    for (ie = E->infos; ie; ie = ie->next) {
+        eng_info_entry *c = calloc(1, sizeof *c);
+        if (!c) goto oom;
+        *tail = c;
+        tail = &c->next;
+        c->info = ie->info;
+        c->info.statement = NULL;
+        if (!(c->name = util_strdup(ie->name))) goto oom;
+        if (ie->info.statement && !(c->info.statement = util_strdup(ie->info.statement)))
+            goto oom;
+    }
+    return 0;
+oom:
+    snapshot_free(s);
+    return -1;
+}
+
+/* Puts the bindings back as they were; the snapshot is consumed. */
+static int snapshot_restore(silc_engine *E, snapshot *s)
+{
+    size_t i;
+    int rc = 0;
+    store_clear(&E->store);
+    for (i = 0; i < s->n; i++)
+        if (store_set(&E->store, s->names[i], s->values[i])) rc = -1;
+    infos_free(E->infos);
+    E->infos = s->infos;
+    s->infos = NULL;
+    E->rand_state = s->rand_state;
+    snapshot_free(s);
+    return rc;
+}
+
+static void lock(void)
+{
+    pthread_mutex_lock(&srv_compute_lock);
+}
+
+static void unlock(void)
+{
+    pthread_mutex_unlock(&srv_compute_lock);
+}
+
+static int reply_text(session *S, uint32_t op, const char *text)
+{
+    char why[256];
+    if (proto_send_text(S->fd, op, text, srv_cfg.io_timeout_ms, why, sizeof why)) {
+        srv_log(LOG_INFO, "session %lu: %s", S->id, why);
+        return -1;
+    }
+    return 0;
+}
+
+static int reply_error(session *S, const char *msg)
+{
+    srv_log(LOG_DEBUG, "session %lu: error: %s", S->id, msg);
+    return reply_text(S, PROTO_ERROR, msg);
+}
+
+/* Sends the collected TEXT frames, then WARN if any, then OK or ERROR. */
+static int finish_exec(session *S, int rc, const char *warnings)
+{
+    struct iovec iov;
+    char why[256];
+    if (S->out.failed) {
+        S->out.failed = 0;
+        S->out.len = 0;
+        if (!rc) {
+            snprintf(S->err, sizeof S->err, "out of memory collecting the statement's output");
+            rc = -1;
+        }
+    }
+    iov.iov_base = S->out.p;
+    iov.iov_len = S->out.len;
+    S->out.len = 0;
+    if (iov.iov_len && proto_send(S->fd, &iov, 1, srv_cfg.io_timeout_ms, why, sizeof why)) {
+        srv_log(LOG_INFO, "session %lu: %s", S->id, why);
+        return -1;
+    }
+    if (warnings && *warnings && reply_text(S, PROTO_WARN, warnings)) return -1;
+    return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
+}
+
+static int do_exec(session *S, const char *text)
+{
+    silc_engine *E = S->E;
+    snapshot snap;
+    char *warnings;
+    uint64_t used;
+    int rc, guarded = srv_cfg.max_session_bytes > 0, r;
+    lock();
+    if (guarded && snapshot_take(E, &snap)) {
+        unlock();
+        return reply_error(S, "out of memory preparing the statement");
+    }
+    rc = api_exec(E, text, S->err, sizeof S->err);
+    if (guarded) {
+        used = session_bytes(E);
+        if (used > srv_cfg.max_session_bytes) {
+            char done[512];
+            snprintf(done, sizeof done, "%.500s", rc ? S->err : "");
+            snprintf(S->err, sizeof S->err, "session memory limit exceeded: the values bound "
+                     "would hold %llu bytes, the limit is %llu bytes (silcd "
+                     "--max-session-bytes); the whole request was rolled back%s%.500s",
+                     (unsigned long long)used, (unsigned long long)srv_cfg.max_session_bytes,
+                     rc ? "; it had also failed: " : "", done);
+            if (snapshot_restore(E, &snap))
+                snprintf(S->err, sizeof S->err, "out of memory restoring the session");
+            rc = -1;
+        } else {
+            snapshot_free(&snap);
+        }
+    }
+    warnings = util_strdup(sb_str(&E->warnings));
+    unlock();
+    r = finish_exec(S, rc, warnings);
+    free(warnings);
+    return r;
+}
+
+/* PUT: refuse before reading the arrays when the session cannot hold them. */
+static int do_put(session *S, proto_stream *st, const proto_request *q)
+{
+    silc_value *v = NULL;
+    const silc_value *old;
+    uint64_t used, old_bytes;
+    char why[256];
+    int rc;
+    if (api_check_name(q->text, S->err, sizeof S->err)) {
+        if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
+        return reply_error(S, S->err);
+    }
+    if (srv_cfg.max_session_bytes > 0) {
+        lock();
+        used = session_bytes(S->E);
+        old = store_get(&S->E->store, q->text);
+        old_bytes = old ? val_bytes(old) : 0;
+        unlock();
+        if (used - old_bytes + q->layout.total > srv_cfg.max_session_bytes) {
+            if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
+            snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
+                     "(%llu bytes) would bring the session to %llu bytes, the limit is %llu "
+                     "bytes (silcd --max-session-bytes); '%s' is unchanged", q->text,
+                     (unsigned long long)q->layout.total,
+                     (unsigned long long)(used - old_bytes + q->layout.total),
+                     (unsigned long long)srv_cfg.max_session_bytes, q->text);
+            return reply_error(S, S->err);
+        }
+    }
+    rc = proto_read_value(st, q, &v, S->err, sizeof S->err);
+    if (rc == PROTO_REFUSED) return reply_error(S, S->err);
+    if (rc) {
+        srv_log(LOG_INFO, "session %lu: PUT '%s' abandoned: %s", S->id, q->text, S->err);
+        return -1;
+    }
+    lock();
+    rc = api_bind(S->E, q->text, v, S->err, sizeof S->err);
+    val_release(v);
+    unlock();
+    return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
+}
+
+static int do_get(session *S, const char *name)
+{
+    silc_value *v;
+    proto_desc d;
+    uint8_t desc[PROTO_DESC_BYTES];
+    struct iovec body[4];
+    char why[256];
+    int k, rc;
+    lock();
+    v = (silc_value *)api_lookup(S->E, name, S->err, sizeof S->err);
+    val_retain(v);
+    unlock();
+    if (!v) return reply_error(S, S->err);
+    /* The value is immutable and retained: its arrays are sent unlocked. */
+    k = proto_value_iov(v, &d, body + 1);
+    proto_encode_desc(desc, &d);
+    body[0].iov_base = desc;
+    body[0].iov_len = sizeof desc;
+    rc = k < 0 ? reply_error(S, "value too large to send")
+               : proto_send_frame(S->fd, PROTO_VALUE, body, k + 1, srv_cfg.io_timeout_ms, why,
+                                  sizeof why);
+    if (k >= 0 && rc) srv_log(LOG_INFO, "session %lu: %s", S->id, why);
+    lock();
+    val_release(v);
+    unlock();
+    return rc;
+}
+
+static int do_delete(session *S, const char *name)
+{
+    int rc = 0;
+    lock();
+    if (!api_lookup(S->E, name, S->err, sizeof S->err)) {
+        rc = -1;
+    } else {
+        store_remove(&S->E->store, name);
+        eng_info_remove(S->E, name);
+    }
+    unlock();
+    return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
+}
+
+static int do_list(session *S)
+{
+    const char **names = NULL;
+    strbuf b;
+    size_t i, n;
+    int rc;
+    sb_init(&b);
+    lock();
+    n = store_names(&S->E->store, &names);
+    for (i = 0; i < n; i++) sb_printf(&b, "%s%s", i ? "\n" : "", names[i]);
+    unlock();
+    free(names);
+    rc = reply_text(S, PROTO_OK, sb_str(&b));
+    sb_free(&b);
+    return rc;
+}
+
+/* INFO without a name describes the session; with one, runs `info name`. */
+static int do_info(session *S, const char *name)
+{
+    char text[1024];
+    uint64_t used;
+    size_t count;
+    if (name) {
+        strbuf b;
+        int rc;
+        if (api_check_name(name, S->err, sizeof S->err)) return reply_error(S, S->err);
+        sb_init(&b);
+        sb_printf(&b, "info %s", name);
+        rc = do_exec(S, sb_str(&b));
+        sb_free(&b);
+        return rc;
+    }
+    lock();
+    used = session_bytes(S->E);
+    count = S->E->store.count;
+    unlock();
+    snprintf(text, sizeof text,
+             "server: silcd %s, protocol %u\nsession: %lu\nnames: %zu\nbytes: %llu\n"
+             "max_session_bytes: %llu\nmax_value_bytes: %llu\n",
+             SILC_VERSION, PROTO_VERSION, S->id, count, (unsigned long long)used,
+             (unsigned long long)srv_cfg.max_session_bytes,
+             (unsigned long long)srv_cfg.max_value_bytes);
+    if (reply_text(S, PROTO_TEXT, text)) return -1;
+    return reply_text(S, PROTO_OK, NULL);
+}
+
+/* Length-independent timing: the loop runs over the expected token whatever
+ * the client sent, and differences are OR-ed, never branched on. */
+static int token_matches(const char *given)
+{
+    size_t glen = given ? strlen(given) : 0, i;
+    unsigned diff = glen != srv_cfg.token_len;
+    for (i = 0; i < srv_cfg.token_len; i++)
+        diff |= (unsigned)(uint8_t)srv_cfg.token[i] ^ (unsigned)(i < glen ? (uint8_t)given[i] : 0);
+    return diff == 0;
+}
+
+/* Hello both ways, then OK, or ERROR and -1. */
+static int handshake(session *S)
+{
+    proto_stream st = {S->fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
+    uint8_t hello[PROTO_HELLO_BYTES];
+    struct iovec iov;
+    uint32_t version;
+    char *token = NULL, why[512];
+    int rc;
+    rc = proto_read_hello(&st, &version, &token, why, sizeof why);
+    if (rc) {
+        srv_log(LOG_INFO, "session %lu: handshake failed: %s", S->id, why);
+        if (rc == PROTO_FATAL) reply_error(S, why);
+        free(token);
+        return -1;
+    }
+    proto_encode_hello(hello, PROTO_VERSION, 0);
+    iov.iov_base = hello;
+    iov.iov_len = sizeof hello;
+    if (proto_send(S->fd, &iov, 1, srv_cfg.io_timeout_ms, why, sizeof why)) {
+        free(token);
+        return -1;
+    }
+    if (version != PROTO_VERSION) {
+        snprintf(why, sizeof why, "protocol version %u is not supported (this server speaks %u)",
+                 (unsigned)version, PROTO_VERSION);
+        rc = -1;
+    } else if (srv_cfg.token && !token_matches(token)) {
+        snprintf(why, sizeof why, "authentication failed: %s token", token ? "wrong" : "missing");
+        rc = -1;
+    }
+    free(token);
+    if (rc) {
+        srv_log(LOG_WARN, "session %lu: refused: %s", S->id, why);
+        reply_error(S, why);
+        return -1;
+    }
+    lock();
+    rc = eng_create(&S->E, srv_cfg.engine_config, S->err, sizeof S->err);
+    if (!rc && srv_cfg.threads > 0) {
+        S->E->threads = srv_cfg.threads;
+        ld_set_threads(S->E, srv_cfg.threads);
+    }
+    unlock();
+    if (rc) {
+        srv_log(LOG_ERROR, "session %lu: engine: %s", S->id, S->err);
+        reply_error(S, S->err);
+        return -1;
+    }
+    S->E->output = capture_output;
+    S->E->output_user = S;
+    return reply_text(S, PROTO_OK, "silcd " SILC_VERSION);
+}
+
+/* Waits for the next request; 0 when one is arriving, -1 on shutdown. */
+static int await_request(int fd)
+{
+    struct pollfd p[2];
+    p[0].fd = fd;
+    p[0].events = POLLIN;
+    p[1].fd = srv_shutdown_fd;
+    p[1].events = POLLIN;
+    for (;;) {
+        p[0].revents = p[1].revents = 0;
+        if (poll(p, 2, -1) < 0) continue;
+        if (p[1].revents) return -1;
+        if (p[0].revents) return 0;
+    }
+}
+
+static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
+{
+    proto_request q;
+    int rc = proto_read_request(st, lim, &q, S->err, sizeof S->err);
+    if (rc == PROTO_BROKEN) {
+        srv_log(LOG_INFO, "session %lu: %s", S->id, S->err);
+        rc = -1;
+    } else if (rc == PROTO_FATAL) {
+        srv_log(LOG_WARN, "session %lu: malformed frame, closing: %s", S->id, S->err);
+        reply_error(S, S->err);
+        rc = -1;
+    } else if (rc == PROTO_REFUSED) {
+        rc = reply_error(S, S->err);
+    } else {
+        srv_log(LOG_DEBUG, "session %lu: %s", S->id, proto_op_name(q.op));
+        switch (q.op) {
+        case PROTO_PUT: rc = do_put(S, st, &q); break;
+        case PROTO_GET: rc = do_get(S, q.text); break;
+        case PROTO_EXEC: rc = do_exec(S, q.text); break;
+        case PROTO_DELETE: rc = do_delete(S, q.text); break;
+        case PROTO_LIST: rc = do_list(S); break;
+        case PROTO_INFO: rc = do_info(S, q.text); break;
+        case PROTO_EXPLAIN: {
+            strbuf b;
+            sb_init(&b);
+            sb_printf(&b, "explain %s", q.text);
+            rc = do_exec(S, sb_str(&b));
+            sb_free(&b);
+            break;
+        }
+        default: /* PROTO_BYE */
+            reply_text(S, PROTO_OK, NULL);
+            rc = -1;
+            break;
+        }
+    }
+    proto_request_free(&q);
+    return rc;
+}
+
+void srv_session(int fd, unsigned long id)
+{
+    session S;
+    proto_stream st;
+    proto_limits lim;
+    memset(&S, 0, sizeof S);
+    S.fd = fd;
+    S.id = id;
+    lim.max_value_bytes = srv_cfg.max_value_bytes;
+    lim.max_text_bytes = srv_cfg.max_text_bytes;
+    st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
+    if (handshake(&S) == 0) {
+        srv_log(LOG_INFO, "session %lu: open", id);
+        while (await_request(fd) == 0 && serve_one(&S, &st, &lim) == 0) {}
+    }
+    if (S.E) {
+        lock();
+        eng_destroy(&S.E);
+        unlock();
+    }
+    free(S.out.p);
+    close(fd);
+    srv_log(LOG_INFO, "session %lu: closed", id);
+}

@@ -1,0 +1,89 @@
+# Remote mode (included from tests/CMakeLists.txt): the protocol's unit tests,
+# the server's robustness, auth and stress tests, the fuzz run, the Python
+# client, and the language suite and examples run again against a silcd that a
+# ctest fixture starts on a Unix socket unique to this build directory.
+if(NOT TARGET silcd)
+  return()
+endif()
+find_package(Threads REQUIRED)
+
+silc_add_test(test_protocol INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_protocol.c)
+foreach(t test_remote test_remote_stress)
+  silc_add_test(${t} INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/${t}.c)
+  target_compile_definitions(${t} PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>")
+  target_link_libraries(${t} PRIVATE Threads::Threads)
+  set_tests_properties(${t} PROPERTIES TIMEOUT 120)
+endforeach()
+
+# The frame decoder under a deterministic mutation fuzzer (always), and under
+# libFuzzer when clang can build it (a short run; longer runs by hand).
+add_executable(fuzz_frame ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c)
+target_compile_definitions(fuzz_frame PRIVATE SILC_FUZZ_DRIVER=1)
+target_include_directories(fuzz_frame PRIVATE ${PROJECT_SOURCE_DIR}/core/src ${PROJECT_SOURCE_DIR}/plugins)
+target_link_libraries(fuzz_frame PRIVATE silc)
+add_test(NAME fuzz_frame COMMAND fuzz_frame 20000)
+set_tests_properties(fuzz_frame PROPERTIES TIMEOUT 120)
+find_program(SILC_CLANG clang)
+if(SILC_CLANG AND NOT SILC_SANITIZE)
+  execute_process(COMMAND ${SILC_CLANG} -fsanitize=fuzzer -x c - -o ${CMAKE_CURRENT_BINARY_DIR}/fuzz_probe
+                  INPUT_FILE ${CMAKE_CURRENT_LIST_DIR}/fuzz/probe.c
+                  RESULT_VARIABLE SILC_LIBFUZZER_RC OUTPUT_QUIET ERROR_QUIET)
+  if(SILC_LIBFUZZER_RC EQUAL 0)
+    set(_fz ${CMAKE_CURRENT_BINARY_DIR}/fuzz_frame_libfuzzer)
+    set(_src ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c ${PROJECT_SOURCE_DIR}/core/src/protocol.c
+             ${PROJECT_SOURCE_DIR}/core/src/envelope.c ${PROJECT_SOURCE_DIR}/core/src/value.c
+             ${PROJECT_SOURCE_DIR}/core/src/util.c)
+    add_custom_command(OUTPUT ${_fz}
+      COMMAND ${SILC_CLANG} -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined
+              -I${PROJECT_SOURCE_DIR}/core/include -I${PROJECT_SOURCE_DIR}/core/src
+              -I${PROJECT_SOURCE_DIR}/plugins ${_src} -lm -o ${_fz}
+      DEPENDS ${_src} VERBATIM)
+    add_custom_target(fuzz_frame_libfuzzer ALL DEPENDS ${_fz})
+    # libFuzzer adds what it finds to its first directory: a scratch one.
+    file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fuzz-corpus)
+    add_test(NAME fuzz_frame_libfuzzer
+             COMMAND ${_fz} -runs=20000 -seed=1 -max_len=4096
+                     ${CMAKE_CURRENT_BINARY_DIR}/fuzz-corpus ${CMAKE_CURRENT_LIST_DIR}/fuzz/corpus)
+    set_tests_properties(fuzz_frame_libfuzzer PROPERTIES TIMEOUT 120)
+  else()
+    message(STATUS "SILC: clang cannot build libFuzzer targets; fuzz_frame runs the built-in mutator only")
+  endif()
+endif()
+
+# A server for the remote variants: one per build directory, on a socket path
+# short enough for sun_path wherever the build directory lies.
+string(MD5 _silcd_hash "${CMAKE_BINARY_DIR}")
+string(SUBSTRING "${_silcd_hash}" 0 12 _silcd_hash)
+set(SILC_TEST_SOCKET "/tmp/silcd-test-${_silcd_hash}.sock")
+set(_state ${CMAKE_CURRENT_BINARY_DIR}/silcd-fixture)
+add_test(NAME silcd_start COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server.sh start
+         $<TARGET_FILE:silcd> ${SILC_TEST_SOCKET} ${_state})
+add_test(NAME silcd_stop COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server.sh stop
+         $<TARGET_FILE:silcd> ${SILC_TEST_SOCKET} ${_state})
+set_tests_properties(silcd_start PROPERTIES FIXTURES_SETUP silcd ENVIRONMENT "${SILC_TEST_ENV}")
+set_tests_properties(silcd_stop PROPERTIES FIXTURES_CLEANUP silcd)
+
+set(_remote_env "${SILC_TEST_ENV};SILC_SERVER=unix:${SILC_TEST_SOCKET}")
+foreach(t test_api test_lang test_truth test_examples)
+  if(TARGET ${t})
+    add_test(NAME ${t}_remote COMMAND ${t})
+    set_tests_properties(${t}_remote PROPERTIES ENVIRONMENT "${_remote_env}" TIMEOUT 600
+                         FIXTURES_REQUIRED silcd)
+  endif()
+endforeach()
+add_test(NAME example_diffusion1d_remote COMMAND diffusion1d 50 100 0.5)
+add_test(NAME example_diffusion2d_remote
+         COMMAND diffusion2d -n 30 -s 5 -o ${CMAKE_CURRENT_BINARY_DIR}/diffusion2d_remote.pgm)
+add_test(NAME test_cli_remote COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/test_cli.sh $<TARGET_FILE:silc_cli>)
+set_tests_properties(example_diffusion1d_remote example_diffusion2d_remote test_cli_remote PROPERTIES
+  ENVIRONMENT "${_remote_env}" TIMEOUT 600 FIXTURES_REQUIRED silcd)
+
+# The Python client speaks the protocol on its own; it runs with the system
+# interpreter, whose numpy comes from Debian's python3-numpy.
+find_program(SILC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(SILC_SYSTEM_PYTHON)
+  add_test(NAME test_python COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/test_python.py
+           ${PROJECT_SOURCE_DIR}/bindings/python)
+  set_tests_properties(test_python PROPERTIES ENVIRONMENT "${_remote_env}" TIMEOUT 120
+                       FIXTURES_REQUIRED silcd)
+endif()

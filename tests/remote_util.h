@@ -1,0 +1,181 @@
+/*
+ * remote_util.h -- helpers of the remote tests: start a private silcd with
+ * given options and wait until it listens, stop it, and speak raw protocol
+ * on a socket for the tests that must send what no client would.
+ */
+#ifndef SILC_REMOTE_UTIL_H
+#define SILC_REMOTE_UTIL_H
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "protocol.h"
+
+typedef struct test_server {
+    pid_t pid;
+    char url[600];
+    char dir[256];
+} test_server;
+
+static inline void sleep_ms(int ms)
+{
+    struct timespec ts;
+    ts.tv_sec = ms / 1000;
+    ts.tv_nsec = (long)(ms % 1000) * 1000000L;
+    nanosleep(&ts, NULL);
+}
+
+/* Starts silcd with the NULL-terminated extra options; the ready file gives
+ * the address.  listen NULL: a fresh unix socket in a private directory.
+ * Returns 0, or the server's exit status (> 0) if it refused to start. */
+static inline int server_start(test_server *s, const char *listen, const char *const *opts)
+{
+    char ready[400], lst[400], logf[400];
+    const char *argv[32];
+    int n = 0, i, status;
+    snprintf(s->dir, sizeof s->dir, "/tmp/silc-rt-XXXXXX");
+    if (!mkdtemp(s->dir)) return -1;
+    snprintf(ready, sizeof ready, "%s/ready", s->dir);
+    snprintf(logf, sizeof logf, "%s/log", s->dir);
+    if (listen) snprintf(lst, sizeof lst, "%s", listen);
+    else snprintf(lst, sizeof lst, "unix:%s/s", s->dir);
+    argv[n++] = SILCD_PATH;
+    argv[n++] = "--listen";
+    argv[n++] = lst;
+    argv[n++] = "--ready-file";
+    argv[n++] = ready;
+    argv[n++] = "--log-level";
+    argv[n++] = "warn";
+    for (i = 0; opts && opts[i] && n < 30; i++) argv[n++] = opts[i];
+    argv[n] = NULL;
+    s->pid = fork();
+    if (s->pid == 0) {
+        FILE *f = freopen(logf, "w", stderr);
+        (void)f;
+        execv(SILCD_PATH, (char *const *)argv);
+        _exit(127);
+    }
+    for (i = 0; i < 400; i++) {
+        FILE *f = fopen(ready, "r");
+        if (f) {
+            int ok = fgets(s->url, sizeof s->url, f) != NULL;
+            fclose(f);
+            if (ok) {
+                s->url[strcspn(s->url, "\n")] = '\0';
+                return 0;
+            }
+        }
+        if (waitpid(s->pid, &status, WNOHANG) == s->pid)
+            return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+        sleep_ms(25);
+    }
+    kill(s->pid, SIGKILL);
+    waitpid(s->pid, &status, 0);
+    return -1;
+}
+
+/* SIGTERM; returns the exit status (0 for a clean shutdown). */
+static inline int server_stop(test_server *s)
+{
+    int status = 0, i;
+    char cmd[400];
+    kill(s->pid, SIGTERM);
+    for (i = 0; i < 400; i++) {
+        if (waitpid(s->pid, &status, WNOHANG) == s->pid) break;
+        sleep_ms(25);
+    }
+    if (i == 400) {
+        kill(s->pid, SIGKILL);
+        waitpid(s->pid, &status, 0);
+        status = -1;
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", s->dir);
+    if (system(cmd)) {}
+    return status < 0 ? -1 : (WIFEXITED(status) ? WEXITSTATUS(status) : 128);
+}
+
+static inline int raw_connect(const char *url)
+{
+    struct sockaddr_un sa;
+    int fd;
+    if (strncmp(url, "unix:", 5) != 0) return -1;
+    memset(&sa, 0, sizeof sa);
+    sa.sun_family = AF_UNIX;
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", url + 5);
+    fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    if (fd >= 0 && connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+static inline int raw_send(int fd, const void *p, size_t n)
+{
+    struct iovec iov;
+    char err[128];
+    iov.iov_base = (void *)(uintptr_t)p;
+    iov.iov_len = n;
+    return proto_send(fd, &iov, 1, 5000, err, sizeof err);
+}
+
+/* Reads one reply; returns its opcode (text in *text, malloc'd) or -1 on
+ * EOF/error, -2 on timeout. */
+static inline int raw_reply(int fd, char **text, int timeout_ms)
+{
+    proto_stream s = {fd, timeout_ms, NULL, 0, 0};
+    proto_limits lim = {(uint64_t)1 << 32, (uint64_t)1 << 24};
+    proto_reply r;
+    char err[256];
+    int rc = proto_read_reply(&s, &lim, &r, err, sizeof err);
+    *text = NULL;
+    if (rc) return strstr(err, "timed out") ? -2 : -1;
+    *text = r.text;
+    r.text = NULL;
+    rc = (int)r.op;
+    proto_reply_free(&r);
+    return rc;
+}
+
+/* Connects and handshakes with the given version and token; returns the fd
+ * after the server's OK, or -1 (with the ERROR text in *msg if one came). */
+static inline int raw_open(const char *url, uint32_t version, const char *token, char **msg)
+{
+    uint8_t hello[PROTO_HELLO_BYTES], back[PROTO_HELLO_BYTES];
+    size_t tl = token ? strlen(token) : 0;
+    proto_stream s;
+    struct iovec iov;
+    char err[128];
+    int fd = raw_connect(url), op;
+    *msg = NULL;
+    if (fd < 0) return -1;
+    proto_encode_hello(hello, version, (uint32_t)tl);
+    raw_send(fd, hello, sizeof hello);
+    if (tl) raw_send(fd, token, tl);
+    s = (proto_stream){fd, 5000, NULL, 0, 0};
+    iov.iov_base = back;
+    iov.iov_len = sizeof back;
+    if (proto_recv(&s, &iov, 1, err, sizeof err)) {
+        close(fd);
+        return -1;
+    }
+    op = raw_reply(fd, msg, 5000);
+    if (op != PROTO_OK) {
+        close(fd);
+        return -1;
+    }
+    free(*msg);
+    *msg = NULL;
+    return fd;
+}
+
+#endif
