@@ -7,6 +7,9 @@
  *     silc [options] -e STATEMENTS
  *     silc [options]                 REPL (readline line editing and history in
  *                                    ~/.silc_history when stdin is a terminal)
+ *     silc [options] tune fit P:T...  fit the tuner's model to timings
+ *     silc [options] tune report [F]  the tuner's last result from the wisdom file
+ *                                    (the `tune` statement, so the same code answers)
  *
  * --put NAME=FILE.mtx loads Matrix Market files before running, --get NAME
  * prints values in Matrix Market format afterwards, so the command composes with
@@ -33,6 +36,11 @@ static const char usage_text[] =
     "usage: silc [options] run FILE      run a script (\"-\" reads standard input)\n"
     "       silc [options] -e STATEMENTS run statements given as text\n"
     "       silc [options]               interactive session\n"
+    "       silc [options] tune fit P:T ...   fit f(p) = a/p + b*p + c to step times T\n"
+    "                                    at thread counts P; prints a, b, c, q, p_opt\n"
+    "       silc [options] tune report [FILE.svg]  samples, fit, p_opt and backends of\n"
+    "                                    the last tuning on this machine (wisdom file),\n"
+    "                                    plot to FILE.svg (default silc-tune.svg)\n"
     "options:\n"
     "  --put NAME=FILE.mtx  load a Matrix Market file as NAME before running (repeatable)\n"
     "  --get NAME           after running, print NAME to standard output in Matrix\n"
@@ -52,6 +60,7 @@ typedef struct {
     int nput;
     const char **get_names;
     int nget;
+    char *tune_text;        /* statement built from `tune ...` arguments */
 } cli_options;
 
 static void fail(const char *fmt, ...)
@@ -80,6 +89,31 @@ static int take_option(int argc, char **argv, int *i, const char *opt, const cha
     return 1;
 }
 
+/* `silc tune WORD ARGS...` becomes the statement `tune WORD ARGS...`, a file
+ * name quoted.  Returns 0, or 2 on a usage error. */
+static int tune_args(int argc, char **argv, int i, cli_options *o)
+{
+    size_t len = 16;
+    int k;
+    if (i >= argc || (strcmp(argv[i], "fit") && strcmp(argv[i], "report")))
+        return fail("tune needs 'fit P:T ...' or 'report [FILE.svg]'"), 2;
+    for (k = i; k < argc; k++) {
+        if (strchr(argv[k], '"') || strchr(argv[k], '\n'))
+            return fail("tune: argument '%s' may not contain quotes or newlines", argv[k]), 2;
+        len += strlen(argv[k]) + 3;
+    }
+    if (!(o->tune_text = malloc(len))) return fail("out of memory"), 2;
+    strcpy(o->tune_text, "tune");
+    for (k = i; k < argc; k++) {
+        int quote = !strcmp(argv[i], "report") && k > i;
+        strcat(o->tune_text, quote ? " \"" : " ");
+        strcat(o->tune_text, argv[k]);
+        if (quote) strcat(o->tune_text, "\"");
+    }
+    o->statements = o->tune_text;
+    return 0;
+}
+
 /* Returns 0 to go on, 1 after printing --help/--version, 2 on a usage error. */
 static int parse_args(int argc, char **argv, cli_options *o)
 {
@@ -106,6 +140,9 @@ static int parse_args(int argc, char **argv, cli_options *o)
             if (!v) return fail("-e needs statements"), 2;
             if (o->statements || o->script) return fail("give only one of 'run FILE' and -e"), 2;
             o->statements = v;
+        } else if (!strcmp(a, "tune")) {
+            if (o->statements || o->script) return fail("give only one of 'run FILE', -e and tune"), 2;
+            return tune_args(argc, argv, i + 1, o);
         } else if (!strcmp(a, "run")) {
             if (i + 1 >= argc) return fail("run needs a file name"), 2;
             if (o->statements || o->script) return fail("give only one of 'run FILE' and -e"), 2;
@@ -347,7 +384,7 @@ int main(int argc, char **argv)
     }
     int status = parse_args(argc, argv, &o);
     if (status) {
-        free(o.put_args), free(o.get_names);
+        free(o.put_args), free(o.get_names), free(o.tune_text);
         return status == 1 ? 0 : 2;
     }
 
@@ -369,7 +406,7 @@ int main(int argc, char **argv)
         if (!status) status = print_gets(ctx, &o);
     }
     silc_close(&ctx);
-    free(o.put_args), free(o.get_names);
+    free(o.put_args), free(o.get_names), free(o.tune_text);
     if (fflush(stdout) || ferror(stdout)) {
         fail("error writing standard output");
         status = 1;

@@ -4,7 +4,7 @@
  * options of solve(A, b, "...")).
  *
  * A key is "section.name": dispatch.<class> (an ordered list of backends),
- * tune.threads / tune.accuracy, core.plugin_path / core.threads, and
+ * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads, and
  * <plugin>.<option> for the typed options a loaded plugin lists.  The INI file
  * (read with inih) spells the same keys as [section] name = value.  Every key
  * and value is checked when it is set, not when it is used, so a typo is
@@ -35,7 +35,7 @@ struct cfg_db {
 };
 
 static const char *const scope_names[3] = {"file", "session", "call"};
-static const char *const tune_keys[] = {"threads", "accuracy"};
+static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
 
 /* Longest list a dispatch key may name; more would only repeat names. */
@@ -329,8 +329,12 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
             if (parse_double(value, &acc) || acc <= 0 || acc >= 1)
                 return eng_error(E, "tune.accuracy expects a number between 0 and 1, got '%s'",
                                  value);
-        } else {
-            return unknown_key(E, section, name, tune_keys, 2);
+        } else if (strcmp(name, "budget") == 0) {
+            if (parse_double(value, &acc) || acc <= 0 || acc > 1)
+                return eng_error(E, "tune.budget expects a share of the run above 0 and at most 1, "
+                                    "got '%s'", value);
+        } else if (strcmp(name, "wisdom") != 0) {
+            return unknown_key(E, section, name, tune_keys, 4);
         }
         return sb_puts(norm, value);
     }

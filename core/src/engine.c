@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "tuner.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -104,7 +105,9 @@ void eng_destroy(silc_engine **pE)
     eng_info_entry *e, *next;
     if (!pE || !*pE) return;
     E = *pE;
-    /* Values first: their attachments may belong to plugins still loaded. */
+    /* Values first: their attachments may belong to plugins still loaded.
+     * The tuner holds some too. */
+    tuner_free(E);
     store_free(&E->store);
     if (E->lang_cache_free && E->lang_cache) E->lang_cache_free(E->lang_cache);
     for (e = E->infos; e; e = next) {

@@ -53,6 +53,7 @@ struct silc_engine {
     void *output_user;
     int threads;                        /* thread budget granted to plugins */
     uint64_t rand_state;                /* rand() seed state */
+    void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
 };

@@ -1,7 +1,8 @@
 /*
  * eval.c -- runs parsed statements: the AST cache, expression evaluation,
  * assignment, control flow and the keyword statements (clear, who, set, info,
- * explain).
+ * explain, tune).  It also feeds the tuner (tuner.c): each top-level EXEC's
+ * text and time, and each solve that ran.
  *
  * Every arithmetic operation becomes a silc_call handed to disp_run(); the
  * core only builds values that are pure structure (literals, zeros, sparse
@@ -13,6 +14,7 @@
  * "'x + y'"), else called "the left operand" / "the right operand".
  */
 #include "lang.h"
+#include "tuner.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -164,6 +166,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         sb_puts(V->explain_out, "\n");
         sb_init(&d);
         rc = disp_explain(E, call, &d);
+        if (!rc) tuner_explain(E, call, &d);
         indent_into(V->explain_out, rc ? E->err : sb_str(&d));
         sb_free(&d);
         if (call->op == SILC_OP_SOLVE) {
@@ -183,6 +186,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         V->has_solve = 1;
         V->report = rep;
         add_backend(V, rep.backend);
+        tuner_note_solve(E, call);
     }
     call->report = NULL;
     *out = call->out;
@@ -779,6 +783,20 @@ static int exec_info(lang_ev *V, const ast_node *s)
 
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
 
+static int exec_tune(lang_ev *V, const ast_node *s)
+{
+    double xs[128];
+    const char *file = NULL;
+    size_t i;
+    int nx = 0;
+    for (i = 0; i < s->nkids; i++) {
+        if (s->kids[i]->kind == AST_STRING) file = s->kids[i]->name;
+        else if (nx < 128) xs[nx++] = s->kids[i]->num;
+        else return eng_error(V->E, "tune %s: too many numbers (at most 64 points)", s->name);
+    }
+    return tuner_command(V->E, s->name, xs, nx, file);
+}
+
 static int exec_explain(lang_ev *V, const ast_node *s)
 {
     strbuf b;
@@ -860,6 +878,8 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
         return exec_info(V, s);
     case ST_EXPLAIN:
         return exec_explain(V, s);
+    case ST_TUNE:
+        return exec_tune(V, s);
     case ST_BREAK:
         *flow = FLOW_BREAK;
         return 0;
@@ -891,6 +911,7 @@ int lang_exec(silc_engine *E, const char *text)
     lang_program *prog;
     lang_ev V;
     size_t i;
+    double t0 = util_now();
     if (!text) return eng_error(E, "no statement text");
     E->err[0] = 0;
     if (program_for(E, text, &prog)) return -1;
@@ -909,5 +930,6 @@ int lang_exec(silc_engine *E, const char *text)
             return -1;
         }
     }
+    tuner_observe(E, text, util_now() - t0);
     return 0;
 }

@@ -52,7 +52,9 @@ enum ast_kind {
     /* statements */
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
-    ST_BLOCK               /* { statements } of IF / WHILE: kids are the statements */
+    ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
+    ST_TUNE                /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
+                              pairs); els unused; an AST_STRING kid names a file */
 };
 
 typedef struct ast_node ast_node;

@@ -6,7 +6,7 @@
  * operand may carry a sign: 2^-1) ; postfix ' [subscripts] f(args).  So
  * -2^2 is -(2^2) and -A*B is (-A)*B, as in MATLAB.
  *
- * Keywords (clear who set info explain if while else break continue) are
+ * Keywords (clear who set info explain tune if while else break continue) are
  * keywords only at the start of a statement and only when not followed by an
  * assignment, so `info = 3` still binds a variable.  The first syntax error
  * stops parsing; its message is Lua-style, "L:C: expected ')' (to close '('
@@ -548,6 +548,78 @@ static ast_node *name_node(ps_state *P, int kind)
     return n;
 }
 
+static ast_node *num_node(ps_state *P)
+{
+    const lx_token *tk = next(P);
+    ast_node *x = node_new(P, AST_NUM, tk);
+    if (x) x->num = tk->num;
+    return x;
+}
+
+/* tune [on [STEPS] | off | status | step | forget | report ["file.svg"] |
+ * fit P:T P:T ...]; a bare `tune` is `tune status`. */
+static ast_node *parse_tune(ps_state *P, const lx_token *kw)
+{
+    static const char *const words[] = {"on", "off", "status", "step", "forget", "report", "fit"};
+    const lx_token *at = peek(P);
+    ast_node *n;
+    size_t i;
+    if (at->kind == TK_EOF || is_separator(at->kind)) {
+        n = node_new(P, ST_TUNE, kw);
+        if (n && !(n->name = util_strdup("status"))) {
+            node_free(n);
+            return fail(P, kw, "out of memory while parsing");
+        }
+        return n;
+    }
+    n = name_node(P, ST_TUNE);
+    if (!n) return NULL;
+    n->start = kw->start;
+    for (i = 0; i < sizeof words / sizeof words[0]; i++)
+        if (!strcmp(n->name, words[i])) break;
+    if (i == sizeof words / sizeof words[0]) {
+        const char *best = util_closest(n->name, words, sizeof words / sizeof words[0]);
+        node_free(n);
+        if (best) return fail(P, at, "unknown tune command '%.*s'; did you mean '%s'?", (int)at->len,
+                              P->src + at->start, best);
+        return fail(P, at, "unknown tune command '%.*s' (on, off, status, step, forget, report, fit)",
+                    (int)at->len, P->src + at->start);
+    }
+    if (!strcmp(n->name, "fit")) {
+        while (is(P, TK_NUMBER)) {
+            if (add_kid(P, n, num_node(P))) goto bad;
+            if (!is(P, TK_COLON)) {
+                node_free(n);
+                return fail(P, peek(P), "tune fit takes points written p:seconds, as in 1:13.5");
+            }
+            next(P);
+            if (!is(P, TK_NUMBER)) {
+                node_free(n);
+                return fail(P, peek(P), "tune fit: expected the seconds after ':'");
+            }
+            if (add_kid(P, n, num_node(P))) goto bad;
+        }
+    } else if (!strcmp(n->name, "on") && is(P, TK_NUMBER)) {
+        if (add_kid(P, n, num_node(P))) goto bad;
+    } else if (!strcmp(n->name, "report") && is(P, TK_STRING)) {
+        const lx_token *tk = next(P);
+        ast_node *x = node_new(P, AST_STRING, tk);
+        if (x && !(x->name = malloc(tk->len - 1))) {
+            node_free(x);
+            x = fail(P, tk, "out of memory while parsing");
+        }
+        if (x) {
+            memcpy(x->name, P->src + tk->start + 1, tk->len - 2);
+            x->name[tk->len - 2] = 0;
+        }
+        if (add_kid(P, n, x)) goto bad;
+    }
+    return n;
+bad:
+    node_free(n);
+    return NULL;
+}
+
 static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
 {
     ast_node *n;
@@ -559,6 +631,7 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
         return node_new(P, tok_is_text(P, kw, "break") ? ST_BREAK : ST_CONTINUE, kw);
     }
     if (tok_is_text(P, kw, "who")) return node_new(P, ST_WHO, kw);
+    if (tok_is_text(P, kw, "tune")) return parse_tune(P, kw);
     if (tok_is_text(P, kw, "clear")) {
         n = node_new(P, ST_CLEAR, kw);
         while (n && peek(P)->kind == TK_NAME)
@@ -615,7 +688,7 @@ static int is_assign_op(int k)
 }
 
 static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
-                                       "info", "set", "explain"};
+                                       "info", "set", "explain", "tune"};
 
 static ast_node *parse_statement(ps_state *P)
 {

@@ -1,0 +1,1293 @@
+/*
+ * tuner.c -- automatic performance tuning: thread count by the seeds' model,
+ * solver backend under an accuracy target, and wisdom (see tuner.h).
+ *
+ * The tuner watches the stream of top-level EXEC texts.  A time-stepping
+ * program repeats the same texts every step, so the smallest k for which the
+ * last 3k texts repeat with period k is the step (or the program says so with
+ * `tune step`).  Once two whole steps are seen the tuner (1) times every
+ * loaded backend that accepts each solve class of the step on copies of the
+ * live matrices, factoring and back-solving separately, and picks the one
+ * with the least predicted cost for the rest of the run among those meeting
+ * tune.accuracy; (2) times whole steps at candidate thread counts, keeping the
+ * minimum of m repeats, until the leave-one-out rule says the fit is settled
+ * or the sampling would exceed tune.budget of the expected run; (3) fits
+ * f(p) = a/p + b*p + c and continues at p_opt; (4) writes the result to the
+ * wisdom file, keyed by machine and problem signature, so the next run with
+ * the same step skips straight to (3)'s answer.
+ *
+ * Thread counts change only between steps, so every timed step ran at one p.
+ * Step times are the sum of the EXECs' own wall times: what SILC's thread
+ * count can change, without the program's work between EXECs.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "tuner.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define T_HIST 192          /* EXEC hashes kept for period detection */
+#define T_MAXK 48           /* longest period looked for */
+#define T_MAXC 16           /* candidate thread counts */
+#define T_MAXCLS 8          /* solve classes per step */
+#define T_MAXB 16           /* candidate backends per class */
+#define T_DEFAULT_STEPS 100 /* run length assumed for backend cost when unknown */
+
+enum { PH_OFF, PH_WAIT, PH_WAIT2, PH_SAMPLE, PH_DONE };
+
+typedef struct t_point {
+    int p;
+    double tmin, t2;        /* least and second-least step time */
+    int reps;
+} t_point;
+
+/* One solve class of a step: its live operands and, once tuned, the table. */
+typedef struct t_class {
+    char cls[40];
+    silc_value *a, *b;      /* retained operands of the latest solve */
+    uint64_t a_id;
+    int count;              /* solves of this class in the step */
+    int reuse;              /* the matrix kept its id from the previous step */
+    char ran[64];           /* backend the program's solve used */
+    tuner_cand cand[T_MAXB];
+    int ncand, winner;      /* winner -1: none met the accuracy target */
+    char reason[320];
+} t_class;
+
+typedef struct tuner {
+    int enabled, user_off;
+    int in_command, step_mark, explicit_steps;
+    /* period detection */
+    uint64_t hist[T_HIST];
+    int nhist, period, pos;
+    uint64_t seq[T_MAXK];
+    uint64_t step_hash;     /* running hash of the texts of the open step */
+    int step_open, cur_p;
+    double step_acc;
+    int steps;              /* whole steps seen since tuning began */
+    /* solves: of the running EXEC, of the open step, of the reference step */
+    t_class pend[T_MAXCLS], cur[T_MAXCLS], ref[T_MAXCLS];
+    int npend, ncur, nref;
+    t_class tab[T_MAXCLS];  /* backend tables of the tuned classes, no operands */
+    int ntab;
+    /* thread sampling */
+    int phase, warmup;
+    int cands[T_MAXC], ncands, ci;
+    t_point pts[T_MAXC];
+    int npts;
+    double sample_total;
+    int sample_steps;
+    tuner_model model;
+    int have_model, p_opt, from_wisdom;
+    char stop[160];
+    int expect_steps;
+    double loo_tol, rep_tol;
+    int max_rep;
+    char signature[24];
+    int progress;           /* a progress line is on the terminal */
+} tuner;
+
+/* ---- the model ------------------------------------------------------------- */
+
+double tuner_model_eval(const tuner_model *m, double p)
+{
+    return m->a / p + m->b * p + m->c;
+}
+
+/* Householder QR of the n x 3 design matrix, then back substitution: better
+ * conditioned than the normal equations when p spans 1..64. */
+int tuner_fit(const double *p, const double *t, int n, int pmin, int pmax, tuner_model *m)
+{
+    double *A, *y, x[3], q = 0;
+    int i, j, k, best = 0;
+    memset(m, 0, sizeof *m);
+    if (n < 3) return -1;
+    A = malloc((size_t)n * 3 * sizeof *A);
+    y = malloc((size_t)n * sizeof *y);
+    if (!A || !y) {
+        free(A), free(y);
+        return -1;
+    }
+    for (i = 0; i < n; i++) {
+        if (!(p[i] >= 1)) {
+            free(A), free(y);
+            return -1;
+        }
+        A[i] = 1.0 / p[i], A[n + i] = p[i], A[2 * n + i] = 1.0, y[i] = t[i];
+    }
+    for (k = 0; k < 3; k++) {
+        double *col = A + (size_t)k * n, norm = 0, alpha, vtv;
+        for (i = k; i < n; i++) norm += col[i] * col[i];
+        norm = sqrt(norm);
+        if (norm == 0) goto singular;
+        alpha = col[k] > 0 ? -norm : norm;
+        col[k] -= alpha;                     /* v = x - alpha e_k, stored in place */
+        vtv = 0;
+        for (i = k; i < n; i++) vtv += col[i] * col[i];
+        for (j = k + 1; j < 3; j++) {
+            double *cj = A + (size_t)j * n, s = 0;
+            for (i = k; i < n; i++) s += col[i] * cj[i];
+            s = 2 * s / vtv;
+            for (i = k; i < n; i++) cj[i] -= s * col[i];
+        }
+        {
+            double s = 0;
+            for (i = k; i < n; i++) s += col[i] * y[i];
+            s = 2 * s / vtv;
+            for (i = k; i < n; i++) y[i] -= s * col[i];
+        }
+        col[k] = alpha;                      /* R's diagonal; below it is v, unused now */
+        if (fabs(alpha) < 1e-12 * (fabs(A[0]) + 1)) goto singular;
+    }
+    for (k = 2; k >= 0; k--) {
+        double s = y[k];
+        for (j = k + 1; j < 3; j++) s -= A[(size_t)j * n + k] * x[j];
+        x[k] = s / A[(size_t)k * n + k];
+    }
+    free(A), free(y);
+    m->a = x[0], m->b = x[1], m->c = x[2];
+    for (i = 0; i < n; i++) {
+        double r = t[i] - tuner_model_eval(m, p[i]);
+        q += r * r;
+    }
+    m->q = q;
+    if (pmin < 1) pmin = 1;
+    if (pmax < pmin) pmax = pmin;
+    if (m->a > 0 && m->b > 0) {
+        double s = sqrt(m->a / m->b);
+        int lo = (int)floor(s), hi = (int)ceil(s);
+        if (lo < pmin) lo = pmin;
+        if (lo > pmax) lo = pmax;
+        if (hi < pmin) hi = pmin;
+        if (hi > pmax) hi = pmax;
+        m->p_opt = tuner_model_eval(m, hi) < tuner_model_eval(m, lo) ? hi : lo;
+        m->t_opt = tuner_model_eval(m, m->p_opt);
+        return 0;
+    }
+    /* No interior minimum: trust the measurements, not the model. */
+    m->guarded = 1;
+    for (i = 1; i < n; i++)
+        if (t[i] < t[best]) best = i;
+    m->p_opt = (int)p[best];
+    if (m->p_opt < pmin) m->p_opt = pmin;
+    if (m->p_opt > pmax) m->p_opt = pmax;
+    m->t_opt = t[best];
+    return 0;
+singular:
+    free(A), free(y);
+    return -1;
+}
+
+int tuner_loo_stable(const double *p, const double *t, int n, int pmin, int pmax, double tol)
+{
+    tuner_model full, part;
+    double pp[T_MAXC * 4], tt[T_MAXC * 4];
+    int i, j, k;
+    if (n < 4 || n > T_MAXC * 4) return 0;
+    if (tuner_fit(p, t, n, pmin, pmax, &full) || !(full.t_opt > 0)) return 0;
+    for (i = 0; i < n; i++) {
+        for (j = k = 0; j < n; j++)
+            if (j != i) pp[k] = p[j], tt[k++] = t[j];
+        if (tuner_fit(pp, tt, k, pmin, pmax, &part)) return 0;
+        /* what choosing the reduced fit's answer would cost, by the full fit
+         * (by the measurement when the full fit has no interior minimum) */
+        if (part.p_opt != full.p_opt) {
+            double cost = INFINITY;
+            if (!full.guarded) cost = tuner_model_eval(&full, part.p_opt);
+            else
+                for (j = 0; j < n; j++)
+                    if ((int)p[j] == part.p_opt) cost = t[j];
+            if (cost > full.t_opt * (1 + tol)) return 0;
+        }
+        if (fabs(part.t_opt - full.t_opt) > tol * full.t_opt) return 0;
+    }
+    return 1;
+}
+
+/* ---- period detection ------------------------------------------------------ */
+
+uint64_t tuner_hash(const char *text)
+{
+    uint64_t h = 1469598103934665603ull;
+    while (*text) h = (h ^ (unsigned char)*text++) * 1099511628211ull;
+    return h;
+}
+
+int tuner_detect_period(const uint64_t *h, int n, int maxk)
+{
+    int k, i;
+    for (k = 1; k <= maxk; k++) {
+        int need = 3 * k;
+        if (need > n) need = 2 * k;   /* long periods: two repeats suffice */
+        if (need > n) return 0;
+        for (i = 0; i < need - k; i++)
+            if (h[n - 1 - i] != h[n - 1 - i - k]) break;
+        if (i == need - k) return k;
+    }
+    return 0;
+}
+
+/* ---- backend ranking -------------------------------------------------------- */
+
+int tuner_rank(tuner_cand *c, int n, double accuracy, double steps, int per_step, int reuse)
+{
+    int i, best = -1;
+    double solves;
+    if (per_step < 1) per_step = 1;
+    if (steps < 1) steps = 1;
+    solves = steps * per_step;
+    for (i = 0; i < n; i++) {
+        if (c[i].failed) {
+            c[i].cost = INFINITY;
+            if (!c[i].why[0]) snprintf(c[i].why, sizeof c[i].why, "failed");
+            continue;
+        }
+        /* a kept matrix is factored once; a new one every step */
+        c[i].cost = reuse ? c[i].first + (solves - 1) * c[i].repeat
+                          : steps * (c[i].first + (per_step - 1) * c[i].repeat);
+        if (!(c[i].berr <= accuracy)) {
+            snprintf(c[i].why, sizeof c[i].why, "too inaccurate (%.2g > %.2g)", c[i].berr, accuracy);
+            continue;
+        }
+        if (best < 0 || c[i].cost < c[best].cost) best = i;
+    }
+    for (i = 0; i < n; i++) {
+        if (c[i].failed || !(c[i].berr <= accuracy)) continue;
+        if (i == best)
+            snprintf(c[i].why, sizeof c[i].why, "fastest accurate");
+        else
+            snprintf(c[i].why, sizeof c[i].why, "%.2fx the winner's cost", c[i].cost / c[best].cost);
+    }
+    return best;
+}
+
+/* ---- machine, candidates, configuration ------------------------------------ */
+
+static int cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 4096 ? 4096 : (int)n;
+}
+
+int tuner_candidates(int ncores, int *out)
+{
+    int n = 0, p, i;
+    static const int over[] = {3, 4, 6, 8};   /* halves of the core count: 1.5x .. 4x */
+    for (p = 1; p < ncores && n < T_MAXC - 5; p *= 2) out[n++] = p;
+    out[n++] = ncores;
+    if (ncores <= 4)
+        for (i = 0; i < 4; i++) {
+            int q = over[i] * ncores / 2;
+            if (q > out[n - 1]) out[n++] = q;
+        }
+    return n;
+}
+
+void tuner_machine(char *out, size_t len)
+{
+    char line[512], model[256] = "unknown-cpu";
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    size_t i;
+    if (f) {
+        while (fgets(line, sizeof line, f)) {
+            char *colon = strchr(line, ':');
+            if (!strncmp(line, "model name", 10) && colon) {
+                char *s = colon + 1;
+                while (*s == ' ' || *s == '\t') s++;
+                snprintf(model, sizeof model, "%s", s);
+                break;
+            }
+        }
+        fclose(f);
+    }
+    model[strcspn(model, "\r\n")] = 0;
+    for (i = 0; model[i]; i++)
+        if (model[i] == ' ' || model[i] == '\t' || model[i] == '|') model[i] = '_';
+    snprintf(out, len, "%s|%d", model, cores());
+}
+
+void tuner_wisdom_path(silc_engine *E, char *out, size_t len)
+{
+    const char *p = cfg_get(E, "tune.wisdom"), *home;
+    if (p && *p) {
+        snprintf(out, len, "%s", p);
+        return;
+    }
+    p = getenv("SILC_WISDOM");
+    if (p && *p) {
+        snprintf(out, len, "%s", p);
+        return;
+    }
+    home = getenv("HOME");
+    snprintf(out, len, "%s/.cache/silc/wisdom", home && *home ? home : ".");
+}
+
+static double cfg_number(silc_engine *E, const char *key, double def)
+{
+    const char *v = cfg_get(E, key);
+    char *end;
+    double x;
+    if (!v) return def;
+    x = strtod(v, &end);
+    return end != v && !*end ? x : def;
+}
+
+static tuner *tuner_get(silc_engine *E)
+{
+    tuner *T = E->tuner;
+    if (T) return T;
+    T = calloc(1, sizeof *T);
+    if (!T) return NULL;
+    T->ncands = tuner_candidates(cores(), T->cands);
+    T->loo_tol = 0.02;
+    T->rep_tol = 0.02;
+    T->max_rep = 4;
+    T->p_opt = E->threads;
+    E->tuner = T;
+    return T;
+}
+
+void tuner_expect_steps(silc_engine *E, int steps)
+{
+    tuner *T = tuner_get(E);
+    if (T) T->expect_steps = steps > 0 ? steps : 0;
+}
+
+void tuner_set_rule(silc_engine *E, double loo_tol, double rep_tol, int max_repeats)
+{
+    tuner *T = tuner_get(E);
+    if (!T) return;
+    if (loo_tol > 0) T->loo_tol = loo_tol;
+    if (rep_tol > 0) T->rep_tol = rep_tol;
+    if (max_repeats >= 1) T->max_rep = max_repeats;
+}
+
+/* ---- solve records ---------------------------------------------------------- */
+
+static void classes_clear(t_class *c, int *n)
+{
+    int i;
+    for (i = 0; i < *n; i++) val_release(c[i].a), val_release(c[i].b);
+    memset(c, 0, sizeof *c * (size_t)*n);
+    *n = 0;
+}
+
+static t_class *class_find(t_class *c, int n, const char *cls)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        if (!strcmp(c[i].cls, cls)) return &c[i];
+    return NULL;
+}
+
+/* Moves the running EXEC's solves into the open step (latest operands win). */
+static void pend_merge(tuner *T)
+{
+    int i;
+    for (i = 0; i < T->npend; i++) {
+        t_class *p = &T->pend[i], *c = class_find(T->cur, T->ncur, p->cls);
+        if (!c && T->ncur < T_MAXCLS) {
+            c = &T->cur[T->ncur++];
+            memset(c, 0, sizeof *c);
+            snprintf(c->cls, sizeof c->cls, "%s", p->cls);
+        }
+        if (!c) continue;
+        val_release(c->a), val_release(c->b);
+        c->a = p->a, c->b = p->b, c->a_id = p->a_id;
+        p->a = p->b = NULL;
+        c->count += p->count;
+        snprintf(c->ran, sizeof c->ran, "%s", p->ran);
+    }
+    classes_clear(T->pend, &T->npend);
+}
+
+void tuner_note_solve(silc_engine *E, const silc_call *call)
+{
+    tuner *T = E->tuner;
+    const char *chain[4];
+    t_class *c;
+    if (!T || !T->enabled || T->phase == PH_DONE || call->nin < 2) return;
+    if (disp_classes(E, call, chain) < 1) return;
+    c = class_find(T->pend, T->npend, chain[0]);
+    if (!c) {
+        if (T->npend >= T_MAXCLS) return;
+        c = &T->pend[T->npend++];
+        memset(c, 0, sizeof *c);
+        snprintf(c->cls, sizeof c->cls, "%s", chain[0]);
+    }
+    val_release(c->a), val_release(c->b);
+    c->a = val_retain((silc_value *)call->in[0]);
+    c->b = val_retain((silc_value *)call->in[1]);
+    c->a_id = call->in[0]->id;
+    c->count++;
+    if (call->report) snprintf(c->ran, sizeof c->ran, "%s", call->report->backend);
+}
+
+/* ---- progress and wisdom ----------------------------------------------------- */
+
+static void progress(tuner *T, int done)
+{
+    if (!isatty(2)) return;
+    if (done) {
+        if (T->progress) fputc('\n', stderr);
+        T->progress = 0;
+        return;
+    }
+    fprintf(stderr, "\rtune: step %d, sampling p = %d (point %d of at most %d)   ", T->steps,
+            T->cands[T->ci], T->ci + 1, T->ncands);
+    fflush(stderr);
+    T->progress = 1;
+}
+
+/* Problem signature: the step's statement sequence, then each solve class
+ * with its sizes and nnz (the structure class is in the class name). */
+static void signature(tuner *T)
+{
+    uint64_t h = T->step_hash;
+    char buf[160];
+    int i;
+    for (i = 0; i < T->ncur; i++) {
+        const t_class *c = &T->cur[i];
+        snprintf(buf, sizeof buf, "%s %lldx%lld nnz %lld rhs %lld", c->cls,
+                 (long long)c->a->m, (long long)c->a->n, (long long)val_props(c->a)->nnz,
+                 (long long)c->b->n);
+        h = (h ^ tuner_hash(buf)) * 1099511628211ull;
+    }
+    snprintf(T->signature, sizeof T->signature, "%016llx", (unsigned long long)h);
+}
+
+static int mkdirs_for(const char *path)
+{
+    char dir[1024];
+    char *s;
+    snprintf(dir, sizeof dir, "%s", path);
+    for (s = dir + 1; *s; s++) {
+        if (*s != '/') continue;
+        *s = 0;
+        if (mkdir(dir, 0755) && errno != EEXIST) return -1;
+        *s = '/';
+    }
+    return 0;
+}
+
+/* Rewrites the wisdom file without this machine+signature's lines, then
+ * appends the current results. */
+static void wisdom_write(silc_engine *E, tuner *T)
+{
+    char path[1024], tmp[1100], machine[300], prefix[400], line[4096];
+    FILE *in, *out;
+    strbuf b;
+    int i;
+    tuner_wisdom_path(E, path, sizeof path);
+    tuner_machine(machine, sizeof machine);
+    snprintf(prefix, sizeof prefix, "%s\t%s\t", machine, T->signature);
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    if (mkdirs_for(path)) return;
+    out = fopen(tmp, "w");
+    if (!out) return;
+    fputs("# silc wisdom v1: machine, signature, then 'threads' p_opt a b c q samples\n"
+          "# (p:seconds:repeats, comma separated) or 'backend' class winner\n", out);
+    in = fopen(path, "r");
+    if (in) {
+        while (fgets(line, sizeof line, in))
+            if (line[0] != '#' && strncmp(line, prefix, strlen(prefix))) fputs(line, out);
+        fclose(in);
+    }
+    sb_init(&b);
+    sb_printf(&b, "%sthreads\t%d\t%.9g %.9g %.9g %.9g\t", prefix, T->p_opt, T->model.a, T->model.b,
+              T->model.c, T->model.q);
+    for (i = 0; i < T->npts; i++)
+        sb_printf(&b, "%s%d:%.9g:%d", i ? "," : "", T->pts[i].p, T->pts[i].tmin, T->pts[i].reps);
+    if (!T->npts) sb_puts(&b, "-");
+    sb_puts(&b, "\n");
+    fputs(sb_str(&b), out);
+    sb_free(&b);
+    for (i = 0; i < T->ntab; i++)
+        if (T->tab[i].ncand && T->tab[i].winner >= 0)
+            fprintf(out, "%sbackend\t%s\t%s\t%s\n", prefix, T->tab[i].cls,
+                    T->tab[i].cand[T->tab[i].winner].backend, T->tab[i].cand[T->tab[i].winner].opts);
+    if (fclose(out) || rename(tmp, path)) remove(tmp);
+}
+
+/* Sets dispatch.<cls> (and the plugin's options for a variant); returns 1
+ * if that changes what runs. */
+static int apply_winner(silc_engine *E, const char *cls, const tuner_cand *w, const char *ran)
+{
+    char key[80];
+    if (!strcmp(w->backend, ran) && !w->opts[0]) return 0;
+    snprintf(key, sizeof key, "dispatch.%s", cls);
+    if (cfg_set(E, CFG_SCOPE_SESSION, key, w->backend)) return 0;
+    if (w->opts[0]) {
+        snprintf(key, sizeof key, "%s.options", w->backend);
+        cfg_set(E, CFG_SCOPE_SESSION, key, w->opts);
+    }
+    return 1;
+}
+
+/* Parses a 'threads' record's fields into T's samples and model. */
+static int wisdom_parse_threads(tuner *T, char *fields)
+{
+    char *tok, *save;
+    int p, used = 0;
+    if (sscanf(fields, "%d %lg %lg %lg %lg %n", &p, &T->model.a, &T->model.b, &T->model.c,
+               &T->model.q, &used) != 5 || !used)
+        return -1;
+    T->p_opt = p;
+    T->npts = 0;
+    for (tok = strtok_r(fields + used, ",\r\n", &save); tok && T->npts < T_MAXC;
+         tok = strtok_r(NULL, ",\r\n", &save)) {
+        t_point *pt = &T->pts[T->npts];
+        if (sscanf(tok, "%d:%lg:%d", &pt->p, &pt->tmin, &pt->reps) == 3) T->npts++;
+    }
+    T->model.p_opt = p;
+    T->model.t_opt = tuner_model_eval(&T->model, p);
+    T->model.guarded = !(T->model.a > 0 && T->model.b > 0);
+    T->have_model = T->npts >= 3;
+    return 0;
+}
+
+/* Looks up this machine's record for signature sig (NULL: the last threads
+ * record of this machine, for `silc tune report`).  Applies backends when
+ * apply is set.  Returns 1 if a threads record was found. */
+static int wisdom_read(silc_engine *E, tuner *T, const char *sig, int apply)
+{
+    char path[1024], machine[300], line[4096];
+    FILE *f;
+    int found = 0;
+    size_t ml;
+    tuner_wisdom_path(E, path, sizeof path);
+    tuner_machine(machine, sizeof machine);
+    ml = strlen(machine);
+    f = fopen(path, "r");
+    if (!f) return 0;
+    while (fgets(line, sizeof line, f)) {
+        char *s, *kind, *rest;
+        if (line[0] == '#' || strncmp(line, machine, ml) || line[ml] != '\t') continue;
+        s = line + ml + 1;
+        kind = strchr(s, '\t');
+        if (!kind) continue;
+        *kind++ = 0;
+        if (sig && strcmp(s, sig)) continue;
+        rest = strchr(kind, '\t');
+        if (!rest) continue;
+        *rest++ = 0;
+        if (!strcmp(kind, "threads")) {
+            if (!wisdom_parse_threads(T, rest)) {
+                found = 1;
+                snprintf(T->signature, sizeof T->signature, "%s", s);
+            }
+        } else if (!strcmp(kind, "backend") && apply && T->ntab < T_MAXCLS) {
+            t_class *c = &T->tab[T->ntab];
+            char *w = strchr(rest, '\t'), *o;
+            if (!w) continue;
+            *w++ = 0;
+            w[strcspn(w, "\r\n")] = 0;
+            o = strchr(w, '\t');
+            if (o) *o++ = 0;
+            memset(c, 0, sizeof *c);
+            snprintf(c->cls, sizeof c->cls, "%s", rest);
+            snprintf(c->cand[0].backend, sizeof c->cand[0].backend, "%s", w);
+            snprintf(c->cand[0].opts, sizeof c->cand[0].opts, "%s", o ? o : "");
+            if (!ld_find(E, w) || !apply_winner(E, rest, &c->cand[0], "")) continue;
+            snprintf(c->reason, sizeof c->reason, "%s%s%s, from the wisdom file", w, o && *o ? " " : "",
+                     o ? o : "");
+            c->winner = -1;
+            T->ntab++;
+        }
+    }
+    fclose(f);
+    return found;
+}
+
+/* ---- backend trials ------------------------------------------------------------ */
+
+/* A copy under a new id: trials factor afresh instead of finding the
+ * program's attached factorization. */
+static silc_value *val_copy(const silc_value *v)
+{
+    silc_value *c = NULL;
+    if (v->format == SILC_FMT_CSR) {
+        c = val_csr_new(v->m, v->n, v->nnz);
+        if (c) {
+            memcpy(c->rowptr, v->rowptr, (size_t)(v->m + 1) * sizeof *v->rowptr);
+            memcpy(c->colind, v->colind, (size_t)v->nnz * sizeof *v->colind);
+            memcpy(c->val, v->val, (size_t)v->nnz * sizeof *v->val);
+            val_csr_set_nnz(c, v->nnz);
+        }
+    } else {
+        c = v->format == SILC_FMT_BAND ? val_band_new(v->m, v->n, v->kl, v->ku)
+                                       : val_dense_new(v->m, v->n);
+        if (c) memcpy(c->val, v->val, (size_t)v->nnz * sizeof *v->val);
+    }
+    return c;
+}
+
+static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b, const char *opts,
+                       silc_report *rep)
+{
+    silc_call call;
+    int rc;
+    memset(&call, 0, sizeof call);
+    memset(rep, 0, sizeof *rep);
+    rep->cond_est = rep->rcond = -1;
+    call.op = SILC_OP_SOLVE;
+    call.nin = 2;
+    call.in[0] = a;
+    call.in[1] = b;
+    call.options = opts;
+    call.report = rep;
+    rc = disp_run(E, &call);
+    if (call.out) val_release(call.out);
+    return rc || !call.out;
+}
+
+/* Option variants tried for the iterative plugins: their defaults alone
+ * would judge the method by one preconditioner. */
+static const struct {
+    const char *backend, *opts;
+} variants[] = {
+    {"lis-style", "-i cg -p none"}, {"lis-style", "-i cg -p ilu"},
+    {"lis-style", "-i bicgstab -p ilu"}, {"petsc", "-ksp_type cg -pc_type icc"},
+    {"petsc", "-ksp_type gmres -pc_type ilu"},
+};
+
+static void trial_one(silc_engine *E, t_class *c, const char *backend, const char *variant)
+{
+    tuner_cand *k = &c->cand[c->ncand++];
+    silc_value *a;
+    silc_report r1, r2;
+    char opts[200];
+    memset(k, 0, sizeof *k);
+    snprintf(k->backend, sizeof k->backend, "%s", backend);
+    snprintf(k->opts, sizeof k->opts, "%s", variant ? variant : "");
+    if (variant) snprintf(opts, sizeof opts, "backend = %s; %s.options = %s", backend, backend, variant);
+    else snprintf(opts, sizeof opts, "backend = %s", backend);
+    a = val_copy(c->a);
+    if (!a) {
+        k->failed = 1;
+        snprintf(k->why, sizeof k->why, "out of memory copying the matrix");
+        return;
+    }
+    if (trial_solve(E, a, c->b, opts, &r1) || trial_solve(E, a, c->b, opts, &r2)) {
+        k->failed = 1;
+        snprintf(k->why, sizeof k->why, "failed: %.80s", E->err);
+    } else {
+        k->first = r1.seconds;
+        k->repeat = r2.seconds < r1.seconds ? r2.seconds : r1.seconds;
+        k->berr = r1.backward_error > r2.backward_error ? r1.backward_error : r2.backward_error;
+    }
+    val_release(a);
+}
+
+static void trial_class(silc_engine *E, tuner *T, t_class *c)
+{
+    const char **names = NULL;
+    size_t nn = ld_backend_names(E, &names), i;
+    double steps = T->expect_steps > T->steps ? T->expect_steps - T->steps : T_DEFAULT_STEPS;
+    double acc = cfg_number(E, "tune.accuracy", 1e-10);
+    silc_call probe;
+    c->ncand = 0;
+    memset(&probe, 0, sizeof probe);
+    probe.op = SILC_OP_SOLVE;
+    probe.nin = 2;
+    probe.in[0] = c->a;
+    probe.in[1] = c->b;
+    probe.op_class = c->cls;
+    for (i = 0; i < nn && c->ncand < T_MAXB; i++) {
+        const ld_backend *lb = ld_find(E, names[i]);
+        const silc_op_entry *op;
+        const char *why = NULL;
+        size_t v, nv;
+        if (!lb || lb->backend->n_ops <= SILC_OP_SOLVE) continue;
+        op = &lb->backend->ops[SILC_OP_SOLVE];
+        if (!op->run || (op->accepts && !op->accepts(&probe, &why))) continue;
+        nv = 0;
+        for (v = 0; v < sizeof variants / sizeof variants[0]; v++)
+            if (!strcmp(variants[v].backend, names[i]) && c->ncand < T_MAXB)
+                trial_one(E, c, names[i], variants[v].opts), nv++;
+        if (!nv) trial_one(E, c, names[i], NULL);
+    }
+    free(names);
+    c->winner = tuner_rank(c->cand, c->ncand, acc, steps, c->count, c->reuse);
+    if (c->winner < 0) {
+        snprintf(c->reason, sizeof c->reason,
+                 "no candidate met tune.accuracy = %.2g; dispatch left as configured", acc);
+        return;
+    }
+    snprintf(c->reason, sizeof c->reason,
+             "%s%s%s: least predicted cost (%.3g s) for %.0f more steps x %d solve(s), factor %s, "
+             "among backends with backward error <= %.2g",
+             c->cand[c->winner].backend, c->cand[c->winner].opts[0] ? " " : "",
+             c->cand[c->winner].opts, c->cand[c->winner].cost, steps, c->count,
+             c->reuse ? "once (matrix kept)" : "every step (matrix changes)", acc);
+}
+
+/* The user's own dispatch.<cls> wins over the tuner: it is reported, not
+ * overridden. */
+static int user_set(silc_engine *E, t_class *c)
+{
+    char key[80];
+    size_t len = strlen(c->reason);
+    snprintf(key, sizeof key, "dispatch.%s", c->cls);
+    if (!cfg_get(E, key)) return 0;
+    snprintf(c->reason + len, sizeof c->reason - len, "; not applied: %s is set in the configuration",
+             key);
+    return 1;
+}
+
+/* Times the backends of every class in the step; returns 1 if the dispatch
+ * changed (the next step refactors, so it is not a fair sample). */
+static int trial_backends(silc_engine *E, tuner *T)
+{
+    char err[sizeof E->err];
+    size_t wlen = E->warnings.len;
+    int i, changed = 0;
+    memcpy(err, E->err, sizeof err);
+    for (i = 0; i < T->ncur; i++) {
+        t_class *c = &T->cur[i];
+        t_class *prev = class_find(T->ref, T->nref, c->cls);
+        c->reuse = prev && prev->a_id == c->a_id;
+        trial_class(E, T, c);
+        if (c->winner >= 0 && !user_set(E, c) && apply_winner(E, c->cls, &c->cand[c->winner], c->ran))
+            changed = 1;
+        if (T->ntab < T_MAXCLS) {
+            T->tab[T->ntab] = *c;
+            T->tab[T->ntab].a = T->tab[T->ntab].b = NULL;
+            T->ntab++;
+        }
+    }
+    memcpy(E->err, err, sizeof err);
+    if (E->warnings.s && E->warnings.len > wlen) {
+        E->warnings.len = wlen;
+        E->warnings.s[wlen] = 0;
+    }
+    return changed;
+}
+
+/* ---- thread sampling ----------------------------------------------------------- */
+
+static void points(const tuner *T, double *p, double *t)
+{
+    int i;
+    for (i = 0; i < T->npts; i++) p[i] = T->pts[i].p, t[i] = T->pts[i].tmin;
+}
+
+static void finish(silc_engine *E, tuner *T, const char *why)
+{
+    double p[T_MAXC], t[T_MAXC];
+    int i, lo = 1 << 30, hi = 1, best = 0;
+    points(T, p, t);
+    for (i = 0; i < T->npts; i++) {
+        if (T->pts[i].p < lo) lo = T->pts[i].p;
+        if (T->pts[i].p > hi) hi = T->pts[i].p;
+        if (t[i] < t[best]) best = i;
+    }
+    T->have_model = T->npts >= 3 && !tuner_fit(p, t, T->npts, lo, hi, &T->model);
+    if (T->have_model) {
+        T->p_opt = T->model.p_opt;
+    } else if (T->npts) {
+        T->p_opt = T->pts[best].p;
+    }
+    snprintf(T->stop, sizeof T->stop, "%s", why);
+    T->phase = PH_DONE;
+    progress(T, 1);
+    ld_set_threads(E, T->p_opt);
+    wisdom_write(E, T);
+    classes_clear(T->ref, &T->nref);
+}
+
+static void sample(silc_engine *E, tuner *T, double secs)
+{
+    t_point *pt = NULL;
+    double p[T_MAXC], t[T_MAXC], best, budget, excess, next_cost;
+    int i, complete;
+    if (T->warmup) {
+        T->warmup = 0;
+        return;
+    }
+    for (i = 0; i < T->npts; i++)
+        if (T->pts[i].p == T->cur_p) pt = &T->pts[i];
+    if (!pt) {
+        pt = &T->pts[T->npts++];
+        memset(pt, 0, sizeof *pt);
+        pt->p = T->cur_p;
+        pt->tmin = pt->t2 = INFINITY;
+    }
+    if (secs < pt->tmin) pt->t2 = pt->tmin, pt->tmin = secs;
+    else if (secs < pt->t2) pt->t2 = secs;
+    pt->reps++;
+    T->sample_total += secs;
+    T->sample_steps++;
+    /* m: the two best repeats agree, or the cap is reached */
+    complete = pt->reps >= T->max_rep || (pt->reps >= 2 && pt->t2 - pt->tmin <= T->rep_tol * pt->tmin) ||
+               T->max_rep == 1;
+    best = INFINITY;
+    for (i = 0; i < T->npts; i++)
+        if (T->pts[i].tmin < best) best = T->pts[i].tmin;
+    /* n: leave-one-out stability, the budget, or the end of the candidates */
+    points(T, p, t);
+    if (complete && T->npts >= 4 &&
+        tuner_loo_stable(p, t, T->npts, T->cands[0], T->cands[T->ci], T->loo_tol)) {
+        finish(E, T, "p_opt and its predicted time stable under leave-one-out");
+        return;
+    }
+    budget = cfg_number(E, "tune.budget", 0.05);
+    if (T->expect_steps > 0) {
+        double next_t = pt->tmin;
+        tuner_model m;
+        if (complete && T->ci + 1 < T->ncands && T->npts >= 3 &&
+            !tuner_fit(p, t, T->npts, 1, 1 << 20, &m) && !m.guarded)
+            next_t = tuner_model_eval(&m, T->cands[T->ci + 1]);
+        excess = T->sample_total - T->sample_steps * best;
+        next_cost = (complete ? 2 : 1) * (next_t > best ? next_t - best : 0);
+        if (excess + next_cost > budget * T->expect_steps * best) {
+            finish(E, T, "sampling would exceed tune.budget of the expected run");
+            return;
+        }
+    }
+    if (!complete) return;
+    if (T->ci + 1 >= T->ncands) {
+        finish(E, T, "every candidate thread count sampled");
+        return;
+    }
+    T->ci++;
+    ld_set_threads(E, T->cands[T->ci]);
+    progress(T, 0);
+}
+
+/* A whole step ended after secs seconds of EXEC time. */
+static void step_done(silc_engine *E, tuner *T, double secs)
+{
+    T->steps++;
+    switch (T->phase) {
+    case PH_WAIT:
+        signature(T);
+        if (wisdom_read(E, T, T->signature, 1)) {
+            T->from_wisdom = 1;
+            snprintf(T->stop, sizeof T->stop, "from the wisdom file");
+            T->phase = PH_DONE;
+            ld_set_threads(E, T->p_opt);
+            break;
+        }
+        classes_clear(T->ref, &T->nref);
+        memcpy(T->ref, T->cur, sizeof T->cur);
+        T->nref = T->ncur;
+        memset(T->cur, 0, sizeof T->cur);
+        T->ncur = 0;
+        T->phase = PH_WAIT2;
+        break;
+    case PH_WAIT2:
+        T->warmup = trial_backends(E, T);
+        classes_clear(T->ref, &T->nref);
+        T->phase = PH_SAMPLE;
+        T->ci = 0;
+        ld_set_threads(E, T->cands[0]);
+        progress(T, 0);
+        break;
+    case PH_SAMPLE:
+        sample(E, T, secs);
+        break;
+    default:
+        break;
+    }
+    classes_clear(T->cur, &T->ncur);
+}
+
+static void step_open(silc_engine *E, tuner *T)
+{
+    T->step_open = 1;
+    T->step_acc = 0;
+    T->step_hash = 1469598103934665603ull;
+    T->cur_p = E->threads;
+    classes_clear(T->cur, &T->ncur);
+}
+
+static void reset(tuner *T)
+{
+    classes_clear(T->pend, &T->npend);
+    classes_clear(T->cur, &T->ncur);
+    classes_clear(T->ref, &T->nref);
+    memset(T->tab, 0, sizeof T->tab);
+    T->ntab = 0;
+    T->nhist = T->period = T->pos = T->step_open = T->steps = 0;
+    T->npts = T->ci = T->sample_steps = T->have_model = T->from_wisdom = T->warmup = 0;
+    T->sample_total = 0;
+    T->stop[0] = T->signature[0] = 0;
+    memset(&T->model, 0, sizeof T->model);
+    T->phase = T->enabled ? PH_WAIT : PH_OFF;
+}
+
+/* Follows tune.threads: "auto" turns tuning on (unless `tune off` said
+ * otherwise), a number fixes the thread count while not tuning. */
+static void follow_config(silc_engine *E, tuner *T, const char *v)
+{
+    char *end;
+    long n;
+    if (!strcmp(v, "auto")) {
+        if (!T->enabled && !T->user_off) {
+            T->enabled = 1;
+            reset(T);
+        }
+        return;
+    }
+    n = strtol(v, &end, 10);
+    if (!T->enabled && end != v && !*end && n >= 1 && n != E->threads) ld_set_threads(E, (int)n);
+}
+
+void tuner_observe(silc_engine *E, const char *text, double seconds)
+{
+    tuner *T = E->tuner;
+    const char *cfg = cfg_get(E, "tune.threads");
+    uint64_t h;
+    if (!T) {
+        if (!cfg) return;
+        if (!(T = tuner_get(E))) return;
+    }
+    if (cfg) follow_config(E, T, cfg);
+    if (T->in_command) {
+        T->in_command = 0;
+        if (!T->step_mark) {
+            classes_clear(T->pend, &T->npend);
+            return;
+        }
+    }
+    if (!T->enabled) {
+        T->step_mark = 0;
+        classes_clear(T->pend, &T->npend);
+        return;
+    }
+    h = tuner_hash(text);
+    if (T->explicit_steps) {
+        if (T->step_open) {
+            T->step_acc += seconds;
+            T->step_hash = (T->step_hash ^ h) * 1099511628211ull;
+            pend_merge(T);
+        } else {
+            classes_clear(T->pend, &T->npend);
+        }
+        if (T->step_mark) {
+            if (T->step_open) step_done(E, T, T->step_acc);
+            step_open(E, T);
+        }
+        T->step_mark = 0;
+        return;
+    }
+    if (T->nhist == T_HIST) {
+        memmove(T->hist, T->hist + T_HIST / 2, sizeof T->hist / 2);
+        T->nhist = T_HIST / 2;
+    }
+    T->hist[T->nhist++] = h;
+    if (T->period) {
+        if (h != T->seq[T->pos]) {
+            T->period = 0;      /* the program left its loop: find the new period */
+            T->step_open = 0;
+        } else {
+            if (T->pos == 0) step_open(E, T);
+            T->step_acc += seconds;
+            T->step_hash = (T->step_hash ^ h) * 1099511628211ull;
+            pend_merge(T);
+            if (++T->pos == T->period) {
+                T->pos = 0;
+                T->step_open = 0;
+                step_done(E, T, T->step_acc);
+            }
+            return;
+        }
+    }
+    classes_clear(T->pend, &T->npend);
+    if (!T->period) {
+        int k = tuner_detect_period(T->hist, T->nhist, T_MAXK);
+        if (k) {
+            T->period = k;
+            T->pos = 0;
+            memcpy(T->seq, T->hist + T->nhist - k, (size_t)k * sizeof *T->seq);
+        }
+    }
+}
+
+/* ---- reports ------------------------------------------------------------------ */
+
+static const char *phase_name(const tuner *T)
+{
+    switch (T->phase) {
+    case PH_WAIT:
+    case PH_WAIT2: return T->period || T->explicit_steps ? "waiting for two whole steps"
+                                                         : "looking for the time step";
+    case PH_SAMPLE: return "sampling thread counts";
+    case PH_DONE: return "tuned";
+    default: return "off";
+    }
+}
+
+static void describe(silc_engine *E, const tuner *T, strbuf *b)
+{
+    char machine[300];
+    int i, j;
+    tuner_machine(machine, sizeof machine);
+    sb_printf(b, "state = %s\n", phase_name(T));
+    sb_printf(b, "machine = %s\n", machine);
+    if (T->explicit_steps) sb_puts(b, "step = marked by 'tune step'\n");
+    else if (T->period) sb_printf(b, "period = %d EXEC%s\n", T->period, T->period > 1 ? "s" : "");
+    sb_printf(b, "steps = %d\n", T->steps);
+    sb_printf(b, "threads = %d\n", E->threads);
+    if (T->signature[0]) sb_printf(b, "signature = %s\n", T->signature);
+    if (T->npts) {
+        sb_printf(b, "sampled steps = %d\n", T->sample_steps);
+        sb_puts(b, "samples (p: least step time of m repeats):\n");
+        for (i = 0; i < T->npts; i++)
+            sb_printf(b, "  p = %d: %.6g s (m = %d)\n", T->pts[i].p, T->pts[i].tmin, T->pts[i].reps);
+    }
+    if (T->have_model) {
+        sb_printf(b, "a = %.6g\nb = %.6g\nc = %.6g\nq = %.6g\n", T->model.a, T->model.b, T->model.c,
+                  T->model.q);
+        if (T->model.guarded)
+            sb_puts(b, "fit has no interior minimum (a <= 0 or b <= 0): p_opt is the best sample\n");
+    }
+    if (T->phase == PH_DONE) {
+        sb_printf(b, "p_opt = %d\n", T->p_opt);
+        if (T->have_model)
+            sb_printf(b, "predicted step time = %.6g s\n", tuner_model_eval(&T->model, T->p_opt));
+        sb_printf(b, "stopped because = %s\n", T->stop);
+    }
+    for (i = 0; i < T->ntab; i++) {
+        const t_class *c = &T->tab[i];
+        if (!c->ncand && !c->reason[0]) continue;
+        sb_printf(b, "backends for %s (%d solve%s a step, ran on %s):\n", c->cls, c->count,
+                  c->count == 1 ? "" : "s", c->ran[0] ? c->ran : "?");
+        if (c->ncand)
+            sb_printf(b, "  %-24s %11s %11s %10s %11s  %s\n", "backend", "first s", "repeat s",
+                      "berr", "cost s", "verdict");
+        for (j = 0; j < c->ncand; j++) {
+            const tuner_cand *k = &c->cand[j];
+            char name[140];
+            snprintf(name, sizeof name, "%s%s%s", k->backend, k->opts[0] ? " " : "", k->opts);
+            if (k->failed)
+                sb_printf(b, "  %-24s %11s %11s %10s %11s  %s\n", name, "-", "-", "-", "-",
+                          k->why);
+            else
+                sb_printf(b, "  %-24s %11.4g %11.4g %10.2g %11.4g  %s\n", name, k->first,
+                          k->repeat, k->berr, k->cost, k->why);
+        }
+        sb_printf(b, "  winner: %s\n", c->reason);
+    }
+}
+
+void tuner_explain(silc_engine *E, const silc_call *call, strbuf *b)
+{
+    tuner *T = E->tuner;
+    const char *chain[4];
+    const t_class *c;
+    int j;
+    if (!T || call->op != SILC_OP_SOLVE || disp_classes(E, call, chain) < 1) return;
+    c = class_find((t_class *)T->tab, T->ntab, chain[0]);
+    if (!c || !c->reason[0]) return;
+    sb_printf(b, "tuner: %s\n", c->reason);
+    for (j = 0; j < c->ncand; j++)
+        sb_printf(b, "  %s%s%s: first %.3g s, repeat %.3g s, backward error %.2g: %s\n",
+                  c->cand[j].backend, c->cand[j].opts[0] ? " " : "", c->cand[j].opts, c->cand[j].first, c->cand[j].repeat, c->cand[j].berr,
+                  c->cand[j].why);
+}
+
+/* The plot: measured times as points, f(p) as a curve, p_opt as a dashed
+ * line, on a log2 p axis. */
+static int write_svg(const tuner *T, const char *path)
+{
+    const double W = 640, H = 400, L = 70, R = 20, TOP = 40, BOT = 50;
+    double pmin = 1e300, pmax = 0, tmax = 0, x0, x1;
+    FILE *f;
+    int i;
+    for (i = 0; i < T->npts; i++) {
+        if (T->pts[i].p < pmin) pmin = T->pts[i].p;
+        if (T->pts[i].p > pmax) pmax = T->pts[i].p;
+        if (T->pts[i].tmin > tmax) tmax = T->pts[i].tmin;
+    }
+    if (T->p_opt > 0 && T->p_opt < pmin) pmin = T->p_opt;
+    if (T->p_opt > pmax) pmax = T->p_opt;
+    if (!(pmin < 1e300)) pmin = 1, pmax = 2;
+    if (pmax <= pmin) pmax = pmin * 2;
+    if (!(tmax > 0)) tmax = 1;
+    tmax *= 1.15;
+    x0 = log2(pmin), x1 = log2(pmax);
+#define SX(p) (L + (log2(p) - x0) / (x1 - x0) * (W - L - R))
+#define SY(t) (TOP + (1 - (t) / tmax) * (H - TOP - BOT))
+    f = fopen(path, "w");
+    if (!f) return -1;
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+               "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"12\">\n",
+            W, H, W, H);
+    fprintf(f, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
+    fprintf(f, "<text x=\"%.0f\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">step time "
+               "vs threads: f(p) = a/p + b p + c</text>\n", W / 2);
+    fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n", L,
+            H - BOT, W - R, H - BOT);
+    fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n", L,
+            TOP, L, H - BOT);
+    for (i = 0; i < T->npts; i++)
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%d</text>\n",
+                SX(T->pts[i].p), H - BOT + 16, T->pts[i].p);
+    for (i = 0; i <= 4; i++)
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.3g</text>\n", L - 6,
+                SY(tmax * i / 4) + 4, tmax * i / 4);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">threads p (log scale)</text>\n",
+            (L + W - R) / 2, H - 12);
+    fprintf(f, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" "
+               "text-anchor=\"middle\">seconds per step</text>\n",
+            (TOP + H - BOT) / 2, (TOP + H - BOT) / 2);
+    if (T->have_model) {
+        fprintf(f, "<polyline class=\"fit\" fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"2\" "
+                   "points=\"");
+        for (i = 0; i <= 100; i++) {
+            double p = pow(2, x0 + (x1 - x0) * i / 100), t = tuner_model_eval(&T->model, p);
+            if (t < 0) t = 0;
+            if (t > tmax) t = tmax;
+            fprintf(f, "%s%.1f,%.1f", i ? " " : "", SX(p), SY(t));
+        }
+        fprintf(f, "\"/>\n");
+    }
+    for (i = 0; i < T->npts; i++)
+        fprintf(f, "<circle class=\"sample\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"#d62728\">"
+                   "<title>p = %d: %.4g s</title></circle>\n",
+                SX(T->pts[i].p), SY(T->pts[i].tmin), T->pts[i].p, T->pts[i].tmin);
+    if (T->p_opt > 0) {
+        fprintf(f, "<line id=\"p_opt\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+                   "stroke=\"#2ca02c\" stroke-dasharray=\"6,4\" stroke-width=\"2\"/>\n",
+                SX(T->p_opt), TOP, SX(T->p_opt), H - BOT);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" fill=\"#2ca02c\">p_opt = %d</text>\n",
+                SX(T->p_opt) + 4, TOP + 12, T->p_opt);
+    }
+    fprintf(f, "</svg>\n");
+#undef SX
+#undef SY
+    return fclose(f) ? -1 : 0;
+}
+
+static int report(silc_engine *E, tuner *T, const char *svg)
+{
+    strbuf b;
+    tuner saved;
+    const tuner *show = T;
+    int rc = 0;
+    if (!T->npts && T->phase != PH_DONE) {
+        /* nothing tuned in this session: show the machine's last wisdom */
+        memset(&saved, 0, sizeof saved);
+        if (!wisdom_read(E, &saved, NULL, 0)) {
+            char path[1024];
+            tuner_wisdom_path(E, path, sizeof path);
+            return eng_error(E, "tune report: nothing tuned in this session and no wisdom for "
+                                "this machine in '%s'", path);
+        }
+        saved.phase = PH_DONE;
+        snprintf(saved.stop, sizeof saved.stop, "from the wisdom file");
+        show = &saved;
+    }
+    sb_init(&b);
+    sb_puts(&b, "tune report\n");
+    describe(E, show, &b);
+    if (write_svg(show, svg))
+        rc = eng_error(E, "tune report: cannot write '%s': %s", svg, strerror(errno));
+    else
+        sb_printf(&b, "plot = %s\n", svg);
+    if (!rc) eng_print(E, sb_str(&b));
+    sb_free(&b);
+    return rc;
+}
+
+/* ---- the `tune` statement --------------------------------------------------------- */
+
+static int cmd_fit(silc_engine *E, const double *xs, int nx)
+{
+    double p[64], t[64];
+    int n = nx / 2, i, lo = 1 << 30, hi = 1;
+    tuner_model m;
+    char line[256];
+    if (nx % 2 || n < 3 || n > 64)
+        return eng_error(E, "tune fit needs 3 to 64 points written p:seconds, as in "
+                            "'tune fit 1:13.5 2:7.23 4:4.41'");
+    for (i = 0; i < n; i++) {
+        p[i] = xs[2 * i], t[i] = xs[2 * i + 1];
+        if (!(p[i] >= 1) || p[i] != floor(p[i]) || !(t[i] > 0) || !isfinite(t[i]))
+            return eng_error(E, "tune fit: point %d: need a whole thread count >= 1 and a time > 0",
+                             i + 1);
+        if ((int)p[i] < lo) lo = (int)p[i];
+        if ((int)p[i] > hi) hi = (int)p[i];
+    }
+    if (tuner_fit(p, t, n, lo, hi, &m))
+        return eng_error(E, "tune fit: the points do not determine a, b and c (need 3 distinct p)");
+    snprintf(line, sizeof line, "a = %.6g\nb = %.6g\nc = %.6g\nq = %.6g\np_opt = %d\n%s", m.a, m.b,
+             m.c, m.q, m.p_opt,
+             m.guarded ? "note = a <= 0 or b <= 0: p_opt is the fastest measured point\n" : "");
+    eng_print(E, line);
+    return 0;
+}
+
+int tuner_command(silc_engine *E, const char *word, const double *xs, int nx, const char *arg)
+{
+    tuner *T = tuner_get(E);
+    if (!T) return eng_error(E, "out of memory starting the tuner");
+    T->in_command = 1;
+    if (!strcmp(word, "fit")) return cmd_fit(E, xs, nx);
+    if (!strcmp(word, "on")) {
+        if (nx == 1 && xs[0] >= 1) T->expect_steps = (int)xs[0];
+        if (!T->enabled) {
+            T->enabled = 1;
+            T->user_off = 0;
+            reset(T);
+        }
+        return 0;
+    }
+    if (!strcmp(word, "off")) {
+        T->enabled = 0;
+        T->user_off = 1;
+        T->explicit_steps = 0;
+        progress(T, 1);
+        classes_clear(T->pend, &T->npend);
+        classes_clear(T->ref, &T->nref);
+        if (T->phase != PH_DONE) T->phase = PH_OFF;
+        return 0;
+    }
+    if (!strcmp(word, "step")) {
+        if (!T->explicit_steps) {
+            T->explicit_steps = 1;
+            T->period = 0;
+            T->step_open = 0;
+        }
+        T->step_mark = 1;
+        return 0;
+    }
+    if (!strcmp(word, "status")) {
+        strbuf b;
+        sb_init(&b);
+        describe(E, T, &b);
+        eng_print(E, sb_str(&b));
+        sb_free(&b);
+        return 0;
+    }
+    if (!strcmp(word, "forget")) {
+        char path[1024];
+        tuner_wisdom_path(E, path, sizeof path);
+        if (remove(path) && errno != ENOENT)
+            return eng_error(E, "tune forget: cannot remove '%s': %s", path, strerror(errno));
+        reset(T);
+        return 0;
+    }
+    if (!strcmp(word, "report")) return report(E, T, arg && *arg ? arg : "silc-tune.svg");
+    return eng_error(E, "unknown tune command '%s' (on, off, status, step, forget, report, fit)",
+                     word);
+}
+
+void tuner_free(silc_engine *E)
+{
+    tuner *T = E ? E->tuner : NULL;
+    if (!T) return;
+    classes_clear(T->pend, &T->npend);
+    classes_clear(T->cur, &T->ncur);
+    classes_clear(T->ref, &T->nref);
+    free(T);
+    E->tuner = NULL;
+}
