@@ -37,7 +37,14 @@ static const char *const op_names[SILC_OP_COUNT] = {
     "add", "scale", "matmul", "elementwise", "map", "transpose", "solve", "reduce", "convert",
     "diag"};
 
-/* Built-in backend lists; a class not listed uses the reference alone. */
+/* Built-in backend lists; a class not listed uses the reference alone.
+ * The sparse lists follow bench/backends on this machine (docs/backends.md,
+ * one thread): CHOLMOD was fastest on the largest SPD problem (the 2-D
+ * Laplacian, 250000 unknowns: 1.3 s against UMFPACK 1.9, MUMPS 2.4, KLU 3.0),
+ * UMFPACK fastest of the LU libraries on grid-like systems and on bayer10;
+ * KLU wins memplus (circuit) but fills badly on grids and missed the 1e-12
+ * backward error on bayer10, so it is not a default.  MUMPS follows UMFPACK
+ * for solve.sparse. */
 static const struct {
     const char *cls;
     const char *list;

@@ -1,0 +1,580 @@
+/*
+ * backends.c -- the direct-solver backends through SILC against the same
+ * libraries called directly, SciPy and GNU Octave.
+ *
+ *     backends [--scipy] [--octave] [--reps R] [--loop N] [--grid K] [--only NAME]
+ *
+ * Problems: the 2-D 5-point Laplacian on a K x K grid (K = 500: 250000
+ * unknowns, SPD) and the shared matrices bcsstk16 (SPD), memplus
+ * (unsymmetric), bayer10 (near-singular).  Right-hand side b = A x0 with
+ * x0_i = 1 + (i mod 10)/10, the same in every tool.
+ *
+ * One solve: for every backend, `x = solve(A, b, "backend = NAME")` on a
+ * freshly put A (so nothing is reused), best of R runs, wall time of the whole
+ * silc_exec (dispatch, analysis, factorization, solve, and the core's backward
+ * error) and the backward error ||b - A x||inf / (||A||inf ||x||inf + ||b||inf).
+ * The row "default" is plain `x = A \ b`.  "direct" is the same library
+ * called here with the same settings as the plugin (UMFPACK, KLU on the CSR
+ * arrays as A' and the transposed solve, as the plugin does; CHOLMOD
+ * supernodal on the upper triangle; MUMPS with AMF ordering, SYM=1 for SPD),
+ * its input already in the library's own format (what a direct user holds),
+ * timed from analysis to solution.  overhead = SILC / direct.
+ * SciPy: scipy.sparse.linalg.spsolve (SuperLU, COLAMD) via /usr/bin/python3;
+ * Octave: A\b via octave-cli; both read the matrix from a file this program
+ * writes, and time only the solve.
+ *
+ * Factor reuse: N solves `x = A \ b` with the same A (one factorization, N
+ * triangular solves) through SILC, directly (factor once, N solves), with
+ * SciPy's splu + N solves, and Octave's loop of A\b (which factors every time).
+ *
+ * Set OPENBLAS_NUM_THREADS=1 (done here if unset) for a single-thread
+ * comparison: every tool then runs its BLAS on one thread.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cholmod.h>
+#include <dmumps_c.h>
+#include <klu.h>
+#include <umfpack.h>
+
+#include "silc.h"
+#include "testlib.h"
+
+typedef struct problem {
+    const char *name;
+    const char *file;       /* NULL: the generated Laplacian */
+    int spd;
+    silc_envelope_t A;      /* CSR */
+    double *b, *x0;
+    double normA;
+} problem;
+
+typedef struct opts {
+    int scipy, octave, reps, loop;
+    int64_t grid;
+    const char *only;
+    char tmpdir[256];
+} opts;
+
+/* ---- small numerics --------------------------------------------------------- */
+
+static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
+{
+    int64_t i, k;
+    for (i = 0; i < A->m; i++) {
+        double s = 0;
+        for (k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
+        y[i] = s;
+    }
+}
+
+static double csr_norminf(const silc_envelope_t *A)
+{
+    double s = 0;
+    int64_t i, k;
+    for (i = 0; i < A->m; i++) {
+        double r = 0;
+        for (k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) r += fabs(A->values[k]);
+        if (r > s) s = r;
+    }
+    return s;
+}
+
+/* The core's formula, recomputed here for the direct calls. */
+static double backward_error(const problem *P, const double *x)
+{
+    int64_t n = P->A.n;
+    double *r = malloc((size_t)n * sizeof *r), nr, be;
+    int64_t i;
+    if (!r) return NAN;
+    csr_matvec(&P->A, x, r);
+    for (i = 0; i < n; i++) r[i] = P->b[i] - r[i];
+    nr = tl_norm_inf(r, n);
+    be = nr / (P->normA * tl_norm_inf(x, n) + tl_norm_inf(P->b, n));
+    free(r);
+    return be;
+}
+
+/* ---- direct calls ------------------------------------------------------------ */
+
+/* Each runs analysis + factorization + `nsolve` solves; returns seconds (< 0 on
+ * failure) and leaves the last solution in x. */
+
+static double direct_umfpack(const problem *P, int nsolve, double *x)
+{
+    const silc_envelope_t *A = &P->A;
+    double control[UMFPACK_CONTROL], info[UMFPACK_INFO], t0 = tl_now(), t;
+    void *sym = NULL, *num = NULL;
+    int k, st;
+    umfpack_dl_defaults(control);
+    /* CSR of A = CSC of A': factor A', solve with its transpose. */
+    st = (int)umfpack_dl_symbolic(A->n, A->m, A->rowptr, A->colind, A->values, &sym, control, info);
+    if (st == UMFPACK_OK)
+        st = (int)umfpack_dl_numeric(A->rowptr, A->colind, A->values, sym, &num, control, info);
+    for (k = 0; k < nsolve && (st == UMFPACK_OK || st == UMFPACK_WARNING_singular_matrix); k++)
+        st = (int)umfpack_dl_solve(UMFPACK_At, A->rowptr, A->colind, A->values, x, P->b, num,
+                                   control, info);
+    t = tl_now() - t0;
+    umfpack_dl_free_symbolic(&sym);
+    umfpack_dl_free_numeric(&num);
+    return st == UMFPACK_OK || st == UMFPACK_WARNING_singular_matrix ? t : -1;
+}
+
+static double direct_klu(const problem *P, int nsolve, double *x)
+{
+    const silc_envelope_t *A = &P->A;
+    klu_l_common c;
+    klu_l_symbolic *S;
+    klu_l_numeric *N = NULL;
+    double t0 = tl_now(), t;
+    int k, ok = 1;
+    klu_l_defaults(&c);
+    S = klu_l_analyze(A->n, A->rowptr, A->colind, &c);
+    if (S) N = klu_l_factor(A->rowptr, A->colind, A->values, S, &c);
+    for (k = 0; k < nsolve && N && ok; k++) {
+        memcpy(x, P->b, (size_t)A->n * sizeof *x);
+        ok = (int)klu_l_tsolve(S, N, A->n, 1, x, &c);
+    }
+    t = S && N && ok ? tl_now() - t0 : -1;
+    klu_l_free_numeric(&N, &c);
+    klu_l_free_symbolic(&S, &c);
+    return t;
+}
+
+static double direct_cholmod(const problem *P, int nsolve, double *x)
+{
+    const silc_envelope_t *A = &P->A;
+    cholmod_common cc;
+    cholmod_sparse S;
+    cholmod_dense B, *X = NULL;
+    cholmod_factor *L = NULL;
+    double t0, t;
+    int k, ok;
+    cholmod_l_start(&cc);
+    memset(&S, 0, sizeof S);
+    S.nrow = (size_t)A->n;
+    S.ncol = (size_t)A->n;
+    S.nzmax = (size_t)A->nnz;
+    S.p = A->rowptr;
+    S.i = A->colind;
+    S.x = A->values;
+    S.stype = 1; /* symmetric, upper triangle used: CSR of A is CSC of A' = A */
+    S.itype = CHOLMOD_LONG;
+    S.xtype = CHOLMOD_REAL;
+    S.dtype = CHOLMOD_DOUBLE;
+    S.sorted = 1;
+    S.packed = 1;
+    memset(&B, 0, sizeof B);
+    B.nrow = B.d = (size_t)A->n;
+    B.ncol = 1;
+    B.nzmax = (size_t)A->n;
+    B.x = P->b;
+    B.xtype = CHOLMOD_REAL;
+    B.dtype = CHOLMOD_DOUBLE;
+    t0 = tl_now();
+    L = cholmod_l_analyze(&S, &cc);
+    ok = L && cholmod_l_factorize(&S, L, &cc) && cc.status == CHOLMOD_OK;
+    for (k = 0; k < nsolve && ok; k++) {
+        cholmod_l_free_dense(&X, &cc);
+        X = cholmod_l_solve(CHOLMOD_A, L, &B, &cc);
+        ok = X != NULL;
+    }
+    t = tl_now() - t0;
+    if (ok) memcpy(x, X->x, (size_t)A->n * sizeof *x);
+    cholmod_l_free_dense(&X, &cc);
+    cholmod_l_free_factor(&L, &cc);
+    cholmod_l_finish(&cc);
+    return ok ? t : -1;
+}
+
+static double direct_mumps(const problem *P, int nsolve, double *x)
+{
+    const silc_envelope_t *A = &P->A;
+    DMUMPS_STRUC_C id;
+    MUMPS_INT *irn = malloc((size_t)A->nnz * sizeof *irn), *jcn = malloc((size_t)A->nnz * sizeof *jcn);
+    double *a = malloc((size_t)A->nnz * sizeof *a), t0, t = -1;
+    int64_t i, k, nz = 0;
+    int s, ok;
+    if (!irn || !jcn || !a) goto out;
+    /* Triplets, 1-based; SYM=1 takes one triangle. */
+    for (i = 0; i < A->m; i++)
+        for (k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+            if (!P->spd || A->colind[k] >= i) {
+                irn[nz] = (MUMPS_INT)(i + 1);
+                jcn[nz] = (MUMPS_INT)(A->colind[k] + 1);
+                a[nz++] = A->values[k];
+            }
+    memset(&id, 0, sizeof id);
+    id.comm_fortran = -987654; /* USE_COMM_WORLD of the sequential stub */
+    id.par = 1;
+    id.sym = P->spd ? 1 : 0;
+    id.job = -1;
+    t0 = tl_now();
+    dmumps_c(&id);
+    id.icntl[0] = id.icntl[1] = id.icntl[2] = -1;
+    id.icntl[3] = 0;
+    id.icntl[6] = 2; /* ICNTL(7) = AMF, the plugin's default */
+    id.n = (MUMPS_INT)A->n;
+    id.nnz = nz;
+    id.irn = irn;
+    id.jcn = jcn;
+    id.a = a;
+    id.job = 4; /* analysis + factorization */
+    dmumps_c(&id);
+    ok = id.infog[0] >= 0;
+    for (s = 0; s < nsolve && ok; s++) {
+        memcpy(x, P->b, (size_t)A->n * sizeof *x);
+        id.rhs = x;
+        id.job = 3;
+        dmumps_c(&id);
+        ok = id.infog[0] >= 0;
+    }
+    if (ok) t = tl_now() - t0;
+    id.job = -2;
+    dmumps_c(&id);
+out:
+    free(irn);
+    free(jcn);
+    free(a);
+    return t;
+}
+
+static const struct {
+    const char *backend;
+    double (*run)(const problem *, int, double *);
+} directs[] = {{"suitesparse.umfpack", direct_umfpack},
+               {"suitesparse.klu", direct_klu},
+               {"suitesparse.cholmod", direct_cholmod},
+               {"mumps", direct_mumps}};
+
+static double (*direct_for(const char *backend))(const problem *, int, double *)
+{
+    size_t i;
+    for (i = 0; i < sizeof directs / sizeof directs[0]; i++)
+        if (!strcmp(directs[i].backend, backend)) return directs[i].run;
+    return NULL;
+}
+
+/* ---- through SILC ------------------------------------------------------------- */
+
+/* SuiteSparse keeps the last symbolic analysis per library and hands it to
+ * a new value of the same pattern; a solve with the small SPD system Z puts
+ * another pattern there, so that every timed run starts from scratch, as the
+ * direct calls do. */
+static void flush_pattern_caches(silc_context *c)
+{
+    static const int64_t rp[] = {0, 2, 5, 7}, ci[] = {0, 1, 0, 1, 2, 1, 2};
+    static const double v[] = {4, 1, 1, 4, 1, 1, 4}, zb[] = {1, 1, 1};
+    silc_envelope_t Z;
+    if (silc_envelope_csr(&Z, 3, 3, rp, ci, v) == 0) silc_put(c, "Z", &Z);
+    silc_envelope_free(&Z);
+    tl_put_vector(c, "zb", 3, zb);
+    silc_exec(c, "z = solve(Z, zb, \"backend = suitesparse.umfpack\")");
+    silc_exec(c, "z = solve(Z, zb, \"backend = suitesparse.klu\")");
+    silc_exec(c, "z = solve(Z, zb, \"backend = suitesparse.cholmod\")");
+    silc_exec(c, "z = solve(Z, zb, \"backend = mumps\")");
+}
+
+/* One solve on a fresh A, best of reps; be and the backend that ran are
+ * filled.  nsolve > 1: that many solves with the same A, timed together. */
+static double silc_time(silc_context *c, tl_capture *cap, const problem *P, const char *backend,
+                        int reps, int nsolve, double *be, char *ran, size_t ranlen)
+{
+    char stmt[160];
+    double best = -1;
+    int r, k;
+    if (!strcmp(backend, "default")) snprintf(stmt, sizeof stmt, "x = A \\ b");
+    else snprintf(stmt, sizeof stmt, "x = solve(%s, b, \"backend = %s\")",
+                  strcmp(backend, "lapack") ? "A" : "Ad", backend);
+    for (r = 0; r < reps; r++) {
+        double t0, t;
+        flush_pattern_caches(c);
+        if (silc_put(c, "A", &P->A) || (!strcmp(backend, "lapack") && silc_exec(c, "Ad = dense(A)"))) {
+            fprintf(stderr, "backends: %s: %s\n", P->name, silc_context_errmsg(c));
+            return -1;
+        }
+        t0 = tl_now();
+        for (k = 0; k < nsolve; k++)
+            if (silc_exec(c, stmt)) {
+                const char *e = silc_context_errmsg(c);
+                snprintf(ran, ranlen, "%s", tl_contains(e, "not installed") ? "not built" : "error");
+                if (!tl_contains(e, "not installed")) fprintf(stderr, "  %s %s: %s\n", P->name, backend, e);
+                return -1;
+            }
+        t = tl_now() - t0;
+        if (best < 0 || t < best) best = t;
+    }
+    {
+        const char *info = tl_info(c, cap, "x");
+        const char *p = strstr(info, "  backend: ");
+        *be = tl_field(info, "backward error");
+        if (p) sscanf(p + 11, "%63s", ran);
+    }
+    silc_exec(c, "clear Ad");
+    return best;
+}
+
+/* ---- SciPy and Octave ------------------------------------------------------------ */
+
+static const char scipy_script[] =
+    "import sys, time, numpy as np, scipy.io, scipy.sparse as sp, scipy.sparse.linalg as sl\n"
+    "src, reps, nloop = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])\n"
+    "if src.startswith('laplace:'):\n"
+    "    k = int(src[8:]); T = sp.diags([-1, 2, -1], [-1, 0, 1], shape=(k, k)); I = sp.identity(k)\n"
+    "    A = (sp.kron(I, T) + sp.kron(T, I)).tocsc()\n"
+    "else:\n"
+    "    A = scipy.io.mmread(src).tocsc()\n"
+    "n = A.shape[0]; x0 = 1 + (np.arange(n) % 10) / 10.0; b = A @ x0\n"
+    "nA = abs(A).sum(axis=1).max()\n"
+    "def be(x): return np.abs(b - A @ x).max() / (nA * np.abs(x).max() + np.abs(b).max())\n"
+    "best = None\n"
+    "for r in range(reps):\n"
+    "    t = time.perf_counter(); x = sl.spsolve(A, b); t = time.perf_counter() - t\n"
+    "    best = t if best is None or t < best else best\n"
+    "print('solve %.6g %.3g' % (best, be(x)))\n"
+    "t = time.perf_counter(); f = sl.splu(A)\n"
+    "for i in range(nloop): x = f.solve(b)\n"
+    "t = time.perf_counter() - t\n"
+    "print('loop %.6g %.3g' % (t, be(x)))\n";
+
+static const char octave_script[] =
+    "args = argv(); T = load(args{1}); reps = str2num(args{2}); nloop = str2num(args{3});\n"
+    "A = spconvert(T); n = rows(A); x0 = 1 + mod((0:n-1)', 10) / 10; b = A * x0;\n"
+    "nA = norm(A, inf); best = inf;\n"
+    "for r = 1:reps, tic; x = A \\ b; best = min(best, toc); end\n"
+    "printf('solve %.6g %.3g\\n', best, norm(b - A*x, inf) / (nA*norm(x, inf) + norm(b, inf)));\n"
+    "tic; for i = 1:nloop, x = A \\ b; end; t = toc;\n"
+    "printf('loop %.6g %.3g\\n', t, norm(b - A*x, inf) / (nA*norm(x, inf) + norm(b, inf)));\n";
+
+/* Writes text to dir/name; returns the path in out. */
+static int write_file(const char *dir, const char *name, const char *text, char *out, size_t len)
+{
+    FILE *f;
+    snprintf(out, len, "%s/%s", dir, name);
+    if (!(f = fopen(out, "w"))) return -1;
+    fputs(text, f);
+    return fclose(f);
+}
+
+/* Triplets "i j v" (1-based), with "m n 0" last so spconvert gets the size. */
+static int write_triplets(const problem *P, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    int64_t i, k;
+    if (!f) return -1;
+    for (i = 0; i < P->A.m; i++)
+        for (k = P->A.rowptr[i]; k < P->A.rowptr[i + 1]; k++)
+            fprintf(f, "%lld %lld %.17g\n", (long long)i + 1, (long long)P->A.colind[k] + 1,
+                    P->A.values[k]);
+    fprintf(f, "%lld %lld 0\n", (long long)P->A.m, (long long)P->A.n);
+    return fclose(f);
+}
+
+/* Runs a tool's script; fills solve and loop (time, backward error). */
+static int run_tool(const char *cmd, double st[2], double lt[2])
+{
+    char line[256];
+    FILE *p = popen(cmd, "r");
+    int got = 0;
+    if (!p) return -1;
+    while (fgets(line, sizeof line, p)) {
+        if (sscanf(line, "solve %lf %lf", &st[0], &st[1]) == 2) got |= 1;
+        if (sscanf(line, "loop %lf %lf", &lt[0], &lt[1]) == 2) got |= 2;
+    }
+    return pclose(p) == 0 && got == 3 ? 0 : -1;
+}
+
+/* ---- the table -------------------------------------------------------------------- */
+
+static void row(const char *who, const char *ran, double t, double be, double ratio)
+{
+    char tb[32], bb[32], rb[32];
+    if (t < 0) snprintf(tb, sizeof tb, "%s", "-");
+    else snprintf(tb, sizeof tb, "%.4f", t);
+    if (isnan(be) || t < 0) snprintf(bb, sizeof bb, "-");
+    else snprintf(bb, sizeof bb, "%.1e", be);
+    if (ratio > 0) snprintf(rb, sizeof rb, "%.3f", ratio);
+    else snprintf(rb, sizeof rb, "-");
+    printf("  %-30s %-22s %10s %10s %9s\n", who, ran, tb, bb, rb);
+}
+
+static int load_problem(problem *P, const opts *o)
+{
+    char err[512], path[1024];
+    int64_t i;
+    if (P->file) {
+        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, P->file);
+        if (tl_read_mtx(&P->A, path, err, sizeof err)) {
+            fprintf(stderr, "backends: %s\n", err);
+            return -1;
+        }
+    } else if (tl_laplacian2d(&P->A, o->grid)) {
+        fprintf(stderr, "backends: out of memory building the Laplacian\n");
+        return -1;
+    }
+    P->x0 = malloc((size_t)P->A.n * sizeof *P->x0);
+    P->b = malloc((size_t)P->A.m * sizeof *P->b);
+    if (!P->x0 || !P->b) return -1;
+    for (i = 0; i < P->A.n; i++) P->x0[i] = 1 + (double)(i % 10) / 10;
+    csr_matvec(&P->A, P->x0, P->b);
+    P->normA = csr_norminf(&P->A);
+    return 0;
+}
+
+static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const opts *o)
+{
+    static const char *const silc_backends[] = {"default", "suitesparse.umfpack", "suitesparse.klu",
+                                                "suitesparse.cholmod", "mumps", "lapack", "reference"};
+    char ran[64], src[1100], cmd[2400], script[512];
+    double *x = malloc((size_t)P->A.n * sizeof *x), st[2], lt[2], scipy_lt[2];
+    int have_scipy = 0, have_octave = 0;
+    size_t i;
+    if (!x) return;
+    tl_put_vector(c, "b", P->A.n, P->b);
+    printf("\n%s: n = %lld, nnz = %lld%s\n", P->name, (long long)P->A.n, (long long)P->A.nnz,
+           P->spd ? ", SPD" : "");
+    printf("  %-30s %-22s %10s %10s %9s\n", "one solve", "backend", "seconds", "bwd err",
+           "SILC/dir");
+    for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++) {
+        const char *b = silc_backends[i];
+        double (*direct)(const problem *, int, double *) = direct_for(b);
+        double be = NAN, t, td = -1;
+        int r;
+        if (!strcmp(b, "suitesparse.cholmod") && !P->spd) continue;
+        if (!strcmp(b, "lapack") && P->A.n > 5000) continue;
+        snprintf(ran, sizeof ran, "%s", b);
+        t = silc_time(c, cap, P, b, o->reps, 1, &be, ran, sizeof ran);
+        if (direct && t >= 0)
+            for (r = 0; r < o->reps; r++) {
+                double d = direct(P, 1, x);
+                if (d >= 0 && (td < 0 || d < td)) td = d;
+            }
+        row(!strcmp(b, "default") ? "SILC  A \\ b (default list)" : "SILC  forced", ran, t, be,
+            -1);
+        if (direct) {
+            char who[64];
+            snprintf(who, sizeof who, "direct %s", strchr(b, '.') ? strchr(b, '.') + 1 : b);
+            row(who, b, td, td >= 0 ? backward_error(P, x) : NAN, td > 0 && t > 0 ? t / td : -1);
+        }
+        fflush(stdout);
+    }
+    if (P->file) snprintf(src, sizeof src, "%s/%s", SILC_SHARED_MATRICES, P->file);
+    else snprintf(src, sizeof src, "laplace:%lld", (long long)o->grid);
+    if (o->scipy) {
+        write_file(o->tmpdir, "bench.py", scipy_script, script, sizeof script);
+        snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %s %d %d", script, src, o->reps, o->loop);
+        have_scipy = run_tool(cmd, st, scipy_lt) == 0;
+        if (have_scipy) row("SciPy spsolve", "SuperLU (COLAMD)", st[0], st[1], -1);
+        else row("SciPy spsolve", "failed", -1, NAN, -1);
+    }
+    if (o->octave) {
+        char trip[512];
+        write_file(o->tmpdir, "bench.m", octave_script, script, sizeof script);
+        snprintf(trip, sizeof trip, "%s/A.txt", o->tmpdir);
+        if (write_triplets(P, trip) == 0) {
+            snprintf(cmd, sizeof cmd, "octave-cli -q %s %s %d %d 2>/dev/null", script, trip, o->reps, o->loop);
+            have_octave = run_tool(cmd, st, lt) == 0;
+            if (have_octave) row("Octave A\\b", "Octave", st[0], st[1], -1);
+            else row("Octave A\\b", "failed", -1, NAN, -1);
+        }
+    }
+
+    printf("  %-30s %-22s %10s %10s %9s\n", "", "", "", "", "");
+    printf("  %d solves, same A (factor reuse)\n", o->loop);
+    for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++) {
+        const char *b = silc_backends[i];
+        double (*direct)(const problem *, int, double *) = direct_for(b);
+        double be = NAN, t, td = -1;
+        if (!strcmp(b, "suitesparse.cholmod") && !P->spd) continue;
+        if (!strcmp(b, "lapack") || !strcmp(b, "reference")) continue;
+        snprintf(ran, sizeof ran, "%s", b);
+        t = silc_time(c, cap, P, b, 1, o->loop, &be, ran, sizeof ran);
+        if (direct && t >= 0) td = direct(P, o->loop, x);
+        row(!strcmp(b, "default") ? "SILC  loop, default" : "SILC  loop, forced", ran, t, be, -1);
+        if (direct) {
+            char who[64];
+            snprintf(who, sizeof who, "direct %s, factor once", strchr(b, '.') ? strchr(b, '.') + 1 : b);
+            row(who, b, td, td >= 0 ? backward_error(P, x) : NAN, td > 0 && t > 0 ? t / td : -1);
+        }
+        fflush(stdout);
+    }
+    if (have_scipy) row("SciPy splu + solve loop", "SuperLU (COLAMD)", scipy_lt[0], scipy_lt[1], -1);
+    if (have_octave) row("Octave loop of A\\b", "Octave", lt[0], lt[1], -1);
+    silc_exec(c, "clear A b x");
+    free(x);
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: backends [--scipy] [--octave] [--reps R] [--loop N] [--grid K] "
+                    "[--only NAME]\n");
+    return 2;
+}
+
+int main(int argc, char **argv)
+{
+    problem probs[] = {{"laplace2d", NULL, 1, {0}, NULL, NULL, 0},
+                       {"bcsstk16", "bcsstk16.mtx", 1, {0}, NULL, NULL, 0},
+                       {"memplus", "memplus.mtx", 0, {0}, NULL, NULL, 0},
+                       {"bayer10", "bayer10.mtx", 0, {0}, NULL, NULL, 0}};
+    opts o;
+    silc_context *c = NULL;
+    tl_capture cap = {0};
+    size_t i;
+    int a;
+    memset(&o, 0, sizeof o);
+    o.reps = 3;
+    o.loop = 100;
+    o.grid = 500;
+    for (a = 1; a < argc; a++) {
+        if (!strcmp(argv[a], "--scipy")) o.scipy = 1;
+        else if (!strcmp(argv[a], "--octave")) o.octave = 1;
+        else if (!strcmp(argv[a], "--reps") && a + 1 < argc) o.reps = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--loop") && a + 1 < argc) o.loop = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--grid") && a + 1 < argc) o.grid = atoll(argv[++a]);
+        else if (!strcmp(argv[a], "--only") && a + 1 < argc) o.only = argv[++a];
+        else return usage();
+    }
+    if (o.reps < 1 || o.loop < 1 || o.grid < 2) return usage();
+    /* Before any BLAS is loaded: one thread everywhere, including the tools. */
+    setenv("OPENBLAS_NUM_THREADS", "1", 0);
+    setenv("OMP_NUM_THREADS", "1", 0);
+    snprintf(o.tmpdir, sizeof o.tmpdir, "/tmp/silc-bench-XXXXXX");
+    if ((o.scipy || o.octave) && !mkdtemp(o.tmpdir)) {
+        perror("backends: mkdtemp");
+        return 1;
+    }
+    if (silc_open(&c, NULL)) {
+        fprintf(stderr, "backends: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
+        return 1;
+    }
+    tl_capture_attach(c, &cap);
+    printf("SILC direct-solver backends; OPENBLAS_NUM_THREADS=%s; best of %d; seconds are wall time\n",
+           getenv("OPENBLAS_NUM_THREADS"), o.reps);
+    for (i = 0; i < sizeof probs / sizeof probs[0]; i++) {
+        problem *P = &probs[i];
+        if (o.only && strcmp(o.only, P->name)) continue;
+        if (load_problem(P, &o) == 0) bench_problem(c, &cap, P, &o);
+        silc_envelope_free(&P->A);
+        free(P->b);
+        free(P->x0);
+    }
+    silc_close(&c);
+    tl_capture_free(&cap);
+    if (o.scipy || o.octave) {
+        char path[512];
+        const char *const files[] = {"bench.py", "bench.m", "A.txt"};
+        for (i = 0; i < 3; i++) {
+            snprintf(path, sizeof path, "%s/%s", o.tmpdir, files[i]);
+            remove(path);
+        }
+        rmdir(o.tmpdir);
+    }
+    return 0;
+}

@@ -1,0 +1,247 @@
+/*
+ * testlib.h -- helpers shared by the test programs, beside check.h.
+ *
+ * Building the 2-D Laplacian as CSR, loading a Matrix Market file and putting
+ * it under a name, fetching a result as a plain array, capturing the text of
+ * `info`/`explain` (silc_set_output) in a buffer and reading numbers back out
+ * of it, and norm helpers.  Header-only with static inline functions, so each
+ * test stays one self-contained program and unused helpers cost nothing.
+ * Every helper returns 0 on success and non-zero on failure, with the reason
+ * in the caller's err buffer where there is one.
+ */
+#ifndef SILC_TESTLIB_H
+#define SILC_TESTLIB_H
+
+#include <ctype.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "silc.h"
+
+#ifndef SILC_SHARED_MATRICES
+#define SILC_SHARED_MATRICES "../shared/matrices"
+#endif
+
+/* ---- matrices ---------------------------------------------------------------- */
+
+/* The 5-point Laplacian on a k x k grid (n = k*k, Dirichlet boundary): 4 on the
+ * diagonal, -1 to each grid neighbour.  SPD, condition number ~ 0.4 k^2. */
+static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
+{
+    int64_t n = k * k, nz = 0, i, j;
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp);
+    int64_t *ci = malloc((size_t)(5 * n) * sizeof *ci);
+    double *v = malloc((size_t)(5 * n) * sizeof *v);
+    int rc = -1;
+    if (rp && ci && v) {
+        rp[0] = 0;
+        for (j = 0; j < k; j++)
+            for (i = 0; i < k; i++) {
+                int64_t r = j * k + i;
+                if (j > 0) ci[nz] = r - k, v[nz++] = -1;
+                if (i > 0) ci[nz] = r - 1, v[nz++] = -1;
+                ci[nz] = r, v[nz++] = 4;
+                if (i < k - 1) ci[nz] = r + 1, v[nz++] = -1;
+                if (j < k - 1) ci[nz] = r + k, v[nz++] = -1;
+                rp[r + 1] = nz;
+            }
+        rc = silc_envelope_csr(e, n, n, rp, ci, v);
+    }
+    free(rp);
+    free(ci);
+    free(v);
+    return rc;
+}
+
+/* Reads a Matrix Market file into e (caller frees). */
+static inline int tl_read_mtx(silc_envelope_t *e, const char *path, char *err, size_t errlen)
+{
+    memset(e, 0, sizeof *e);
+    return silc_mm_read(e, path, err, errlen);
+}
+
+/* Reads SILC_SHARED_MATRICES/file and binds it to name; m, n (may be NULL)
+ * receive its shape. */
+static inline int tl_put_shared(silc_context *c, const char *name, const char *file, int64_t *m,
+                                int64_t *n, char *err, size_t errlen)
+{
+    char path[1024];
+    silc_envelope_t e;
+    int rc;
+    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
+    if (tl_read_mtx(&e, path, err, errlen)) return -1;
+    if (m) *m = e.m;
+    if (n) *n = e.n;
+    rc = silc_put(c, name, &e);
+    if (rc) snprintf(err, errlen, "put %s: %s", name, silc_context_errmsg(c));
+    silc_envelope_free(&e);
+    return rc;
+}
+
+/* Puts a dense column vector. */
+static inline int tl_put_vector(silc_context *c, const char *name, int64_t n, const double *x)
+{
+    silc_envelope_t e;
+    int rc;
+    if (silc_envelope_vector(&e, n, x)) return -1;
+    rc = silc_put(c, name, &e);
+    silc_envelope_free(&e);
+    return rc;
+}
+
+/* Fetches name as a malloc'd column-major array of m*n entries. */
+static inline double *tl_get_dense(silc_context *c, const char *name, int64_t *m, int64_t *n)
+{
+    silc_envelope_t e;
+    double *x = NULL;
+    memset(&e, 0, sizeof e);
+    if (silc_get(c, &e, name)) return NULL;
+    x = malloc((size_t)(e.m * e.n > 0 ? e.m * e.n : 1) * sizeof *x);
+    if (x && silc_envelope_to_dense(&e, x)) {
+        free(x);
+        x = NULL;
+    }
+    if (m) *m = e.m;
+    if (n) *n = e.n;
+    silc_envelope_free(&e);
+    return x;
+}
+
+/* ---- output capture ---------------------------------------------------------- */
+
+/* Text printed by `info`, `who` and `explain`, appended; grows as needed. */
+typedef struct tl_capture {
+    char *text;
+    size_t len, cap;
+} tl_capture;
+
+static inline void tl_capture_fn(void *user, const char *text)
+{
+    tl_capture *c = user;
+    size_t add = strlen(text);
+    if (c->len + add + 1 > c->cap) {
+        size_t cap = c->cap ? c->cap : 4096;
+        char *t;
+        while (cap < c->len + add + 1) cap *= 2;
+        if (!(t = realloc(c->text, cap))) return;
+        c->text = t;
+        c->cap = cap;
+    }
+    memcpy(c->text + c->len, text, add + 1);
+    c->len += add;
+}
+
+static inline void tl_capture_reset(tl_capture *c)
+{
+    c->len = 0;
+    if (c->text) c->text[0] = '\0';
+}
+
+static inline const char *tl_capture_text(const tl_capture *c)
+{
+    return c->text ? c->text : "";
+}
+
+static inline void tl_capture_free(tl_capture *c)
+{
+    free(c->text);
+    memset(c, 0, sizeof *c);
+}
+
+/* Sends ctx's output into c (c must outlive the context or be detached). */
+static inline void tl_capture_attach(silc_context *ctx, tl_capture *c)
+{
+    silc_set_output(ctx, tl_capture_fn, c);
+}
+
+/* Runs `info name` and returns the captured text (valid until the next
+ * capture on c). */
+static inline const char *tl_info(silc_context *ctx, tl_capture *c, const char *name)
+{
+    char cmd[160];
+    tl_capture_reset(c);
+    snprintf(cmd, sizeof cmd, "info %s", name);
+    if (silc_exec(ctx, cmd)) return "";
+    return tl_capture_text(c);
+}
+
+/* ---- text ---------------------------------------------------------------------- */
+
+/* Case-insensitive substring test; NULL haystack contains nothing. */
+static inline int tl_contains(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; hay && *hay; hay++) {
+        size_t i = 0;
+        while (i < n && hay[i] &&
+               tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n) return 1;
+    }
+    return 0;
+}
+
+/* The number after "label:" in text (e.g. "backward error" in `info` output);
+ * NAN when the label is missing. */
+static inline double tl_field(const char *text, const char *label)
+{
+    char key[128];
+    const char *p;
+    snprintf(key, sizeof key, "%s:", label);
+    p = text ? strstr(text, key) : NULL;
+    if (!p) return NAN;
+    return strtod(p + strlen(key), NULL);
+}
+
+/* ---- numbers ------------------------------------------------------------------- */
+
+static inline double tl_norm_inf(const double *x, int64_t n)
+{
+    double s = 0;
+    int64_t i;
+    for (i = 0; i < n; i++)
+        if (fabs(x[i]) > s || isnan(x[i])) s = isnan(x[i]) ? NAN : fabs(x[i]);
+    return s;
+}
+
+static inline double tl_diff_inf(const double *x, const double *y, int64_t n)
+{
+    double s = 0;
+    int64_t i;
+    for (i = 0; i < n; i++) {
+        double d = fabs(x[i] - y[i]);
+        if (d > s || isnan(d)) s = isnan(d) ? NAN : d;
+    }
+    return s;
+}
+
+/* ||x - y||_inf / ||y||_inf (absolute when y = 0). */
+static inline double tl_rel_diff(const double *x, const double *y, int64_t n)
+{
+    double ny = tl_norm_inf(y, n), d = tl_diff_inf(x, y, n);
+    return ny > 0 ? d / ny : d;
+}
+
+/* Reproducible values in [0.5, 1.5): a right-hand side or exact solution that
+ * is not special to any ordering or scaling. */
+static inline void tl_fill(double *x, int64_t n, uint64_t seed)
+{
+    int64_t i;
+    for (i = 0; i < n; i++) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        x[i] = 0.5 + (double)(seed >> 11) / 9007199254740992.0;
+    }
+}
+
+static inline double tl_now(void)
+{
+    struct timespec t;
+    timespec_get(&t, TIME_UTC);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+#endif
