@@ -1,0 +1,197 @@
+/*
+ * lis.h -- internal interfaces of plugin-lis-style, our own implementation
+ * of the Lis user experience (no Lis code): the Lis option string, Krylov and
+ * stationary solvers, preconditioners, and double-double `-f quad`.
+ *
+ * The pieces, one file each:
+ *   lis_options.c     the option string -> lis_options (Lis names and numbers)
+ *   lis_kernels.c     double SpMV and vector kernels (OpenMP), host-free
+ *   lis_dd.c          double-double scalars and vector kernels
+ *   lis_space.c       the solver's arithmetic: scalars and vectors that are
+ *                     double or double-double depending on -f, convergence test
+ *   lis_precond.c     Jacobi, ILU(k), IC(0), SSOR, ILUT
+ *   lis_krylov.c      CG, BiCG, CGS, BiCGSTAB, BiCGSTAB(l), GPBiCG, TFQMR,
+ *                     MINRES, IDR(s)
+ *   lis_gmres.c       GMRES(m), FGMRES(m)
+ *   lis_stationary.c  Jacobi, Gauss-Seidel, SOR
+ *   lis_style.c       the plugin table, the SOLVE op, attachments, reports
+ * Every solver is written once against the lis_space.c operations declared
+ * here, so each one runs in double and in double-double.
+ */
+#ifndef LIS_H
+#define LIS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lis_dd.h"
+#include "lis_kernels.h"
+#include "silc_plugin.h"
+
+extern const silc_host_api *lis_host;
+
+/* ---- options ------------------------------------------------------------------ */
+
+/* Solver numbers are Lis's own (`-i 2` is BiCG), from the Lis 2.x option
+ * table (lis_solver_set_option(3), the Lis User Guide): cg 1, bicg 2, cgs 3,
+ * bicgstab 4, bicgstabl 5, gpbicg 6, tfqmr 7, orthomin 8, gmres 9, jacobi 10,
+ * gs 11, sor 12, bicgsafe 13, cr 14, bicr 15, crs 16, bicrstab 17, gpbicr 18,
+ * bicrsafe 19, fgmres 20, idrs 21, idr1 22, minres 23, cocg 24, cocr 25.
+ * The ones not implemented here are refused by name. */
+enum lis_solver_id {
+    LIS_CG = 1, LIS_BICG = 2, LIS_CGS = 3, LIS_BICGSTAB = 4, LIS_BICGSTABL = 5,
+    LIS_GPBICG = 6, LIS_TFQMR = 7, LIS_GMRES = 9, LIS_JACOBI = 10, LIS_GS = 11,
+    LIS_SOR = 12, LIS_FGMRES = 20, LIS_IDRS = 21, LIS_MINRES = 23
+};
+
+/* Preconditioner numbers as in Lis (-p): none 0, jacobi 1, ilu 2, ssor 3,
+ * hybrid 4, is 5, sainv 6, saamg 7, iluc 8, ilut 9.  IC(0) is not among
+ * Lis's, so it has a name only (and an internal number outside Lis's range). */
+enum lis_precon_id {
+    LIS_PC_NONE = 0, LIS_PC_JACOBI = 1, LIS_PC_ILU = 2, LIS_PC_SSOR = 3, LIS_PC_ILUT = 9,
+    LIS_PC_IC = 100
+};
+
+typedef struct lis_options {
+    int solver, precon;         /* 0 / -1 = not given (lis_options_finish) */
+    int ilu_fill;               /* -ilu_fill k: ILU(k) */
+    int ell;                    /* -ell l: BiCGSTAB(l) */
+    int idrs_s;                 /* -idrs_s / -irestart s: IDR(s) */
+    int restart;                /* -restart m: GMRES(m), FGMRES(m) */
+    int64_t maxiter;
+    double tol;
+    double omega;               /* -omega: SOR */
+    double ssor_omega;          /* -ssor_omega: SSOR preconditioner */
+    double ilut_drop, ilut_rate;
+    int conv_cond;              /* 0: ||r|| / ||r0||, 1: ||r|| / ||b|| (2-norms) */
+    int initx_zeros;            /* 1: x0 = 0; 0: x0 = in[2] when given */
+    int print;                  /* 1: residual history through host->log */
+    int quad;                   /* 1: -f quad (double-double) */
+    int given;                  /* options the string set */
+} lis_options;
+
+void lis_options_init(lis_options *o);
+/* Parses a Lis option string into o (on top of the defaults).  On error
+ * returns -1 with a message in err naming the option and the closest valid. */
+int lis_options_parse(const char *text, lis_options *o, char *err, size_t errlen);
+/* Fills the solver and preconditioner left unset.  An empty option string
+ * gets a method for the class: CG + IC(0) under an SPD class, BiCGSTAB +
+ * ILU(0) otherwise.  Once any option is written, Lis's defaults apply to the
+ * rest: -i bicg, -p none. */
+void lis_options_finish(lis_options *o, int spd_class);
+const char *lis_solver_name(int solver);
+/* "BiCGSTAB(2)", "GMRES(40)", "IDR(4)", "CG". */
+void lis_solver_label(const lis_options *o, char *buf, size_t len);
+/* "ILU(0)", "ILUT(drop 0.05, rate 5)", "SSOR(omega 1)", "none": also the
+ * preconditioner's attachment key suffix. */
+void lis_precon_label(const lis_options *o, char *buf, size_t len);
+
+/* ---- preconditioners ---------------------------------------------------------------- */
+
+typedef struct lis_pc {
+    int kind;                   /* enum lis_precon_id */
+    int64_t n;
+    double *dinv;               /* Jacobi: 1/a_ii; factors: 1/u_ii; SSOR: 1/a_ii */
+    /* Factors of ILU(k), ILUT, IC(0): M = (I + L) D (I + D^-1 U) with L strictly
+     * lower and U strictly upper in CSR, D = diag(1/dinv). */
+    int64_t *lp, *li, *up, *ui;
+    double *lx, *ux;
+    lk_csr A;                   /* SSOR: the matrix itself (borrowed) */
+    double omega;               /* SSOR */
+    double shift;               /* diagonal shift that made the factorization work */
+    int64_t nnz;                /* entries of L + U + D */
+    double seconds;             /* setup time */
+} lis_pc;
+
+/* Builds the preconditioner of o for A.  Returns SILC_OK, SILC_ENOMEM, or
+ * SILC_EBREAKDOWN with a message in err (zero diagonal; pivots that stay bad
+ * even after diagonal shifts). */
+int lis_pc_build(const lk_csr *A, const lis_options *o, lis_pc **out, char *err, size_t errlen);
+void lis_pc_free(void *pc);
+void lis_pc_apply(const lis_pc *P, const double *x, double *y);   /* y = M^-1 x   */
+void lis_pc_apply_t(const lis_pc *P, const double *x, double *y); /* y = M^-T x   */
+
+/* ---- the solver's arithmetic (lis_space.c) ------------------------------------ */
+
+/* A vector of the solver: h alone in double, h + l in double-double. */
+typedef struct lis_vec {
+    double *h, *l;
+} lis_vec;
+
+enum lis_outcome { LIS_CONVERGED = 0, LIS_MAXITER, LIS_BREAKDOWN, LIS_NAN, LIS_NOMEM };
+
+typedef struct lis_ctx {
+    const lk_csr *A;
+    const lk_csr *At;           /* A' (BiCG only), else NULL */
+    const lis_pc *pc;           /* NULL = none */
+    const lis_options *o;
+    int64_t n;
+    int quad;
+    lis_vec b;
+    double den;                 /* denominator of the relative residual */
+    int64_t iter;               /* iterations so far (all restarts together) */
+    double resid;               /* latest relative residual the solver saw */
+    char label[32];             /* "BiCG" for messages */
+    char why[160];              /* what broke down */
+    double *w1, *w2;            /* double scratch for preconditioning in quad */
+} lis_ctx;
+
+/* Scalars are double-double numbers; in double mode each operation rounds
+ * its result to double, so a solver is written once for both precisions. */
+static inline dd s_add(const lis_ctx *c, dd a, dd b) { return c->quad ? dd_add(a, b) : dd_d(a.hi + b.hi); }
+static inline dd s_sub(const lis_ctx *c, dd a, dd b) { return c->quad ? dd_sub(a, b) : dd_d(a.hi - b.hi); }
+static inline dd s_mul(const lis_ctx *c, dd a, dd b) { return c->quad ? dd_mul(a, b) : dd_d(a.hi * b.hi); }
+static inline dd s_div(const lis_ctx *c, dd a, dd b) { return c->quad ? dd_div(a, b) : dd_d(a.hi / b.hi); }
+static inline dd s_sqrt(const lis_ctx *c, dd a) { return c->quad ? dd_sqrt(a) : dd_d(sqrt(a.hi)); }
+static inline int s_zero(dd a) { return a.hi == 0.0; }
+
+int lv_new(lis_ctx *c, lis_vec *v);                    /* zero-filled; LIS_NOMEM */
+void lv_free(lis_vec *v);
+int lv_new_many(lis_ctx *c, lis_vec *v, int count);
+void lv_free_many(lis_vec *v, int count);
+void lv_copy(const lis_ctx *c, const lis_vec *x, lis_vec *y);           /* y = x */
+void lv_zero(const lis_ctx *c, lis_vec *y);
+void lv_scale(const lis_ctx *c, dd a, lis_vec *x);                      /* x = a x */
+void lv_axpy(const lis_ctx *c, dd a, const lis_vec *x, lis_vec *y);     /* y += a x */
+void lv_xpay(const lis_ctx *c, const lis_vec *x, dd a, lis_vec *y);     /* y = x + a y */
+void lv_waxpby(const lis_ctx *c, dd a, const lis_vec *x, dd b, const lis_vec *y, lis_vec *w);
+dd lv_dot(const lis_ctx *c, const lis_vec *x, const lis_vec *y);
+dd lv_nrm2(const lis_ctx *c, const lis_vec *x);
+void lv_matvec(const lis_ctx *c, const lis_vec *x, lis_vec *y);         /* y = A x */
+void lv_matvec_t(const lis_ctx *c, const lis_vec *x, lis_vec *y);       /* y = A' x */
+void lv_psolve(lis_ctx *c, const lis_vec *x, lis_vec *y);               /* y = M^-1 x */
+void lv_psolve_t(lis_ctx *c, const lis_vec *x, lis_vec *y);             /* y = M^-T x */
+void lv_residual(const lis_ctx *c, const lis_vec *x, lis_vec *r);       /* r = b - A x */
+
+/* One iteration finished with residual norm rnorm (absolute, 2-norm):
+ * counts it, logs it under -print out, and returns LIS_CONVERGED, LIS_NAN or
+ * -1 (go on).  lis_limit() says whether the iteration budget is spent. */
+int lis_step(lis_ctx *c, dd rnorm);
+int lis_check(lis_ctx *c, dd rnorm);    /* the same test, not counted as an iteration */
+int lis_limit(const lis_ctx *c);
+/* Records why the method broke down and returns LIS_BREAKDOWN. */
+int lis_breakdown(lis_ctx *c, const char *why);
+/* A scalar the method divides by is zero (breakdown) or NaN (LIS_NAN). */
+int lis_fail(lis_ctx *c, dd v, const char *why);
+/* The relative residual of x, computed afresh (b - A x). */
+double lis_true_resid(lis_ctx *c, const lis_vec *x, lis_vec *work);
+
+/* ---- solvers: x holds the initial guess on entry, the iterate on return ---- */
+
+typedef int (*lis_solver_fn)(lis_ctx *c, lis_vec *x);
+int lis_cg(lis_ctx *c, lis_vec *x);
+int lis_bicg(lis_ctx *c, lis_vec *x);
+int lis_cgs(lis_ctx *c, lis_vec *x);
+int lis_bicgstab(lis_ctx *c, lis_vec *x);
+int lis_bicgstabl(lis_ctx *c, lis_vec *x);
+int lis_gpbicg(lis_ctx *c, lis_vec *x);
+int lis_tfqmr(lis_ctx *c, lis_vec *x);
+int lis_minres(lis_ctx *c, lis_vec *x);
+int lis_idrs(lis_ctx *c, lis_vec *x);
+int lis_gmres(lis_ctx *c, lis_vec *x);
+int lis_fgmres(lis_ctx *c, lis_vec *x);
+int lis_jacobi(lis_ctx *c, lis_vec *x);
+int lis_gs(lis_ctx *c, lis_vec *x);
+int lis_sor(lis_ctx *c, lis_vec *x);
+
+#endif

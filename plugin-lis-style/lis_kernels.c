@@ -1,0 +1,114 @@
+/*
+ * lis_kernels.c -- CSR SpMV and vector kernels in double precision, each a
+ * `#pragma omp parallel for` over rows or entries.
+ *
+ * Static scheduling with the same row split in every kernel keeps each
+ * thread on the same part of every vector (first-touch locality); a 2-D
+ * Laplacian has equal work per row, so static is also balanced.  Loops below
+ * a few thousand entries stay serial, because a fork costs more than the
+ * work.  Dot products reduce with OpenMP's reduction clause, so their
+ * rounding differs between thread counts in the last bits only.
+ */
+#include "lis_kernels.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Below this many entries a loop is not worth a parallel region. */
+#define LK_PAR_MIN 4096
+
+void lk_set_threads(int nthreads)
+{
+#ifdef _OPENMP
+    if (nthreads > 0) omp_set_num_threads(nthreads);
+#else
+    (void)nthreads;
+#endif
+}
+
+int lk_threads(void)
+{
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+void lk_spmv(const lk_csr *A, const double *x, double *y)
+{
+    const int64_t *rp = A->rp, *ci = A->ci;
+    const double *v = A->v;
+    int64_t i, m = A->m;
+#pragma omp parallel for schedule(static) if (m > LK_PAR_MIN)
+    for (i = 0; i < m; i++) {
+        double s = 0.0;
+        for (int64_t k = rp[i]; k < rp[i + 1]; k++) s += v[k] * x[ci[k]];
+        y[i] = s;
+    }
+}
+
+void lk_residual(const lk_csr *A, const double *b, const double *x, double *r)
+{
+    const int64_t *rp = A->rp, *ci = A->ci;
+    const double *v = A->v;
+    int64_t i, m = A->m;
+#pragma omp parallel for schedule(static) if (m > LK_PAR_MIN)
+    for (i = 0; i < m; i++) {
+        double s = b[i];
+        for (int64_t k = rp[i]; k < rp[i + 1]; k++) s -= v[k] * x[ci[k]];
+        r[i] = s;
+    }
+}
+
+double lk_dot(int64_t n, const double *x, const double *y)
+{
+    double s = 0.0;
+    int64_t i;
+#pragma omp parallel for schedule(static) reduction(+ : s) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) s += x[i] * y[i];
+    return s;
+}
+
+void lk_copy(int64_t n, const double *x, double *y)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) y[i] = x[i];
+}
+
+void lk_zero(int64_t n, double *y)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) y[i] = 0.0;
+}
+
+void lk_scale(int64_t n, double a, double *x)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) x[i] *= a;
+}
+
+void lk_axpy(int64_t n, double a, const double *x, double *y)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) y[i] += a * x[i];
+}
+
+void lk_xpay(int64_t n, const double *x, double a, double *y)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) y[i] = x[i] + a * y[i];
+}
+
+void lk_waxpby(int64_t n, double a, const double *x, double b, const double *y, double *w)
+{
+    int64_t i;
+#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) w[i] = a * x[i] + b * y[i];
+}

@@ -1,0 +1,36 @@
+/*
+ * lis_kernels.h -- the double-precision kernels of plugin-lis-style: CSR
+ * matrix-vector product and the BLAS-1 vector operations the Krylov solvers
+ * are made of, parallel with OpenMP.
+ *
+ * The kernels know nothing of SILC (plain arrays and an int64 CSR), so
+ * bench/iterative.c compiles this file on its own to time the very kernel the
+ * plugin runs.  Without OpenMP they compile to serial loops.
+ */
+#ifndef LIS_KERNELS_H
+#define LIS_KERNELS_H
+
+#include <stdint.h>
+
+/* A borrowed CSR matrix: rp[m+1], ci[nnz] (0-based, sorted per row), v[nnz]. */
+typedef struct lk_csr {
+    int64_t m, n;
+    const int64_t *rp;
+    const int64_t *ci;
+    const double *v;
+} lk_csr;
+
+void lk_set_threads(int nthreads);
+int lk_threads(void);
+
+void lk_spmv(const lk_csr *A, const double *x, double *y);              /* y = A x        */
+void lk_residual(const lk_csr *A, const double *b, const double *x, double *r); /* r = b - A x */
+double lk_dot(int64_t n, const double *x, const double *y);
+void lk_copy(int64_t n, const double *x, double *y);                    /* y = x          */
+void lk_zero(int64_t n, double *y);
+void lk_scale(int64_t n, double a, double *x);                          /* x = a x        */
+void lk_axpy(int64_t n, double a, const double *x, double *y);          /* y = y + a x    */
+void lk_xpay(int64_t n, const double *x, double a, double *y);          /* y = x + a y    */
+void lk_waxpby(int64_t n, double a, const double *x, double b, const double *y, double *w); /* w = a x + b y */
+
+#endif

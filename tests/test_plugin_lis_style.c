@@ -1,0 +1,681 @@
+/*
+ * test_plugin_lis_style.c -- the lis-style iterative backend through the
+ * public API, against exact solutions and the reference direct solver.
+ *
+ * A context sends solve.sparse, solve.sparse.spd and solve.band to lis-style
+ * (band too, because the structure rules classify a CSR matrix of small
+ * bandwidth, such as the Toeplitz case below, as banded); a second context
+ * sends them to "reference".  Checked:
+ *   - Lis's reference behaviours: the 10x10-grid 2-D Laplacian (100 unknowns,
+ *     460 nonzeros, b = A*ones) with -i bicg -p none -tol 1e-12 converges in
+ *     10..30 iterations (read from `info x`) to within 1e-10 of ones; the
+ *     n = 200 Toeplitz matrix (2 on the diagonal, 1 above, 2 two below) with
+ *     -i bicg -maxiter 1000 -f double is reported not converged, with the
+ *     residual, leaving the store unchanged, and with -f quad converges;
+ *   - every solver with every preconditioner on an SPD grid operator (CG and
+ *     MINRES only there) and on an unsymmetric convection-diffusion operator,
+ *     against the exact solution x_i = 1 + i/n; every solver in -f quad;
+ *   - the SPD shared matrices with CG+IC(0) and CG+ILU(0) (-tol 1e-10
+ *     -maxiter 20000): converged => reported residual <= tol and the relative
+ *     error against the reference direct solve <= 1e-10 * its condition
+ *     estimate (the 1-norm estimate bounds the 2-norm condition of a symmetric
+ *     matrix from above, up to the estimator's slack); not converged => an
+ *     honest error and an unchanged store;
+ *   - option strings good (names, Lis numbers, config file, `set`, per call)
+ *     and bad (unknown solver with a suggestion, malformed number, missing
+ *     value, unknown option), breakdown and NaN (overflow) reporting;
+ *   - preconditioner reuse while A is unchanged, rebuild after A changes;
+ *     dense A accepted by conversion; several right-hand sides; two threads.
+ */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+#include <ctype.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "check.h"
+#include "silc.h"
+
+#ifndef SILC_SHARED_MATRICES
+#define SILC_SHARED_MATRICES "../shared/matrices"
+#endif
+
+/* ---- helpers -------------------------------------------------------------------- */
+
+static char out_buf[32768];
+
+static void capture(void *user, const char *text)
+{
+    size_t have = strlen(out_buf);
+    (void)user;
+    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
+}
+
+static int contains(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; hay && *hay; hay++) {
+        size_t i = 0;
+        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n) return 1;
+    }
+    return 0;
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static silc_context *open_ctx(const char *backend, const char *config)
+{
+    static const char *const classes[] = {"solve.sparse", "solve.sparse.spd", "solve.band",
+                                          "solve.dense", "solve.dense.spd", NULL};
+    silc_context *c = NULL;
+    char cmd[160];
+    if (silc_open(&c, config)) {
+        fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
+        return NULL;
+    }
+    silc_set_output(c, capture, NULL);
+    for (int i = 0; classes[i]; i++) {
+        snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", classes[i], backend);
+        CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
+    }
+    return c;
+}
+
+static const char *info(silc_context *c, const char *name)
+{
+    char cmd[64];
+    out_buf[0] = '\0';
+    snprintf(cmd, sizeof cmd, "info %s", name);
+    if (silc_exec(c, cmd)) snprintf(out_buf, sizeof out_buf, "(info failed: %s)", silc_context_errmsg(c));
+    return out_buf;
+}
+
+static double info_number(const char *text, const char *label)
+{
+    const char *p = strstr(text, label);
+    return p ? atof(p + strlen(label)) : -1;
+}
+
+static void put(silc_context *c, const char *name, const silc_envelope_t *e)
+{
+    CHECK(silc_put(c, name, e) == 0, "put %s: %s", name, silc_context_errmsg(c));
+}
+
+static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
+{
+    silc_envelope_t e;
+    CHECK(silc_envelope_dense(&e, m, n, x) == 0, "envelope %s", name);
+    put(c, name, &e);
+    silc_envelope_free(&e);
+}
+
+static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
+{
+    silc_envelope_t e;
+    double *x;
+    if (silc_get(c, &e, name)) {
+        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
+        return NULL;
+    }
+    if (e.m != m || e.n != n) {
+        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
+              (long long)m, (long long)n);
+        silc_envelope_free(&e);
+        return NULL;
+    }
+    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *x);
+    if (x) silc_envelope_to_dense(&e, x);
+    silc_envelope_free(&e);
+    return x;
+}
+
+/* ||x - y||_2 / ||y||_2 */
+static double rel_err2(const double *x, const double *y, int64_t n)
+{
+    double d = 0, s = 0;
+    for (int64_t i = 0; i < n; i++) {
+        d += (x[i] - y[i]) * (x[i] - y[i]);
+        s += y[i] * y[i];
+    }
+    return s > 0 ? sqrt(d / s) : sqrt(d);
+}
+
+static double max_dev(const double *x, double v, int64_t n)
+{
+    double d = 0;
+    for (int64_t i = 0; i < n; i++)
+        if (!(fabs(x[i] - v) <= d)) d = fabs(x[i] - v);
+    return d;
+}
+
+static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
+{
+    for (int64_t i = 0; i < A->m; i++) {
+        double s = 0;
+        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
+        y[i] = s;
+    }
+}
+
+/* ---- generated matrices -------------------------------------------------------- */
+
+/* 5-point operator on a k x k grid: 4 on the diagonal, -1 -/+ beta west/east
+ * (beta = 0: the Laplacian; beta > 0 an upwinded convection, still an
+ * M-matrix, so Jacobi and Gauss-Seidel converge on it). */
+static void grid(silc_envelope_t *e, int64_t k, double beta)
+{
+    int64_t n = k * k, nz = 0;
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
+    double *v = malloc((size_t)(5 * n) * sizeof *v);
+    for (int64_t r = 0; r < n; r++) {
+        int64_t i = r / k, j = r % k;
+        rp[r] = nz;
+        if (i > 0) ci[nz] = r - k, v[nz++] = -1;
+        if (j > 0) ci[nz] = r - 1, v[nz++] = -1 - beta;
+        ci[nz] = r, v[nz++] = 4 + 2 * beta;
+        if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1 + beta;
+        if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
+    }
+    rp[n] = nz;
+    CHECK(silc_envelope_csr(e, n, n, rp, ci, v) == 0, "grid envelope");
+    free(rp);
+    free(ci);
+    free(v);
+}
+
+/* Toeplitz: 2 on the diagonal, 1 on the superdiagonal, gamma two below. */
+static void toeplitz(silc_envelope_t *e, int64_t n, double gamma)
+{
+    int64_t nz = 0;
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(3 * n) * sizeof *ci);
+    double *v = malloc((size_t)(3 * n) * sizeof *v);
+    for (int64_t i = 0; i < n; i++) {
+        rp[i] = nz;
+        if (i >= 2) ci[nz] = i - 2, v[nz++] = gamma;
+        ci[nz] = i, v[nz++] = 2;
+        if (i + 1 < n) ci[nz] = i + 1, v[nz++] = 1;
+    }
+    rp[n] = nz;
+    CHECK(silc_envelope_csr(e, n, n, rp, ci, v) == 0, "toeplitz envelope");
+    free(rp);
+    free(ci);
+    free(v);
+}
+
+/* Puts A and b = A * xt. */
+static void put_system(silc_context *c, const silc_envelope_t *A, const double *xt)
+{
+    double *b = malloc((size_t)A->m * sizeof *b);
+    csr_matvec(A, xt, b);
+    put(c, "A", A);
+    put_dense(c, "b", A->m, 1, b);
+    free(b);
+}
+
+/* ---- Lis's reference behaviours ------------------------------------------------ */
+
+static void test_laplacian_bicg(silc_context *c)
+{
+    silc_envelope_t A;
+    double ones[100], *x, it;
+    const char *in;
+    for (int i = 0; i < 100; i++) ones[i] = 1;
+    grid(&A, 10, 0);
+    CHECK(A.m == 100 && A.nnz == 460, "10x10 Laplacian is %lldx%lld with %lld nonzeros", (long long)A.m,
+          (long long)A.n, (long long)A.nnz);
+    put_system(c, &A, ones);
+    CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -p none -tol 1e-12\")") == 0,
+          "laplacian bicg: %s", silc_context_errmsg(c));
+    in = info(c, "x");
+    it = info_number(in, "iterations: ");
+    CHECK(contains(in, "backend: lis-style"), "info does not name lis-style:\n%s", in);
+    CHECK(contains(in, "BiCG, no preconditioner"), "method not reported:\n%s", in);
+    CHECK(it >= 10 && it <= 30, "BiCG on the 10x10 Laplacian took %g iterations (Lis: about 15)", it);
+    CHECK(info_number(in, "final relative residual: ") <= 1e-12, "residual above tol:\n%s", in);
+    x = get_dense(c, "x", 100, 1);
+    if (x) CHECK(max_dev(x, 1, 100) <= 1e-10, "laplacian bicg: |x - 1| = %g", max_dev(x, 1, 100));
+    printf("  10x10 Laplacian, BiCG, no preconditioner: %g iterations\n", it);
+    free(x);
+    silc_envelope_free(&A);
+}
+
+static void test_toeplitz(silc_context *c)
+{
+    silc_envelope_t A;
+    int64_t n = 200;
+    double *ones = malloc((size_t)n * sizeof *ones), *x, it, t;
+    const char *in, *msg;
+    for (int64_t i = 0; i < n; i++) ones[i] = 1;
+    toeplitz(&A, n, 2.0);
+    put_system(c, &A, ones);
+    CHECK(silc_exec(c, "x = zeros(200, 1) + 7") == 0, "x = 7: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -maxiter 1000 -f double\")") != 0,
+          "toeplitz: BiCG in double converged, Lis reports it does not");
+    msg = silc_context_errmsg(c);
+    CHECK(contains(msg, "lis-style BiCG: not converged after 1000 iterations") &&
+              contains(msg, "relative residual"), "toeplitz double: message '%s'", msg);
+    printf("  Toeplitz n=200 gamma=2, BiCG double: %s\n", msg);
+    x = get_dense(c, "x", n, 1);
+    if (x) CHECK(max_dev(x, 7, n) == 0, "a failed solve changed x");
+    free(x);
+    t = now();
+    CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -maxiter 1000 -f quad\")") == 0,
+          "toeplitz: BiCG in quad: %s", silc_context_errmsg(c));
+    t = now() - t;
+    in = info(c, "x");
+    it = info_number(in, "iterations: ");
+    CHECK(contains(in, "double-double"), "quad not in the method:\n%s", in);
+    CHECK(info_number(in, "final relative residual: ") <= 1e-12, "quad residual above tol:\n%s", in);
+    x = get_dense(c, "x", n, 1);
+    /* The matrix is well conditioned (cond_1 ~ 10): 1e-12 residual, 1e-10 error. */
+    if (x) CHECK(max_dev(x, 1, n) <= 1e-10, "toeplitz quad: |x - 1| = %g", max_dev(x, 1, n));
+    printf("  Toeplitz n=200 gamma=2, BiCG quad: converged in %g iterations, %.3f s, |x-1| = %.2g\n",
+           it, t, x ? max_dev(x, 1, n) : -1);
+    free(x);
+    free(ones);
+    silc_envelope_free(&A);
+}
+
+/* ---- every solver, every preconditioner ------------------------------------------ */
+
+static const char *const krylov[] = {"cg", "minres", "bicg", "cgs", "bicgstab", "bicgstabl",
+                                     "gpbicg", "tfqmr", "gmres", "fgmres", "idrs", NULL};
+static const char *const stationary[] = {"jacobi", "gs", "sor", NULL};
+static const char *const precons[] = {"none", "jacobi", "ilu", "ilu -ilu_fill 1", "ic", "ssor",
+                                      "ilut", NULL};
+
+static int run_one(silc_context *c, const char *opts, int64_t n, const double *xt, double tol_err,
+                   const char *label)
+{
+    char cmd[256];
+    double *x, it, res;
+    const char *in;
+    int ok = 1;
+    snprintf(cmd, sizeof cmd, "x = solve(A, b, \"lis-style.options = %s\")", opts);
+    if (silc_exec(c, cmd)) {
+        CHECK(0, "%s: %s: %s", label, opts, silc_context_errmsg(c));
+        return 0;
+    }
+    in = info(c, "x");
+    it = info_number(in, "iterations: ");
+    res = info_number(in, "final relative residual: ");
+    ok &= it > 0 && res >= 0 && res <= 1e-10;
+    CHECK(it > 0 && res >= 0 && res <= 1e-10, "%s: %s: iterations %g, residual %g", label, opts, it, res);
+    x = get_dense(c, "x", n, 1);
+    if (x) {
+        double e = rel_err2(x, xt, n);
+        ok &= e <= tol_err;
+        CHECK(e <= tol_err, "%s: %s: relative error %g > %g", label, opts, e, tol_err);
+    }
+    free(x);
+    return ok;
+}
+
+static void test_all_methods(silc_context *c)
+{
+    int64_t k = 12, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt);
+    char opts[160];
+    int ran = 0, good = 0;
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    for (int sym = 1; sym >= 0; sym--) {
+        silc_envelope_t A;
+        const char *label = sym ? "SPD 12x12 Laplacian" : "unsymmetric convection-diffusion";
+        grid(&A, k, sym ? 0 : 0.4);
+        put_system(c, &A, xt);
+        /* cond_2 is below 100 for both: residual 1e-10 -> error below 1e-8. */
+        for (int s = 0; krylov[s]; s++) {
+            if (!sym && (!strcmp(krylov[s], "cg") || !strcmp(krylov[s], "minres"))) continue;
+            int symmetric_method = !strcmp(krylov[s], "cg") || !strcmp(krylov[s], "minres");
+            for (int p = 0; precons[p]; p++) {
+                /* IC is for symmetric matrices; CG and MINRES need a symmetric
+                 * preconditioner, which ILUT's dropping is not. */
+                if (!sym && !strcmp(precons[p], "ic")) continue;
+                if (symmetric_method && !strcmp(precons[p], "ilut")) continue;
+                snprintf(opts, sizeof opts, "-i %s -p %s -tol 1e-10 -maxiter 5000", krylov[s], precons[p]);
+                good += run_one(c, opts, n, xt, 1e-8, label);
+                ran++;
+            }
+            snprintf(opts, sizeof opts, "-i %s -p none -tol 1e-12 -maxiter 5000 -f quad", krylov[s]);
+            good += run_one(c, opts, n, xt, 1e-8, label);
+            ran++;
+        }
+        for (int s = 0; stationary[s]; s++) {
+            snprintf(opts, sizeof opts, "-i %s -p none -tol 1e-10 -maxiter 20000", stationary[s]);
+            good += run_one(c, opts, n, xt, 1e-8, label);
+            snprintf(opts, sizeof opts, "-i %s -p none -tol 1e-10 -maxiter 20000 -f quad", stationary[s]);
+            good += run_one(c, opts, n, xt, 1e-8, label);
+            ran += 2;
+        }
+        silc_envelope_free(&A);
+    }
+    printf("  every solver x preconditioner (double and quad): %d of %d runs agree with the exact solution\n",
+           good, ran);
+    free(xt);
+}
+
+/* ---- the SPD shared matrices against the reference direct solve -------------------- */
+
+static void test_shared_spd(silc_context *c, silc_context *ref)
+{
+    static const char *const files[] = {"bcsstk01", "bcsstk02", "LFAT5", "494_bus", "gr_30_30",
+                                        "1138_bus", "bcsstk13", "bcsstk16", NULL};
+    static const char *const pcs[] = {"ic", "ilu", NULL};
+    for (int f = 0; files[f]; f++) {
+        char path[512], err[256], cmd[256];
+        silc_envelope_t A;
+        double *ones, *b, *xref, cond;
+        int64_t n;
+        snprintf(path, sizeof path, "%s/%s.mtx", SILC_SHARED_MATRICES, files[f]);
+        if (silc_mm_read(&A, path, err, sizeof err)) {
+            CHECK(0, "read %s: %s", path, err);
+            continue;
+        }
+        n = A.n;
+        ones = malloc((size_t)n * sizeof *ones);
+        b = malloc((size_t)n * sizeof *b);
+        for (int64_t i = 0; i < n; i++) ones[i] = 1;
+        csr_matvec(&A, ones, b);
+        put(c, "A", &A);
+        put_dense(c, "b", n, 1, b);
+        put(ref, "A", &A);
+        put_dense(ref, "b", n, 1, b);
+        CHECK(silc_exec(ref, "xr = A \\ b") == 0, "%s reference: %s", files[f], silc_context_errmsg(ref));
+        cond = info_number(info(ref, "xr"), "condition estimate: ");
+        xref = get_dense(ref, "xr", n, 1);
+        for (int p = 0; pcs[p] && xref; p++) {
+            double t = now(), *x, it, res, e;
+            int rc;
+            CHECK(silc_exec(c, "x = zeros(1, 1) + 7") == 0, "x = 7");
+            snprintf(cmd, sizeof cmd,
+                     "x = solve(A, b, \"lis-style.options = -i cg -p %s -tol 1e-10 -maxiter 20000\")", pcs[p]);
+            rc = silc_exec(c, cmd);
+            t = now() - t;
+            if (rc) {
+                const char *msg = silc_context_errmsg(c);
+                CHECK(contains(msg, "not converged") || contains(msg, "breakdown"),
+                      "%s CG+%s failed without an honest message: %s", files[f], pcs[p], msg);
+                x = get_dense(c, "x", 1, 1);
+                CHECK(x && x[0] == 7, "%s: a failed solve changed x", files[f]);
+                printf("  %-9s n=%-5lld CG+%-3s  %.3f s  not converged: %s\n", files[f], (long long)n,
+                       pcs[p], t, msg);
+                free(x);
+                continue;
+            }
+            {
+                const char *in = info(c, "x");
+                it = info_number(in, "iterations: ");
+                res = info_number(in, "final relative residual: ");
+            }
+            CHECK(res >= 0 && res <= 1e-10, "%s CG+%s: reported converged with residual %g", files[f], pcs[p], res);
+            x = get_dense(c, "x", n, 1);
+            if (!x) continue;
+            e = rel_err2(x, xref, n);
+            CHECK(e <= 1e-10 * (cond > 1 ? cond : 1), "%s CG+%s: error %.3g vs reference > 1e-10 * cond %.3g",
+                  files[f], pcs[p], e, cond);
+            printf("  %-9s n=%-5lld CG+%-3s  %.3f s  %6g iterations, residual %.2g, error vs reference %.2g "
+                   "(cond %.2g)\n", files[f], (long long)n, pcs[p], t, it, res, e, cond);
+            free(x);
+        }
+        free(xref);
+        free(ones);
+        free(b);
+        silc_envelope_free(&A);
+    }
+}
+
+/* ---- options -------------------------------------------------------------------------- */
+
+static void expect_error(silc_context *c, const char *opts, const char *want1, const char *want2)
+{
+    char cmd[256];
+    const char *msg;
+    snprintf(cmd, sizeof cmd, "x = solve(A, b, \"lis-style.options = %s\")", opts);
+    CHECK(silc_exec(c, cmd) != 0, "'%s' was accepted", opts);
+    msg = silc_context_errmsg(c);
+    CHECK(contains(msg, want1) && contains(msg, want2), "'%s': message '%s' lacks '%s' / '%s'", opts,
+          msg, want1, want2);
+}
+
+static void test_options(silc_context *c)
+{
+    silc_envelope_t A;
+    int64_t k = 10, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt);
+    const char *in;
+    char conf[] = "/tmp/silc_lis_style_XXXXXX";
+    int fd;
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0.4);
+    put_system(c, &A, xt);
+    /* Good: names, Lis numbers, every knob. */
+    run_one(c, "-i 2 -p 0 -tol 1e-11", n, xt, 1e-8, "options");
+    in = info(c, "x");
+    CHECK(contains(in, "BiCG, no preconditioner"), "-i 2 -p 0 is not BiCG without preconditioner:\n%s", in);
+    run_one(c, "-i 4 -p 2 -ilu_fill 2 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "BiCGSTAB + ILU(2)"), "-i 4 -p 2 -ilu_fill 2:\n%s", out_buf);
+    run_one(c, "-i bicgstabl -ell 4 -p 9 -ilut_drop 0.01 -ilut_rate 3 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "BiCGSTAB(4) + ILUT(0.01,3)"), "bicgstabl/ilut:\n%s", out_buf);
+    run_one(c, "-i 21 -idrs_s 4 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "IDR(4)"), "-i 21 -idrs_s 4:\n%s", out_buf);
+    run_one(c, "-i 20 -restart 5 -p 3 -ssor_omega 1.2 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "FGMRES(5) + SSOR(1.2)"), "-i 20 -restart 5:\n%s", out_buf);
+    run_one(c, "-i 12 -omega 1.5 -tol 1e-11 -maxiter 5000", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "SOR(1.5)"), "-i 12 -omega 1.5:\n%s", out_buf);
+    run_one(c, "-i gmres -conv_cond nrm2_b -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "||b||"), "-conv_cond nrm2_b not in the note:\n%s", out_buf);
+    run_one(c, "-i gmres -conv_cond 0 -initx_zeros false -print none -f 0 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(contains(info(c, "x"), "started from 0"), "-initx_zeros false not noted:\n%s", out_buf);
+    /* Bad. */
+    expect_error(c, "-i cgx", "unknown solver 'cgx'", "did you mean 'cg'");
+    expect_error(c, "-tol abc", "-tol", "'abc'");
+    expect_error(c, "-p", "-p needs a value", "ilu");
+    expect_error(c, "-foo 1", "unknown option '-foo'", "did you mean");
+    expect_error(c, "-i bicg -maxiter", "-maxiter needs a value", "");
+    expect_error(c, "-i cr", "'cr'", "not implemented");
+    expect_error(c, "-i gs -p ilu", "takes no preconditioner", "");
+    expect_error(c, "-omega 2.5", "-omega", "2.5");
+    expect_error(c, "-f single", "-f", "single");
+    expect_error(c, "cg", "unexpected 'cg'", "-i cg");
+    /* Session `set`, and the config file. */
+    CHECK(silc_exec(c, "set lis-style.options = -i tfqmr -p jacobi -tol 1e-11") == 0, "set: %s",
+          silc_context_errmsg(c));
+    CHECK(silc_exec(c, "x = A \\ b") == 0, "set options: %s", silc_context_errmsg(c));
+    CHECK(contains(info(c, "x"), "TFQMR + Jacobi"), "set lis-style.options not used:\n%s", out_buf);
+    fd = mkstemp(conf);
+    if (fd >= 0) {
+        FILE *f = fdopen(fd, "w");
+        silc_context *cf;
+        fputs("[dispatch]\nsolve.sparse = lis-style\n[lis-style]\noptions = -i cgs -p ssor -tol 1e-11\n", f);
+        fclose(f);
+        cf = open_ctx("lis-style", conf);
+        if (cf) {
+            silc_set_output(cf, capture, NULL);
+            put_system(cf, &A, xt);
+            CHECK(silc_exec(cf, "x = A \\ b") == 0, "config options: %s", silc_context_errmsg(cf));
+            CHECK(contains(info(cf, "x"), "CGS + SSOR(1)"), "config file options not used:\n%s", out_buf);
+            silc_close(&cf);
+        }
+        remove(conf);
+    }
+    CHECK(silc_exec(c, "set lis-style.options = -i bicgstab") == 0, "reset: %s", silc_context_errmsg(c));
+    silc_envelope_free(&A);
+    free(xt);
+}
+
+/* ---- breakdown, NaN ------------------------------------------------------------------------ */
+
+static void test_failures(silc_context *c)
+{
+    /* [0 1; 1 0] (padded to 4x4 so it is not classified as banded) with b =
+     * e1: CG's first curvature p'Ap is 0. */
+    static const int64_t rp[] = {0, 1, 2, 3, 4}, ci[] = {1, 0, 3, 2};
+    static const double v[] = {1, 1, 1, 1}, b[] = {1, 0, 1, 0};
+    static const double hugeb[] = {1e300, 0, 1e300, 0};
+    silc_envelope_t A;
+    const char *msg;
+    CHECK(silc_envelope_csr(&A, 4, 4, rp, ci, v) == 0, "swap envelope");
+    put(c, "A", &A);
+    put_dense(c, "b", 4, 1, b);
+    CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i cg -p none\")") != 0,
+          "CG on [0 1; 1 0] did not break down");
+    msg = silc_context_errmsg(c);
+    CHECK(contains(msg, "lis-style CG: breakdown at iteration 1") && contains(msg, "relative residual"),
+          "breakdown message '%s'", msg);
+    /* A finite right-hand side whose squares overflow: the inner products
+     * become Inf, their ratios NaN inside the first iteration. */
+    static const int64_t rp2[] = {0, 2, 4, 6, 8}, ci2[] = {0, 1, 0, 1, 2, 3, 2, 3};
+    static const double v2[] = {2, 1, 1, 2, 2, 1, 1, 2};
+    silc_envelope_free(&A);
+    CHECK(silc_envelope_csr(&A, 4, 4, rp2, ci2, v2) == 0, "blocks envelope");
+    put(c, "A", &A);
+    put_dense(c, "b", 4, 1, hugeb);
+    CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicgstab -p none\")") != 0,
+          "overflowing right-hand side accepted");
+    msg = silc_context_errmsg(c);
+    CHECK(contains(msg, "lis-style BiCGSTAB: produced NaN at iteration 1"), "NaN message '%s'", msg);
+    silc_envelope_free(&A);
+}
+
+/* ---- reuse, dense, several right-hand sides, threads ------------------------------------------ */
+
+static void test_reuse_and_formats(silc_context *c)
+{
+    silc_envelope_t A;
+    int64_t k = 20, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt), *x, *B = malloc((size_t)(2 * n) * sizeof *B);
+    const char *opts = "lis-style.options = -i cg -p ic -tol 1e-12";
+    char cmd[160];
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0);
+    put_system(c, &A, xt);
+    snprintf(cmd, sizeof cmd, "x = solve(A, b, \"%s\")", opts);
+    CHECK(silc_exec(c, cmd) == 0, "reuse 1: %s", silc_context_errmsg(c));
+    CHECK(contains(info(c, "x"), "reused factorization: no"), "first solve reused:\n%s", out_buf);
+    CHECK(silc_exec(c, cmd) == 0, "reuse 2: %s", silc_context_errmsg(c));
+    CHECK(contains(info(c, "x"), "reused factorization: yes") && contains(out_buf, "preconditioner reused"),
+          "second solve with the same A did not reuse the preconditioner:\n%s", out_buf);
+    CHECK(silc_exec(c, "A = 2 * A; b = 2 * b") == 0, "A = 2A: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(c, cmd) == 0, "reuse 3: %s", silc_context_errmsg(c));
+    CHECK(contains(info(c, "x"), "reused factorization: no"), "a new A reused the old preconditioner:\n%s",
+          out_buf);
+    x = get_dense(c, "x", n, 1);
+    if (x) CHECK(rel_err2(x, xt, n) <= 1e-9, "after A = 2A: error %g", rel_err2(x, xt, n));
+    free(x);
+    /* Dense A (converted once to CSR), two right-hand sides. */
+    CHECK(silc_exec(c, "D = dense(A)") == 0, "dense: %s", silc_context_errmsg(c));
+    {
+        silc_envelope_t Ae;
+        double *bb = malloc((size_t)n * sizeof *bb);
+        CHECK(silc_get(c, &Ae, "b") == 0, "get b");
+        silc_envelope_to_dense(&Ae, bb);
+        silc_envelope_free(&Ae);
+        for (int64_t i = 0; i < n; i++) B[i] = bb[i], B[n + i] = 3 * bb[i];
+        free(bb);
+    }
+    put_dense(c, "B", n, 2, B);
+    snprintf(cmd, sizeof cmd, "X = solve(D, B, \"%s\")", opts);
+    CHECK(silc_exec(c, cmd) == 0, "dense, 2 rhs: %s", silc_context_errmsg(c));
+    CHECK(contains(info(c, "X"), "backend: lis-style"), "dense solve not by lis-style:\n%s", out_buf);
+    x = get_dense(c, "X", n, 2);
+    if (x) {
+        double e1 = rel_err2(x, xt, n), e2;
+        for (int64_t i = 0; i < n; i++) x[n + i] /= 3;
+        e2 = rel_err2(x + n, xt, n);
+        CHECK(e1 <= 1e-9 && e2 <= 1e-9, "dense 2 rhs: errors %g %g", e1, e2);
+    }
+    free(x);
+    silc_envelope_free(&A);
+    free(xt);
+    free(B);
+}
+
+static void test_threads(silc_context *c)
+{
+    silc_envelope_t A;
+    int64_t k = 90, n = k * k; /* above the kernels' parallel threshold */
+    double *xt = malloc((size_t)n * sizeof *xt), *x1, *x2, t1, t2;
+    const char *cmd = "x = solve(A, b, \"lis-style.options = -i bicgstab -p ilu -tol 1e-10\")";
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0.4);
+    put_system(c, &A, xt);
+    CHECK(silc_exec(c, cmd) == 0, "warm-up: %s", silc_context_errmsg(c)); /* builds ILU(0) */
+    CHECK(silc_exec(c, "set tune.threads = 1") == 0, "threads 1: %s", silc_context_errmsg(c));
+    t1 = now();
+    CHECK(silc_exec(c, cmd) == 0, "1 thread: %s", silc_context_errmsg(c));
+    t1 = now() - t1;
+    x1 = get_dense(c, "x", n, 1);
+    CHECK(silc_exec(c, "set tune.threads = 2") == 0, "threads 2: %s", silc_context_errmsg(c));
+    t2 = now();
+    CHECK(silc_exec(c, cmd) == 0, "2 threads: %s", silc_context_errmsg(c));
+    t2 = now() - t2;
+    x2 = get_dense(c, "x", n, 1);
+    if (x1 && x2) {
+        CHECK(rel_err2(x1, xt, n) <= 1e-7 && rel_err2(x2, xt, n) <= 1e-7, "threads: errors %g %g",
+              rel_err2(x1, xt, n), rel_err2(x2, xt, n));
+        printf("  90x90 convection-diffusion BiCGSTAB+ILU(0): 1 thread %.3f s, 2 threads %.3f s\n", t1, t2);
+    }
+    CHECK(silc_exec(c, "set tune.threads = 1") == 0, "threads back: %s", silc_context_errmsg(c));
+    free(x1);
+    free(x2);
+    free(xt);
+    silc_envelope_free(&A);
+}
+
+/* An empty option string picks a method for the class; Lis's defaults
+ * (BiCG, no preconditioner) apply once options are written. */
+static void test_defaults(void)
+{
+    silc_context *c = open_ctx("lis-style", NULL);
+    silc_envelope_t A;
+    int64_t k = 15, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt);
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    if (!c) return;
+    for (int sym = 1; sym >= 0; sym--) {
+        grid(&A, k, sym ? 0 : 0.4);
+        put_system(c, &A, xt);
+        CHECK(silc_exec(c, "x = A \\ b") == 0, "default: %s", silc_context_errmsg(c));
+        CHECK(contains(info(c, "x"), sym ? "CG + IC(0)" : "BiCGSTAB + ILU(0)"), "default method:\n%s", out_buf);
+        CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -tol 1e-10\")") == 0, "lis defaults: %s",
+              silc_context_errmsg(c));
+        CHECK(contains(info(c, "x"), "BiCG, no preconditioner"), "Lis defaults:\n%s", out_buf);
+        silc_envelope_free(&A);
+    }
+    free(xt);
+    silc_close(&c);
+}
+
+int main(void)
+{
+    silc_context *c = open_ctx("lis-style", NULL), *ref = open_ctx("reference", NULL);
+    if (!c || !ref) {
+        CHECK(0, "cannot open contexts");
+        return check_done();
+    }
+    printf("lis-style: Lis reference behaviours\n");
+    test_laplacian_bicg(c);
+    test_toeplitz(c);
+    printf("lis-style: solvers and preconditioners\n");
+    test_all_methods(c);
+    printf("lis-style: options\n");
+    test_options(c);
+    test_defaults();
+    test_failures(c);
+    test_reuse_and_formats(c);
+    test_threads(c);
+    printf("lis-style: SPD shared matrices, CG + IC(0) / ILU(0), tol 1e-10\n");
+    test_shared_spd(c, ref);
+    silc_close(&c);
+    silc_close(&ref);
+    return check_done();
+}
