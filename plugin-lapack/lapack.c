@@ -15,7 +15,8 @@
  *           solve.diag and the sparse classes are left to other backends.
  *
  * The factorization is attached to A ("lapack.<kind>"), so repeated solves
- * with an unchanged A factor once.  The thread count is OpenBLAS's.
+ * with an unchanged A factor once.  lapack.precision = mixed sends general
+ * and SPD dense solves to dsgesv / dsposv instead (see solve_mixed).  The thread count is OpenBLAS's.
  */
 #include "lapack.h"
 
@@ -254,6 +255,93 @@ static void fill_report(silc_report *r, const lp_factor *F)
     snprintf(r->note, sizeof r->note, "%s", F->note);
 }
 
+/* ITER < 0 of dsgesv / dsposv: why the double-precision fallback ran. */
+static const char *iter_reason(lapack_int iter)
+{
+    switch (iter) {
+    case -1: return "the matrix is too small for mixed precision to pay";
+    case -2: return "an entry overflows single precision";
+    case -3: return "the single-precision factorization failed";
+    case -31: return "refinement did not converge in 30 steps";
+    default: return "LAPACK chose double precision";
+    }
+}
+
+/* lapack.precision = mixed: dsgesv / dsposv factor in single precision and
+ * refine in double, falling back to a double factorization themselves when
+ * that fails (too ill-conditioned, out of single range).  The single factors
+ * live inside the call, so nothing is attached and every solve factors anew;
+ * the condition estimate exists only when the fallback left double factors. */
+static int solve_mixed(silc_call *call, int route, const silc_view *A, const silc_view *B,
+                       const silc_props *P)
+{
+    lapack_int n = (lapack_int)A->n, nrhs = (lapack_int)B->n, iter = 0, info, *ipiv, *iwork;
+    double *a = lp_alloc((size_t)n * (size_t)n, sizeof(double));
+    double *b = lp_alloc((size_t)n * (size_t)nrhs, sizeof(double));
+    double *work = lp_alloc((size_t)n * (size_t)(nrhs > 4 ? nrhs : 4), sizeof(double));
+    float *swork = lp_alloc((size_t)n * (size_t)(n + nrhs), sizeof(float));
+    silc_value *out = lp_host->dense_new(A->n, B->n);
+    silc_report *r = call->report;
+    silc_view X;
+    double t0 = lp_host->now(), rcond = -1;
+    int rc = SILC_OK, chol = route == R_CHOL;
+    ipiv = lp_alloc((size_t)n, sizeof(lapack_int));
+    iwork = lp_alloc((size_t)n, sizeof(lapack_int));
+    if (!a || !b || !work || !swork || !out || !ipiv || !iwork) {
+        rc = lp_nomem(call);
+        goto done;
+    }
+    lp_host->view(out, &X);
+    memcpy(a, A->val, (size_t)n * (size_t)n * sizeof(double));
+    rhs_copy(B, b, n);
+    info = chol ? LAPACKE_dsposv_work(LAPACK_COL_MAJOR, 'L', n, nrhs, a, n, b, n, X.val, n, work,
+                                      swork, &iter)
+                : LAPACKE_dsgesv_work(LAPACK_COL_MAJOR, n, nrhs, a, n, ipiv, b, n, X.val, n, work,
+                                      swork, &iter);
+    if (info > 0) {
+        rc = chol ? lp_host->error(call, SILC_ENOTSPD,
+                                   "dsposv: matrix is not positive definite (leading minor %d, status %d)",
+                                   (int)info, (int)info)
+                  : lp_host->error(call, SILC_ESINGULAR,
+                                   "dsgesv: singular matrix (U(%d,%d) is exactly zero, status %d)",
+                                   (int)info, (int)info, (int)info);
+        goto done;
+    }
+    if (info < 0) {
+        rc = lp_illegal(call, chol ? "dsposv" : "dsgesv", info);
+        goto done;
+    }
+    /* After a fallback a holds the double factors: estimate as the double path does. */
+    if (iter < 0 &&
+        (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
+              : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork)))
+        rcond = -1;
+    snprintf(r->method, sizeof r->method, "mixed precision %s (%s)", chol ? "Cholesky" : "LU",
+             chol ? "dsposv" : "dsgesv");
+    if (iter >= 0)
+        snprintf(r->note, sizeof r->note,
+                 "factored in single precision, %d refinement step%s in double (ITER=%d)", (int)iter,
+                 iter == 1 ? "" : "s", (int)iter);
+    else
+        snprintf(r->note, sizeof r->note, "fell back to double precision (ITER=%d: %s)", (int)iter,
+                 iter_reason(iter));
+    if (rcond > 0) r->rcond = rcond, r->cond_est = 1.0 / rcond;
+    else if (rcond == 0) r->rcond = 0, r->cond_est = INFINITY;
+    r->factor_seconds = 0;
+    r->solve_seconds = lp_host->now() - t0;
+    call->out = out;
+    out = NULL;
+done:
+    if (out) lp_host->release(out);
+    lp_free(a);
+    lp_free(b);
+    lp_free(work);
+    lp_free(swork);
+    lp_free(ipiv);
+    lp_free(iwork);
+    return rc;
+}
+
 static int op_solve(silc_call *call)
 {
     silc_view A, B, X;
@@ -279,6 +367,13 @@ static int op_solve(silc_call *call)
     }
     P = lp_host->props(call->in[0]);
     route = route_of(call, &A, P);
+    if ((route == R_LU || route == R_CHOL) && A.format == SILC_FMT_DENSE) {
+        const char *prec = lp_host->option_string(call, "precision", "double");
+        if (strcmp(prec, "mixed") == 0) return solve_mixed(call, route, &A, &B, P);
+        if (strcmp(prec, "double") != 0)
+            return lp_host->error(call, SILC_EARG,
+                                  "option 'lapack.precision' expects double or mixed, got '%s'", prec);
+    }
     if (route == R_RECT) {
         if ((rc = lp_host->option_double(call, "rank_tol", 0.0, &rank_tol))) return rc;
         if (!(rank_tol > 0)) rank_tol = (double)(A.m > A.n ? A.m : A.n) * DBL_EPSILON;
@@ -362,6 +457,9 @@ static const silc_option_spec lp_options[] = {
     {"rank_tol", SILC_OPT_DOUBLE, "0",
      "least squares: rcond below which A counts as rank deficient and dgelsy is used "
      "(0 = max(m,n) * eps)"},
+    {"precision", SILC_OPT_STRING, "double",
+     "general and SPD dense solves: double (dgetrf / dpotrf) or mixed (dsgesv / dsposv: factor "
+     "in single precision, refine in double, fall back to double when that fails)"},
 };
 
 static char lp_version[192];

@@ -436,6 +436,10 @@ static int factor_new(silc_call *call, const silc_view *v, int sym, const settin
         return host->error(call, SILC_ENOMEM, "mumps: out of memory for %lld triplets",
                            (long long)v->nnz);
     }
+    if (nnz == 0) { /* MUMPS would answer "NNZ out of range" (INFOG(1)=-2) */
+        factor_free(F);
+        return host->error(call, SILC_ESINGULAR, "mumps: singular matrix (no nonzero entries)");
+    }
     id = &F->id;
     id->job = MUMPS_JOB_INIT;
     id->par = 1;

@@ -224,7 +224,7 @@ int ref_dense_tri(int64_t n, const double *A, int lower, ref_factor *F, char *ms
 {
     for (int64_t k = 0; k < n; k++)
         if (A[k + k * n] == 0.0) {
-            snprintf(msg, msglen, "triangular solve: zero diagonal entry at row %lld", (long long)k + 1);
+            snprintf(msg, msglen, "singular triangular matrix: zero diagonal entry at row %lld", (long long)k + 1);
             return SILC_ESINGULAR;
         }
     dense_tri *f = dense_tri_new(n, A);

@@ -67,7 +67,7 @@ static int diag_factor(const silc_view *a, ref_factor *F, char *msg, size_t msgl
     for (int64_t i = 0; i < n; i++) {
         f->d[i] = ref_view_get(a, i, i);
         if (f->d[i] == 0.0) {
-            snprintf(msg, msglen, "zero diagonal entry at row %lld", (long long)i + 1);
+            snprintf(msg, msglen, "singular diagonal matrix: zero diagonal entry at row %lld", (long long)i + 1);
             diag_free(f);
             return SILC_ESINGULAR;
         }

@@ -86,7 +86,7 @@ int ref_sparse_tri(const ref_sp *A, int lower, ref_factor *F, char *msg, size_t 
         for (int64_t q = A->p[j]; q < A->p[j + 1]; q++)
             if (A->i[q] == j && A->x[q] != 0.0) f->dpos[j] = q;
         if (f->dpos[j] < 0) {
-            snprintf(msg, msglen, "triangular solve: zero diagonal entry at row %lld", (long long)j + 1);
+            snprintf(msg, msglen, "singular triangular matrix: zero diagonal entry at row %lld", (long long)j + 1);
             sp_tri_free(f);
             return SILC_ESINGULAR;
         }

@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 1
+#define SILC_ABI_MINOR 2
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -144,6 +144,11 @@ typedef struct silc_report {
     char backend[64];
     double seconds;
     double backward_error;
+    /* ABI 1.2 (write these only when host->abi_minor >= 2) */
+    int single_factor;      /* plugin: x comes from a single-precision factorization; the core
+                               refines it in double (solve.refine, default 10 steps for these) */
+    int refine_steps;       /* host: iterative-refinement steps the core kept */
+    double backward_error_unrefined; /* host: backward error before refinement, -1 = none ran */
 } silc_report;
 
 typedef struct silc_call {

@@ -4,7 +4,9 @@
  * options of solve(A, b, "...")).
  *
  * A key is "section.name": dispatch.<class> (an ordered list of backends),
- * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads, and
+ * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads,
+ * solve.refine / solve.refine_residual (iterative refinement, refine.c; per call
+ * they may be written without the section: "refine = 2"), and
  * <plugin>.<option> for the typed options a loaded plugin lists.  The INI file
  * (read with inih) spells the same keys as [section] name = value.  Every key
  * and value is checked when it is set, not when it is used, so a typo is
@@ -37,6 +39,7 @@ struct cfg_db {
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
+static const char *const solve_keys[] = {"refine", "refine_residual"};
 
 /* Longest list a dispatch key may name; more would only repeat names. */
 #define CFG_MAX_LIST 32
@@ -187,6 +190,7 @@ static int unknown_section(silc_engine *E, const char *section)
     cands[n++] = "dispatch";
     cands[n++] = "tune";
     cands[n++] = "core";
+    cands[n++] = "solve";
     for (i = 0; ld_known_backends[i] && nk < 16; i++) {
         plugin_part(ld_known_backends[i], known[nk], sizeof known[nk]);
         cands[n++] = known[nk++];
@@ -195,7 +199,7 @@ static int unknown_section(silc_engine *E, const char *section)
         cands[n++] = ld_plugin_at(E, i)->table->name;
     best = util_closest(section, cands, n);
     if (best) return eng_error(E, "unknown section [%s]; did you mean [%s]?", section, best);
-    return eng_error(E, "unknown section [%s] (sections: dispatch, tune, core, or a plugin name)",
+    return eng_error(E, "unknown section [%s] (sections: dispatch, tune, core, solve, or a plugin name)",
                      section);
 }
 
@@ -346,6 +350,21 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         }
         return sb_puts(norm, value);
     }
+    if (strcmp(section, "solve") == 0) {
+        int64_t steps;
+        if (strcmp(name, "refine") == 0) {
+            if (parse_int(value, &steps) || steps < 0 || steps > 100)
+                return eng_error(E, "solve.refine expects a number of refinement steps from 0 to "
+                                    "100, got '%s'", value);
+        } else if (strcmp(name, "refine_residual") == 0) {
+            if (strcmp(value, "double") != 0 && strcmp(value, "extended") != 0)
+                return eng_error(E, "solve.refine_residual expects 'double' or 'extended', got '%s'",
+                                 value);
+        } else {
+            return unknown_key(E, section, name, solve_keys, 2);
+        }
+        return sb_puts(norm, value);
+    }
     pl = ld_find_plugin(E, section);
     if (pl) {
         if (check_option(E, pl->table, name, value)) return -1;
@@ -447,6 +466,10 @@ int cfg_set(silc_engine *E, int scope, const char *key, const char *value)
     trim_copy(v, sizeof v, value, strlen(value));
     if (!k[0]) return eng_error(E, "empty option key");
     dot = strchr(k, '.');
+    /* The refinement knobs read naturally without their section:
+     * solve(A, b, "refine = 2"). */
+    if (!dot && (strcmp(k, solve_keys[0]) == 0 || strcmp(k, solve_keys[1]) == 0))
+        return set_parts(E, scope, "solve", k, v);
     if (!dot) return set_parts(E, scope, "", k, v);
     trim_copy(section, sizeof section, k, (size_t)(dot - k));
     return set_parts(E, scope, section, dot + 1, v);

@@ -20,6 +20,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "refine.h"
 
 #include <float.h>
 #include <math.h>
@@ -343,6 +344,11 @@ static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed)
     else if (r->cond_est > 0 && eps_cond > 1e-4)
         eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
                  r->cond_est);
+    /* Hook (issue 7): a result that does not solve the system is never
+     * returned silently, whatever the backend claimed. */
+    if (r->backward_error > 1e-3)
+        eng_warn(E, "'\\': the result of %s has backward error %.2g: it does not solve the system",
+                 r->backend, r->backward_error);
     if (has_nonfinite(call->out))
         eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
 }
@@ -410,6 +416,9 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 snprintf(ctx.err, sizeof ctx.err, "reported success but returned no result");
             }
             if (rc == SILC_OK) {
+                /* Hook (refine.c): iterative refinement as solve.refine asks,
+                 * by the backend that just solved, before the report. */
+                if (call->op == SILC_OP_SOLVE) refine_solve(E, call, b);
                 if (call->op == SILC_OP_SOLVE) finish_solve(E, call, cholesky_failed);
                 call->host_private = NULL;
                 sb_free(&skipped);
@@ -454,6 +463,11 @@ int disp_run(silc_engine *E, silc_call *call)
         rc = SILC_EARG;
     } else if (call->op == SILC_OP_SOLVE && (call->nin < 2 || !call->in[1])) {
         eng_error(E, "solve needs a right-hand side");
+        rc = SILC_EARG;
+    } else if (call->op == SILC_OP_SOLVE &&
+               (refine_check_finite(E, call->in[0], "the matrix") ||
+                refine_check_finite(E, call->in[1], "the right-hand side"))) {
+        /* Hook (refine.c): NaN/Inf operands are an error before any backend runs. */
         rc = SILC_EARG;
     } else {
         silc_report *saved = call->report;

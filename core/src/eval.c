@@ -15,6 +15,7 @@
  */
 #include "lang.h"
 #include "tuner.h"
+#include "refine.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -414,6 +415,10 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
             return run2(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
         if (a->m != b->m)
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
+        /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
+         * repeats the check with role names for every other route). */
+        if (refine_check_finite(V->E, a, o->lname) || refine_check_finite(V->E, b, o->rname))
+            return -1;
         return run2(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
     case TK_CARET:
         if (val_is_scalar(a) && val_is_scalar(b))
@@ -761,8 +766,15 @@ static int exec_info(lang_ev *V, const ast_node *s)
             sb_printf(&b, "  solve: %s\n", r->method[0] ? r->method : "(method not reported)");
             sb_printf(&b, "  backend: %s\n", in->backends[0] ? in->backends : r->backend);
             sb_printf(&b, "  backward error: %.3g\n", r->backward_error);
+            if (r->backward_error_unrefined >= 0)
+                sb_printf(&b, "  refinement: %d step%s, backward error before: %.3g\n",
+                          r->refine_steps, r->refine_steps == 1 ? "" : "s",
+                          r->backward_error_unrefined);
             if (r->cond_est >= 0) {
                 sb_printf(&b, "  condition estimate: %.3g\n", r->cond_est);
+                /* First-order bound on the relative forward error (Higham, 7.2). */
+                sb_printf(&b, "  forward error bound: cond x backward error = %.3g\n",
+                          r->cond_est * r->backward_error);
             } else {
                 sb_puts(&b, "  condition estimate: not available\n");
             }

@@ -1,0 +1,304 @@
+/*
+ * refine.c -- iterative refinement of direct solves, and the check that a
+ * solve's operands are finite.
+ *
+ * Refinement (Wilkinson; Higham, "Accuracy and Stability", ch. 12): with x
+ * from a backend, repeat r = b - A x, solve A d = r with the same backend,
+ * x += d.  Two flavours, chosen by solve.refine_residual:
+ *
+ *   double    r in working precision.  This repairs an unstable or low-
+ *             precision solve (a single-precision factorization, a pivot
+ *             order that lost accuracy) down to a backward error of order
+ *             eps, but cannot beat the forward error cond * eps.  The loop
+ *             stops when the backward error reaches eps or stops halving, and
+ *             a step that makes it worse is thrown away.
+ *   extended  r accumulated in double-double (each product split exactly
+ *             with fma, each sum with TwoSum), rounded once.  Then the
+ *             forward error itself converges to about eps while
+ *             cond * eps < 1.  The backward error of a stable solve is
+ *             already at eps, so this loop watches the size of the
+ *             correction instead, as LAPACK's xGERFSX does: it stops when
+ *             ||d|| / ||x|| reaches eps or stops halving.
+ *
+ * The correction solve goes straight to the backend that made x (not through
+ * the dispatcher again), with the same class and per-call options, so it
+ * finds the factorization that backend attached to A.  Least-squares and
+ * iterative solves are left alone with a note: the first has no square
+ * residual equation, the second is better served by a tighter tolerance.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "refine.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- finite operands ------------------------------------------------------- */
+
+int refine_check_finite(silc_engine *E, const silc_value *v, const char *name)
+{
+    silc_view w;
+    int64_t i, j, p;
+    if (!v || !val_props(v)->has_nonfinite) return 0;
+    val_view(v, &w);
+    for (i = 0; i < w.m; i++)
+        for (j = 0; j < w.n; j++) {
+            double x;
+            if (w.format == SILC_FMT_CSR) { /* only stored entries can be non-finite */
+                if (j > 0) break;
+                for (p = w.rowptr[i]; p < w.rowptr[i + 1]; p++)
+                    if (!isfinite(w.val[p])) {
+                        j = w.colind[p];
+                        x = w.val[p];
+                        goto found;
+                    }
+                continue;
+            }
+            x = val_get(v, i, j);
+            if (!isfinite(x)) goto found;
+            continue;
+        found:
+            return eng_error(E, "%s has %s at (%lld, %lld): a solve needs finite entries", name,
+                             isnan(x) ? "NaN" : x > 0 ? "Inf" : "-Inf", (long long)i + 1,
+                             (long long)j + 1);
+        }
+    return 0;
+}
+
+/* ---- residuals ------------------------------------------------------------- */
+
+/* (*hi + *lo) -= a * x.  Plain: *hi -= a x.  Extended: the product is split
+ * exactly (a x = p + e by fma) and added with TwoSum, so hi + lo carries the
+ * sum to about twice the working precision. */
+static void acc_sub(double *hi, double *lo, double a, double x, int extended)
+{
+    double p = a * x, s, bb, err, e;
+    if (!extended) {
+        *hi -= p;
+        return;
+    }
+    e = fma(a, x, -p);
+    s = *hi - p;
+    bb = s - *hi;
+    err = (*hi - (s - bb)) + (-p - bb);
+    *hi = s;
+    *lo += err - e;
+}
+
+/* R = B - A X for k columns (A m x n; X n x k, B and R m x k, column-major). */
+static void residual(const silc_value *A, const double *B, const double *X, int64_t k,
+                     int extended, double *R, double *lo)
+{
+    silc_view a;
+    int64_t i, j, c, p;
+    val_view(A, &a);
+    memcpy(R, B, (size_t)(a.m * k) * sizeof *R);
+    memset(lo, 0, (size_t)(a.m * k) * sizeof *lo);
+    for (c = 0; c < k; c++) {
+        double *r = R + c * a.m, *l = lo + c * a.m;
+        const double *x = X + c * a.n;
+        if (a.format == SILC_FMT_CSR) {
+            for (i = 0; i < a.m; i++)
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++)
+                    acc_sub(&r[i], &l[i], a.val[p], x[a.colind[p]], extended);
+        } else if (a.format == SILC_FMT_BAND) {
+            for (j = 0; j < a.n; j++) {
+                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
+                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
+                for (i = lo_i; i < hi_i; i++)
+                    acc_sub(&r[i], &l[i], a.val[(a.ku + i - j) + j * a.ld], x[j], extended);
+            }
+        } else {
+            for (j = 0; j < a.n; j++)
+                for (i = 0; i < a.m; i++) acc_sub(&r[i], &l[i], a.val[i + j * a.m], x[j], extended);
+        }
+        if (extended)
+            for (i = 0; i < a.m; i++) r[i] += l[i];
+    }
+}
+
+/* Infinity norm of the m x k column-major array (max row sum of |.|). */
+static double norm_inf(const double *x, int64_t m, int64_t k)
+{
+    double best = 0;
+    int64_t i, c;
+    for (i = 0; i < m; i++) {
+        double s = 0;
+        for (c = 0; c < k; c++) s += fabs(x[i + c * m]);
+        if (!(s <= best)) best = s; /* NaN wins */
+    }
+    return best;
+}
+
+/* Dense copy of any value (m x n, column-major). */
+static double *dense_copy(const silc_value *v)
+{
+    double *x = malloc((size_t)(v->m * v->n > 0 ? v->m * v->n : 1) * sizeof *x);
+    int64_t i, j;
+    if (!x) return NULL;
+    if (v->format == SILC_FMT_DENSE) {
+        if (v->m * v->n > 0) memcpy(x, v->val, (size_t)(v->m * v->n) * sizeof *x);
+        return x;
+    }
+    for (j = 0; j < v->n; j++)
+        for (i = 0; i < v->m; i++) x[i + j * v->m] = val_get(v, i, j);
+    return x;
+}
+
+/* ---- the loop -------------------------------------------------------------- */
+
+/* The correction D = A \ R by backend b with the call's class and options;
+ * NULL (and why in err) when it fails. */
+static silc_value *correction(silc_engine *E, const silc_call *call, const ld_backend *b,
+                              const silc_value *R, char *err, size_t errlen)
+{
+    silc_call c = *call;
+    silc_report rep;
+    host_call_ctx ctx;
+    int rc;
+    memset(&rep, 0, sizeof rep);
+    rep.cond_est = rep.rcond = -1;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.E = E;
+    ctx.backend = b;
+    c.in[1] = R;
+    c.out = NULL;
+    c.report = &rep;
+    c.host_private = &ctx;
+    rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
+    if (rc == SILC_OK && c.out && c.out->m == call->out->m && c.out->n == call->out->n)
+        return c.out;
+    val_release(c.out);
+    snprintf(err, errlen, "%s", ctx.err[0] ? ctx.err : "the correction solve failed");
+    return NULL;
+}
+
+/* Steps asked for: solve.refine, else the default of single-precision
+ * factorizations, else none. */
+static int64_t steps_wanted(const silc_engine *E, const silc_report *r, int *extended)
+{
+    const char *v = cfg_get(E, "solve.refine"), *res = cfg_get(E, "solve.refine_residual");
+    *extended = res && strcmp(res, "extended") == 0;
+    if (v) return strtoll(v, NULL, 10);
+    return r->single_factor ? REFINE_SINGLE_DEFAULT : 0;
+}
+
+static void add_note(silc_report *r, const char *text)
+{
+    size_t len = strlen(r->note);
+    snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", text);
+}
+
+void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
+{
+    silc_report *r = call->report;
+    const silc_value *A = call->in[0], *Bv = call->in[1];
+    double *B = NULL, *X = NULL, *R = NULL, *lo = NULL, nA, nB, be, be0, dprev = INFINITY;
+    double t0 = util_now();
+    int64_t want, step, kept = 0, n = A->n, k = Bv->n;
+    int extended;
+    char note[200], why[sizeof(((host_call_ctx *)0)->err)];
+    const char *stop = "step limit";
+    r->backward_error_unrefined = -1;
+    r->refine_steps = 0;
+    want = steps_wanted(E, r, &extended);
+    if (want <= 0 || !call->out) return;
+    if (A->m != A->n || n == 0 || k == 0) {
+        if (A->m != A->n) add_note(r, "refinement skipped: least-squares solve");
+        return;
+    }
+    if (r->iterations > 0 && !r->single_factor) {
+        add_note(r, "refinement skipped: iterative solver (tighten its tolerance instead)");
+        return;
+    }
+    B = dense_copy(Bv);
+    X = dense_copy(call->out);
+    R = malloc((size_t)(n * k) * sizeof *R);
+    lo = malloc((size_t)(n * k) * sizeof *lo);
+    if (!B || !X || !R || !lo) {
+        add_note(r, "refinement skipped: out of memory");
+        goto done;
+    }
+    nA = val_props(A)->norminf;
+    nB = norm_inf(B, n, k);
+    residual(A, B, X, k, extended, R, lo);
+    be = be0 = norm_inf(R, n, k) / (nA * norm_inf(X, n, k) + nB);
+    for (step = 0; step < want; step++) {
+        silc_value *Rv, *D;
+        double *Xn, ben, dn;
+        int64_t i;
+        if (!extended && be <= DBL_EPSILON) {
+            stop = "backward error at working precision";
+            break;
+        }
+        if (!(be == be)) {
+            stop = "residual is not finite";
+            break;
+        }
+        Rv = val_dense_new(n, k);
+        if (!Rv) {
+            stop = "out of memory";
+            break;
+        }
+        memcpy(Rv->val, R, (size_t)(n * k) * sizeof *R);
+        D = correction(E, call, b, Rv, why, sizeof why);
+        val_release(Rv);
+        if (!D) {
+            stop = why;
+            break;
+        }
+        Xn = dense_copy(D); /* becomes the candidate x + d */
+        val_release(D);
+        if (!Xn) {
+            stop = "out of memory";
+            break;
+        }
+        dn = norm_inf(Xn, n, k) / norm_inf(X, n, k);
+        for (i = 0; i < n * k; i++) Xn[i] += X[i];
+        residual(A, B, Xn, k, extended, R, lo);
+        ben = norm_inf(R, n, k) / (nA * norm_inf(Xn, n, k) + nB);
+        if (extended ? !(dn < dprev) : !(ben < be)) {
+            /* Not an improvement: the previous x stays. */
+            free(Xn);
+            stop = extended ? "correction stopped shrinking" : "backward error stopped decreasing";
+            break;
+        }
+        free(X);
+        X = Xn;
+        kept++;
+        if (extended ? (dn <= DBL_EPSILON || dn > 0.5 * dprev) : ben > 0.5 * be) {
+            be = ben;
+            stop = extended ? (dn <= DBL_EPSILON ? "correction at working precision"
+                                                 : "correction stopped halving")
+                            : "backward error stopped halving";
+            break;
+        }
+        be = ben;
+        dprev = dn;
+    }
+    if (kept > 0) {
+        silc_value *out = val_dense_new(n, k);
+        if (out) {
+            memcpy(out->val, X, (size_t)(n * k) * sizeof *X);
+            val_release(call->out);
+            call->out = out;
+        } else {
+            kept = 0;
+            stop = "out of memory";
+        }
+    }
+    r->refine_steps = (int)kept;
+    r->backward_error_unrefined = be0;
+    snprintf(note, sizeof note, "refinement (%s residual): %lld step%s, backward error %.2g -> %.2g (%.60s)",
+             extended ? "double-double" : "double", (long long)kept, kept == 1 ? "" : "s", be0,
+             kept ? be : be0, stop);
+    add_note(r, note);
+done:
+    r->seconds += util_now() - t0;
+    free(B);
+    free(X);
+    free(R);
+    free(lo);
+}

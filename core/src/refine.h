@@ -1,0 +1,32 @@
+/*
+ * refine.h -- what the dispatcher asks of refine.c: the finite-operand check
+ * made before any solve, and iterative refinement after a direct solve.
+ *
+ * Refinement lives once in the core, whichever backend solved: the residual
+ * r = b - A x is formed here (in double, or in double-double for
+ * solve.refine_residual = extended), the correction A d = r is solved by the
+ * same backend with the same options (its factorization, attached to A, makes
+ * that one more triangular solve), and x += d.  Keys: solve.refine (steps,
+ * per call "refine = 2") and solve.refine_residual (double | extended).  A
+ * backend whose factorization is single precision sets report->single_factor
+ * and gets up to REFINE_SINGLE_DEFAULT steps unless refine is set.
+ */
+#ifndef SILC_REFINE_H
+#define SILC_REFINE_H
+
+#include "engine.h"
+
+#define REFINE_SINGLE_DEFAULT 10
+
+/* If v stores a NaN or Inf, sets E->err to "<name> has NaN at (i, j)" (1-based)
+ * and returns -1; else 0.  Cheap when v is finite (the cached props say so). */
+int refine_check_finite(silc_engine *E, const silc_value *v, const char *name);
+
+/* Refines call->out, a solution just computed by backend b, as the
+ * configuration and call->report->single_factor ask; replaces call->out when
+ * a step was kept and records steps, the backward error before and a note in
+ * the report.  Never fails the solve: a correction that cannot be computed
+ * ends the refinement with a note. */
+void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b);
+
+#endif
