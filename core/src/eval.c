@@ -544,6 +544,8 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
     }
     case AST_CALL:
         return bi_call(V, n, out);
+    case AST_MATRIX:
+        return cc_matrix(V, n, out);
     default:
         return eng_error(E, "internal error: statement where an expression was expected");
     }

@@ -49,6 +49,8 @@ enum ast_kind {
     /* expressions */
     AST_NUM, AST_NAME, AST_STRING, AST_END, AST_COLON_ALL, AST_RANGE,
     AST_BINARY, AST_UNARY, AST_TRANSPOSE, AST_INDEX, AST_CALL,
+    AST_MATRIX,            /* [a, b; c, d]: kids are AST_ROW nodes (none for []) */
+    AST_ROW,               /* one row of a matrix literal: kids are its blocks */
     /* statements */
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
@@ -121,6 +123,12 @@ int bi_constant(const char *name, double *x);
 int bi_call(lang_ev *V, const ast_node *call, silc_value **out);
 /* Shared with index.c: CSR copy of any value (core-side, no dispatch). */
 silc_value *bi_to_csr(const silc_value *a);
+
+/* ---- matrix literals (concat.c) ---------------------------------------------- */
+/* [a, b; c, d]: blocks side by side must have equal rows, rows stacked equal
+ * columns; 0x0 blocks are skipped, as in MATLAB.  The result is CSR when any
+ * block is CSR, else dense.  Returns 0 with *out, or -1 with E->err set. */
+int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out);
 
 /* ---- subscripts (index.c) ----------------------------------------------------- */
 /* base[subs] and target[subs] = rhs.  what names the matrix for messages

@@ -66,6 +66,7 @@ static void advance(lx_state *L, size_t k)
 static int at_statement_start(const lx_state *L)
 {
     int k;
+    if (L->depth > 0) return 0; /* inside ( ) or [ ]: ';' separates matrix rows */
     if (L->out->n == 0) return 1;
     k = L->out->t[L->out->n - 1].kind;
     return k == TK_NEWLINE || k == TK_SEMI || k == TK_LBRACE || k == TK_RBRACE;

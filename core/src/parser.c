@@ -225,6 +225,41 @@ static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetex
     return close_with(P, closer, closetext, opener, n);
 }
 
+/* [a, b; c, d]: rows separated by ';', blocks by ','.  Newlines inside the
+ * brackets are ignored by the lexer, so a literal may span lines. */
+static ast_node *parse_matrix(ps_state *P)
+{
+    const lx_token *open = next(P);
+    ast_node *m = node_new(P, AST_MATRIX, open), *row = NULL;
+    if (!m) return NULL;
+    if (is(P, TK_RBRACKET)) {
+        if (close_with(P, TK_RBRACKET, "]", open, m)) goto fail;
+        return m;
+    }
+    for (;;) {
+        row = node_new(P, AST_ROW, peek(P));
+        if (!row) goto fail;
+        for (;;) {
+            if (add_kid(P, row, parse_expr(P))) goto fail;
+            if (!is(P, TK_COMMA)) break;
+            next(P);
+        }
+        if (add_kid(P, m, row)) {
+            row = NULL;
+            goto fail;
+        }
+        row = NULL;
+        if (!is(P, TK_SEMI)) break;
+        next(P);
+    }
+    if (close_with(P, TK_RBRACKET, "]", open, m)) goto fail;
+    return m;
+fail:
+    node_free(row);
+    node_free(m);
+    return NULL;
+}
+
 static ast_node *parse_primary(ps_state *P)
 {
     const lx_token *tk = peek(P);
@@ -242,6 +277,8 @@ static ast_node *parse_primary(ps_state *P)
             return fail(P, tk, "out of memory while parsing");
         }
         return n;
+    case TK_LBRACKET:
+        return parse_matrix(P);
     case TK_LPAREN: {
         next(P);
         n = parse_expr(P);
