@@ -33,10 +33,10 @@
  * wants it).  Around every stretch of PETSc calls PetscReturnErrorHandler is
  * pushed, so errors come back as codes and PETSc never prints or aborts.
  */
-#define _GNU_SOURCE /* dladdr */
 #include "petsc_plugin.h"
 
-#include <dlfcn.h>
+#include "common/blas_threads.h"
+
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -624,7 +624,7 @@ static const silc_option_spec petsc_options[] = {
 
 /* PETSc is threaded only through BLAS (OpenBLAS here), found among this
  * module's own dependencies: RTLD_LOCAL hides it from a global look-up. */
-static void (*openblas_threads)(int);
+static blas_threads_fn openblas_threads;
 
 static void petsc_set_threads(int n)
 {
@@ -642,13 +642,7 @@ static silc_plugin petsc_plugin = {
 
 static void find_openblas(void)
 {
-    Dl_info info;
-    void *self;
-    if (!dladdr(&petsc_plugin, &info) || !info.dli_fname) return;
-    self = dlopen(info.dli_fname, RTLD_NOW | RTLD_LOCAL | RTLD_NOLOAD);
-    if (!self) return;
-    *(void **)&openblas_threads = dlsym(self, "openblas_set_num_threads");
-    dlclose(self);
+    openblas_threads = blas_threads_find(&petsc_plugin);
     if (openblas_threads) petsc_plugin.set_threads = petsc_set_threads;
 }
 

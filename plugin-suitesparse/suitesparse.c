@@ -16,10 +16,10 @@
  * openblas_set_num_threads in the BLAS our libraries already loaded and calls
  * it; with another BLAS the call is a no-op.  KLU is sequential.
  */
-#define _GNU_SOURCE /* RTLD_DEFAULT, RTLD_NOLOAD */
 #include "ss.h"
 
-#include <dlfcn.h>
+#include "common/blas_threads.h"
+
 #include <pthread.h>
 #include <string.h>
 
@@ -65,25 +65,14 @@ static const silc_option_spec ss_options[] = {
      "20*(m+n)*eps*max column norm, -1 = none"},
 };
 
-/* openblas_set_num_threads of the BLAS our libraries loaded, or NULL.  The
- * module is loaded RTLD_LOCAL, so its BLAS is not in the global scope: look
- * it up by its SONAME with RTLD_NOLOAD (which never loads anything new). */
-static void (*blas_set_threads)(int);
+static blas_threads_fn blas_set_threads;
 
 static void find_blas_threads(void)
 {
-    static const char *const sonames[] = {"libblas.so.3", "libopenblas.so.0", NULL};
-    void *sym = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
-    int i;
-    for (i = 0; !sym && sonames[i]; i++) {
-        void *h = dlopen(sonames[i], RTLD_LAZY | RTLD_LOCAL | RTLD_NOLOAD);
-        if (!h) continue;
-        sym = dlsym(h, "openblas_set_num_threads");
-        dlclose(h); /* drops only the reference RTLD_NOLOAD added */
-    }
-    if (sym) memcpy(&blas_set_threads, &sym, sizeof blas_set_threads);
-    ss_host->log(3, "suitesparse: openblas_set_num_threads %s", sym ? "found: set_threads controls BLAS"
-                                                               : "not found: set_threads does nothing");
+    blas_set_threads = blas_threads_find((const void *)&ss_host);
+    ss_host->log(3, "suitesparse: openblas_set_num_threads %s",
+                 blas_set_threads ? "found: set_threads controls BLAS"
+                                  : "not found: set_threads does nothing");
 }
 
 static void ss_set_threads(int nthreads)

@@ -26,24 +26,12 @@
 
 #include "check.h"
 #include "silc.h"
-
-#ifndef SILC_SHARED_MATRICES
-#define SILC_SHARED_MATRICES "../shared/matrices"
-#endif
+#include "testlib.h"
 
 static const char *const classes[] = {"solve.dense", "solve.dense.spd", "solve.triangular",
                                       "solve.band", "solve.rect", "matmul.dense"};
 
 /* ---- output capture and helpers ------------------------------------------------ */
-
-static char out_buf[16384];
-
-static void capture(void *user, const char *text)
-{
-    size_t have = strlen(out_buf);
-    (void)user;
-    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
-}
 
 static silc_context *open_ctx(const char *backend)
 {
@@ -53,38 +41,12 @@ static silc_context *open_ctx(const char *backend)
         fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
         return NULL;
     }
-    silc_set_output(c, capture, NULL);
+    silc_set_output(c, tl_out_fn, NULL);
     for (size_t i = 0; i < sizeof classes / sizeof classes[0]; i++) {
         snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", classes[i], backend);
         CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
     }
     return c;
-}
-
-static int contains(const char *hay, const char *needle)
-{
-    size_t n = strlen(needle);
-    for (; hay && *hay; hay++) {
-        size_t i = 0;
-        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i])) i++;
-        if (i == n) return 1;
-    }
-    return 0;
-}
-
-/* Runs `info name` (or any statement) and returns its output. */
-static const char *run_out(silc_context *c, const char *stmt)
-{
-    out_buf[0] = '\0';
-    if (silc_exec(c, stmt)) snprintf(out_buf, sizeof out_buf, "error: %s", silc_context_errmsg(c));
-    return out_buf;
-}
-
-static const char *info(silc_context *c, const char *name)
-{
-    char cmd[64];
-    snprintf(cmd, sizeof cmd, "info %s", name);
-    return run_out(c, cmd);
 }
 
 /* The "condition estimate: X" of an info text, -1 if absent. */
@@ -93,46 +55,6 @@ static double info_cond(const char *text)
     const char *p = strstr(text, "condition estimate: ");
     if (!p || strncmp(p + 20, "not", 3) == 0) return -1;
     return strtod(p + 20, NULL);
-}
-
-static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *a)
-{
-    silc_envelope_t e;
-    CHECK(silc_envelope_dense(&e, m, n, a) == 0, "envelope %s", name);
-    CHECK(silc_put(c, name, &e) == 0, "put %s: %s", name, silc_context_errmsg(c));
-    silc_envelope_free(&e);
-}
-
-/* Fetches an m x n value into a new array (NULL on failure). */
-static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
-{
-    silc_envelope_t e;
-    double *x;
-    memset(&e, 0, sizeof e);
-    if (silc_get(c, &e, name)) {
-        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
-        return NULL;
-    }
-    if (e.m != m || e.n != n) {
-        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
-              (long long)m, (long long)n);
-        silc_envelope_free(&e);
-        return NULL;
-    }
-    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof(double));
-    if (x) silc_envelope_to_dense(&e, x);
-    silc_envelope_free(&e);
-    return x;
-}
-
-static double rel_err(const double *x, const double *y, int64_t n)
-{
-    double d = 0, s = 0;
-    for (int64_t i = 0; i < n; i++) {
-        if (fabs(x[i] - y[i]) > d) d = fabs(x[i] - y[i]);
-        if (fabs(y[i]) > s) s = fabs(y[i]);
-    }
-    return s > 0 ? d / s : d;
 }
 
 /* Forward-error bound: 10 n eps cond (cond >= 1). */
@@ -201,31 +123,31 @@ static void check_square(silc_context *L, silc_context *R, const char *label, in
     }
     for (int64_t i = 0; i < n; i++) xt[i] = (double)(i + 1);
     matvec(n, n, A, xt, b);
-    put_dense(L, "A", n, n, A);
-    put_dense(L, "b", n, 1, b);
-    put_dense(R, "A", n, n, A);
-    put_dense(R, "b", n, 1, b);
+    tl_put_dense_checked(L, "A", n, n, A);
+    tl_put_dense_checked(L, "b", n, 1, b);
+    tl_put_dense_checked(R, "A", n, n, A);
+    tl_put_dense_checked(R, "b", n, 1, b);
     CHECK(silc_exec(L, "x = A \\ b") == 0, "%s: lapack solve: %s", label, silc_context_errmsg(L));
     CHECK(silc_exec(R, "x = A \\ b") == 0, "%s: reference solve: %s", label, silc_context_errmsg(R));
-    text = info(L, "x");
-    CHECK(contains(text, "backend: lapack"), "%s: info does not name lapack:\n%s", label, text);
-    CHECK(contains(text, routine), "%s: info does not name %s:\n%s", label, routine, text);
+    text = tl_out_info(L, "x");
+    CHECK(tl_contains(text, "backend: lapack"), "%s: info does not name lapack:\n%s", label, text);
+    CHECK(tl_contains(text, routine), "%s: info does not name %s:\n%s", label, routine, text);
     cond = info_cond(text);
     CHECK(cond >= 1, "%s: no condition estimate (%g)", label, cond);
-    xl = get_dense(L, "x", n, 1);
-    xr = get_dense(R, "x", n, 1);
+    xl = tl_get_dense_checked(L, "x", n, 1);
+    xr = tl_get_dense_checked(R, "x", n, 1);
     if (xl && xr) {
-        CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g (cond %.3g)", label,
-              rel_err(xl, xt, n), bound(n, cond), cond);
-        CHECK(rel_err(xl, xr, n) <= bound(n, cond), "%s: lapack and reference differ by %.3g > %.3g",
-              label, rel_err(xl, xr, n), bound(n, cond));
+        CHECK(tl_rel_diff(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g (cond %.3g)", label,
+              tl_rel_diff(xl, xt, n), bound(n, cond), cond);
+        CHECK(tl_rel_diff(xl, xr, n) <= bound(n, cond), "%s: lapack and reference differ by %.3g > %.3g",
+              label, tl_rel_diff(xl, xr, n), bound(n, cond));
     }
     free(xl);
     free(xr);
     /* The same A again: the attached factorization is reused. */
     CHECK(silc_exec(L, "y = A \\ (2 * b)") == 0, "%s: second solve: %s", label, silc_context_errmsg(L));
-    text = info(L, "y");
-    CHECK(contains(text, "reused factorization: yes") || contains(routine, "dtrtrs"),
+    text = tl_out_info(L, "y");
+    CHECK(tl_contains(text, "reused factorization: yes") || tl_contains(routine, "dtrtrs"),
           "%s: second solve did not reuse the factorization:\n%s", label, text);
     free(xt);
     free(b);
@@ -287,9 +209,9 @@ static void test_dense(silc_context *L, silc_context *R)
     {
         double B[120 * 3], *X;
         for (int64_t k = 0; k < n * 3; k++) B[k] = urand();
-        put_dense(L, "B", n, 3, B);
+        tl_put_dense_checked(L, "B", n, 3, B);
         CHECK(silc_exec(L, "X = A \\ B; R = A * X - B") == 0, "multiple rhs: %s", silc_context_errmsg(L));
-        X = get_dense(L, "R", n, 3);
+        X = tl_get_dense_checked(L, "R", n, 3);
         if (X) {
             double r = 0;
             for (int64_t k = 0; k < n * 3; k++) r = fmax(r, fabs(X[k]));
@@ -301,9 +223,9 @@ static void test_dense(silc_context *L, silc_context *R)
     /* Exactly singular: a zero column gives an exactly zero pivot. */
     for (int64_t k = 0; k < n * n; k++) A[k] = urand();
     for (int64_t i = 0; i < n; i++) A[i + 7 * n] = 0.0;
-    put_dense(L, "Z", n, n, A);
+    tl_put_dense_checked(L, "Z", n, n, A);
     CHECK(silc_exec(L, "z = Z \\ b") != 0, "singular matrix solved");
-    CHECK(contains(silc_context_errmsg(L), "dgetrf") && contains(silc_context_errmsg(L), "singular"),
+    CHECK(tl_contains(silc_context_errmsg(L), "dgetrf") && tl_contains(silc_context_errmsg(L), "singular"),
           "singular message does not name dgetrf: %s", silc_context_errmsg(L));
     free(A);
     free(M);
@@ -336,24 +258,24 @@ static void test_rect(silc_context *L, silc_context *R)
         }
     }
     gauss(n, G, r);
-    put_dense(L, "T", m, n, A);
-    put_dense(L, "c", m, 1, b);
-    put_dense(R, "T", m, n, A);
-    put_dense(R, "c", m, 1, b);
+    tl_put_dense_checked(L, "T", m, n, A);
+    tl_put_dense_checked(L, "c", m, 1, b);
+    tl_put_dense_checked(R, "T", m, n, A);
+    tl_put_dense_checked(R, "c", m, 1, b);
     CHECK(silc_exec(L, "x = T \\ c") == 0, "tall: %s", silc_context_errmsg(L));
     CHECK(silc_exec(R, "x = T \\ c") == 0, "tall reference: %s", silc_context_errmsg(R));
-    text = info(L, "x");
-    CHECK(contains(text, "backend: lapack") && contains(text, "dgeqrf"), "tall info:\n%s", text);
-    xl = get_dense(L, "x", n, 1);
-    xr = get_dense(R, "x", n, 1);
+    text = tl_out_info(L, "x");
+    CHECK(tl_contains(text, "backend: lapack") && tl_contains(text, "dgeqrf"), "tall info:\n%s", text);
+    xl = tl_get_dense_checked(L, "x", n, 1);
+    xr = tl_get_dense_checked(R, "x", n, 1);
     if (xl && xr) {
-        CHECK(rel_err(xl, r, n) < 1e-11, "tall vs normal equations: %.3g", rel_err(xl, r, n));
-        CHECK(rel_err(xl, xr, n) < 1e-11, "tall vs reference: %.3g", rel_err(xl, xr, n));
+        CHECK(tl_rel_diff(xl, r, n) < 1e-11, "tall vs normal equations: %.3g", tl_rel_diff(xl, r, n));
+        CHECK(tl_rel_diff(xl, xr, n) < 1e-11, "tall vs reference: %.3g", tl_rel_diff(xl, xr, n));
     }
     free(xl);
     free(xr);
-    CHECK(silc_exec(L, "y = T \\ c") == 0 && contains(info(L, "y"), "reused factorization: yes"),
-          "tall: factor not reused:\n%s", out_buf);
+    CHECK(silc_exec(L, "y = T \\ c") == 0 && tl_contains(tl_out_info(L, "y"), "reused factorization: yes"),
+          "tall: factor not reused:\n%s", tl_out());
 
     /* Wide: the minimum-norm solution x = W' (W W') \ c, W = T' (n x m). */
     for (int64_t i = 0; i < n; i++) {
@@ -371,24 +293,24 @@ static void test_rect(silc_context *L, silc_context *R)
             xw[k] = 0;
             for (int64_t i = 0; i < n; i++) xw[k] += A[k + i * m] * r[i];
         }
-        put_dense(L, "d", n, 1, b);
+        tl_put_dense_checked(L, "d", n, 1, b);
         CHECK(silc_exec(L, "W = T'; w = W \\ d") == 0, "wide: %s", silc_context_errmsg(L));
-        text = info(L, "w");
-        CHECK(contains(text, "backend: lapack") && contains(text, "dgelqf"), "wide info:\n%s", text);
-        xl = get_dense(L, "w", m, 1);
-        if (xl) CHECK(rel_err(xl, xw, m) < 1e-11, "wide vs minimum norm: %.3g", rel_err(xl, xw, m));
+        text = tl_out_info(L, "w");
+        CHECK(tl_contains(text, "backend: lapack") && tl_contains(text, "dgelqf"), "wide info:\n%s", text);
+        xl = tl_get_dense_checked(L, "w", m, 1);
+        if (xl) CHECK(tl_rel_diff(xl, xw, m) < 1e-11, "wide vs minimum norm: %.3g", tl_rel_diff(xl, xw, m));
         free(xl);
     }
 
     /* Rank deficient: column 5 repeated as column 6.  The answer must still
      * satisfy the normal equations A'(c - A x) = 0. */
     for (int64_t k = 0; k < m; k++) A[k + 6 * m] = A[k + 5 * m];
-    put_dense(L, "D", m, n, A);
+    tl_put_dense_checked(L, "D", m, n, A);
     CHECK(silc_exec(L, "x = D \\ c; g = D' * (c - D * x)") == 0, "rank deficient: %s",
           silc_context_errmsg(L));
-    text = info(L, "x");
-    CHECK(contains(text, "dgelsy") && contains(text, "rank 24 of 25"), "rank-deficient info:\n%s", text);
-    xl = get_dense(L, "g", n, 1);
+    text = tl_out_info(L, "x");
+    CHECK(tl_contains(text, "dgelsy") && tl_contains(text, "rank 24 of 25"), "rank-deficient info:\n%s", text);
+    xl = tl_get_dense_checked(L, "g", n, 1);
     if (xl) {
         double g = 0;
         for (int64_t i = 0; i < n; i++) g = fmax(g, fabs(xl[i]));
@@ -428,32 +350,32 @@ static void check_band(silc_context *L, silc_context *R, const char *label, int6
     CHECK(silc_envelope_band(&e, n, n, kl, ku, band) == 0, "%s: band envelope", label);
     CHECK(silc_put(L, "A", &e) == 0 && silc_put(R, "A", &e) == 0, "%s: put", label);
     silc_envelope_free(&e);
-    put_dense(L, "b", n, 1, b);
-    put_dense(R, "b", n, 1, b);
+    tl_put_dense_checked(L, "b", n, 1, b);
+    tl_put_dense_checked(R, "b", n, 1, b);
     CHECK(silc_exec(L, "x = A \\ b") == 0, "%s: %s", label, silc_context_errmsg(L));
     CHECK(silc_exec(R, "x = A \\ b") == 0, "%s reference: %s", label, silc_context_errmsg(R));
-    text = info(L, "x");
-    CHECK(contains(text, "backend: lapack") && contains(text, routine), "%s: info does not name %s:\n%s",
+    text = tl_out_info(L, "x");
+    CHECK(tl_contains(text, "backend: lapack") && tl_contains(text, routine), "%s: info does not name %s:\n%s",
           label, routine, text);
     cond = info_cond(text);
     CHECK(cond >= 1, "%s: no condition estimate", label);
-    xl = get_dense(L, "x", n, 1);
-    xr = get_dense(R, "x", n, 1);
+    xl = tl_get_dense_checked(L, "x", n, 1);
+    xr = tl_get_dense_checked(R, "x", n, 1);
     if (xl && xr) {
-        CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: error %.3g (cond %.3g)", label,
-              rel_err(xl, xt, n), cond);
-        CHECK(rel_err(xl, xr, n) <= bound(n, cond), "%s: vs reference %.3g", label, rel_err(xl, xr, n));
+        CHECK(tl_rel_diff(xl, xt, n) <= bound(n, cond), "%s: error %.3g (cond %.3g)", label,
+              tl_rel_diff(xl, xt, n), cond);
+        CHECK(tl_rel_diff(xl, xr, n) <= bound(n, cond), "%s: vs reference %.3g", label, tl_rel_diff(xl, xr, n));
     }
     free(xl);
     free(xr);
-    CHECK(silc_exec(L, "y = A \\ b") == 0 && contains(info(L, "y"), "reused factorization: yes"),
-          "%s: factor not reused:\n%s", label, out_buf);
+    CHECK(silc_exec(L, "y = A \\ b") == 0 && tl_contains(tl_out_info(L, "y"), "reused factorization: yes"),
+          "%s: factor not reused:\n%s", label, tl_out());
     /* The same matrix stored dense is still banded: the dispatcher sends it to
      * solve.band and lapack copies the band out of it. */
     CHECK(silc_exec(L, "F = dense(A); z = F \\ b") == 0, "%s dense-stored: %s", label,
           silc_context_errmsg(L));
-    text = info(L, "z");
-    CHECK(contains(text, "backend: lapack") && contains(text, routine), "%s dense-stored: info:\n%s", label,
+    text = tl_out_info(L, "z");
+    CHECK(tl_contains(text, "backend: lapack") && tl_contains(text, routine), "%s dense-stored: info:\n%s", label,
           text);
     free(band);
     free(xt);
@@ -486,7 +408,7 @@ static void test_band(silc_context *L, silc_context *R)
     check_band(L, R, "band", 300, 3, 2, gen_band, "dgbtrf");
     check_band(L, R, "SPD band", 300, 2, 2, spd_band, "dpbtrf");
     check_band(L, R, "indefinite symmetric band", 60, 2, 2, indef_band, "dgbtrf");
-    CHECK(contains(info(L, "x"), "dpbtrf: not positive definite"), "no fallback note:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(L, "x"), "dpbtrf: not positive definite"), "no fallback note:\n%s", tl_out());
     check_band(L, R, "1-D Laplacian", 200, 1, 1, lap1d, "dpttrf");
     check_band(L, R, "tridiagonal", 200, 1, 1, gen_tri, "dgttrf");
 }
@@ -505,31 +427,31 @@ static void test_matmul_and_declines(silc_context *L)
         return;
     }
     for (int64_t j = 0; j < n; j++) matvec(m, k, A, B + j * k, C + j * m);
-    put_dense(L, "P", m, k, A);
-    put_dense(L, "Q", k, n, B);
-    text = run_out(L, "explain C = P * Q");
-    CHECK(contains(text, "lapack -> would run"), "matmul not sent to lapack:\n%s", text);
+    tl_put_dense_checked(L, "P", m, k, A);
+    tl_put_dense_checked(L, "Q", k, n, B);
+    text = tl_out_exec(L, "explain C = P * Q");
+    CHECK(tl_contains(text, "lapack -> would run"), "matmul not sent to lapack:\n%s", text);
     CHECK(silc_exec(L, "C = P * Q; v = P * Q[:, 1]; u = P[1, :] * Q") == 0, "matmul: %s",
           silc_context_errmsg(L));
-    got = get_dense(L, "C", m, n);
-    if (got) CHECK(rel_err(got, C, m * n) < 1e-14, "dgemm: %.3g", rel_err(got, C, m * n));
+    got = tl_get_dense_checked(L, "C", m, n);
+    if (got) CHECK(tl_rel_diff(got, C, m * n) < 1e-14, "dgemm: %.3g", tl_rel_diff(got, C, m * n));
     free(got);
-    got = get_dense(L, "v", m, 1);
-    if (got) CHECK(rel_err(got, C, m) < 1e-14, "dgemv: %.3g", rel_err(got, C, m));
+    got = tl_get_dense_checked(L, "v", m, 1);
+    if (got) CHECK(tl_rel_diff(got, C, m) < 1e-14, "dgemv: %.3g", tl_rel_diff(got, C, m));
     free(got);
-    got = get_dense(L, "u", 1, n);
+    got = tl_get_dense_checked(L, "u", 1, n);
     if (got) {
         double row[15];
         for (int64_t j = 0; j < n; j++) row[j] = C[j * m];
-        CHECK(rel_err(got, row, n) < 1e-14, "dgemv (transposed): %.3g", rel_err(got, row, n));
+        CHECK(tl_rel_diff(got, row, n) < 1e-14, "dgemv (transposed): %.3g", tl_rel_diff(got, row, n));
     }
     free(got);
 
     /* CSR is declined with the reason. */
     CHECK(silc_exec(L, "set dispatch.solve.sparse = lapack; S = sparse(P[1:20, 1:20] + 10 * eye(20))") == 0,
           "sparse setup: %s", silc_context_errmsg(L));
-    text = run_out(L, "explain s = S \\ Q[:, 1]");
-    CHECK(contains(text, "needs dense or band storage"), "CSR not declined:\n%s", text);
+    text = tl_out_exec(L, "explain s = S \\ Q[:, 1]");
+    CHECK(tl_contains(text, "needs dense or band storage"), "CSR not declined:\n%s", text);
     free(A);
     free(B);
 }
@@ -546,26 +468,8 @@ static double timed(silc_context *c, const char *stmt, int *rc)
     *rc = silc_exec(c, stmt);
     if (*rc) return -1;
     snprintf(warn_buf, sizeof warn_buf, "%s", silc_context_warnings(c));
-    p = strstr(info(c, "x"), "wall time: ");
+    p = strstr(tl_out_info(c, "x"), "wall time: ");
     return p ? strtod(p + 11, NULL) : -1;
-}
-
-/* Normwise backward error ||b - A x||_inf / (||A||_inf ||x||_inf + ||b||_inf), A in CSR. */
-static double backward_error(const silc_envelope_t *A, const double *x, const double *b)
-{
-    double r = 0, an = 0, xn = 0, bn = 0;
-    for (int64_t i = 0; i < A->m; i++) {
-        double s = b[i], rs = 0;
-        for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
-            s -= A->values[p] * x[A->colind[p]];
-            rs += fabs(A->values[p]);
-        }
-        r = fmax(r, fabs(s));
-        an = fmax(an, rs);
-        bn = fmax(bn, fabs(b[i]));
-    }
-    for (int64_t j = 0; j < A->n; j++) xn = fmax(xn, fabs(x[j]));
-    return r / (an * xn + bn);
 }
 
 static void test_shared(silc_context *L, silc_context *R)
@@ -602,26 +506,26 @@ static void test_shared(silc_context *L, silc_context *R)
         for (int64_t i = 0; i < m; i++)
             for (int64_t p = e.rowptr[i]; p < e.rowptr[i + 1]; p++) b[i] += e.values[p] * xt[e.colind[p]];
         CHECK(silc_put(L, "A", &e) == 0 && silc_put(R, "A", &e) == 0, "%s: put", file);
-        put_dense(L, "b", m, 1, b);
-        put_dense(R, "b", m, 1, b);
+        tl_put_dense_checked(L, "b", m, 1, b);
+        tl_put_dense_checked(R, "b", m, 1, b);
         CHECK(silc_exec(L, "A = dense(A)") == 0 && silc_exec(R, "A = dense(A)") == 0, "%s: dense()", file);
         tl = timed(L, "x = A \\ b", &rcl);
         if (rcl) {
             /* Only singular matrices may be refused, and the message must say so. */
-            CHECK(strstr(cls, "singular") && contains(silc_context_errmsg(L), "singular"),
+            CHECK(strstr(cls, "singular") && tl_contains(silc_context_errmsg(L), "singular"),
                   "%s (%s): lapack failed: %s", file, cls, silc_context_errmsg(L));
             printf("%-18s %6lld %6lld  %-13s refused: %s\n", file, m, n, cls, silc_context_errmsg(L));
             goto next;
         }
-        cond = info_cond(info(L, "x"));
-        CHECK(contains(out_buf, "backend: lapack"), "%s: not solved by lapack:\n%s", file, out_buf);
-        CHECK(cond * DBL_EPSILON <= 1e-4 || contains(warn_buf, "singular") || contains(warn_buf, "digits"),
+        cond = info_cond(tl_out_info(L, "x"));
+        CHECK(tl_contains(tl_out(), "backend: lapack"), "%s: not solved by lapack:\n%s", file, tl_out());
+        CHECK(cond * DBL_EPSILON <= 1e-4 || tl_contains(warn_buf, "singular") || tl_contains(warn_buf, "digits"),
               "%s: cond %.3g and no warning", file, cond);
         tr = timed(R, "x = A \\ b", &rcr);
-        xl = get_dense(L, "x", n, 1);
-        xr = rcr ? NULL : get_dense(R, "x", n, 1);
-        if (xl) berr = backward_error(&e, xl, b);
-        if (xl && xr) diff = rel_err(xl, xr, n);
+        xl = tl_get_dense_checked(L, "x", n, 1);
+        xr = rcr ? NULL : tl_get_dense_checked(R, "x", n, 1);
+        if (xl) berr = tl_backward_error(&e, xl, b);
+        if (xl && xr) diff = tl_rel_diff(xl, xr, n);
         printf("%-18s %6lld %6lld  %-13s %9.4f %9.4f %9.3g %9.3g %9.3g\n", file, m, n, cls, tl, tr, cond,
                berr, diff);
         /* Backward stable whatever the conditioning (LU growth is mild in practice). */
@@ -629,8 +533,8 @@ static void test_shared(silc_context *L, silc_context *R)
         if (cond < 0) {
             CHECK(strcmp(cls, "rect") == 0, "%s: no condition estimate", file);
         } else if (bound(n, cond) < 1e-2 && xl && xr) {
-            CHECK(rel_err(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g", file,
-                  rel_err(xl, xt, n), bound(n, cond));
+            CHECK(tl_rel_diff(xl, xt, n) <= bound(n, cond), "%s: lapack error %.3g > %.3g", file,
+                  tl_rel_diff(xl, xt, n), bound(n, cond));
             CHECK(diff <= bound(n, cond), "%s: lapack vs reference %.3g > %.3g", file, diff, bound(n, cond));
         }
     next:

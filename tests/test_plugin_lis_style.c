@@ -37,33 +37,9 @@
 
 #include "check.h"
 #include "silc.h"
-
-#ifndef SILC_SHARED_MATRICES
-#define SILC_SHARED_MATRICES "../shared/matrices"
-#endif
+#include "testlib.h"
 
 /* ---- helpers -------------------------------------------------------------------- */
-
-static char out_buf[32768];
-
-static void capture(void *user, const char *text)
-{
-    size_t have = strlen(out_buf);
-    (void)user;
-    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
-}
-
-static int contains(const char *hay, const char *needle)
-{
-    size_t n = strlen(needle);
-    for (; hay && *hay; hay++) {
-        size_t i = 0;
-        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
-            i++;
-        if (i == n) return 1;
-    }
-    return 0;
-}
 
 static double now(void)
 {
@@ -82,60 +58,12 @@ static silc_context *open_ctx(const char *backend, const char *config)
         fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
         return NULL;
     }
-    silc_set_output(c, capture, NULL);
+    silc_set_output(c, tl_out_fn, NULL);
     for (int i = 0; classes[i]; i++) {
         snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", classes[i], backend);
         CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
     }
     return c;
-}
-
-static const char *info(silc_context *c, const char *name)
-{
-    char cmd[64];
-    out_buf[0] = '\0';
-    snprintf(cmd, sizeof cmd, "info %s", name);
-    if (silc_exec(c, cmd)) snprintf(out_buf, sizeof out_buf, "(info failed: %s)", silc_context_errmsg(c));
-    return out_buf;
-}
-
-static double info_number(const char *text, const char *label)
-{
-    const char *p = strstr(text, label);
-    return p ? atof(p + strlen(label)) : -1;
-}
-
-static void put(silc_context *c, const char *name, const silc_envelope_t *e)
-{
-    CHECK(silc_put(c, name, e) == 0, "put %s: %s", name, silc_context_errmsg(c));
-}
-
-static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
-{
-    silc_envelope_t e;
-    CHECK(silc_envelope_dense(&e, m, n, x) == 0, "envelope %s", name);
-    put(c, name, &e);
-    silc_envelope_free(&e);
-}
-
-static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
-{
-    silc_envelope_t e;
-    double *x;
-    if (silc_get(c, &e, name)) {
-        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
-        return NULL;
-    }
-    if (e.m != m || e.n != n) {
-        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
-              (long long)m, (long long)n);
-        silc_envelope_free(&e);
-        return NULL;
-    }
-    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *x);
-    if (x) silc_envelope_to_dense(&e, x);
-    silc_envelope_free(&e);
-    return x;
 }
 
 /* ||x - y||_2 / ||y||_2 */
@@ -157,15 +85,6 @@ static double max_dev(const double *x, double v, int64_t n)
     return d;
 }
 
-static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
-{
-    for (int64_t i = 0; i < A->m; i++) {
-        double s = 0;
-        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
-        y[i] = s;
-    }
-}
-
 /* ---- generated matrices -------------------------------------------------------- */
 
 /* 5-point operator on a k x k grid: 4 on the diagonal, -1 -/+ beta west/east
@@ -173,23 +92,7 @@ static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
  * M-matrix, so Jacobi and Gauss-Seidel converge on it). */
 static void grid(silc_envelope_t *e, int64_t k, double beta)
 {
-    int64_t n = k * k, nz = 0;
-    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
-    double *v = malloc((size_t)(5 * n) * sizeof *v);
-    for (int64_t r = 0; r < n; r++) {
-        int64_t i = r / k, j = r % k;
-        rp[r] = nz;
-        if (i > 0) ci[nz] = r - k, v[nz++] = -1;
-        if (j > 0) ci[nz] = r - 1, v[nz++] = -1 - beta;
-        ci[nz] = r, v[nz++] = 4 + 2 * beta;
-        if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1 + beta;
-        if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
-    }
-    rp[n] = nz;
-    CHECK(silc_envelope_csr(e, n, n, rp, ci, v) == 0, "grid envelope");
-    free(rp);
-    free(ci);
-    free(v);
+    CHECK(tl_grid2d(e, k, beta, 4 + 2 * beta) == 0, "grid envelope");
 }
 
 /* Toeplitz: 2 on the diagonal, 1 on the superdiagonal, gamma two below. */
@@ -215,9 +118,9 @@ static void toeplitz(silc_envelope_t *e, int64_t n, double gamma)
 static void put_system(silc_context *c, const silc_envelope_t *A, const double *xt)
 {
     double *b = malloc((size_t)A->m * sizeof *b);
-    csr_matvec(A, xt, b);
-    put(c, "A", A);
-    put_dense(c, "b", A->m, 1, b);
+    tl_csr_matvec(A, xt, b);
+    tl_put_checked(c, "A", A);
+    tl_put_dense_checked(c, "b", A->m, 1, b);
     free(b);
 }
 
@@ -235,13 +138,13 @@ static void test_laplacian_bicg(silc_context *c)
     put_system(c, &A, ones);
     CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -p none -tol 1e-12\")") == 0,
           "laplacian bicg: %s", silc_context_errmsg(c));
-    in = info(c, "x");
-    it = info_number(in, "iterations: ");
-    CHECK(contains(in, "backend: lis-style"), "info does not name lis-style:\n%s", in);
-    CHECK(contains(in, "BiCG, no preconditioner"), "method not reported:\n%s", in);
+    in = tl_out_info(c, "x");
+    it = tl_out_number(in, "iterations: ");
+    CHECK(tl_contains(in, "backend: lis-style"), "info does not name lis-style:\n%s", in);
+    CHECK(tl_contains(in, "BiCG, no preconditioner"), "method not reported:\n%s", in);
     CHECK(it >= 10 && it <= 30, "BiCG on the 10x10 Laplacian took %g iterations (Lis: about 15)", it);
-    CHECK(info_number(in, "final relative residual: ") <= 1e-12, "residual above tol:\n%s", in);
-    x = get_dense(c, "x", 100, 1);
+    CHECK(tl_out_number(in, "final relative residual: ") <= 1e-12, "residual above tol:\n%s", in);
+    x = tl_get_dense_checked(c, "x", 100, 1);
     if (x) CHECK(max_dev(x, 1, 100) <= 1e-10, "laplacian bicg: |x - 1| = %g", max_dev(x, 1, 100));
     printf("  10x10 Laplacian, BiCG, no preconditioner: %g iterations\n", it);
     free(x);
@@ -261,21 +164,21 @@ static void test_toeplitz(silc_context *c)
     CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -maxiter 1000 -f double\")") != 0,
           "toeplitz: BiCG in double converged, Lis reports it does not");
     msg = silc_context_errmsg(c);
-    CHECK(contains(msg, "lis-style BiCG: not converged after 1000 iterations") &&
-              contains(msg, "relative residual"), "toeplitz double: message '%s'", msg);
+    CHECK(tl_contains(msg, "lis-style BiCG: not converged after 1000 iterations") &&
+              tl_contains(msg, "relative residual"), "toeplitz double: message '%s'", msg);
     printf("  Toeplitz n=200 gamma=2, BiCG double: %s\n", msg);
-    x = get_dense(c, "x", n, 1);
+    x = tl_get_dense_checked(c, "x", n, 1);
     if (x) CHECK(max_dev(x, 7, n) == 0, "a failed solve changed x");
     free(x);
     t = now();
     CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicg -maxiter 1000 -f quad\")") == 0,
           "toeplitz: BiCG in quad: %s", silc_context_errmsg(c));
     t = now() - t;
-    in = info(c, "x");
-    it = info_number(in, "iterations: ");
-    CHECK(contains(in, "double-double"), "quad not in the method:\n%s", in);
-    CHECK(info_number(in, "final relative residual: ") <= 1e-12, "quad residual above tol:\n%s", in);
-    x = get_dense(c, "x", n, 1);
+    in = tl_out_info(c, "x");
+    it = tl_out_number(in, "iterations: ");
+    CHECK(tl_contains(in, "double-double"), "quad not in the method:\n%s", in);
+    CHECK(tl_out_number(in, "final relative residual: ") <= 1e-12, "quad residual above tol:\n%s", in);
+    x = tl_get_dense_checked(c, "x", n, 1);
     /* The matrix is well conditioned (cond_1 ~ 10): 1e-12 residual, 1e-10 error. */
     if (x) CHECK(max_dev(x, 1, n) <= 1e-10, "toeplitz quad: |x - 1| = %g", max_dev(x, 1, n));
     printf("  Toeplitz n=200 gamma=2, BiCG quad: converged in %g iterations, %.3f s, |x-1| = %.2g\n",
@@ -305,12 +208,12 @@ static int run_one(silc_context *c, const char *opts, int64_t n, const double *x
         CHECK(0, "%s: %s: %s", label, opts, silc_context_errmsg(c));
         return 0;
     }
-    in = info(c, "x");
-    it = info_number(in, "iterations: ");
-    res = info_number(in, "final relative residual: ");
+    in = tl_out_info(c, "x");
+    it = tl_out_number(in, "iterations: ");
+    res = tl_out_number(in, "final relative residual: ");
     ok &= it > 0 && res >= 0 && res <= 1e-10;
     CHECK(it > 0 && res >= 0 && res <= 1e-10, "%s: %s: iterations %g, residual %g", label, opts, it, res);
-    x = get_dense(c, "x", n, 1);
+    x = tl_get_dense_checked(c, "x", n, 1);
     if (x) {
         double e = rel_err2(x, xt, n);
         ok &= e <= tol_err;
@@ -384,14 +287,14 @@ static void test_shared_spd(silc_context *c, silc_context *ref)
         ones = malloc((size_t)n * sizeof *ones);
         b = malloc((size_t)n * sizeof *b);
         for (int64_t i = 0; i < n; i++) ones[i] = 1;
-        csr_matvec(&A, ones, b);
-        put(c, "A", &A);
-        put_dense(c, "b", n, 1, b);
-        put(ref, "A", &A);
-        put_dense(ref, "b", n, 1, b);
+        tl_csr_matvec(&A, ones, b);
+        tl_put_checked(c, "A", &A);
+        tl_put_dense_checked(c, "b", n, 1, b);
+        tl_put_checked(ref, "A", &A);
+        tl_put_dense_checked(ref, "b", n, 1, b);
         CHECK(silc_exec(ref, "xr = A \\ b") == 0, "%s reference: %s", files[f], silc_context_errmsg(ref));
-        cond = info_number(info(ref, "xr"), "condition estimate: ");
-        xref = get_dense(ref, "xr", n, 1);
+        cond = tl_out_number(tl_out_info(ref, "xr"), "condition estimate: ");
+        xref = tl_get_dense_checked(ref, "xr", n, 1);
         for (int p = 0; pcs[p] && xref; p++) {
             double t = now(), *x, it, res, e;
             int rc;
@@ -402,9 +305,9 @@ static void test_shared_spd(silc_context *c, silc_context *ref)
             t = now() - t;
             if (rc) {
                 const char *msg = silc_context_errmsg(c);
-                CHECK(contains(msg, "not converged") || contains(msg, "breakdown"),
+                CHECK(tl_contains(msg, "not converged") || tl_contains(msg, "breakdown"),
                       "%s CG+%s failed without an honest message: %s", files[f], pcs[p], msg);
-                x = get_dense(c, "x", 1, 1);
+                x = tl_get_dense_checked(c, "x", 1, 1);
                 CHECK(x && x[0] == 7, "%s: a failed solve changed x", files[f]);
                 printf("  %-9s n=%-5lld CG+%-3s  %.3f s  not converged: %s\n", files[f], (long long)n,
                        pcs[p], t, msg);
@@ -412,12 +315,12 @@ static void test_shared_spd(silc_context *c, silc_context *ref)
                 continue;
             }
             {
-                const char *in = info(c, "x");
-                it = info_number(in, "iterations: ");
-                res = info_number(in, "final relative residual: ");
+                const char *in = tl_out_info(c, "x");
+                it = tl_out_number(in, "iterations: ");
+                res = tl_out_number(in, "final relative residual: ");
             }
             CHECK(res >= 0 && res <= 1e-10, "%s CG+%s: reported converged with residual %g", files[f], pcs[p], res);
-            x = get_dense(c, "x", n, 1);
+            x = tl_get_dense_checked(c, "x", n, 1);
             if (!x) continue;
             e = rel_err2(x, xref, n);
             CHECK(e <= 1e-10 * (cond > 1 ? cond : 1), "%s CG+%s: error %.3g vs reference > 1e-10 * cond %.3g",
@@ -442,7 +345,7 @@ static void expect_error(silc_context *c, const char *opts, const char *want1, c
     snprintf(cmd, sizeof cmd, "x = solve(A, b, \"lis-style.options = %s\")", opts);
     CHECK(silc_exec(c, cmd) != 0, "'%s' was accepted", opts);
     msg = silc_context_errmsg(c);
-    CHECK(contains(msg, want1) && contains(msg, want2), "'%s': message '%s' lacks '%s' / '%s'", opts,
+    CHECK(tl_contains(msg, want1) && tl_contains(msg, want2), "'%s': message '%s' lacks '%s' / '%s'", opts,
           msg, want1, want2);
 }
 
@@ -459,22 +362,22 @@ static void test_options(silc_context *c)
     put_system(c, &A, xt);
     /* Good: names, Lis numbers, every knob. */
     run_one(c, "-i 2 -p 0 -tol 1e-11", n, xt, 1e-8, "options");
-    in = info(c, "x");
-    CHECK(contains(in, "BiCG, no preconditioner"), "-i 2 -p 0 is not BiCG without preconditioner:\n%s", in);
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "BiCG, no preconditioner"), "-i 2 -p 0 is not BiCG without preconditioner:\n%s", in);
     run_one(c, "-i 4 -p 2 -ilu_fill 2 -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "BiCGSTAB + ILU(2)"), "-i 4 -p 2 -ilu_fill 2:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "BiCGSTAB + ILU(2)"), "-i 4 -p 2 -ilu_fill 2:\n%s", tl_out());
     run_one(c, "-i bicgstabl -ell 4 -p 9 -ilut_drop 0.01 -ilut_rate 3 -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "BiCGSTAB(4) + ILUT(0.01,3)"), "bicgstabl/ilut:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "BiCGSTAB(4) + ILUT(0.01,3)"), "bicgstabl/ilut:\n%s", tl_out());
     run_one(c, "-i 21 -idrs_s 4 -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "IDR(4)"), "-i 21 -idrs_s 4:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "IDR(4)"), "-i 21 -idrs_s 4:\n%s", tl_out());
     run_one(c, "-i 20 -restart 5 -p 3 -ssor_omega 1.2 -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "FGMRES(5) + SSOR(1.2)"), "-i 20 -restart 5:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "FGMRES(5) + SSOR(1.2)"), "-i 20 -restart 5:\n%s", tl_out());
     run_one(c, "-i 12 -omega 1.5 -tol 1e-11 -maxiter 5000", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "SOR(1.5)"), "-i 12 -omega 1.5:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "SOR(1.5)"), "-i 12 -omega 1.5:\n%s", tl_out());
     run_one(c, "-i gmres -conv_cond nrm2_b -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "||b||"), "-conv_cond nrm2_b not in the note:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "||b||"), "-conv_cond nrm2_b not in the note:\n%s", tl_out());
     run_one(c, "-i gmres -conv_cond 0 -initx_zeros false -print none -f 0 -tol 1e-11", n, xt, 1e-8, "options");
-    CHECK(contains(info(c, "x"), "started from 0"), "-initx_zeros false not noted:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "started from 0"), "-initx_zeros false not noted:\n%s", tl_out());
     /* Bad. */
     expect_error(c, "-i cgx", "unknown solver 'cgx'", "did you mean 'cg'");
     expect_error(c, "-tol abc", "-tol", "'abc'");
@@ -490,7 +393,7 @@ static void test_options(silc_context *c)
     CHECK(silc_exec(c, "set lis-style.options = -i tfqmr -p jacobi -tol 1e-11") == 0, "set: %s",
           silc_context_errmsg(c));
     CHECK(silc_exec(c, "x = A \\ b") == 0, "set options: %s", silc_context_errmsg(c));
-    CHECK(contains(info(c, "x"), "TFQMR + Jacobi"), "set lis-style.options not used:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "TFQMR + Jacobi"), "set lis-style.options not used:\n%s", tl_out());
     fd = mkstemp(conf);
     if (fd >= 0) {
         FILE *f = fdopen(fd, "w");
@@ -499,10 +402,10 @@ static void test_options(silc_context *c)
         fclose(f);
         cf = open_ctx("lis-style", conf);
         if (cf) {
-            silc_set_output(cf, capture, NULL);
+            silc_set_output(cf, tl_out_fn, NULL);
             put_system(cf, &A, xt);
             CHECK(silc_exec(cf, "x = A \\ b") == 0, "config options: %s", silc_context_errmsg(cf));
-            CHECK(contains(info(cf, "x"), "CGS + SSOR(1)"), "config file options not used:\n%s", out_buf);
+            CHECK(tl_contains(tl_out_info(cf, "x"), "CGS + SSOR(1)"), "config file options not used:\n%s", tl_out());
             silc_close(&cf);
         }
         remove(conf);
@@ -524,12 +427,12 @@ static void test_failures(silc_context *c)
     silc_envelope_t A;
     const char *msg;
     CHECK(silc_envelope_csr(&A, 4, 4, rp, ci, v) == 0, "swap envelope");
-    put(c, "A", &A);
-    put_dense(c, "b", 4, 1, b);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", 4, 1, b);
     CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i cg -p none\")") != 0,
           "CG on [0 1; 1 0] did not break down");
     msg = silc_context_errmsg(c);
-    CHECK(contains(msg, "lis-style CG: breakdown at iteration 1") && contains(msg, "relative residual"),
+    CHECK(tl_contains(msg, "lis-style CG: breakdown at iteration 1") && tl_contains(msg, "relative residual"),
           "breakdown message '%s'", msg);
     /* A finite right-hand side whose squares overflow: the inner products
      * become Inf, their ratios NaN inside the first iteration. */
@@ -537,12 +440,12 @@ static void test_failures(silc_context *c)
     static const double v2[] = {2, 1, 1, 2, 2, 1, 1, 2};
     silc_envelope_free(&A);
     CHECK(silc_envelope_csr(&A, 4, 4, rp2, ci2, v2) == 0, "blocks envelope");
-    put(c, "A", &A);
-    put_dense(c, "b", 4, 1, hugeb);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", 4, 1, hugeb);
     CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -i bicgstab -p none\")") != 0,
           "overflowing right-hand side accepted");
     msg = silc_context_errmsg(c);
-    CHECK(contains(msg, "lis-style BiCGSTAB: produced NaN at iteration 1"), "NaN message '%s'", msg);
+    CHECK(tl_contains(msg, "lis-style BiCGSTAB: produced NaN at iteration 1"), "NaN message '%s'", msg);
     silc_envelope_free(&A);
 }
 
@@ -560,15 +463,15 @@ static void test_reuse_and_formats(silc_context *c)
     put_system(c, &A, xt);
     snprintf(cmd, sizeof cmd, "x = solve(A, b, \"%s\")", opts);
     CHECK(silc_exec(c, cmd) == 0, "reuse 1: %s", silc_context_errmsg(c));
-    CHECK(contains(info(c, "x"), "reused factorization: no"), "first solve reused:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "reused factorization: no"), "first solve reused:\n%s", tl_out());
     CHECK(silc_exec(c, cmd) == 0, "reuse 2: %s", silc_context_errmsg(c));
-    CHECK(contains(info(c, "x"), "reused factorization: yes") && contains(out_buf, "preconditioner reused"),
-          "second solve with the same A did not reuse the preconditioner:\n%s", out_buf);
+    CHECK(tl_contains(tl_out_info(c, "x"), "reused factorization: yes") && tl_contains(tl_out(), "preconditioner reused"),
+          "second solve with the same A did not reuse the preconditioner:\n%s", tl_out());
     CHECK(silc_exec(c, "A = 2 * A; b = 2 * b") == 0, "A = 2A: %s", silc_context_errmsg(c));
     CHECK(silc_exec(c, cmd) == 0, "reuse 3: %s", silc_context_errmsg(c));
-    CHECK(contains(info(c, "x"), "reused factorization: no"), "a new A reused the old preconditioner:\n%s",
-          out_buf);
-    x = get_dense(c, "x", n, 1);
+    CHECK(tl_contains(tl_out_info(c, "x"), "reused factorization: no"), "a new A reused the old preconditioner:\n%s",
+          tl_out());
+    x = tl_get_dense_checked(c, "x", n, 1);
     if (x) CHECK(rel_err2(x, xt, n) <= 1e-9, "after A = 2A: error %g", rel_err2(x, xt, n));
     free(x);
     /* Dense A (converted once to CSR), two right-hand sides. */
@@ -582,11 +485,11 @@ static void test_reuse_and_formats(silc_context *c)
         for (int64_t i = 0; i < n; i++) B[i] = bb[i], B[n + i] = 3 * bb[i];
         free(bb);
     }
-    put_dense(c, "B", n, 2, B);
+    tl_put_dense_checked(c, "B", n, 2, B);
     snprintf(cmd, sizeof cmd, "X = solve(D, B, \"%s\")", opts);
     CHECK(silc_exec(c, cmd) == 0, "dense, 2 rhs: %s", silc_context_errmsg(c));
-    CHECK(contains(info(c, "X"), "backend: lis-style"), "dense solve not by lis-style:\n%s", out_buf);
-    x = get_dense(c, "X", n, 2);
+    CHECK(tl_contains(tl_out_info(c, "X"), "backend: lis-style"), "dense solve not by lis-style:\n%s", tl_out());
+    x = tl_get_dense_checked(c, "X", n, 2);
     if (x) {
         double e1 = rel_err2(x, xt, n), e2;
         for (int64_t i = 0; i < n; i++) x[n + i] /= 3;
@@ -613,12 +516,12 @@ static void test_threads(silc_context *c)
     t1 = now();
     CHECK(silc_exec(c, cmd) == 0, "1 thread: %s", silc_context_errmsg(c));
     t1 = now() - t1;
-    x1 = get_dense(c, "x", n, 1);
+    x1 = tl_get_dense_checked(c, "x", n, 1);
     CHECK(silc_exec(c, "set tune.threads = 2") == 0, "threads 2: %s", silc_context_errmsg(c));
     t2 = now();
     CHECK(silc_exec(c, cmd) == 0, "2 threads: %s", silc_context_errmsg(c));
     t2 = now() - t2;
-    x2 = get_dense(c, "x", n, 1);
+    x2 = tl_get_dense_checked(c, "x", n, 1);
     if (x1 && x2) {
         CHECK(rel_err2(x1, xt, n) <= 1e-7 && rel_err2(x2, xt, n) <= 1e-7, "threads: errors %g %g",
               rel_err2(x1, xt, n), rel_err2(x2, xt, n));
@@ -645,10 +548,10 @@ static void test_defaults(void)
         grid(&A, k, sym ? 0 : 0.4);
         put_system(c, &A, xt);
         CHECK(silc_exec(c, "x = A \\ b") == 0, "default: %s", silc_context_errmsg(c));
-        CHECK(contains(info(c, "x"), sym ? "CG + IC(0)" : "BiCGSTAB + ILU(0)"), "default method:\n%s", out_buf);
+        CHECK(tl_contains(tl_out_info(c, "x"), sym ? "CG + IC(0)" : "BiCGSTAB + ILU(0)"), "default method:\n%s", tl_out());
         CHECK(silc_exec(c, "x = solve(A, b, \"lis-style.options = -tol 1e-10\")") == 0, "lis defaults: %s",
               silc_context_errmsg(c));
-        CHECK(contains(info(c, "x"), "BiCG, no preconditioner"), "Lis defaults:\n%s", out_buf);
+        CHECK(tl_contains(tl_out_info(c, "x"), "BiCG, no preconditioner"), "Lis defaults:\n%s", tl_out());
         silc_envelope_free(&A);
     }
     free(xt);

@@ -35,10 +35,7 @@
 
 #include "check.h"
 #include "silc.h"
-
-#ifndef SILC_SHARED_MATRICES
-#define SILC_SHARED_MATRICES "../shared/matrices"
-#endif
+#include "testlib.h"
 
 /* Under AddressSanitizer: OpenMPI, hwloc and libevent keep start-up
  * allocations until exit by design, and PETSc 3.18 drops a 32-byte title when
@@ -57,122 +54,11 @@ const char *__asan_default_options(void)
     return "fast_unwind_on_malloc=0";
 }
 
-static char out_buf[16384];
-
-static void capture(void *user, const char *text)
-{
-    (void)user;
-    strncat(out_buf, text, sizeof out_buf - strlen(out_buf) - 1);
-}
-
-/* Runs `info name` and returns its text. */
-static const char *info(silc_context *c, const char *name)
-{
-    char stmt[64];
-    out_buf[0] = '\0';
-    snprintf(stmt, sizeof stmt, "info %s", name);
-    if (silc_exec(c, stmt)) snprintf(out_buf, sizeof out_buf, "info failed: %s", silc_context_errmsg(c));
-    return out_buf;
-}
-
-/* The number after label in text, -1 if absent. */
-static double info_num(const char *text, const char *label)
-{
-    const char *p = strstr(text, label);
-    return p ? strtod(p + strlen(label), NULL) : -1;
-}
-
-static silc_context *open_forced(const char *backend)
-{
-    silc_context *c = NULL;
-    char stmt[160];
-    if (silc_open(&c, NULL)) {
-        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        return NULL;
-    }
-    silc_set_output(c, capture, NULL);
-    snprintf(stmt, sizeof stmt, "set dispatch.solve.sparse = %s; set dispatch.solve.sparse.spd = %s",
-             backend, backend);
-    CHECK(silc_exec(c, stmt) == 0, "%s: %s", stmt, silc_context_errmsg(c));
-    return c;
-}
-
-/* k x k grid, 5-point stencil, diagonal 4 - shift, as CSR. */
-static int laplacian(silc_envelope_t *A, int k, double shift)
-{
-    int64_t n = (int64_t)k * k, nz = 0;
-    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
-    double *v = malloc((size_t)(5 * n) * sizeof *v);
-    int rc = -1;
-    if (rp && ci && v) {
-        for (int64_t r = 0; r < n; r++) {
-            int64_t i = r / k, j = r % k;
-            rp[r] = nz;
-            if (i > 0) ci[nz] = r - k, v[nz++] = -1;
-            if (j > 0) ci[nz] = r - 1, v[nz++] = -1;
-            ci[nz] = r, v[nz++] = 4 - shift;
-            if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1;
-            if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
-        }
-        rp[n] = nz;
-        rc = silc_envelope_csr(A, n, n, rp, ci, v);
-    }
-    free(rp);
-    free(ci);
-    free(v);
-    return rc;
-}
-
-static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
-{
-    for (int64_t i = 0; i < A->m; i++) {
-        double s = 0;
-        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
-        y[i] = s;
-    }
-}
-
-static double norminf(const double *x, int64_t n)
-{
-    double s = 0;
-    for (int64_t i = 0; i < n; i++)
-        if (fabs(x[i]) > s) s = fabs(x[i]);
-    return s;
-}
-
-/* ||x - y||_inf / ||y||_inf */
-static double reldiff(const double *x, const double *y, int64_t n)
-{
-    double d = 0;
-    for (int64_t i = 0; i < n; i++)
-        if (fabs(x[i] - y[i]) > d || isnan(x[i])) d = isnan(x[i]) ? INFINITY : fabs(x[i] - y[i]);
-    return d / norminf(y, n);
-}
-
 /* PUTs A and b = A * ones into c. */
 static int put_system(silc_context *c, const silc_envelope_t *A, double *ones, double *b)
 {
-    silc_envelope_t eb;
-    int64_t n = A->m;
-    int rc;
-    for (int64_t i = 0; i < n; i++) ones[i] = 1.0;
-    csr_matvec(A, ones, b);
-    if (silc_put(c, "A", A) || silc_envelope_vector(&eb, n, b)) return -1;
-    rc = silc_put(c, "b", &eb);
-    silc_envelope_free(&eb);
-    return rc;
-}
-
-/* Fetches the n-vector name into x. */
-static int get_vec(silc_context *c, const char *name, double *x, int64_t n)
-{
-    silc_envelope_t e;
-    int rc;
-    if (silc_get(c, &e, name)) return -1;
-    rc = (e.m == n && e.n == 1) ? silc_envelope_to_dense(&e, x) : -1;
-    silc_envelope_free(&e);
-    return rc;
+    for (int64_t i = 0; i < A->m; i++) ones[i] = 1.0;
+    return tl_put_system(c, A, ones, b);
 }
 
 /* x = solve(A, b, "petsc.options = <opts>"); returns silc_exec's status. */
@@ -190,7 +76,7 @@ static double reference_cond(silc_context *cr)
         CHECK(0, "reference solve: %s", silc_context_errmsg(cr));
         return -1;
     }
-    return info_num(info(cr, "xr"), "condition estimate: ");
+    return tl_out_number(tl_out_info(cr, "xr"), "condition estimate: ");
 }
 
 /* ---- iterative methods on the Laplacian ------------------------------------------ */
@@ -221,21 +107,21 @@ static void test_iterative(silc_context *cp, silc_context *cr, const double *one
             CHECK(0, "%s: %s", cases[i].opts, e);
             continue;
         }
-        t = info(cp, "x");
+        t = tl_out_info(cp, "x");
         CHECK(strstr(t, "  backend: petsc\n") != NULL, "%s backend:\n%s", cases[i].opts, t);
         CHECK(strstr(t, cases[i].method) != NULL, "%s method (want %s):\n%s", cases[i].opts,
               cases[i].method, t);
         CHECK(strstr(t, "note: KSP_CONVERGED_") != NULL, "%s converged reason:\n%s", cases[i].opts, t);
-        its = info_num(t, "iterations: ");
-        res = info_num(t, "final relative residual: ");
-        secs = info_num(t, "solve time: ");
+        its = tl_out_number(t, "iterations: ");
+        res = tl_out_number(t, "final relative residual: ");
+        secs = tl_out_number(t, "solve time: ");
         CHECK(its >= 1, "%s iterations %g", cases[i].opts, its);
         CHECK(res >= 0 && res <= 1e-8, "%s final relative residual %g", cases[i].opts, res);
-        CHECK(get_vec(cp, "x", x, n) == 0, "get x: %s", silc_context_errmsg(cp));
-        CHECK(reldiff(x, ones, n) <= bound, "%s forward error %g > %g", cases[i].opts,
-              reldiff(x, ones, n), bound);
+        CHECK(tl_get_vec(cp, "x", x, n) == 0, "get x: %s", silc_context_errmsg(cp));
+        CHECK(tl_rel_diff(x, ones, n) <= bound, "%s forward error %g > %g", cases[i].opts,
+              tl_rel_diff(x, ones, n), bound);
         printf("%-48s %5.0f iterations  residual %8.2g  error %8.2g  %.3g s\n", cases[i].opts, its, res,
-               reldiff(x, ones, n), secs);
+               tl_rel_diff(x, ones, n), secs);
     }
     free(x);
 }
@@ -267,16 +153,16 @@ static void test_direct(silc_context *cp, const double *ones, int64_t n, double 
             printf("skipped %s %s: not in this PETSc (%s)\n", cases[i].pc, cases[i].package, e);
             continue;
         }
-        t = info(cp, "x");
+        t = tl_out_info(cp, "x");
         CHECK(strstr(t, method) != NULL, "%s method (want %s):\n%s", opts, method, t);
-        c = info_num(t, "condition estimate: ");
-        secs = info_num(t, "solve time: ");
+        c = tl_out_number(t, "condition estimate: ");
+        secs = tl_out_number(t, "solve time: ");
         CHECK(c > cond / 10 && c < cond * 10, "%s condition estimate %g (reference %g)", opts, c, cond);
-        CHECK(get_vec(cp, "x", x, n) == 0, "get x");
-        CHECK(reldiff(x, ones, n) <= 100 * DBL_EPSILON * cond, "%s forward error %g", opts,
-              reldiff(x, ones, n));
+        CHECK(tl_get_vec(cp, "x", x, n) == 0, "get x");
+        CHECK(tl_rel_diff(x, ones, n) <= 100 * DBL_EPSILON * cond, "%s forward error %g", opts,
+              tl_rel_diff(x, ones, n));
         printf("%-8s %-8s error %8.2g  cond %8.2g  %.3g s\n", cases[i].pc, cases[i].package,
-               reldiff(x, ones, n), c, secs);
+               tl_rel_diff(x, ones, n), c, secs);
     }
     free(x);
 }
@@ -306,17 +192,17 @@ static void test_options(silc_context *cp)
     CHECK(silc_exec(cp, "set petsc.options = -ksp_type bcgs -pc_type jacobi -ksp_rtol 1e-10") == 0,
           "set petsc.options: %s", silc_context_errmsg(cp));
     CHECK(silc_exec(cp, "x = A \\ b") == 0, "session options: %s", silc_context_errmsg(cp));
-    CHECK(strstr(info(cp, "x"), "KSP bcgs + PC jacobi") != NULL, "session options used:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cp, "x"), "KSP bcgs + PC jacobi") != NULL, "session options used:\n%s", tl_out());
     CHECK(solve_with(cp, "x", "-ksp_type cg -pc_type sor") == 0, "per-call: %s", silc_context_errmsg(cp));
-    CHECK(strstr(info(cp, "x"), "KSP cg + PC sor") != NULL, "per-call options used:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cp, "x"), "KSP cg + PC sor") != NULL, "per-call options used:\n%s", tl_out());
     CHECK(silc_exec(cp, "x = A \\ b") == 0, "after per-call: %s", silc_context_errmsg(cp));
-    t = info(cp, "x");
+    t = tl_out_info(cp, "x");
     CHECK(strstr(t, "KSP bcgs + PC jacobi") != NULL, "per-call options leaked:\n%s", t);
     CHECK(strstr(t, "rtol 1e-10") != NULL, "tolerance shown in note:\n%s", t);
 
     /* Same A, same options: the KSP and its preconditioner are reused. */
     CHECK(silc_exec(cp, "y = A \\ (2 * b)") == 0, "second solve: %s", silc_context_errmsg(cp));
-    t = info(cp, "y");
+    t = tl_out_info(cp, "y");
     CHECK(strstr(t, "reused factorization: yes") != NULL, "second solve reuses:\n%s", t);
     CHECK(silc_exec(cp, "r = norm(y - 2 * x) / norm(x)") == 0, "compare: %s", silc_context_errmsg(cp));
     {
@@ -349,11 +235,11 @@ static void test_multi_rhs(silc_context *cp, const double *ones, int64_t n)
           "multi-rhs: %s", silc_context_errmsg(cp));
     if (silc_get(cp, &e, "Z") == 0 && e.m == n && e.n == 3 && silc_envelope_to_dense(&e, X) == 0) {
         for (int j = 0; j < 3; j++)
-            CHECK(reldiff(X + j * n, ones, n) <= 1e-7, "column %d error %g", j, reldiff(X + j * n, ones, n));
+            CHECK(tl_rel_diff(X + j * n, ones, n) <= 1e-7, "column %d error %g", j, tl_rel_diff(X + j * n, ones, n));
     } else {
         CHECK(0, "get Z: %s", silc_context_errmsg(cp));
     }
-    CHECK(strstr(info(cp, "Z"), "3 right-hand sides") != NULL, "multi-rhs note:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cp, "Z"), "3 right-hand sides") != NULL, "multi-rhs note:\n%s", tl_out());
     silc_envelope_free(&e);
     free(X);
 }
@@ -367,14 +253,14 @@ static void test_indefinite(silc_context *cp)
     int64_t n = (int64_t)k * k;
     double *ones = malloc((size_t)n * sizeof *ones), *b = malloc((size_t)n * sizeof *b),
            *x = malloc((size_t)n * sizeof *x);
-    if (ones && b && x && laplacian(&A, k, 1.0) == 0) {
+    if (ones && b && x && tl_grid2d(&A, k, 0, 4 - 1.0) == 0) {
         CHECK(put_system(cp, &A, ones, b) == 0, "put indefinite");
         CHECK(solve_with(cp, "x", "-ksp_rtol 1e-10 -pc_type none") == 0, "indefinite: %s",
               silc_context_errmsg(cp));
-        const char *t = info(cp, "x");
+        const char *t = tl_out_info(cp, "x");
         CHECK(strstr(t, "Cholesky failed") && strstr(t, "KSP gmres"), "indefinite falls back to GMRES:\n%s", t);
-        CHECK(get_vec(cp, "x", x, n) == 0 && reldiff(x, ones, n) < 1e-6, "indefinite error %g",
-              reldiff(x, ones, n));
+        CHECK(tl_get_vec(cp, "x", x, n) == 0 && tl_rel_diff(x, ones, n) < 1e-6, "indefinite error %g",
+              tl_rel_diff(x, ones, n));
         silc_envelope_free(&A);
     } else {
         CHECK(0, "indefinite setup");
@@ -454,17 +340,17 @@ static void test_shared(silc_context *cp, silc_context *cr, const char *file, co
     if (ones && b && xp && xr && put_system(cp, &A, ones, b) == 0 && put_system(cr, &A, ones, b) == 0) {
         double cond = reference_cond(cr);
         CHECK(solve_with(cp, "x", opts) == 0, "%s %s: %s", file, opts, silc_context_errmsg(cp));
-        const char *t = info(cp, "x");
-        double its = info_num(t, "iterations: ");
+        const char *t = tl_out_info(cp, "x");
+        double its = tl_out_number(t, "iterations: ");
         CHECK(strstr(t, "  backend: petsc\n") != NULL, "%s backend:\n%s", file, t);
-        if (get_vec(cp, "x", xp, n) == 0 && get_vec(cr, "xr", xr, n) == 0) {
-            double bound = (rtol > 0 ? 10 * rtol : 100 * DBL_EPSILON) * cond, d = reldiff(xp, xr, n);
+        if (tl_get_vec(cp, "x", xp, n) == 0 && tl_get_vec(cr, "xr", xr, n) == 0) {
+            double bound = (rtol > 0 ? 10 * rtol : 100 * DBL_EPSILON) * cond, d = tl_rel_diff(xp, xr, n);
             CHECK(cond >= 1, "%s reference condition estimate %g", file, cond);
             CHECK(d <= bound || bound >= 1, "%s: petsc vs reference %g > %g", file, d, bound);
-            CHECK(reldiff(xp, ones, n) <= bound || bound >= 1, "%s: petsc vs exact %g > %g", file,
-                  reldiff(xp, ones, n), bound);
+            CHECK(tl_rel_diff(xp, ones, n) <= bound || bound >= 1, "%s: petsc vs exact %g > %g", file,
+                  tl_rel_diff(xp, ones, n), bound);
             printf("%-13s %-48s n %5lld cond %8.2g its %4.0f |x-x_ref| %8.2g |x-x*| %8.2g\n", file, opts,
-                   (long long)n, cond, its, d, reldiff(xp, ones, n));
+                   (long long)n, cond, its, d, tl_rel_diff(xp, ones, n));
         } else {
             CHECK(0, "%s: cannot fetch x", file);
         }
@@ -484,13 +370,13 @@ static void test_dense_declined(silc_context *cp)
 {
     CHECK(silc_exec(cp, "set dispatch.solve.dense = petsc; set dispatch.solve.dense.spd = petsc") == 0,
           "force dense: %s", silc_context_errmsg(cp));
-    out_buf[0] = '\0';
+    tl_out()[0] = '\0';
     CHECK(silc_exec(cp, "D = dense(eye(4) * 3 + ones(4, 4)); explain d = D \\ ones(4, 1)") == 0,
           "explain: %s", silc_context_errmsg(cp));
-    CHECK(strstr(out_buf, "petsc: declines:") && strstr(out_buf, "dense"), "dense declined:\n%s", out_buf);
+    CHECK(strstr(tl_out(), "petsc: declines:") && strstr(tl_out(), "dense"), "dense declined:\n%s", tl_out());
     /* The reference plugin, the last resort, still answers. */
     CHECK(silc_exec(cp, "d = D \\ ones(4, 1)") == 0, "dense solve: %s", silc_context_errmsg(cp));
-    CHECK(strstr(info(cp, "d"), "  backend: reference\n") != NULL, "dense solved by:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cp, "d"), "  backend: reference\n") != NULL, "dense solved by:\n%s", tl_out());
 }
 
 static void test_two_contexts(silc_context *cp, silc_context *cq, const silc_envelope_t *A, double *ones,
@@ -508,9 +394,9 @@ static void test_two_contexts(silc_context *cp, silc_context *cq, const silc_env
         for (int i = 0; i < 2; i++) {
             CHECK(solve_with(c[i], "x", "-ksp_type cg -pc_type icc -ksp_rtol 1e-12") == 0, "context %d: %s", i,
                   silc_context_errmsg(c[i]));
-            CHECK(get_vec(c[i], "x", x, n) == 0 && reldiff(x, ones, n) < 1e-7, "context %d round %d error %g",
-                  i, round, reldiff(x, ones, n));
-            CHECK(strstr(info(c[i], "x"), "  backend: petsc\n") != NULL, "context %d backend:\n%s", i, out_buf);
+            CHECK(tl_get_vec(c[i], "x", x, n) == 0 && tl_rel_diff(x, ones, n) < 1e-7, "context %d round %d error %g",
+                  i, round, tl_rel_diff(x, ones, n));
+            CHECK(strstr(tl_out_info(c[i], "x"), "  backend: petsc\n") != NULL, "context %d backend:\n%s", i, tl_out());
         }
     }
     free(x);
@@ -518,12 +404,12 @@ static void test_two_contexts(silc_context *cp, silc_context *cq, const silc_env
 
 int main(void)
 {
-    silc_context *cp = open_forced("petsc"), *cr = open_forced("reference"), *cq = open_forced("petsc");
+    silc_context *cp = tl_open_forced("petsc"), *cr = tl_open_forced("reference"), *cq = tl_open_forced("petsc");
     silc_envelope_t A;
     const int k = 32;
     int64_t n = (int64_t)k * k;
     double *ones = malloc((size_t)n * sizeof *ones), *b = malloc((size_t)n * sizeof *b);
-    if (cp && cr && cq && ones && b && laplacian(&A, k, 0) == 0) {
+    if (cp && cr && cq && ones && b && tl_grid2d(&A, k, 0, 4) == 0) {
         CHECK(put_system(cp, &A, ones, b) == 0 && put_system(cr, &A, ones, b) == 0, "put laplacian");
         double cond = reference_cond(cr);
         CHECK(cond > 1e2 && cond < 1e4, "laplacian condition estimate %g", cond);

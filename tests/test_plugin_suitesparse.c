@@ -33,33 +33,9 @@
 
 #include "check.h"
 #include "silc.h"
-
-#ifndef SILC_SHARED_MATRICES
-#define SILC_SHARED_MATRICES "../shared/matrices"
-#endif
+#include "testlib.h"
 
 /* ---- output capture and helpers ------------------------------------------------ */
-
-static char out_buf[32768];
-
-static void capture(void *user, const char *text)
-{
-    size_t have = strlen(out_buf);
-    (void)user;
-    snprintf(out_buf + have, sizeof out_buf - have, "%s", text);
-}
-
-static int contains(const char *hay, const char *needle)
-{
-    size_t n = strlen(needle);
-    for (; hay && *hay; hay++) {
-        size_t i = 0;
-        while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
-            i++;
-        if (i == n) return 1;
-    }
-    return 0;
-}
 
 static silc_context *open_ctx(const char *const *classes, const char *backend)
 {
@@ -69,27 +45,12 @@ static silc_context *open_ctx(const char *const *classes, const char *backend)
         fprintf(stderr, "silc_open: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
         return NULL;
     }
-    silc_set_output(c, capture, NULL);
+    silc_set_output(c, tl_out_fn, NULL);
     for (; *classes; classes++) {
         snprintf(cmd, sizeof cmd, "set dispatch.%s = %s", *classes, backend);
         CHECK(silc_exec(c, cmd) == 0, "%s: %s", cmd, silc_context_errmsg(c));
     }
     return c;
-}
-
-static const char *info(silc_context *c, const char *name)
-{
-    char cmd[64];
-    out_buf[0] = '\0';
-    snprintf(cmd, sizeof cmd, "info %s", name);
-    if (silc_exec(c, cmd)) snprintf(out_buf, sizeof out_buf, "(info failed: %s)", silc_context_errmsg(c));
-    return out_buf;
-}
-
-static double info_number(const char *text, const char *label)
-{
-    const char *p = strstr(text, label);
-    return p ? atof(p + strlen(label)) : -1;
 }
 
 static double now(void)
@@ -99,63 +60,10 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static void put(silc_context *c, const char *name, const silc_envelope_t *e)
-{
-    CHECK(silc_put(c, name, e) == 0, "put %s: %s", name, silc_context_errmsg(c));
-}
-
-static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
-{
-    silc_envelope_t e;
-    CHECK(silc_envelope_dense(&e, m, n, x) == 0, "envelope %s", name);
-    put(c, name, &e);
-    silc_envelope_free(&e);
-}
-
-/* The m x n dense value name, or NULL (with a failed check). */
-static double *get_dense(silc_context *c, const char *name, int64_t m, int64_t n)
-{
-    silc_envelope_t e;
-    double *x;
-    if (silc_get(c, &e, name)) {
-        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
-        return NULL;
-    }
-    if (e.m != m || e.n != n) {
-        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
-              (long long)m, (long long)n);
-        silc_envelope_free(&e);
-        return NULL;
-    }
-    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *x);
-    if (x) silc_envelope_to_dense(&e, x);
-    silc_envelope_free(&e);
-    return x;
-}
-
-static double rel_err(const double *x, const double *y, int64_t n)
-{
-    double d = 0, s = 0;
-    for (int64_t i = 0; i < n; i++) {
-        if (fabs(x[i] - y[i]) > d) d = fabs(x[i] - y[i]);
-        if (fabs(y[i]) > s) s = fabs(y[i]);
-    }
-    return s > 0 ? d / s : d;
-}
-
 static double bound(int64_t n, double cond)
 {
     double b = 1e3 * (double)n * DBL_EPSILON * (cond > 1 ? cond : 1);
     return b < 1e-1 ? b : 1e-1;
-}
-
-static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
-{
-    for (int64_t i = 0; i < A->m; i++) {
-        double s = 0;
-        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
-        y[i] = s;
-    }
 }
 
 /* ---- generated matrices -------------------------------------------------------- */
@@ -164,23 +72,7 @@ static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
  * the west/east (beta = 0: the Laplacian, symmetric). */
 static void grid(silc_envelope_t *e, int64_t k, double beta, double shift)
 {
-    int64_t n = k * k, nz = 0;
-    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
-    double *v = malloc((size_t)(5 * n) * sizeof *v);
-    for (int64_t r = 0; r < n; r++) {
-        int64_t i = r / k, j = r % k;
-        rp[r] = nz;
-        if (i > 0) ci[nz] = r - k, v[nz++] = -1;
-        if (j > 0) ci[nz] = r - 1, v[nz++] = -1 - beta;
-        ci[nz] = r, v[nz++] = 4 + shift;
-        if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1 + beta;
-        if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
-    }
-    rp[n] = nz;
-    CHECK(silc_envelope_csr(e, n, n, rp, ci, v) == 0, "grid envelope");
-    free(rp);
-    free(ci);
-    free(v);
+    CHECK(tl_grid2d(e, k, beta, 4 + shift) == 0, "grid envelope");
 }
 
 /* x = A \ b in c (A, b already there) with the exact solution xt known. */
@@ -196,15 +88,15 @@ static void check_exact(silc_context *c, const char *backend, const char *label,
         return;
     }
     t = now() - t;
-    in = info(c, "x");
-    CHECK(contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, label, in);
-    cond = info_number(in, "condition estimate: ");
-    be = info_number(in, "backward error: ");
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, label, in);
+    cond = tl_out_number(in, "condition estimate: ");
+    be = tl_out_number(in, "backward error: ");
     CHECK(be >= 0 && be < 1e-12, "%s %s: backward error %g", backend, label, be);
-    x = get_dense(c, "x", n, 1);
+    x = tl_get_dense_checked(c, "x", n, 1);
     if (!x) return;
-    CHECK(rel_err(x, xt, n) <= bound(n, cond), "%s %s: forward error %.3g > %.3g (cond %.3g)",
-          backend, label, rel_err(x, xt, n), bound(n, cond), cond);
+    CHECK(tl_rel_diff(x, xt, n) <= bound(n, cond), "%s %s: forward error %.3g > %.3g (cond %.3g)",
+          backend, label, tl_rel_diff(x, xt, n), bound(n, cond), cond);
     printf("  %-22s %-28s n=%-6lld %.4f s  cond %.3g  backward error %.2g\n", backend, label,
            (long long)n, t, cond, be);
     free(x);
@@ -219,16 +111,16 @@ static void test_generated(silc_context *c, const char *backend, int symmetric_o
     double *xt = malloc((size_t)n * sizeof *xt), *b = malloc((size_t)n * sizeof *b);
     for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
     grid(&A, k, 0, 0);
-    csr_matvec(&A, xt, b);
-    put(c, "A", &A);
-    put_dense(c, "b", n, 1, b);
+    tl_csr_matvec(&A, xt, b);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", n, 1, b);
     check_exact(c, backend, "2-D Laplacian 60x60", &A, xt);
     silc_envelope_free(&A);
     if (!symmetric_only) {
         grid(&A, k, 0.4, 0);
-        csr_matvec(&A, xt, b);
-        put(c, "A", &A);
-        put_dense(c, "b", n, 1, b);
+        tl_csr_matvec(&A, xt, b);
+        tl_put_checked(c, "A", &A);
+        tl_put_dense_checked(c, "b", n, 1, b);
         check_exact(c, backend, "convection-diffusion 60x60", &A, xt);
         silc_envelope_free(&A);
     }
@@ -254,19 +146,19 @@ static void test_generated_qr(silc_context *c)
     memcpy(v, L.values, (size_t)nz * sizeof *v);
     for (int64_t i = 0; i < n; i++) ci[nz + i] = i, v[nz + i] = 1, rp[n + 1 + i] = nz + i + 1;
     CHECK(silc_envelope_csr(&A, 2 * n, n, rp, ci, v) == 0, "tall envelope");
-    csr_matvec(&A, xt, b);
-    put(c, "A", &A);
-    put_dense(c, "b", 2 * n, 1, b);
+    tl_csr_matvec(&A, xt, b);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", 2 * n, 1, b);
     check_exact(c, "suitesparse.spqr", "[Laplacian; I] 3200x1600", &A, xt);
-    csr_matvec(&L, xt, b);
-    put(c, "A", &L);
-    put_dense(c, "b", n, 1, b);
+    tl_csr_matvec(&L, xt, b);
+    tl_put_checked(c, "A", &L);
+    tl_put_dense_checked(c, "b", n, 1, b);
     CHECK(silc_exec(c, "x = solve(A, b, \"backend = suitesparse.spqr\")") == 0, "spqr square: %s",
           silc_context_errmsg(c));
-    in = info(c, "x");
-    CHECK(contains(in, "suitesparse.spqr") && contains(in, "full rank 1600"), "spqr square:\n%s", in);
-    x = get_dense(c, "x", n, 1);
-    if (x) CHECK(rel_err(x, xt, n) < 1e-10, "spqr square: forward error %.3g", rel_err(x, xt, n));
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "suitesparse.spqr") && tl_contains(in, "full rank 1600"), "spqr square:\n%s", in);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    if (x) CHECK(tl_rel_diff(x, xt, n) < 1e-10, "spqr square: forward error %.3g", tl_rel_diff(x, xt, n));
     free(x);
     free(xt);
     free(b);
@@ -286,24 +178,24 @@ static void test_reuse(silc_context *c, const char *backend, int symmetric)
     const char *in;
     for (int64_t i = 0; i < n; i++) b[i] = sin((double)i);
     grid(&A, k, symmetric ? 0 : 0.3, 0);
-    put(c, "A", &A);
-    put_dense(c, "b", n, 1, b);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", n, 1, b);
     CHECK(silc_exec(c, "x = A \\ b; y = A \\ (2 * b)") == 0, "%s reuse: %s", backend,
           silc_context_errmsg(c));
-    in = info(c, "x");
-    CHECK(contains(in, "reused factorization: no"), "%s: first solve reused?\n%s", backend, in);
-    in = info(c, "y");
-    CHECK(contains(in, "reused factorization: yes"), "%s: second solve did not reuse:\n%s", backend, in);
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "reused factorization: no"), "%s: first solve reused?\n%s", backend, in);
+    in = tl_out_info(c, "y");
+    CHECK(tl_contains(in, "reused factorization: yes"), "%s: second solve did not reuse:\n%s", backend, in);
     CHECK(silc_exec(c, "A2 = 2 * A; x2 = A2 \\ b") == 0, "%s refactor: %s", backend, silc_context_errmsg(c));
-    in = info(c, "x2");
-    CHECK(contains(in, "symbolic analysis reused"), "%s: same pattern, symbolic not reused:\n%s",
+    in = tl_out_info(c, "x2");
+    CHECK(tl_contains(in, "symbolic analysis reused"), "%s: same pattern, symbolic not reused:\n%s",
           backend, in);
-    CHECK(contains(in, "reused factorization: no"), "%s: A2 is a new value:\n%s", backend, in);
-    x = get_dense(c, "x", n, 1);
-    x2 = get_dense(c, "x2", n, 1);
+    CHECK(tl_contains(in, "reused factorization: no"), "%s: A2 is a new value:\n%s", backend, in);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    x2 = tl_get_dense_checked(c, "x2", n, 1);
     if (x && x2) {
         for (int64_t i = 0; i < n; i++) x2[i] *= 2;
-        CHECK(rel_err(x2, x, n) < 1e-12, "%s: 2 * (2A \\ b) != A \\ b (%.3g)", backend, rel_err(x2, x, n));
+        CHECK(tl_rel_diff(x2, x, n) < 1e-12, "%s: 2 * (2A \\ b) != A \\ b (%.3g)", backend, tl_rel_diff(x2, x, n));
     }
     free(x2);
     if (strstr(backend, "klu")) {
@@ -311,12 +203,12 @@ static void test_reuse(silc_context *c, const char *backend, int symmetric)
          * is refactored into them without pivot search. */
         CHECK(silc_exec(c, "clear A2 x2; A = 3 * A; x3 = A \\ b") == 0, "klu refactor: %s",
               silc_context_errmsg(c));
-        in = info(c, "x3");
-        CHECK(contains(in, "klu_l_refactor"), "klu: no numeric refactor:\n%s", in);
-        x2 = get_dense(c, "x3", n, 1);
+        in = tl_out_info(c, "x3");
+        CHECK(tl_contains(in, "klu_l_refactor"), "klu: no numeric refactor:\n%s", in);
+        x2 = tl_get_dense_checked(c, "x3", n, 1);
         if (x && x2) {
             for (int64_t i = 0; i < n; i++) x2[i] *= 3;
-            CHECK(rel_err(x2, x, n) < 1e-12, "klu: 3 * (3A \\ b) != A \\ b (%.3g)", rel_err(x2, x, n));
+            CHECK(tl_rel_diff(x2, x, n) < 1e-12, "klu: 3 * (3A \\ b) != A \\ b (%.3g)", tl_rel_diff(x2, x, n));
         }
         free(x2);
     }
@@ -333,16 +225,16 @@ static void test_multi_rhs(silc_context *c, const char *backend)
     double *B = malloc((size_t)(3 * n) * sizeof *B), *X, *x;
     for (int64_t i = 0; i < 3 * n; i++) B[i] = cos((double)i);
     grid(&A, k, 0, 0);
-    put(c, "A", &A);
-    put_dense(c, "B", n, 3, B);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "B", n, 3, B);
     CHECK(silc_exec(c, "X = A \\ B; Xs = A \\ sparse(B); x = A \\ B[:, 2]") == 0, "%s multi rhs: %s",
           backend, silc_context_errmsg(c));
-    X = get_dense(c, "X", n, 3);
-    x = get_dense(c, "x", n, 1);
-    if (X && x) CHECK(rel_err(X + n, x, n) < 1e-13, "%s: column 2 of A\\B differs from A\\b", backend);
+    X = tl_get_dense_checked(c, "X", n, 3);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    if (X && x) CHECK(tl_rel_diff(X + n, x, n) < 1e-13, "%s: column 2 of A\\B differs from A\\b", backend);
     free(x);
-    x = get_dense(c, "Xs", n, 3);
-    if (X && x) CHECK(rel_err(X, x, 3 * n) < 1e-13, "%s: A\\sparse(B) differs from A\\B", backend);
+    x = tl_get_dense_checked(c, "Xs", n, 3);
+    if (X && x) CHECK(tl_rel_diff(X, x, 3 * n) < 1e-13, "%s: A\\sparse(B) differs from A\\B", backend);
     free(x);
     free(X);
     free(B);
@@ -371,8 +263,8 @@ static void test_shared(silc_context *c, silc_context *r, const char *backend, c
     int64_t n;
     if (read_shared(file, &A)) return;
     n = A.n;
-    put(c, "A", &A);
-    put(r, "A", &A);
+    tl_put_checked(c, "A", &A);
+    tl_put_checked(r, "A", &A);
     t = now();
     CHECK(silc_exec(c, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "%s %s: %s", backend, file,
           silc_context_errmsg(c));
@@ -381,22 +273,22 @@ static void test_shared(silc_context *c, silc_context *r, const char *backend, c
     CHECK(silc_exec(r, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "reference %s: %s", file,
           silc_context_errmsg(r));
     tr = now() - tr;
-    in = info(c, "x");
-    CHECK(contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, file, in);
-    be = info_number(in, "backward error: ");
-    mine = info_number(in, "condition estimate: ");
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, backend), "%s %s: info does not name the backend:\n%s", backend, file, in);
+    be = tl_out_number(in, "backward error: ");
+    mine = tl_out_number(in, "condition estimate: ");
     CHECK(be >= 0 && be < 1e-10, "%s %s: backward error %g", backend, file, be);
-    cond = info_number(info(r, "x"), "condition estimate: ");
+    cond = tl_out_number(tl_out_info(r, "x"), "condition estimate: ");
     /* Above 1e8 the backend's estimate must be a real one, not a pivot ratio. */
     if (cond > 1e8 && !strstr(backend, "spqr"))
         CHECK(mine >= cond / 10 && mine <= cond * 10, "%s %s: condition estimate %.3g, reference %.3g",
               backend, file, mine, cond);
-    x = get_dense(c, "x", n, 1);
-    xr = get_dense(r, "x", n, 1);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    xr = tl_get_dense_checked(r, "x", n, 1);
     if (x && xr)
-        CHECK(rel_err(x, xr, n) <= 2 * bound(n, cond),
+        CHECK(tl_rel_diff(x, xr, n) <= 2 * bound(n, cond),
               "%s %s: differs from reference by %.3g > %.3g (cond %.3g)", backend, file,
-              rel_err(x, xr, n), 2 * bound(n, cond), cond);
+              tl_rel_diff(x, xr, n), 2 * bound(n, cond), cond);
     printf("  %-22s %-14s %5lldx%-5lld %8.4f s (reference %8.4f s)  cond %.3g (reference %.3g)  "
            "backward error %.2g\n",
            backend, file, (long long)A.m, (long long)A.n, t, tr, mine, cond, be);
@@ -410,15 +302,15 @@ static void test_singular(silc_context *c, const char *backend, const char *fn, 
 {
     silc_envelope_t A;
     if (read_shared(file, &A)) return;
-    put(c, "A", &A);
+    tl_put_checked(c, "A", &A);
     if (silc_exec(c, "b = A * ones(cols(A), 1); x = A \\ b")) {
         const char *msg = silc_context_errmsg(c);
-        CHECK(contains(msg, fn) && contains(msg, "singular"), "%s %s: message should name %s: %s",
+        CHECK(tl_contains(msg, fn) && tl_contains(msg, "singular"), "%s %s: message should name %s: %s",
               backend, file, fn, msg);
         printf("  %-22s %-14s error: %s\n", backend, file, msg);
     } else {
         const char *w = silc_context_warnings(c);
-        CHECK(contains(w, "singular to working precision"), "%s %s: singular matrix solved silently",
+        CHECK(tl_contains(w, "singular to working precision"), "%s %s: singular matrix solved silently",
               backend, file);
         printf("  %-22s %-14s warning: %s", backend, file, w);
     }
@@ -437,18 +329,18 @@ static void test_not_spd(void)
     if (!c) return;
     for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
     grid(&A, k, 0, -3.7); /* diagonal 0.3, eigenvalues in (-3.7, 4.3) */
-    csr_matvec(&A, xt, b);
-    put(c, "A", &A);
-    put_dense(c, "b", n, 1, b);
-    out_buf[0] = '\0';
-    CHECK(silc_exec(c, "explain x = A \\ b") == 0 && contains(out_buf, "suitesparse.cholmod -> would run"),
-          "explain should pick cholmod:\n%s", out_buf);
+    tl_csr_matvec(&A, xt, b);
+    tl_put_checked(c, "A", &A);
+    tl_put_dense_checked(c, "b", n, 1, b);
+    tl_out()[0] = '\0';
+    CHECK(silc_exec(c, "explain x = A \\ b") == 0 && tl_contains(tl_out(), "suitesparse.cholmod -> would run"),
+          "explain should pick cholmod:\n%s", tl_out());
     CHECK(silc_exec(c, "x = A \\ b") == 0, "not SPD: %s", silc_context_errmsg(c));
-    in = info(c, "x");
-    CHECK(contains(in, "suitesparse.umfpack") && contains(in, "Cholesky failed"),
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "suitesparse.umfpack") && tl_contains(in, "Cholesky failed"),
           "not SPD: expected the LU fallback in info:\n%s", in);
-    x = get_dense(c, "x", n, 1);
-    if (x) CHECK(rel_err(x, xt, n) < 1e-8, "not SPD: forward error %.3g", rel_err(x, xt, n));
+    x = tl_get_dense_checked(c, "x", n, 1);
+    if (x) CHECK(tl_rel_diff(x, xt, n) < 1e-8, "not SPD: forward error %.3g", tl_rel_diff(x, xt, n));
     free(x);
     free(xt);
     free(b);
@@ -468,22 +360,22 @@ static void test_rect_extra(silc_context *c, silc_context *r)
     n = A.n;
     g = malloc((size_t)m * sizeof *g);
     for (int64_t i = 0; i < m; i++) g[i] = sin(3.0 * (double)i);
-    put(c, "A", &A);
-    put(r, "A", &A);
-    put_dense(c, "g", m, 1, g);
-    put_dense(r, "g", m, 1, g);
+    tl_put_checked(c, "A", &A);
+    tl_put_checked(r, "A", &A);
+    tl_put_dense_checked(c, "g", m, 1, g);
+    tl_put_dense_checked(r, "g", m, 1, g);
     CHECK(silc_exec(c, "x = A \\ g; y = A \\ g") == 0, "spqr lsq: %s", silc_context_errmsg(c));
     CHECK(silc_exec(r, "x = A \\ g") == 0, "reference lsq: %s", silc_context_errmsg(r));
-    in = info(c, "y");
-    CHECK(contains(in, "reused factorization: yes") && contains(in, "suitesparse.spqr"),
+    in = tl_out_info(c, "y");
+    CHECK(tl_contains(in, "reused factorization: yes") && tl_contains(in, "suitesparse.spqr"),
           "spqr: second solve did not reuse the QR:\n%s", in);
-    CHECK(contains(in, "least-squares"), "spqr: note should say least squares:\n%s", in);
-    cond = info_number(info(r, "x"), "condition estimate: ");
-    x = get_dense(c, "x", n, 1);
-    xr = get_dense(r, "x", n, 1);
+    CHECK(tl_contains(in, "least-squares"), "spqr: note should say least squares:\n%s", in);
+    cond = tl_out_number(tl_out_info(r, "x"), "condition estimate: ");
+    x = tl_get_dense_checked(c, "x", n, 1);
+    xr = tl_get_dense_checked(r, "x", n, 1);
     if (x && xr)
-        CHECK(rel_err(x, xr, n) <= 1e-6, "spqr lsq illc1033: differs from reference by %.3g (cond %.3g)",
-              rel_err(x, xr, n), cond);
+        CHECK(tl_rel_diff(x, xr, n) <= 1e-6, "spqr lsq illc1033: differs from reference by %.3g (cond %.3g)",
+              tl_rel_diff(x, xr, n), cond);
     free(x);
     free(xr);
     free(g);
@@ -491,13 +383,13 @@ static void test_rect_extra(silc_context *c, silc_context *r)
 
     /* Underdetermined: A = ash219' is 85 x 219 of full row rank. */
     if (read_shared("ash219.mtx", &A)) return;
-    put(c, "B", &A);
+    tl_put_checked(c, "B", &A);
     CHECK(silc_exec(c, "A = trans(B); b = A * ones(cols(A), 1); x = A \\ b; r = b - A * x") == 0,
           "spqr wide: %s", silc_context_errmsg(c));
-    in = info(c, "x");
-    CHECK(contains(in, "basic solution"), "spqr wide: note should say basic solution:\n%s", in);
-    x = get_dense(c, "x", A.m, 1);
-    g = get_dense(c, "r", A.n, 1);
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "basic solution"), "spqr wide: note should say basic solution:\n%s", in);
+    x = tl_get_dense_checked(c, "x", A.m, 1);
+    g = tl_get_dense_checked(c, "r", A.n, 1);
     if (x && g) {
         double rn = 0;
         for (int64_t i = 0; i < A.m; i++) nnz += x[i] != 0;
@@ -518,15 +410,15 @@ static void test_condest(silc_context *c, silc_context *r, const char *backend)
     double cond, cref;
     const char *in;
     if (read_shared("sherman1.mtx", &A)) return;
-    put(c, "A", &A);
-    put(r, "A", &A);
+    tl_put_checked(c, "A", &A);
+    tl_put_checked(r, "A", &A);
     CHECK(silc_exec(c, "b = A * ones(cols(A), 1); x = solve(A, b, \"suitesparse.condest = true\")") == 0,
           "%s condest: %s", backend, silc_context_errmsg(c));
     CHECK(silc_exec(r, "b = A * ones(cols(A), 1); x = A \\ b") == 0, "reference: %s", silc_context_errmsg(r));
-    in = info(c, "x");
-    cond = info_number(in, "condition estimate: ");
-    cref = info_number(info(r, "x"), "condition estimate: ");
-    CHECK(contains(info(c, "x"), "Hager"), "%s: condest note missing:\n%s", backend, out_buf);
+    in = tl_out_info(c, "x");
+    cond = tl_out_number(in, "condition estimate: ");
+    cref = tl_out_number(tl_out_info(r, "x"), "condition estimate: ");
+    CHECK(tl_contains(tl_out_info(c, "x"), "Hager"), "%s: condest note missing:\n%s", backend, tl_out());
     CHECK(cond > 0 && cref > 0 && cond <= 10 * cref && cref <= 10 * cond,
           "%s: condest %.3g vs reference %.3g", backend, cond, cref);
     silc_envelope_free(&A);

@@ -28,9 +28,11 @@
 
 /* ---- matrices ---------------------------------------------------------------- */
 
-/* The 5-point Laplacian on a k x k grid (n = k*k, Dirichlet boundary): 4 on the
- * diagonal, -1 to each grid neighbour.  SPD, condition number ~ 0.4 k^2. */
-static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
+/* The 5-point operator on a k x k grid (n = k*k, Dirichlet boundary), as CSR:
+ * diag on the diagonal, -1 to the north and south neighbours, -1 - beta west
+ * and -1 + beta east (beta = 0, diag = 4: the Laplacian; beta > 0: an
+ * upwinded convection; diag < 4: shifted towards indefinite). */
+static inline int tl_grid2d(silc_envelope_t *e, int64_t k, double beta, double diag)
 {
     int64_t n = k * k, nz = 0, i, j;
     int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp);
@@ -43,9 +45,9 @@ static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
             for (i = 0; i < k; i++) {
                 int64_t r = j * k + i;
                 if (j > 0) ci[nz] = r - k, v[nz++] = -1;
-                if (i > 0) ci[nz] = r - 1, v[nz++] = -1;
-                ci[nz] = r, v[nz++] = 4;
-                if (i < k - 1) ci[nz] = r + 1, v[nz++] = -1;
+                if (i > 0) ci[nz] = r - 1, v[nz++] = -1 - beta;
+                ci[nz] = r, v[nz++] = diag;
+                if (i < k - 1) ci[nz] = r + 1, v[nz++] = -1 + beta;
                 if (j < k - 1) ci[nz] = r + k, v[nz++] = -1;
                 rp[r + 1] = nz;
             }
@@ -55,6 +57,43 @@ static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
     free(ci);
     free(v);
     return rc;
+}
+
+/* The 5-point Laplacian on a k x k grid: SPD, condition number ~ 0.4 k^2. */
+static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
+{
+    return tl_grid2d(e, k, 0, 4);
+}
+
+/* y = A x for A in CSR. */
+static inline void tl_csr_matvec(const silc_envelope_t *A, const double *x, double *y)
+{
+    int64_t i, p;
+    for (i = 0; i < A->m; i++) {
+        double s = 0;
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) s += A->values[p] * x[A->colind[p]];
+        y[i] = s;
+    }
+}
+
+/* Normwise backward error ||b - A x||_inf / (||A||_inf ||x||_inf + ||b||_inf),
+ * A in CSR. */
+static inline double tl_backward_error(const silc_envelope_t *A, const double *x, const double *b)
+{
+    double r = 0, an = 0, xn = 0, bn = 0;
+    int64_t i, j, p;
+    for (i = 0; i < A->m; i++) {
+        double s = b[i], rs = 0;
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
+            s -= A->values[p] * x[A->colind[p]];
+            rs += fabs(A->values[p]);
+        }
+        r = fmax(r, fabs(s));
+        an = fmax(an, rs);
+        bn = fmax(bn, fabs(b[i]));
+    }
+    for (j = 0; j < A->n; j++) xn = fmax(xn, fabs(x[j]));
+    return r / (an * xn + bn);
 }
 
 /* Reads a Matrix Market file into e (caller frees). */
@@ -109,6 +148,25 @@ static inline double *tl_get_dense(silc_context *c, const char *name, int64_t *m
     if (n) *n = e.n;
     silc_envelope_free(&e);
     return x;
+}
+
+/* Puts A as "A" and b = A x (b: caller's array of A->m) as "b". */
+static inline int tl_put_system(silc_context *c, const silc_envelope_t *A, const double *x, double *b)
+{
+    tl_csr_matvec(A, x, b);
+    if (silc_put(c, "A", A)) return -1;
+    return tl_put_vector(c, "b", A->m, b);
+}
+
+/* Fetches the n-vector name into x; an error if it is not n x 1. */
+static inline int tl_get_vec(silc_context *c, const char *name, double *x, int64_t n)
+{
+    silc_envelope_t e;
+    int rc;
+    if (silc_get(c, &e, name)) return -1;
+    rc = (e.m == n && e.n == 1) ? silc_envelope_to_dense(&e, x) : -1;
+    silc_envelope_free(&e);
+    return rc;
 }
 
 /* ---- output capture ---------------------------------------------------------- */
@@ -167,6 +225,54 @@ static inline const char *tl_info(silc_context *ctx, tl_capture *c, const char *
     snprintf(cmd, sizeof cmd, "info %s", name);
     if (silc_exec(ctx, cmd)) return "";
     return tl_capture_text(c);
+}
+
+/* ---- one output buffer ------------------------------------------------------- */
+
+/* The plugin tests send every context's output into one fixed buffer (the
+ * last statement's text, reset by tl_out_exec), which failure messages print. */
+#define TL_OUT_SIZE 32768
+
+static inline char *tl_out(void)
+{
+    static char buf[TL_OUT_SIZE];
+    return buf;
+}
+
+/* silc_set_output callback appending to tl_out(), truncating when full. */
+static inline void tl_out_fn(void *user, const char *text)
+{
+    char *out = tl_out();
+    size_t have = strlen(out);
+    (void)user;
+    snprintf(out + have, TL_OUT_SIZE - have, "%s", text);
+}
+
+/* Runs stmt and returns what it printed, or "error: <message>". */
+static inline const char *tl_out_exec(silc_context *c, const char *stmt)
+{
+    char *out = tl_out();
+    out[0] = '\0';
+    if (silc_exec(c, stmt)) snprintf(out, TL_OUT_SIZE, "error: %s", silc_context_errmsg(c));
+    return out;
+}
+
+/* Runs `info name` and returns its text, or "info failed: <message>". */
+static inline const char *tl_out_info(silc_context *c, const char *name)
+{
+    char cmd[160], *out = tl_out();
+    out[0] = '\0';
+    snprintf(cmd, sizeof cmd, "info %s", name);
+    if (silc_exec(c, cmd)) snprintf(out, TL_OUT_SIZE, "info failed: %s", silc_context_errmsg(c));
+    return out;
+}
+
+/* The number right after label in text (label includes its ": "), -1 when
+ * the label is missing. */
+static inline double tl_out_number(const char *text, const char *label)
+{
+    const char *p = strstr(text, label);
+    return p ? strtod(p + strlen(label), NULL) : -1;
 }
 
 /* ---- text ---------------------------------------------------------------------- */
@@ -243,5 +349,66 @@ static inline double tl_now(void)
     timespec_get(&t, TIME_UTC);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
+
+/* ---- with check.h: helpers that record their own failures -------------------- */
+
+#ifdef SILC_CHECK_H
+/* A context printing into tl_out() whose sparse solve classes (solve.sparse
+ * and solve.sparse.spd) are forced to backend; NULL with a failed check. */
+static inline silc_context *tl_open_forced(const char *backend)
+{
+    silc_context *c = NULL;
+    char stmt[160];
+    if (silc_open(&c, NULL)) {
+        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
+        silc_close(&c);
+        return NULL;
+    }
+    silc_set_output(c, tl_out_fn, NULL);
+    snprintf(stmt, sizeof stmt, "set dispatch.solve.sparse = %s; set dispatch.solve.sparse.spd = %s",
+             backend, backend);
+    CHECK(silc_exec(c, stmt) == 0, "%s: %s", stmt, silc_context_errmsg(c));
+    return c;
+}
+
+/* Puts e under name; a failed check names it. */
+static inline void tl_put_checked(silc_context *c, const char *name, const silc_envelope_t *e)
+{
+    CHECK(silc_put(c, name, e) == 0, "put %s: %s", name, silc_context_errmsg(c));
+}
+
+/* Puts the column-major m x n array x under name. */
+static inline void tl_put_dense_checked(silc_context *c, const char *name, int64_t m, int64_t n,
+                                        const double *x)
+{
+    silc_envelope_t e;
+    CHECK(silc_envelope_dense(&e, m, n, x) == 0, "envelope %s", name);
+    tl_put_checked(c, name, &e);
+    silc_envelope_free(&e);
+}
+
+/* The m x n value name as a new column-major array, or NULL with a failed
+ * check (missing, or another shape). */
+static inline double *tl_get_dense_checked(silc_context *c, const char *name, int64_t m, int64_t n)
+{
+    silc_envelope_t e;
+    double *x;
+    memset(&e, 0, sizeof e);
+    if (silc_get(c, &e, name)) {
+        CHECK(0, "get %s: %s", name, silc_context_errmsg(c));
+        return NULL;
+    }
+    if (e.m != m || e.n != n) {
+        CHECK(0, "%s is %lldx%lld, want %lldx%lld", name, (long long)e.m, (long long)e.n,
+              (long long)m, (long long)n);
+        silc_envelope_free(&e);
+        return NULL;
+    }
+    x = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *x);
+    if (x) silc_envelope_to_dense(&e, x);
+    silc_envelope_free(&e);
+    return x;
+}
+#endif
 
 #endif
