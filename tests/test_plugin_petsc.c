@@ -37,23 +37,6 @@
 #include "silc.h"
 #include "testlib.h"
 
-/* Under AddressSanitizer: OpenMPI, hwloc and libevent keep start-up
- * allocations until exit by design, and PETSc 3.18 drops a 32-byte title when
- * an options block fails (an unknown -pc_type); none of them is this
- * project's leak.  Those libraries are built without frame pointers, so the
- * suppressions only match with the slow unwinder. */
-const char *__lsan_default_suppressions(void);
-const char *__lsan_default_suppressions(void)
-{
-    return "leak:libmpi.so\nleak:libopen-pal.so\nleak:libopen-rte.so\nleak:libhwloc.so\n"
-           "leak:libpmix.so\nleak:libevent\nleak:mca_\nleak:PetscOptionsBegin_Private\n";
-}
-const char *__asan_default_options(void);
-const char *__asan_default_options(void)
-{
-    return "fast_unwind_on_malloc=0";
-}
-
 /* PUTs A and b = A * ones into c. */
 static int put_system(silc_context *c, const silc_envelope_t *A, double *ones, double *b)
 {

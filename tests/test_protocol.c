@@ -19,7 +19,7 @@ typedef struct buf {
 
 static void put(buf *b, const void *p, size_t n)
 {
-    memcpy(b->p + b->len, p, n);
+    if (n) memcpy(b->p + b->len, p, n); /* p may be NULL for an empty body */
     b->len += n;
 }
 

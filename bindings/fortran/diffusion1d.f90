@@ -56,6 +56,7 @@ program diffusion1d
     ' dt=', num(dt), ' time=', num(real(clock1 - clock0, c_double) / rate), 's'
   write (*, '(a, es10.3, a, es10.3, a)') 'max error=', err, &
     ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
+  deallocate(u, x)
   if (.not. (err <= tol)) then   ! written so that a NaN fails too
     write (error_unit, '(a, es10.3, a)') 'diffusion1d: error above the tolerance ', tol, &
       ': the scheme did not converge as it should'

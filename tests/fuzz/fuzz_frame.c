@@ -131,7 +131,7 @@ static void put(buf *b, const void *p, size_t n)
         b->p = realloc(b->p, b->cap);
         if (!b->p) exit(1);
     }
-    memcpy(b->p + b->len, p, n);
+    if (n) memcpy(b->p + b->len, p, n); /* p may be NULL for an empty body */
     b->len += n;
 }
 
