@@ -11,6 +11,8 @@
  */
 #include "lis_kernels.h"
 
+#include <math.h>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -69,6 +71,31 @@ double lk_dot(int64_t n, const double *x, const double *y)
 #pragma omp parallel for schedule(static) reduction(+ : s) if (n > LK_PAR_MIN)
     for (i = 0; i < n; i++) s += x[i] * y[i];
     return s;
+}
+
+/* ||x||_2 that neither overflows nor underflows (as LAPACK's dnrm2).  The
+ * plain sum of squares is exact enough whenever it lands in [1e-290, 1e290]:
+ * squares that underflowed were then below 1e-18 of it.  Outside that range
+ * (entries beyond 1e145 or below 1e-145) the entries are scaled by a power
+ * of two that brings the largest near 1, which rounds nothing. */
+double lk_nrm2(int64_t n, const double *x)
+{
+    double s = lk_dot(n, x, x), mx = 0;
+    int64_t i;
+    int e;
+    if (s >= 1e-290 && s <= 1e290) return sqrt(s);
+    if (s != s) return s;
+#pragma omp parallel for schedule(static) reduction(max : mx) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) mx = fmax(mx, fabs(x[i]));
+    if (mx == 0 || isinf(mx)) return mx;
+    frexp(mx, &e);
+    s = 0;
+#pragma omp parallel for schedule(static) reduction(+ : s) if (n > LK_PAR_MIN)
+    for (i = 0; i < n; i++) {
+        double t = ldexp(x[i], -e);
+        s += t * t;
+    }
+    return ldexp(sqrt(s), e);
 }
 
 void lk_copy(int64_t n, const double *x, double *y)

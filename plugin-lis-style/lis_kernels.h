@@ -26,6 +26,7 @@ int lk_threads(void);
 void lk_spmv(const lk_csr *A, const double *x, double *y);              /* y = A x        */
 void lk_residual(const lk_csr *A, const double *b, const double *x, double *r); /* r = b - A x */
 double lk_dot(int64_t n, const double *x, const double *y);
+double lk_nrm2(int64_t n, const double *x);                             /* ||x||_2, scaled */
 void lk_copy(int64_t n, const double *x, double *y);                    /* y = x          */
 void lk_zero(int64_t n, double *y);
 void lk_scale(int64_t n, double a, double *x);                          /* x = a x        */

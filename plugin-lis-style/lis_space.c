@@ -96,9 +96,15 @@ dd lv_dot(const lis_ctx *c, const lis_vec *x, const lis_vec *y)
     return dd_d(lk_dot(c->n, x->h, y->h));
 }
 
+/* Scaled in double (lk_nrm2); in double-double, the high parts' scaled norm
+ * stands in when the sum of squares leaves the safe range. */
 dd lv_nrm2(const lis_ctx *c, const lis_vec *x)
 {
-    return s_sqrt(c, lv_dot(c, x, x));
+    dd s;
+    if (!c->quad) return dd_d(lk_nrm2(c->n, x->h));
+    s = lv_dot(c, x, x);
+    if (s.hi >= 1e-290 && s.hi <= 1e290) return s_sqrt(c, s);
+    return dd_d(lk_nrm2(c->n, x->h));
 }
 
 void lv_matvec(const lis_ctx *c, const lis_vec *x, lis_vec *y)

@@ -265,16 +265,17 @@ static void test_matrix(double *A, int spd)
 }
 
 /* x = A \\ b for a scaled system must be x1 * f, with a finite backward error
- * and the same condition estimate.  An iterative backend may instead stop
- * with an error, or return with the core's large-backward-error warning
- * (docs/accuracy.md lists which do): never silently wrong. */
+ * and the same condition estimate.  PETSc may instead stop with an error, or
+ * return with the core's large-backward-error warning (docs/accuracy.md says
+ * why): never silently wrong.  lis-style solves scaled systems scaled (see
+ * plugin-lis-style/lis_style.c) and must get them right. */
 static void check_scaled(const backend *B, double sc, const char *what, const double *x1, double f)
 {
     char warn[512];
     const char *info;
     double want[6], *x, be, est;
-    int i, rc = run(B, NULL);
-    if (B->iterative && rc == RUN_ERR) {
+    int i, rc = run(B, NULL), may_fail = B->iterative && strcmp(B->name, "lis-style") != 0;
+    if (may_fail && rc == RUN_ERR) {
         CHECK(silc_context_errmsg(ctx)[0] != '\0', "scale %g (%s), %s: no message", sc, what, label(B));
         return;
     }
@@ -286,7 +287,7 @@ static void check_scaled(const backend *B, double sc, const char *what, const do
     info = tl_info(ctx, &cap, "x");
     be = tl_field(info, "backward error");
     est = tl_field(info, "condition estimate");
-    if (B->iterative && tl_rel_diff(x, want, 6) >= 1e-10) {
+    if (may_fail && tl_rel_diff(x, want, 6) >= 1e-10) {
         CHECK(tl_contains(warn, "backward error"), "scale %g (%s), %s: wrong (%.3g) without a warning",
               sc, what, label(B), tl_rel_diff(x, want, 6));
     } else {
@@ -304,14 +305,18 @@ static void check_scaled(const backend *B, double sc, const char *what, const do
 static void test_scaling(void)
 {
     static const double scales[] = {1e-300, 1e-150, 1e150, 1e300};
+    /* CG's inner products (r, r) and (p, A p) are the first to underflow. */
+    static const backend lis_cg = {"lis-style", 1, 1,
+                                   "; lis-style.options = -i cg -p none -tol 1e-12 -maxiter 200"};
     double M[36], Ms[36], b[6], bs[6], x1[6];
     int spd, s, i, n = 6;
     size_t k;
     for (spd = 0; spd <= 1; spd++) {
         test_matrix(M, spd);
         for (i = 0; i < n; i++) b[i] = 1.0 + i;
-        for (k = 0; k < NB; k++) {
-            const backend *B = &backends[k];
+        for (k = 0; k <= NB; k++) {
+            const backend *B = k < NB ? &backends[k] : &lis_cg;
+            if (k == NB && !spd) continue;
             double *x;
             int rc;
             put_matrix("A", n, n, M, B->sparse, 0);

@@ -1,7 +1,8 @@
 /*
  * test_tuner.c -- the tuner (core/src/tuner.c): the seeds' published fits,
  * the guards, period detection, the leave-one-out stopping rule, the budget,
- * wisdom round trips, the SVG report and backend choice on a real matrix.
+ * wisdom round trips, the SVG report and backend choice on a real matrix
+ * (mixed-precision variants among the candidates: mumps single, lapack mixed).
  *
  * No assertion depends on a clock: whole runs are driven through
  * tuner_observe() with step times computed from a synthetic model of the
@@ -283,6 +284,45 @@ static void test_backends(const char *wisdom)
     CHECK(lang_exec(E, "explain x = A \\ b") == 0, "explain: %s", E->err);
     CHECK(strstr(sb_str(&captured), "tuner:") != NULL, "explain shows the tuner: %s",
           sb_str(&captured));
+
+    /* Mixed precision is a candidate where its backend is installed: MUMPS
+     * with a single-precision factor for the sparse class, refined by the
+     * core to the target (so admitted, not "too inaccurate"). */
+    CHECK(status_has(E, "backends for solve.sparse"), "status: %s", sb_str(&captured));
+    if (strstr(sb_str(&captured), "\n  mumps ")) {
+        const char *row = strstr(sb_str(&captured), "\n  mumps precision = single ");
+        CHECK(row != NULL, "mumps single is a candidate: %s", sb_str(&captured));
+        if (row) {
+            const char *end = strchr(row + 1, '\n');
+            char line[256];
+            snprintf(line, sizeof line, "%.*s", end ? (int)(end - row - 1) : 200, row + 1);
+            CHECK(!strstr(line, "too inaccurate") && !strstr(line, " - "),
+                  "mumps single meets the target: %s", line);
+            printf("candidate: %s\n", line);
+        }
+    }
+    eng_destroy(&E);
+
+    /* The dense class: lapack at mixed precision (dsgesv) next to its default. */
+    E = open_engine(wisdom);
+    {
+        const int N = 80;
+        silc_value *A = val_dense_new(N, N), *b = val_dense_new(N, 1);
+        for (int64_t j = 0; j < N; j++) {
+            for (int64_t k = 0; k < N; k++)
+                A->val[k + j * N] = k == j ? 2.0 * N : 1.0 / (double)(1 + (k * 7 + j * 3) % 11);
+            b->val[j] = 1 + (double)(j % 5);
+        }
+        store_set(&E->store, "A", A);
+        store_set(&E->store, "b", b);
+        val_release(A), val_release(b);
+    }
+    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
+    for (i = 0; i < 6; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "dense solve: %s", E->err);
+    CHECK(status_has(E, "backends for solve.dense"), "dense table shown: %s", sb_str(&captured));
+    if (strstr(sb_str(&captured), "\n  lapack "))
+        CHECK(strstr(sb_str(&captured), "\n  lapack precision = mixed ") != NULL,
+              "lapack mixed is a candidate: %s", sb_str(&captured));
     eng_destroy(&E);
 
     /* an impossible target: every candidate is refused and dispatch stays */

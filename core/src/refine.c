@@ -295,6 +295,15 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
              extended ? "double-double" : "double", (long long)kept, kept == 1 ? "" : "s", be0,
              kept ? be : be0, stop);
     add_note(r, note);
+    /* A single-precision factor gains about -log10(cond * eps_single) digits
+     * per step, none once the (scaled) matrix's condition reaches
+     * 1 / eps_single: then x is about as bad as the single solve, and says so. */
+    if (r->single_factor && !((kept ? be : be0) <= REFINE_SINGLE_CONVERGED))
+        eng_warn(E,
+                 "'\\': refinement of %s's single-precision factorization stopped at backward "
+                 "error %.2g (%s): too ill-conditioned for a single-precision factor, use a "
+                 "double one",
+                 b->full_name, kept ? be : be0, stop);
 done:
     r->seconds += util_now() - t0;
     free(B);

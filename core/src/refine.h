@@ -17,6 +17,10 @@
 #include "engine.h"
 
 #define REFINE_SINGLE_DEFAULT 10
+/* Backward error a refined single-precision solve must reach, else a warning
+ * says refinement did not converge (a lone single solve gives ~1e-8, a
+ * converged refinement ~1e-16). */
+#define REFINE_SINGLE_CONVERGED 1e-12
 
 /* If v stores a NaN or Inf, sets E->err to "<name> has NaN at (i, j)" (1-based)
  * and returns -1; else 0.  Cheap when v is finite (the cached props say so). */

@@ -514,7 +514,23 @@ static void wisdom_write(silc_engine *E, tuner *T)
     if (fclose(out) || rename(tmp, path)) remove(tmp);
 }
 
-/* Sets dispatch.<cls> (and the plugin's options for a variant); returns 1
+/* The setting a variant stands for: an option string ("-i cg -p none") is
+ * <backend>.options, "key = value" is <backend>.key.  Returns the value. */
+static const char *variant_setting(const char *backend, const char *opts, char *key, size_t keylen)
+{
+    const char *eq = opts[0] != '-' ? strchr(opts, '=') : NULL;
+    size_t klen;
+    if (!eq) {
+        snprintf(key, keylen, "%s.options", backend);
+        return opts;
+    }
+    for (klen = (size_t)(eq - opts); klen > 0 && opts[klen - 1] == ' '; klen--) continue;
+    snprintf(key, keylen, "%s.%.*s", backend, (int)klen, opts);
+    for (eq++; *eq == ' '; eq++) continue;
+    return eq;
+}
+
+/* Sets dispatch.<cls> (and the plugin's setting for a variant); returns 1
  * if that changes what runs. */
 static int apply_winner(silc_engine *E, const char *cls, const tuner_cand *w, const char *ran)
 {
@@ -523,8 +539,8 @@ static int apply_winner(silc_engine *E, const char *cls, const tuner_cand *w, co
     snprintf(key, sizeof key, "dispatch.%s", cls);
     if (cfg_set(E, CFG_SCOPE_SESSION, key, w->backend)) return 0;
     if (w->opts[0]) {
-        snprintf(key, sizeof key, "%s.options", w->backend);
-        cfg_set(E, CFG_SCOPE_SESSION, key, w->opts);
+        const char *value = variant_setting(w->backend, w->opts, key, sizeof key);
+        cfg_set(E, CFG_SCOPE_SESSION, key, value);
     }
     return 1;
 }
@@ -646,14 +662,20 @@ static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b,
     return rc || !call.out;
 }
 
-/* Option variants tried for the iterative plugins: their defaults alone
- * would judge the method by one preconditioner. */
+/* Variants tried for a backend, in classes starting with cls (NULL: all).
+ * The iterative plugins' defaults alone would judge the method by one
+ * preconditioner; the direct ones are also tried at mixed precision (a
+ * single-precision factor refined to double: faster, and as accurate while
+ * cond < 1 / eps_single, which the measured backward error checks).  opts ""
+ * is the backend's defaults; see variant_setting for the rest. */
 static const struct {
-    const char *backend, *opts;
+    const char *backend, *cls, *opts;
 } variants[] = {
-    {"lis-style", "-i cg -p none"}, {"lis-style", "-i cg -p ilu"},
-    {"lis-style", "-i bicgstab -p ilu"}, {"petsc", "-ksp_type cg -pc_type icc"},
-    {"petsc", "-ksp_type gmres -pc_type ilu"},
+    {"lis-style", NULL, "-i cg -p none"}, {"lis-style", NULL, "-i cg -p ilu"},
+    {"lis-style", NULL, "-i bicgstab -p ilu"}, {"petsc", NULL, "-ksp_type cg -pc_type icc"},
+    {"petsc", NULL, "-ksp_type gmres -pc_type ilu"},
+    {"lapack", "solve.dense", ""}, {"lapack", "solve.dense", "precision = mixed"},
+    {"mumps", "solve.sparse", ""}, {"mumps", "solve.sparse", "precision = single"},
 };
 
 static void trial_one(silc_engine *E, t_class *c, const char *backend, const char *variant)
@@ -665,8 +687,13 @@ static void trial_one(silc_engine *E, t_class *c, const char *backend, const cha
     memset(k, 0, sizeof *k);
     snprintf(k->backend, sizeof k->backend, "%s", backend);
     snprintf(k->opts, sizeof k->opts, "%s", variant ? variant : "");
-    if (variant) snprintf(opts, sizeof opts, "backend = %s; %s.options = %s", backend, backend, variant);
-    else snprintf(opts, sizeof opts, "backend = %s", backend);
+    if (variant) {
+        char key[80];
+        const char *value = variant_setting(backend, variant, key, sizeof key);
+        snprintf(opts, sizeof opts, "backend = %s; %s = %s", backend, key, value);
+    } else {
+        snprintf(opts, sizeof opts, "backend = %s", backend);
+    }
     a = val_copy(c->a);
     if (!a) {
         k->failed = 1;
@@ -708,8 +735,9 @@ static void trial_class(silc_engine *E, tuner *T, t_class *c)
         if (!op->run || (op->accepts && !op->accepts(&probe, &why))) continue;
         nv = 0;
         for (v = 0; v < sizeof variants / sizeof variants[0]; v++)
-            if (!strcmp(variants[v].backend, names[i]) && c->ncand < T_MAXB)
-                trial_one(E, c, names[i], variants[v].opts), nv++;
+            if (!strcmp(variants[v].backend, names[i]) && c->ncand < T_MAXB &&
+                (!variants[v].cls || !strncmp(c->cls, variants[v].cls, strlen(variants[v].cls))))
+                trial_one(E, c, names[i], variants[v].opts[0] ? variants[v].opts : NULL), nv++;
         if (!nv) trial_one(E, c, names[i], NULL);
     }
     free(names);

@@ -54,7 +54,8 @@ uint64_t tuner_hash(const char *text);
 /* ---- backend choice -------------------------------------------------------- */
 typedef struct tuner_cand {
     char backend[64];
-    char opts[64];         /* option variant of an iterative plugin, "" if none */
+    char opts[64];         /* variant: an option string for <backend>.options ("-i cg"),
+                              or "key = value" for <backend>.key; "" if none */
     double first, repeat;  /* seconds: a solve that factors, one that reuses */
     double berr;           /* backward error the core computed */
     int failed;            /* the backend declined or failed */
