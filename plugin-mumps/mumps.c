@@ -25,23 +25,37 @@
  * turns it off.  Workspace errors (the -9 class) double ICNTL(14) and retry
  * up to four times.
  *
+ * mumps.precision = single factors with smumps_c instead (mixed precision):
+ * the entries are scaled by a power of two so the largest is near 1 and
+ * converted to float once (kept in the attachment), every solve scales each
+ * right-hand-side column the same way, solves in single and scales back, and
+ * the report sets single_factor, so the core's refine.c refines in double
+ * (up to 10 steps unless solve.refine says otherwise).  Each step then gains
+ * about -log10(cond * eps_single) digits, cond of the matrix as MUMPS scales
+ * it; once that reaches 1 / eps_single (1.7e7) it gains none and the core
+ * warns.  When the entries span more than
+ * single precision's range, or the single LU is numerically singular, the
+ * matrix is factored in double and the note says why.
+ *
  * The module links MUMPS's static archives with -Wl,--exclude-libs,ALL and
  * -Bsymbolic (see CMakeLists.txt): Debian's sequential MUMPS carries a stub
  * MPI and the same dmumps_c symbol as the MPI MUMPS inside PETSc, and neither
  * may leak out of this plugin or bind to the other's.
  */
-#define _GNU_SOURCE /* dladdr */
+#include "common/blas_threads.h"
 #include "silc_plugin.h"
 
-#include <dlfcn.h>
+#include <float.h>
 #include <stddef.h>
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <dmumps_c.h>
+#include <smumps_c.h>
 
 #define MUMPS_JOB_INIT (-1)
 #define MUMPS_JOB_END (-2)
@@ -53,11 +67,10 @@
 #define N_ICNTL 40
 #define N_CNTL 15
 
-/* Fortran's 1-based ICNTL(i), INFOG(i), ... as C lvalues. */
-#define ICNTL(id, i) ((id)->icntl[(i)-1])
-#define CNTL(id, i) ((id)->cntl[(i)-1])
-#define INFOG(id, i) ((id)->infog[(i)-1])
-#define RINFOG(id, i) ((id)->rinfog[(i)-1])
+/* Fortran's 1-based ICNTL(i), INFOG(i) of a factorization F as C lvalues
+ * (the integer arrays are alike in both arithmetics). */
+#define ICNTL(F, i) ((F)->icntl[(i)-1])
+#define INFOG(F, i) ((F)->infog[(i)-1])
 
 static const silc_host_api *host;
 
@@ -67,7 +80,7 @@ static const silc_host_api *host;
 #define C(k, help) {"cntl_" #k, SILC_OPT_DOUBLE, "", "CNTL(" #k "): " help}
 /* The list order matters: icntl_k is entry k-1, cntl_k is entry N_ICNTL+k-1.
  * An empty default means "MUMPS's own default". */
-static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 1] = {
+static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
     IC(1, "-1", "output stream for error messages (<= 0: none)"),
     IC(2, "-1", "output stream for diagnostics (<= 0: none)"),
     IC(3, "-1", "output stream for global information (<= 0: none)"),
@@ -126,6 +139,8 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 1] = {
     C(15, "reserved"),
     {"condest", SILC_OPT_BOOL, "true",
      "estimate the 1-norm condition number (Hager-Higham, 2-10 extra solves per factorization)"},
+    {"precision", SILC_OPT_STRING, "double",
+     "factorization precision: double, or single (smumps factor, refined in double by the core)"},
 };
 #undef IC
 #undef C
@@ -155,6 +170,7 @@ typedef struct settings {
     double cntl[N_CNTL];
     int cntl_set[N_CNTL];
     int64_t condest;
+    int single;                 /* mumps.precision = single */
 } settings;
 
 static int read_settings(silc_call *call, settings *s)
@@ -173,6 +189,14 @@ static int read_settings(silc_call *call, settings *s)
         s->cntl[k - 1] = s->cntl_set[k - 1] ? v : 0.0;
     }
     if ((rc = host->option_int(call, "condest", 1, &s->condest))) return rc;
+    {
+        const char *prec = host->option_string(call, "precision", "double");
+        if (!prec) return SILC_EARG; /* the host has set the message */
+        if (strcmp(prec, "single") != 0 && strcmp(prec, "double") != 0)
+            return host->error(call, SILC_EARG,
+                               "option 'mumps.precision' expects double or single, got '%s'", prec);
+        s->single = strcmp(prec, "single") == 0;
+    }
     for (k = 0; k < (int)(sizeof fixed_icntl / sizeof fixed_icntl[0]); k++) {
         int64_t v = s->icntl[fixed_icntl[k].k - 1];
         if (v != fixed_icntl[k].value)
@@ -196,7 +220,7 @@ static int same_settings(const settings *a, const settings *b)
         if (a->icntl[k] != b->icntl[k]) return 0;
     for (k = 0; k < N_CNTL; k++)
         if (a->cntl_set[k] != b->cntl_set[k] || a->cntl[k] != b->cntl[k]) return 0;
-    return a->condest == b->condest;
+    return a->condest == b->condest && a->single == b->single;
 }
 
 /* ---- error meanings -------------------------------------------------------------- */
@@ -252,10 +276,18 @@ static int workspace_error(int code)
 /* ---- the factorization attachment ------------------------------------------------ */
 
 typedef struct mumps_factor {
-    DMUMPS_STRUC_C id;
+    union {
+        DMUMPS_STRUC_C d;
+        SMUMPS_STRUC_C s;
+    } id;                       /* id.s when single, else id.d */
+    int single;                 /* factored by smumps_c from af */
+    MUMPS_INT *icntl, *infog;   /* the arrays of the instance in use */
     int live;                   /* JOB=-1 succeeded: JOB=-2 must run */
     MUMPS_INT *irn, *jcn;       /* 1-based triplets; MUMPS reads them again for */
     double *a;                  /* error analysis and iterative refinement */
+    float *af;                  /* single: 2^scale_a * a in float, a is then freed */
+    int scale_a;
+    const char *fallback;       /* why mumps.precision = single factored in double */
     settings opts;              /* the options it was computed with */
     double cond_est;            /* 1-norm condition estimate, -1 = not computed */
     int analysed;               /* the error analysis ran (on the first 1-column solve) */
@@ -264,17 +296,32 @@ typedef struct mumps_factor {
     int retries;                /* ICNTL(14) doublings that were needed */
 } mumps_factor;
 
+/* One MUMPS call (JOB=job) in the arithmetic F was set up for. */
+static void mumps_job(mumps_factor *F, int job)
+{
+    if (F->single) {
+        F->id.s.job = job;
+        smumps_c(&F->id.s);
+    } else {
+        F->id.d.job = job;
+        dmumps_c(&F->id.d);
+    }
+}
+
+/* Sets an integer or index-array member of whichever instance F uses. */
+#define ID_SET(F, member, value)                                                                   \
+    ((F)->single ? (void)((F)->id.s.member = (value)) : (void)((F)->id.d.member = (value)))
+#define ID_N(F) ((F)->single ? (F)->id.s.n : (F)->id.d.n)
+
 static void factor_free(void *p)
 {
     mumps_factor *F = p;
     if (!F) return;
-    if (F->live) {
-        F->id.job = MUMPS_JOB_END;
-        dmumps_c(&F->id);
-    }
+    if (F->live) mumps_job(F, MUMPS_JOB_END);
     host->free(F->irn);
     host->free(F->jcn);
     host->free(F->a);
+    host->free(F->af);
     host->free(F);
 }
 
@@ -326,10 +373,11 @@ static int build_triplets(const silc_view *v, int lower, mumps_factor *F, int64_
 }
 
 /* The "dmumps_c (JOB=k): meaning (INFOG(1)=c, INFOG(2)=d)" message. */
-static int mumps_fail(silc_call *call, int status, const DMUMPS_STRUC_C *id, int job)
+static int mumps_fail(silc_call *call, int status, const mumps_factor *F, int job)
 {
-    return host->error(call, status, "dmumps_c (JOB=%d): %s (INFOG(1)=%d, INFOG(2)=%d)", job,
-                       mumps_meaning((int)INFOG(id, 1)), (int)INFOG(id, 1), (int)INFOG(id, 2));
+    return host->error(call, status, "%s (JOB=%d): %s (INFOG(1)=%d, INFOG(2)=%d)",
+                       F->single ? "smumps_c" : "dmumps_c", job, mumps_meaning((int)INFOG(F, 1)),
+                       (int)INFOG(F, 1), (int)INFOG(F, 2));
 }
 
 /* Status of a failed factorization: singular and not-positive-definite are
@@ -346,26 +394,69 @@ static int factor_status(int code, int sym)
  * call again".  Bounded: every retry spends one of MUMPS_RETRIES. */
 #define SOLVE_AGAIN (-1)
 
+/* Power-of-two exponent that brings the largest |x[i]| (i < n) into [0.5, 1),
+ * so values fit single precision without changing a bit of their mantissas. */
+static int scale_exponent(const double *x, int64_t n)
+{
+    double mx = 0;
+    int e = 0;
+    int64_t i;
+    for (i = 0; i < n; i++)
+        if (fabs(x[i]) > mx) mx = fabs(x[i]);
+    if (mx > 0 && isfinite(mx)) frexp(mx, &e);
+    return -e;
+}
+
+/* Single precision: each column of rhs scaled by its own power of two, solved
+ * by smumps_c, scaled back (x = 2^(scale_a - q) y for (2^scale_a A) y = 2^q b). */
+static int solve_single(mumps_factor *F, double *rhs, int64_t nrhs)
+{
+    int64_t n = F->id.s.n, i, c;
+    float *y = host->alloc((size_t)(n * nrhs) * sizeof *y);
+    int *q = host->alloc((size_t)nrhs * sizeof *q);
+    if (!y || !q) {
+        host->free(y);
+        host->free(q);
+        return SILC_ENOMEM;
+    }
+    for (c = 0; c < nrhs; c++) {
+        q[c] = scale_exponent(rhs + c * n, n);
+        for (i = 0; i < n; i++) y[i + c * n] = (float)ldexp(rhs[i + c * n], q[c]);
+    }
+    F->id.s.rhs = y;
+    mumps_job(F, MUMPS_JOB_SOLVE);
+    if (INFOG(F, 1) >= 0)
+        for (c = 0; c < nrhs; c++)
+            for (i = 0; i < n; i++) rhs[i + c * n] = ldexp((double)y[i + c * n], F->scale_a - q[c]);
+    F->id.s.rhs = NULL;
+    host->free(y);
+    host->free(q);
+    return SILC_OK;
+}
+
 /* JOB=3 on nrhs columns of rhs, overwritten by the solution.  When the solve
  * runs out of workspace, refactors with twice ICNTL(14) and asks the caller to
  * refill rhs (the failed solve may have overwritten it). */
 static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs)
 {
-    DMUMPS_STRUC_C *id = &F->id;
-    id->rhs = rhs;
-    id->nrhs = (MUMPS_INT)nrhs;
-    id->lrhs = id->n;
-    id->job = MUMPS_JOB_SOLVE;
-    dmumps_c(id);
-    if (INFOG(id, 1) >= 0) return SILC_OK;
-    if (!workspace_error((int)INFOG(id, 1)) || F->retries >= MUMPS_RETRIES)
-        return mumps_fail(call, factor_status((int)INFOG(id, 1), 0), id, MUMPS_JOB_SOLVE);
-    ICNTL(id, 14) = ICNTL(id, 14) > 0 ? 2 * ICNTL(id, 14) : 40;
+    ID_SET(F, nrhs, (MUMPS_INT)nrhs);
+    ID_SET(F, lrhs, ID_N(F));
+    if (F->single) {
+        if (solve_single(F, rhs, nrhs))
+            return host->error(call, SILC_ENOMEM, "mumps: out of memory for the single-precision solve");
+    } else {
+        F->id.d.rhs = rhs;
+        mumps_job(F, MUMPS_JOB_SOLVE);
+    }
+    if (INFOG(F, 1) >= 0) return SILC_OK;
+    if (!workspace_error((int)INFOG(F, 1)) || F->retries >= MUMPS_RETRIES)
+        return mumps_fail(call, factor_status((int)INFOG(F, 1), 0), F, MUMPS_JOB_SOLVE);
+    ICNTL(F, 14) = ICNTL(F, 14) > 0 ? 2 * ICNTL(F, 14) : 40;
     F->retries++;
-    id->job = MUMPS_JOB_FACTOR;
-    dmumps_c(id);
-    if (INFOG(id, 1) < 0)
-        return mumps_fail(call, factor_status((int)INFOG(id, 1), id->sym), id, MUMPS_JOB_FACTOR);
+    mumps_job(F, MUMPS_JOB_FACTOR);
+    if (INFOG(F, 1) < 0)
+        return mumps_fail(call, factor_status((int)INFOG(F, 1), F->single ? F->id.s.sym : F->id.d.sym),
+                          F, MUMPS_JOB_FACTOR);
     return SOLVE_AGAIN;
 }
 
@@ -374,10 +465,10 @@ static int solve_vec(silc_call *call, mumps_factor *F, const double *in, double 
 {
     int rc;
     do {
-        memcpy(out, in, (size_t)F->id.n * sizeof(double));
-        ICNTL(&F->id, 9) = trans ? 2 : 1;
+        memcpy(out, in, (size_t)ID_N(F) * sizeof(double));
+        ICNTL(F, 9) = trans ? 2 : 1;
         rc = run_solve(call, F, out, 1);
-        ICNTL(&F->id, 9) = 1;
+        ICNTL(F, 9) = 1;
     } while (rc == SOLVE_AGAIN);
     return rc;
 }
@@ -394,7 +485,7 @@ static int apply_inverse(void *ctx, double *x, int trans, double *work)
 {
     est_ctx *c = ctx;
     if ((c->rc = solve_vec(c->call, c->F, x, work, trans))) return c->rc;
-    memcpy(x, work, (size_t)c->F->id.n * sizeof *x);
+    memcpy(x, work, (size_t)ID_N(c->F) * sizeof *x);
     return 0;
 }
 
@@ -402,30 +493,87 @@ static int apply_inverse(void *ctx, double *x, int trans, double *work)
  * analysis is switched off meanwhile (it would run on every solve). */
 static int estimate_inv_norm1(silc_call *call, mumps_factor *F, double *est_out)
 {
-    int icntl11 = (int)ICNTL(&F->id, 11);
+    int icntl11 = (int)ICNTL(F, 11);
     double *work;
     est_ctx c = {call, F, 0};
     *est_out = -1;
     if (host->struct_size < offsetof(silc_host_api, inv_norm1_est) + sizeof host->inv_norm1_est)
         return 0; /* an ABI 1.0 host lends no estimator: the estimate stays unknown */
-    work = host->alloc((size_t)F->id.n * sizeof *work);
+    work = host->alloc((size_t)ID_N(F) * sizeof *work);
     if (!work) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
-    ICNTL(&F->id, 11) = 0;
-    *est_out = host->inv_norm1_est(F->id.n, apply_inverse, &c, work);
-    ICNTL(&F->id, 11) = icntl11;
+    ICNTL(F, 11) = 0;
+    *est_out = host->inv_norm1_est(ID_N(F), apply_inverse, &c, work);
+    ICNTL(F, 11) = icntl11;
     host->free(work);
     return c.rc;
 }
 
-/* Initializes MUMPS for A, analyses and factors it (JOB=-1, then JOB=4, then
- * JOB=2 again with twice the workspace while it runs short). */
+/* mumps.precision = single: af = 2^scale_a a in float, the largest entry near
+ * 1.  Returns why that cannot be done, or NULL. */
+static const char *to_single(mumps_factor *F, int64_t nnz)
+{
+    int64_t k;
+    F->scale_a = scale_exponent(F->a, nnz);
+    for (k = 0; k < nnz; k++) {
+        double x = ldexp(F->a[k], F->scale_a);
+        if (x != 0 && fabs(x) < FLT_MIN) return "its entries span more than single precision's range";
+    }
+    F->af = host->alloc((size_t)nnz * sizeof *F->af);
+    if (!F->af) return "no memory for a single-precision copy";
+    for (k = 0; k < nnz; k++) F->af[k] = (float)ldexp(F->a[k], F->scale_a);
+    return NULL;
+}
+
+/* JOB=-1, then JOB=4, then JOB=2 again with twice the workspace while it runs
+ * short, in F's arithmetic.  Returns INFOG(1) and the last JOB in *job. */
+static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const settings *s, int *job)
+{
+    int k;
+    F->icntl = F->single ? F->id.s.icntl : F->id.d.icntl;
+    F->infog = F->single ? F->id.s.infog : F->id.d.infog;
+    ID_SET(F, par, 1);
+    ID_SET(F, sym, sym);
+    ID_SET(F, comm_fortran, MUMPS_USE_COMM_WORLD);
+    mumps_job(F, *job = MUMPS_JOB_INIT);
+    if (INFOG(F, 1) < 0) return (int)INFOG(F, 1);
+    F->live = 1;
+    for (k = 1; k <= N_ICNTL; k++)
+        if (s->icntl[k - 1] != ICNTL_UNSET) ICNTL(F, k) = (MUMPS_INT)s->icntl[k - 1];
+    for (k = 1; k <= N_CNTL; k++)
+        if (s->cntl_set[k - 1]) {
+            if (F->single)
+                F->id.s.cntl[k - 1] = (float)s->cntl[k - 1];
+            else
+                F->id.d.cntl[k - 1] = s->cntl[k - 1];
+        }
+    ID_SET(F, n, (MUMPS_INT)n);
+    ID_SET(F, nnz, nnz);
+    ID_SET(F, nz, nnz <= INT_MAX ? (MUMPS_INT)nnz : 0);
+    ID_SET(F, irn, F->irn);
+    ID_SET(F, jcn, F->jcn);
+    if (F->single)
+        F->id.s.a = F->af;
+    else
+        F->id.d.a = F->a;
+    mumps_job(F, *job = MUMPS_JOB_ANALYSE_FACTOR);
+    /* Workspace errors come from the factorization phase, after a complete
+     * analysis: only the factorization (JOB=2) is repeated. */
+    while (INFOG(F, 1) < 0 && workspace_error((int)INFOG(F, 1)) && F->retries < MUMPS_RETRIES) {
+        ICNTL(F, 14) = ICNTL(F, 14) > 0 ? 2 * ICNTL(F, 14) : 40;
+        F->retries++;
+        mumps_job(F, *job = MUMPS_JOB_FACTOR);
+    }
+    return (int)INFOG(F, 1);
+}
+
+/* Initializes MUMPS for A, analyses and factors it, in single precision when
+ * the settings ask and the entries allow. */
 static int factor_new(silc_call *call, const silc_view *v, int sym, const settings *s,
                       mumps_factor **out)
 {
     mumps_factor *F = host->calloc(1, sizeof *F);
-    DMUMPS_STRUC_C *id;
     int64_t nnz = 0;
-    int k, rc;
+    int rc, code, job;
     double t0 = host->now();
     *out = NULL;
     if (!F) return host->error(call, SILC_ENOMEM, "mumps: out of memory");
@@ -440,48 +588,35 @@ static int factor_new(silc_call *call, const silc_view *v, int sym, const settin
         factor_free(F);
         return host->error(call, SILC_ESINGULAR, "mumps: singular matrix (no nonzero entries)");
     }
-    id = &F->id;
-    id->job = MUMPS_JOB_INIT;
-    id->par = 1;
-    id->sym = sym;
-    id->comm_fortran = MUMPS_USE_COMM_WORLD;
-    dmumps_c(id);
-    if (INFOG(id, 1) < 0) {
-        rc = mumps_fail(call, SILC_ELIB, id, MUMPS_JOB_INIT);
+    if (s->single) {
+        F->fallback = to_single(F, nnz);
+        F->single = F->fallback == NULL;
+    }
+    code = analyse_factor(F, (int)v->n, nnz, sym, s, &job);
+    if (code == -10 && F->single && sym == 0) {
+        /* Singular in single precision may still be regular in double. */
+        mumps_job(F, MUMPS_JOB_END);
+        memset(&F->id, 0, sizeof F->id);
+        F->live = F->single = F->retries = 0;
+        host->free(F->af);
+        F->af = NULL;
+        F->fallback = "the single-precision LU was numerically singular";
+        code = analyse_factor(F, (int)v->n, nnz, sym, s, &job);
+    }
+    if (code < 0) {
+        rc = mumps_fail(call, job == MUMPS_JOB_INIT ? SILC_ELIB : factor_status(code, sym), F, job);
         factor_free(F);
         return rc;
     }
-    F->live = 1;
-    for (k = 1; k <= N_ICNTL; k++)
-        if (s->icntl[k - 1] != ICNTL_UNSET) ICNTL(id, k) = (MUMPS_INT)s->icntl[k - 1];
-    for (k = 1; k <= N_CNTL; k++)
-        if (s->cntl_set[k - 1]) CNTL(id, k) = s->cntl[k - 1];
-    id->n = (MUMPS_INT)v->n;
-    id->nnz = nnz;
-    id->nz = nnz <= INT_MAX ? (MUMPS_INT)nnz : 0;
-    id->irn = F->irn;
-    id->jcn = F->jcn;
-    id->a = F->a;
-    id->job = MUMPS_JOB_ANALYSE_FACTOR;
-    dmumps_c(id);
-    /* Workspace errors come from the factorization phase, after a complete
-     * analysis: only the factorization (JOB=2) is repeated. */
-    while (INFOG(id, 1) < 0 && workspace_error((int)INFOG(id, 1)) && F->retries < MUMPS_RETRIES) {
-        ICNTL(id, 14) = ICNTL(id, 14) > 0 ? 2 * ICNTL(id, 14) : 40;
-        F->retries++;
-        id->job = MUMPS_JOB_FACTOR;
-        dmumps_c(id);
-    }
-    if (INFOG(id, 1) < 0) {
-        rc = mumps_fail(call, factor_status((int)INFOG(id, 1), sym), id, id->job);
-        factor_free(F);
-        return rc;
+    if (F->single) { /* MUMPS reads af from now on */
+        host->free(F->a);
+        F->a = NULL;
     }
     /* LDL' of an SPD matrix has only positive pivots; INFOG(12) counts the negative ones. */
-    if (sym == 1 && INFOG(id, 12) > 0) {
+    if (sym == 1 && INFOG(F, 12) > 0) {
         rc = host->error(call, SILC_ENOTSPD,
-                         "dmumps_c (JOB=4): matrix is not positive definite (INFOG(12)=%d negative "
-                         "pivots)", (int)INFOG(id, 12));
+                         "%s (JOB=4): matrix is not positive definite (INFOG(12)=%d negative pivots)",
+                         F->single ? "smumps_c" : "dmumps_c", (int)INFOG(F, 12));
         factor_free(F);
         return rc;
     }
@@ -523,32 +658,53 @@ static void dense_copy(const silc_view *b, double *x)
     }
 }
 
+/* Appends "; text" (or text) to the report's note, truncating. */
+static void note_add(silc_report *r, const char *fmt, ...)
+{
+    size_t len = strlen(r->note);
+    va_list ap;
+    if (len + 3 >= sizeof r->note) return;
+    if (len) {
+        memcpy(r->note + len, "; ", 3);
+        len += 2;
+    }
+    va_start(ap, fmt);
+    vsnprintf(r->note + len, sizeof r->note - len, fmt, ap);
+    va_end(ap);
+}
+
 static void fill_report(silc_report *r, const mumps_factor *F)
 {
-    const DMUMPS_STRUC_C *id = &F->id;
-    int len = 0;
-    snprintf(r->method, sizeof r->method, "%s (MUMPS multifrontal, SYM=%d, %s order)",
-             id->sym == 1 ? "LDL' Cholesky" : "LU", (int)id->sym, ordering_name((int)INFOG(id, 7)));
+    int sym = (int)(F->single ? F->id.s.sym : F->id.d.sym);
+    const char *fact = sym == 1 ? "LDL' Cholesky" : "LU";
+    if (F->single)
+        snprintf(r->method, sizeof r->method, "%s (MUMPS single precision) + refinement",
+                 sym == 1 ? "LDL'" : "LU");
+    else
+        snprintf(r->method, sizeof r->method, "%s (MUMPS multifrontal, SYM=%d, %s order)", fact, sym,
+                 ordering_name((int)INFOG(F, 7)));
     r->cond_est = F->cond_est;
     r->rcond = -1;
     r->iterations = 0;
+    r->note[0] = '\0';
+    if (F->single) {
+        if (host->abi_minor >= 2) r->single_factor = 1;
+        note_add(r, "SYM=%d, %s order", sym, ordering_name((int)INFOG(F, 7)));
+    } else if (F->fallback) {
+        note_add(r, "mumps.precision = single: factored in double, %s", F->fallback);
+    }
     /* RINFOG(7), (8): backward errors omega1, omega2; (9): forward error
      * bound; (10), (11): condition numbers cond1, cond2 (ICNTL(11)=1 only). */
     if (F->analysed)
-        len = snprintf(r->note, sizeof r->note,
-                       "MUMPS error analysis (first solve): omega1 %.2g, omega2 %.2g", F->rinfog[6],
-                       F->rinfog[7]);
-    if (F->analysed && ICNTL(id, 11) == 1 && len < (int)sizeof r->note)
-        len += snprintf(r->note + len, sizeof r->note - (size_t)len,
-                        ", cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9],
-                        F->rinfog[10], F->rinfog[8]);
-    if (F->retries && len < (int)sizeof r->note)
-        len += snprintf(r->note + len, sizeof r->note - (size_t)len,
-                        "%sworkspace raised to ICNTL(14)=%d after %d retr%s", len ? "; " : "",
-                        (int)ICNTL(id, 14), F->retries, F->retries == 1 ? "y" : "ies");
-    if (INFOG(id, 1) > 0 && len < (int)sizeof r->note)
-        snprintf(r->note + len, sizeof r->note - (size_t)len, "%sMUMPS warning INFOG(1)=%d",
-                 len ? "; " : "", (int)INFOG(id, 1));
+        note_add(r, "MUMPS error analysis (first solve): omega1 %.2g, omega2 %.2g", F->rinfog[6],
+                 F->rinfog[7]);
+    if (F->analysed && ICNTL(F, 11) == 1)
+        note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
+                 F->rinfog[8]);
+    if (F->retries)
+        note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
+                 F->retries, F->retries == 1 ? "y" : "ies");
+    if (INFOG(F, 1) > 0) note_add(r, "MUMPS warning INFOG(1)=%d", (int)INFOG(F, 1));
 }
 
 static int ends_with_spd(const char *cls)
@@ -588,11 +744,14 @@ static int solve_run(silc_call *call)
     mumps_factor *F;
     silc_value *X;
     int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse;
-    const char *key = sym ? "mumps.ldlt" : "mumps.lu";
+    const char *key;
     double t0;
     const char *why = NULL;
     if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
     if ((rc = read_settings(call, &s))) return rc;
+    /* Both precisions' factorizations can live on A at once. */
+    key = sym ? (s.single ? "mumps.ldlt.single" : "mumps.ldlt")
+              : (s.single ? "mumps.lu.single" : "mumps.lu");
     host->view(call->in[0], &a);
     host->view(call->in[1], &b);
     if (b.m != a.n)
@@ -622,15 +781,16 @@ static int solve_run(silc_call *call)
     host->view(X, &o);
     t0 = host->now();
     /* The error analysis runs once per factorization (see the top of the file). */
-    icntl11 = (int)ICNTL(&F->id, 11);
+    icntl11 = (int)ICNTL(F, 11);
     analyse = !F->analysed && b.n == 1 && icntl11 > 0;
-    if (!analyse) ICNTL(&F->id, 11) = 0;
+    if (!analyse) ICNTL(F, 11) = 0;
     do dense_copy(&b, o.val);
     while ((rc = run_solve(call, F, o.val, b.n)) == SOLVE_AGAIN);
-    ICNTL(&F->id, 11) = icntl11;
+    ICNTL(F, 11) = icntl11;
     if (!rc && analyse) {
         F->analysed = 1;
-        memcpy(F->rinfog, F->id.rinfog, sizeof F->rinfog);
+        int k;
+        for (k = 0; k < 11; k++) F->rinfog[k] = F->single ? F->id.s.rinfog[k] : F->id.d.rinfog[k];
     }
     if (rc) {
         host->release(X);
@@ -656,7 +816,7 @@ static const silc_backend mumps_backends[] = {
 /* Sequential MUMPS is threaded only through BLAS: the OpenBLAS it was linked
  * with, found among this module's own dependencies (RTLD_LOCAL hides it from
  * a global look-up). */
-static void (*openblas_threads)(int);
+static blas_threads_fn openblas_threads;
 
 static void mumps_set_threads(int n)
 {
@@ -674,14 +834,7 @@ static silc_plugin mumps_plugin = {
 
 static void find_openblas(void)
 {
-    Dl_info info;
-    void *self;
-    if (!dladdr(&mumps_plugin, &info) || !info.dli_fname) return;
-    self = dlopen(info.dli_fname, RTLD_NOW | RTLD_LOCAL | RTLD_NOLOAD);
-    if (!self) return;
-    /* dlsym on a handle searches the module and its dependencies. */
-    *(void **)&openblas_threads = dlsym(self, "openblas_set_num_threads");
-    dlclose(self);
+    openblas_threads = blas_threads_find(&mumps_plugin);
     if (openblas_threads) mumps_plugin.set_threads = mumps_set_threads;
 }
 

@@ -19,153 +19,29 @@
  *   - neumann (singular): an error naming dmumps_c and the INFOG meaning, or a
  *     warning that the matrix is singular to working precision;
  *   - plugins loaded together: solves through mumps, reference and whichever
- *     other library plugins are installed interleave in one process.
+ *     other library plugins are installed interleave in one process;
+ *   - mumps.precision = single (smumps factor, refined in double by the core):
+ *     the Laplacian, west0479 and sherman1 reach backward error <= 1e-14 with
+ *     the refinement steps in `info`; the factor is reused; a 1e-300-scaled
+ *     Laplacian still works (power-of-two scaling into float range); entries
+ *     spanning more than float's range fall back to double with a note;
+ *     Hilbert n = 9 (cond 5e11 > 1 / eps_single) gets a warning that
+ *     refinement did not converge; a bad precision value is refused.
  */
 #include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
 #include "silc.h"
-
-#ifndef SILC_SHARED_MATRICES
-#define SILC_SHARED_MATRICES "../shared/matrices"
-#endif
-
-static char out_buf[16384];
-
-static void capture(void *user, const char *text)
-{
-    (void)user;
-    strncat(out_buf, text, sizeof out_buf - strlen(out_buf) - 1);
-}
-
-/* Runs `info name` and returns its text. */
-static const char *info(silc_context *c, const char *name)
-{
-    char stmt[64];
-    out_buf[0] = '\0';
-    snprintf(stmt, sizeof stmt, "info %s", name);
-    if (silc_exec(c, stmt)) snprintf(out_buf, sizeof out_buf, "info failed: %s", silc_context_errmsg(c));
-    return out_buf;
-}
-
-/* The "condition estimate: X" of the last info text, -1 if none. */
-static double info_cond(const char *text)
-{
-    const char *p = strstr(text, "condition estimate: ");
-    return p ? strtod(p + strlen("condition estimate: "), NULL) : -1;
-}
-
-static silc_context *open_forced(const char *backend)
-{
-    silc_context *c = NULL;
-    char stmt[160];
-    if (silc_open(&c, NULL)) {
-        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        return NULL;
-    }
-    silc_set_output(c, capture, NULL);
-    snprintf(stmt, sizeof stmt, "set dispatch.solve.sparse = %s; set dispatch.solve.sparse.spd = %s",
-             backend, backend);
-    CHECK(silc_exec(c, stmt) == 0, "%s: %s", stmt, silc_context_errmsg(c));
-    return c;
-}
-
-/* k x k grid, 5-point stencil, diagonal 4 - shift, as CSR. */
-static int laplacian(silc_envelope_t *A, int k, double shift)
-{
-    int64_t n = (int64_t)k * k, nz = 0;
-    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
-    double *v = malloc((size_t)(5 * n) * sizeof *v);
-    int rc = -1;
-    if (rp && ci && v) {
-        for (int64_t r = 0; r < n; r++) {
-            int64_t i = r / k, j = r % k;
-            rp[r] = nz;
-            if (i > 0) ci[nz] = r - k, v[nz++] = -1;
-            if (j > 0) ci[nz] = r - 1, v[nz++] = -1;
-            ci[nz] = r, v[nz++] = 4 - shift;
-            if (j < k - 1) ci[nz] = r + 1, v[nz++] = -1;
-            if (i < k - 1) ci[nz] = r + k, v[nz++] = -1;
-        }
-        rp[n] = nz;
-        rc = silc_envelope_csr(A, n, n, rp, ci, v);
-    }
-    free(rp);
-    free(ci);
-    free(v);
-    return rc;
-}
-
-static void csr_matvec(const silc_envelope_t *A, const double *x, double *y)
-{
-    for (int64_t i = 0; i < A->m; i++) {
-        double s = 0;
-        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += A->values[k] * x[A->colind[k]];
-        y[i] = s;
-    }
-}
-
-static double norminf(const double *x, int64_t n)
-{
-    double s = 0;
-    for (int64_t i = 0; i < n; i++)
-        if (fabs(x[i]) > s) s = fabs(x[i]);
-    return s;
-}
-
-/* ||x - y||_inf / ||y||_inf */
-static double reldiff(const double *x, const double *y, int64_t n)
-{
-    double d = 0;
-    for (int64_t i = 0; i < n; i++)
-        if (fabs(x[i] - y[i]) > d) d = fabs(x[i] - y[i]);
-    return d / norminf(y, n);
-}
-
-/* ||b - A x||_inf / (||A||_inf ||x||_inf + ||b||_inf), computed here. */
-static double backward_error(const silc_envelope_t *A, const double *x, const double *b)
-{
-    int64_t n = A->m;
-    double *r = malloc((size_t)n * sizeof *r), nA = 0;
-    if (!r) return INFINITY;
-    csr_matvec(A, x, r);
-    for (int64_t i = 0; i < n; i++) r[i] -= b[i];
-    for (int64_t i = 0; i < n; i++) {
-        double s = 0;
-        for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) s += fabs(A->values[k]);
-        if (s > nA) nA = s;
-    }
-    double be = norminf(r, n) / (nA * norminf(x, n) + norminf(b, n));
-    free(r);
-    return be;
-}
+#include "testlib.h"
 
 /* PUTs A and b = A * xs (xs_i = 1 + i/n) into c. */
 static int put_system(silc_context *c, const silc_envelope_t *A, double *xs, double *b)
 {
-    silc_envelope_t eb;
-    int64_t n = A->m;
-    int rc;
-    for (int64_t i = 0; i < n; i++) xs[i] = 1.0 + (double)i / (double)n;
-    csr_matvec(A, xs, b);
-    if (silc_put(c, "A", A) || silc_envelope_vector(&eb, n, b)) return -1;
-    rc = silc_put(c, "b", &eb);
-    silc_envelope_free(&eb);
-    return rc;
-}
-
-/* Fetches the n-vector name into x. */
-static int get_vec(silc_context *c, const char *name, double *x, int64_t n)
-{
-    silc_envelope_t e;
-    int rc;
-    if (silc_get(c, &e, name)) return -1;
-    rc = (e.m == n && e.n == 1) ? silc_envelope_to_dense(&e, x) : -1;
-    silc_envelope_free(&e);
-    return rc;
+    for (int64_t i = 0; i < A->m; i++) xs[i] = 1.0 + (double)i / (double)A->m;
+    return tl_put_system(c, A, xs, b);
 }
 
 static void test_laplacian(silc_context *cm)
@@ -177,32 +53,32 @@ static void test_laplacian(silc_context *cm)
            *x = malloc((size_t)n * sizeof *x), *X = malloc((size_t)(3 * n) * sizeof *X);
     const char *t;
     double cond;
-    if (!xs || !b || !x || !X || laplacian(&A, k, 0)) {
+    if (!xs || !b || !x || !X || tl_grid2d(&A, k, 0, 4)) {
         CHECK(0, "laplacian: setup failed");
         goto out;
     }
     CHECK(put_system(cm, &A, xs, b) == 0, "put: %s", silc_context_errmsg(cm));
     CHECK(silc_exec(cm, "x = A \\ b") == 0, "laplacian solve: %s", silc_context_errmsg(cm));
-    t = info(cm, "x");
+    t = tl_out_info(cm, "x");
     CHECK(strstr(t, "  backend: mumps\n") != NULL, "laplacian backend:\n%s", t);
     CHECK(strstr(t, "LDL'") && strstr(t, "SYM=1") && strstr(t, "AMF"), "laplacian method:\n%s", t);
     CHECK(strstr(t, "omega1") != NULL, "laplacian error analysis in note:\n%s", t);
     CHECK(strstr(t, "reused factorization: no") != NULL, "first solve factors:\n%s", t);
-    cond = info_cond(t);
+    cond = tl_out_number(t, "condition estimate: ");
     /* The 1-norm condition of the 40x40 Laplacian is about 1e3. */
     CHECK(cond > 1e2 && cond < 1e4, "laplacian condition estimate %g", cond);
-    CHECK(get_vec(cm, "x", x, n) == 0, "get x: %s", silc_context_errmsg(cm));
-    CHECK(reldiff(x, xs, n) <= 100 * DBL_EPSILON * cond, "laplacian forward error %g (cond %g)",
-          reldiff(x, xs, n), cond);
-    CHECK(backward_error(&A, x, b) < 1e-14, "laplacian backward error %g", backward_error(&A, x, b));
+    CHECK(tl_get_vec(cm, "x", x, n) == 0, "get x: %s", silc_context_errmsg(cm));
+    CHECK(tl_rel_diff(x, xs, n) <= 100 * DBL_EPSILON * cond, "laplacian forward error %g (cond %g)",
+          tl_rel_diff(x, xs, n), cond);
+    CHECK(tl_backward_error(&A, x, b) < 1e-14, "laplacian backward error %g", tl_backward_error(&A, x, b));
 
     /* Same A: the factorization is reused, the answer the same. */
     CHECK(silc_exec(cm, "y = A \\ (2 * b)") == 0, "second solve: %s", silc_context_errmsg(cm));
-    t = info(cm, "y");
+    t = tl_out_info(cm, "y");
     CHECK(strstr(t, "reused factorization: yes") != NULL, "second solve reuses:\n%s", t);
-    CHECK(get_vec(cm, "y", x, n) == 0, "get y");
+    CHECK(tl_get_vec(cm, "y", x, n) == 0, "get y");
     for (int64_t i = 0; i < n; i++) x[i] /= 2;
-    CHECK(reldiff(x, xs, n) <= 100 * DBL_EPSILON * cond, "reused forward error %g", reldiff(x, xs, n));
+    CHECK(tl_rel_diff(x, xs, n) <= 100 * DBL_EPSILON * cond, "reused forward error %g", tl_rel_diff(x, xs, n));
 
     /* Three right-hand sides at once. */
     CHECK(silc_exec(cm, "B = b * ones(1, 3); Z = A \\ B") == 0, "multi-rhs: %s", silc_context_errmsg(cm));
@@ -210,8 +86,8 @@ static void test_laplacian(silc_context *cm)
         silc_envelope_t e;
         if (silc_get(cm, &e, "Z") == 0 && e.m == n && e.n == 3 && silc_envelope_to_dense(&e, X) == 0) {
             for (int j = 0; j < 3; j++)
-                CHECK(reldiff(X + j * n, xs, n) <= 100 * DBL_EPSILON * cond, "column %d error %g", j,
-                      reldiff(X + j * n, xs, n));
+                CHECK(tl_rel_diff(X + j * n, xs, n) <= 100 * DBL_EPSILON * cond, "column %d error %g", j,
+                      tl_rel_diff(X + j * n, xs, n));
         } else {
             CHECK(0, "get Z: %s", silc_context_errmsg(cm));
         }
@@ -220,16 +96,16 @@ static void test_laplacian(silc_context *cm)
     silc_envelope_free(&A);
 
     /* Symmetric, positive diagonal, indefinite: SYM=1 fails, LU (SYM=0) answers. */
-    if (laplacian(&A, k, 1.0) == 0) {
+    if (tl_grid2d(&A, k, 0, 4 - 1.0) == 0) {
         CHECK(put_system(cm, &A, xs, b) == 0, "put shifted");
         CHECK(silc_exec(cm, "x = A \\ b") == 0, "shifted solve: %s", silc_context_errmsg(cm));
-        t = info(cm, "x");
+        t = tl_out_info(cm, "x");
         CHECK(strstr(t, "  backend: mumps\n") && strstr(t, "SYM=0"), "shifted uses mumps LU:\n%s", t);
         CHECK(strstr(t, "Cholesky failed") != NULL, "shifted notes the fallback:\n%s", t);
-        cond = info_cond(t);
-        CHECK(get_vec(cm, "x", x, n) == 0, "get shifted x");
-        CHECK(cond > 0 && reldiff(x, xs, n) <= 100 * DBL_EPSILON * cond, "shifted forward error %g (cond %g)",
-              reldiff(x, xs, n), cond);
+        cond = tl_out_number(t, "condition estimate: ");
+        CHECK(tl_get_vec(cm, "x", x, n) == 0, "get shifted x");
+        CHECK(cond > 0 && tl_rel_diff(x, xs, n) <= 100 * DBL_EPSILON * cond, "shifted forward error %g (cond %g)",
+              tl_rel_diff(x, xs, n), cond);
         silc_envelope_free(&A);
     } else {
         CHECK(0, "shifted laplacian setup");
@@ -256,20 +132,20 @@ static void test_shared(silc_context *cm, silc_context *cr, const char *file)
            *xm = malloc((size_t)n * sizeof *xm), *xr = malloc((size_t)n * sizeof *xr);
     if (xs && b && xm && xr && put_system(cm, &A, xs, b) == 0 && put_system(cr, &A, xs, b) == 0) {
         CHECK(silc_exec(cm, "x = A \\ b") == 0, "%s mumps: %s", file, silc_context_errmsg(cm));
-        const char *t = info(cm, "x");
-        double cond = info_cond(t);
+        const char *t = tl_out_info(cm, "x");
+        double cond = tl_out_number(t, "condition estimate: ");
         CHECK(strstr(t, "  backend: mumps\n") != NULL, "%s backend:\n%s", file, t);
         CHECK(cond >= 1, "%s condition estimate %g", file, cond);
         CHECK(silc_exec(cr, "x = A \\ b") == 0, "%s reference: %s", file, silc_context_errmsg(cr));
-        if (get_vec(cm, "x", xm, n) == 0 && get_vec(cr, "x", xr, n) == 0) {
-            double bound = 100 * DBL_EPSILON * cond, d = reldiff(xm, xr, n);
-            CHECK(backward_error(&A, xm, b) < 1e-12, "%s mumps backward error %g", file,
-                  backward_error(&A, xm, b));
+        if (tl_get_vec(cm, "x", xm, n) == 0 && tl_get_vec(cr, "x", xr, n) == 0) {
+            double bound = 100 * DBL_EPSILON * cond, d = tl_rel_diff(xm, xr, n);
+            CHECK(tl_backward_error(&A, xm, b) < 1e-12, "%s mumps backward error %g", file,
+                  tl_backward_error(&A, xm, b));
             CHECK(d <= bound || bound >= 1, "%s: mumps vs reference %g > %g", file, d, bound);
-            CHECK(reldiff(xm, xs, n) <= bound || bound >= 1, "%s: mumps vs exact %g > %g", file,
-                  reldiff(xm, xs, n), bound);
+            CHECK(tl_rel_diff(xm, xs, n) <= bound || bound >= 1, "%s: mumps vs exact %g > %g", file,
+                  tl_rel_diff(xm, xs, n), bound);
             printf("%-14s n %6lld  cond %8.2g  |x_mumps - x_ref| %8.2g  |x_mumps - x*| %8.2g\n", file,
-                   (long long)n, cond, d, reldiff(xm, xs, n));
+                   (long long)n, cond, d, tl_rel_diff(xm, xs, n));
         } else {
             CHECK(0, "%s: cannot fetch x", file);
         }
@@ -288,8 +164,8 @@ static void test_options(silc_context *cm)
     const char *e;
     CHECK(silc_exec(cm, "set mumps.icntl_7 = 5") == 0, "icntl_7 = 5: %s", silc_context_errmsg(cm));
     CHECK(silc_exec(cm, "x = A \\ b") == 0, "solve with icntl_7 = 5: %s", silc_context_errmsg(cm));
-    CHECK(strstr(info(cm, "x"), "reused factorization: no") != NULL,
-          "changed options refactor:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cm, "x"), "reused factorization: no") != NULL,
+          "changed options refactor:\n%s", tl_out());
     CHECK(silc_exec(cm, "set mumps.icntl_7 = 2") == 0, "icntl_7 back to 2");
     CHECK(silc_exec(cm, "set mumps.icntl_99 = 1") != 0, "icntl_99 must be refused");
     e = silc_context_errmsg(cm);
@@ -301,7 +177,7 @@ static void test_options(silc_context *cm)
     CHECK(strstr(e, "icntl_5") && strstr(e, "assembled"), "icntl_5 message: %s", e);
     CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.icntl_11 = 1\")") == 0, "icntl_11 = 1: %s",
           silc_context_errmsg(cm));
-    CHECK(strstr(info(cm, "x"), "cond1") != NULL, "full error analysis shows cond1:\n%s", out_buf);
+    CHECK(strstr(tl_out_info(cm, "x"), "cond1") != NULL, "full error analysis shows cond1:\n%s", tl_out());
 }
 
 /* Fails with a message naming dmumps_c and the INFOG meaning, or warns. */
@@ -404,9 +280,146 @@ static void test_together(silc_context *cm)
         }
 }
 
+/* ---- mumps.precision = single ---------------------------------------------------- */
+
+/* Solves the system in cm with mumps.precision = single; checks the method,
+ * that refinement ran and that the backward error reached 1e-14.  Returns the
+ * number of refinement steps, -1 on failure. */
+static int single_solve(silc_context *cm, const silc_envelope_t *A, const double *b, double *x,
+                        const char *what)
+{
+    const char *t;
+    double steps, be;
+    if (silc_exec(cm, "x = solve(A, b, \"mumps.precision = single\")")) {
+        CHECK(0, "%s single: %s", what, silc_context_errmsg(cm));
+        return -1;
+    }
+    t = tl_out_info(cm, "x");
+    CHECK(strstr(t, "  backend: mumps\n") && strstr(t, "MUMPS single precision) + refinement"),
+          "%s single method:\n%s", what, t);
+    steps = tl_out_number(t, "refinement: ");
+    CHECK(steps >= 1 && steps <= 10, "%s single: refinement steps %g:\n%s", what, steps, t);
+    CHECK(strstr(t, "backward error before: ") != NULL, "%s single: no unrefined error:\n%s", what, t);
+    if (tl_get_vec(cm, "x", x, A->m)) {
+        CHECK(0, "%s single: get x", what);
+        return -1;
+    }
+    be = tl_backward_error(A, x, b);
+    CHECK(be <= 1e-14, "%s single: backward error %g after refinement", what, be);
+    CHECK(strstr(silc_context_warnings(cm), "single-precision") == NULL, "%s single warns: %s", what,
+          silc_context_warnings(cm));
+    printf("%-14s single + %g refinement steps: backward error %.2g, before %.2g\n", what, steps, be,
+           tl_out_number(t, "backward error before: "));
+    return (int)steps;
+}
+
+/* The n x n Hilbert matrix as CSR. */
+static int hilbert_csr(silc_envelope_t *H, int64_t n)
+{
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(n * n) * sizeof *ci);
+    double *v = malloc((size_t)(n * n) * sizeof *v);
+    int rc = -1;
+    if (rp && ci && v) {
+        for (int64_t i = 0; i <= n; i++) rp[i] = i * n;
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t j = 0; j < n; j++) ci[i * n + j] = j, v[i * n + j] = 1.0 / (double)(i + j + 1);
+        rc = silc_envelope_csr(H, n, n, rp, ci, v);
+    }
+    free(rp);
+    free(ci);
+    free(v);
+    return rc;
+}
+
+static void test_single(silc_context *cm)
+{
+    silc_envelope_t A;
+    const int k = 40;
+    int64_t n = (int64_t)k * k;
+    double *xs = malloc((size_t)n * sizeof *xs), *b = malloc((size_t)n * sizeof *b),
+           *x = malloc((size_t)n * sizeof *x);
+    const char *t;
+    if (!xs || !b || !x || tl_laplacian2d(&A, k)) {
+        CHECK(0, "single: setup failed");
+        goto out;
+    }
+    CHECK(put_system(cm, &A, xs, b) == 0, "put: %s", silc_context_errmsg(cm));
+    single_solve(cm, &A, b, x, "laplacian");
+    CHECK(tl_rel_diff(x, xs, n) <= 1e-12, "laplacian single forward error %g", tl_rel_diff(x, xs, n));
+    /* The single factor stays on A next to the double one and is reused. */
+    CHECK(silc_exec(cm, "y = A \\ b; x = solve(A, b, \"mumps.precision = single\")") == 0, "again: %s",
+          silc_context_errmsg(cm));
+    t = tl_out_info(cm, "x");
+    CHECK(strstr(t, "reused factorization: yes") && strstr(t, "single precision"),
+          "single factor reused:\n%s", t);
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.precision = half\")") != 0, "precision = half accepted");
+    CHECK(strstr(silc_context_errmsg(cm), "expects double or single") != NULL, "half: %s",
+          silc_context_errmsg(cm));
+
+    /* Scaled far outside float's range: the power-of-two scaling takes it. */
+    for (int64_t p = 0; p < A.nnz; p++) A.values[p] *= 1e-300;
+    CHECK(put_system(cm, &A, xs, b) == 0, "put scaled");
+    single_solve(cm, &A, b, x, "laplacian*1e-300");
+    CHECK(tl_rel_diff(x, xs, n) <= 1e-12, "scaled single forward error %g", tl_rel_diff(x, xs, n));
+
+    /* Rows scaled from 1e-30 to 1e30: no power of two fits all entries into
+     * float, so the matrix is factored in double, and the note says so. */
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t p = A.rowptr[i]; p < A.rowptr[i + 1]; p++)
+            A.values[p] = A.values[p] * 1e300 * pow(10.0, 60.0 * (double)i / (double)(n - 1) - 30);
+    CHECK(put_system(cm, &A, xs, b) == 0, "put wide");
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.precision = single\")") == 0, "wide: %s",
+          silc_context_errmsg(cm));
+    t = tl_out_info(cm, "x");
+    CHECK(strstr(t, "factored in double") && strstr(t, "range") && !strstr(t, "single precision)"),
+          "wide range falls back to double:\n%s", t);
+    CHECK(tl_get_vec(cm, "x", x, n) == 0 && tl_backward_error(&A, x, b) <= 1e-14,
+          "wide backward error %g", tl_backward_error(&A, x, b));
+    silc_envelope_free(&A);
+
+    static const char *files[] = {"west0479.mtx", "sherman1.mtx"};
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+        char path[1024], err[256];
+        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, files[f]);
+        if (silc_mm_read(&A, path, err, sizeof err)) {
+            CHECK(0, "%s: %s", files[f], err);
+            continue;
+        }
+        if (A.m <= n && put_system(cm, &A, xs, b) == 0)
+            single_solve(cm, &A, b, x, files[f]);
+        else
+            CHECK(0, "%s: setup failed", files[f]);
+        silc_envelope_free(&A);
+    }
+
+    /* Hilbert 9: cond_1 5e11, beyond 1 / eps_single even after scaling.  The
+     * single factor cannot be refined to double accuracy, and a warning says
+     * so; in double the same system gets no such warning. */
+    if (hilbert_csr(&A, 9) == 0 && put_system(cm, &A, xs, b) == 0) {
+        CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.precision = single\")") == 0, "hilbert single: %s",
+              silc_context_errmsg(cm));
+        const char *w = silc_context_warnings(cm);
+        CHECK(strstr(w, "single-precision factorization stopped") && strstr(w, "ill-conditioned"),
+              "hilbert single must warn: '%s'", w);
+        CHECK(tl_get_vec(cm, "x", x, 9) == 0 && tl_backward_error(&A, x, b) > 1e-12,
+              "hilbert single: backward error %g reached double accuracy", tl_backward_error(&A, x, b));
+        printf("hilbert9 single: %s\n", w);
+        CHECK(silc_exec(cm, "x = A \\ b") == 0, "hilbert double: %s", silc_context_errmsg(cm));
+        CHECK(strstr(silc_context_warnings(cm), "single-precision") == NULL, "hilbert double warns: %s",
+              silc_context_warnings(cm));
+    } else {
+        CHECK(0, "hilbert setup");
+    }
+    silc_envelope_free(&A);
+out:
+    free(xs);
+    free(b);
+    free(x);
+}
+
 int main(void)
 {
-    silc_context *cm = open_forced("mumps"), *cr = open_forced("reference");
+    silc_context *cm = tl_open_forced("mumps"), *cr = tl_open_forced("reference");
     if (cm && cr) {
         test_laplacian(cm);
         test_shared(cm, cr, "west0479.mtx");
@@ -415,6 +428,7 @@ int main(void)
         test_options(cm);
         test_together(cm);
         test_singular(cm);
+        test_single(cm);
     }
     silc_close(&cm);
     silc_close(&cr);
