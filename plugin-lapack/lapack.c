@@ -476,15 +476,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_pl
                                         const char **errmsg)
 {
     const char *config;
-    if (!host || !out) {
-        if (errmsg) *errmsg = "lapack: no host table";
-        return 1;
-    }
-    if (host->abi_major != SILC_ABI_MAJOR || host->index_bytes != (int)sizeof(silc_index) ||
-        host->struct_size < offsetof(silc_host_api, threads) + sizeof(host->threads)) {
-        if (errmsg) *errmsg = "lapack: host ABI does not match the one this plugin was built for";
-        return 1;
-    }
+    if (silc_host_check(host, SILC_HOST_NEEDS(threads), errmsg) || !out) return 1;
     lp_host = host;
     config = openblas_get_config();
     snprintf(lp_version, sizeof lp_version, "1.0 %s", config ? config : "OpenBLAS (unknown version)");

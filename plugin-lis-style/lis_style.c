@@ -555,15 +555,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_pl
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (!host || !out) {
-        if (errmsg) *errmsg = "lis-style: no host table";
-        return 1;
-    }
-    if (host->abi_major != SILC_ABI_MAJOR || host->index_bytes != (int)sizeof(silc_index) ||
-        host->struct_size < offsetof(silc_host_api, threads) + sizeof(host->threads)) {
-        if (errmsg) *errmsg = "lis-style: host ABI (major version, index width or table size) does not match";
-        return 1;
-    }
+    if (silc_host_check(host, SILC_HOST_NEEDS(threads), errmsg) || !out) return 1;
     lis_host = host;
     *out = &lis_plugin;
     return 0;

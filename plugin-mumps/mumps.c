@@ -497,8 +497,6 @@ static int estimate_inv_norm1(silc_call *call, mumps_factor *F, double *est_out)
     double *work;
     est_ctx c = {call, F, 0};
     *est_out = -1;
-    if (host->struct_size < offsetof(silc_host_api, inv_norm1_est) + sizeof host->inv_norm1_est)
-        return 0; /* an ABI 1.0 host lends no estimator: the estimate stays unknown */
     work = host->alloc((size_t)ID_N(F) * sizeof *work);
     if (!work) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     ICNTL(F, 11) = 0;
@@ -843,18 +841,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (!h || !out) {
-        if (errmsg) *errmsg = "mumps: no host table";
-        return 1;
-    }
-    if (h->abi_major != SILC_ABI_MAJOR || h->struct_size < sizeof(silc_host_api)) {
-        if (errmsg) *errmsg = "mumps: host ABI does not match the one this plugin was built for";
-        return 1;
-    }
-    if (h->index_bytes != (int)sizeof(silc_index)) {
-        if (errmsg) *errmsg = "mumps: host index width differs from the plugin's";
-        return 1;
-    }
+    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
     host = h;
     find_openblas();
     *out = &mumps_plugin;

@@ -651,18 +651,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (!h || !out) {
-        if (errmsg) *errmsg = "petsc: no host table";
-        return 1;
-    }
-    if (h->abi_major != SILC_ABI_MAJOR || h->struct_size < sizeof(silc_host_api)) {
-        if (errmsg) *errmsg = "petsc: host ABI does not match the one this plugin was built for";
-        return 1;
-    }
-    if (h->index_bytes != (int)sizeof(silc_index)) {
-        if (errmsg) *errmsg = "petsc: host index width differs from the plugin's";
-        return 1;
-    }
+    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
     host = h;
     find_openblas();
     *out = &petsc_plugin;

@@ -287,22 +287,7 @@ static const silc_plugin ref_plugin = {
 
 static int ref_init(const silc_host_api *host, const silc_plugin **out, const char **errmsg)
 {
-    if (!host || !out) {
-        if (errmsg) *errmsg = "reference: no host table";
-        return 1;
-    }
-    if (host->abi_major != SILC_ABI_MAJOR) {
-        if (errmsg) *errmsg = "reference: host ABI major version differs from the plugin's";
-        return 1;
-    }
-    if (host->index_bytes != (int)sizeof(silc_index)) {
-        if (errmsg) *errmsg = "reference: host index width differs from the plugin's";
-        return 1;
-    }
-    if (host->struct_size < offsetof(silc_host_api, threads) + sizeof(host->threads)) {
-        if (errmsg) *errmsg = "reference: host API table is too old";
-        return 1;
-    }
+    if (silc_host_check(host, SILC_HOST_NEEDS(threads), errmsg) || !out) return 1;
     ref_host = host;
     *out = &ref_plugin;
     return 0;

@@ -175,8 +175,6 @@ static int ss_apply(void *ctx, double *x, int trans, double *work)
 double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), void *ctx)
 {
     ss_est e = {solve, ctx};
-    if (ss_host->struct_size < offsetof(silc_host_api, inv_norm1_est) + sizeof ss_host->inv_norm1_est)
-        return -1; /* an ABI 1.0 host lends no estimator */
     return ss_host->inv_norm1_est(n, ss_apply, &e, NULL);
 }
 

@@ -101,15 +101,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (!h || !out) {
-        if (errmsg) *errmsg = "suitesparse: no host table";
-        return 1;
-    }
-    if (h->abi_major != SILC_ABI_MAJOR || h->index_bytes != (int)sizeof(silc_index) ||
-        h->struct_size < offsetof(silc_host_api, threads) + sizeof h->threads) {
-        if (errmsg) *errmsg = "suitesparse: host ABI does not match the one this plugin was built for";
-        return 1;
-    }
+    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
     pthread_mutex_lock(&users_mutex);
     if (ss_users == 0) {
         ss_host = h;

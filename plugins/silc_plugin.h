@@ -272,6 +272,23 @@ typedef struct silc_plugin {
     void (*shutdown)(void);            /* NULL if nothing to release; called once at unload */
 } silc_plugin;
 
+/* The check every silc_plugin_init starts with: the host table exists, speaks
+ * this major version and index width, and is long enough to hold every host
+ * function the plugin calls (needed = SILC_HOST_NEEDS(last field used), so a
+ * newer plugin still runs on an older host when it only uses older fields).
+ * Returns 0, or 1 with *errmsg set to a static reason. */
+#define SILC_HOST_NEEDS(field) (offsetof(silc_host_api, field) + sizeof(((silc_host_api *)0)->field))
+static inline int silc_host_check(const silc_host_api *h, size_t needed, const char **errmsg)
+{
+    const char *why = NULL;
+    if (!h) why = "no host table";
+    else if (h->abi_major != SILC_ABI_MAJOR) why = "the host speaks another ABI major version";
+    else if (h->index_bytes != (int)sizeof(silc_index)) why = "the host uses another index width";
+    else if (h->struct_size < needed) why = "the host table lacks functions this plugin calls";
+    if (why && errmsg) *errmsg = why;
+    return why != NULL;
+}
+
 /* The one exported symbol.  Returns 0 and *out on success; on failure returns
  * non-zero and may set *errmsg to a static message. */
 typedef int (*silc_plugin_init_fn)(const silc_host_api *host, const silc_plugin **out,

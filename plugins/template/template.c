@@ -77,10 +77,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
                                         const char **errmsg)
 {
     /* Refuse a host older than the fields this plugin uses. */
-    if (h->abi_major != SILC_ABI_MAJOR || h->struct_size < sizeof(silc_host_api)) {
-        *errmsg = "template: host ABI does not match the one this plugin was built for";
-        return 1;
-    }
+    if (silc_host_check(h, SILC_HOST_NEEDS(attach_set), errmsg) || !out) return 1;
     host = h;
     *out = &template_plugin;
     return 0;
