@@ -271,70 +271,10 @@ static void test_all_methods(silc_context *c)
 
 static void test_shared_spd(silc_context *c, silc_context *ref)
 {
-    static const char *const files[] = {"bcsstk01", "bcsstk02", "LFAT5", "494_bus", "gr_30_30",
-                                        "1138_bus", "bcsstk13", "bcsstk16", NULL};
-    static const char *const pcs[] = {"ic", "ilu", NULL};
-    for (int f = 0; files[f]; f++) {
-        char path[512], err[256], cmd[256];
-        silc_envelope_t A;
-        double *ones, *b, *xref, cond;
-        int64_t n;
-        snprintf(path, sizeof path, "%s/%s.mtx", SILC_SHARED_MATRICES, files[f]);
-        if (silc_mm_read(&A, path, err, sizeof err)) {
-            CHECK(0, "read %s: %s", path, err);
-            continue;
-        }
-        n = A.n;
-        ones = malloc((size_t)n * sizeof *ones);
-        b = malloc((size_t)n * sizeof *b);
-        for (int64_t i = 0; i < n; i++) ones[i] = 1;
-        tl_csr_matvec(&A, ones, b);
-        tl_put_checked(c, "A", &A);
-        tl_put_dense_checked(c, "b", n, 1, b);
-        tl_put_checked(ref, "A", &A);
-        tl_put_dense_checked(ref, "b", n, 1, b);
-        CHECK(silc_exec(ref, "xr = A \\ b") == 0, "%s reference: %s", files[f], silc_context_errmsg(ref));
-        cond = tl_out_number(tl_out_info(ref, "xr"), "condition estimate: ");
-        xref = tl_get_dense_checked(ref, "xr", n, 1);
-        for (int p = 0; pcs[p] && xref; p++) {
-            double t = now(), *x, it, res, e;
-            int rc;
-            CHECK(silc_exec(c, "x = zeros(1, 1) + 7") == 0, "x = 7");
-            snprintf(cmd, sizeof cmd,
-                     "x = solve(A, b, \"lis-style.options = -i cg -p %s -tol 1e-10 -maxiter 20000\")", pcs[p]);
-            rc = silc_exec(c, cmd);
-            t = now() - t;
-            if (rc) {
-                const char *msg = silc_context_errmsg(c);
-                CHECK(tl_contains(msg, "not converged") || tl_contains(msg, "breakdown"),
-                      "%s CG+%s failed without an honest message: %s", files[f], pcs[p], msg);
-                x = tl_get_dense_checked(c, "x", 1, 1);
-                CHECK(x && x[0] == 7, "%s: a failed solve changed x", files[f]);
-                printf("  %-9s n=%-5lld CG+%-3s  %.3f s  not converged: %s\n", files[f], (long long)n,
-                       pcs[p], t, msg);
-                free(x);
-                continue;
-            }
-            {
-                const char *in = tl_out_info(c, "x");
-                it = tl_out_number(in, "iterations: ");
-                res = tl_out_number(in, "final relative residual: ");
-            }
-            CHECK(res >= 0 && res <= 1e-10, "%s CG+%s: reported converged with residual %g", files[f], pcs[p], res);
-            x = tl_get_dense_checked(c, "x", n, 1);
-            if (!x) continue;
-            e = rel_err2(x, xref, n);
-            CHECK(e <= 1e-10 * (cond > 1 ? cond : 1), "%s CG+%s: error %.3g vs reference > 1e-10 * cond %.3g",
-                  files[f], pcs[p], e, cond);
-            printf("  %-9s n=%-5lld CG+%-3s  %.3f s  %6g iterations, residual %.2g, error vs reference %.2g "
-                   "(cond %.2g)\n", files[f], (long long)n, pcs[p], t, it, res, e, cond);
-            free(x);
-        }
-        free(xref);
-        free(ones);
-        free(b);
-        silc_envelope_free(&A);
-    }
+    tl_spd_sweep(c, ref, "CG+IC(0)",
+                 "x = solve(A, b, \"lis-style.options = -i cg -p ic -tol 1e-10 -maxiter 20000\")", 1e-10);
+    tl_spd_sweep(c, ref, "CG+ILU(0)",
+                 "x = solve(A, b, \"lis-style.options = -i cg -p ilu -tol 1e-10 -maxiter 20000\")", 1e-10);
 }
 
 /* ---- options -------------------------------------------------------------------------- */

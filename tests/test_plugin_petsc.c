@@ -405,6 +405,10 @@ int main(void)
         test_shared(cp, cr, "west0479.mtx",
                     "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps", 0);
         test_shared(cp, cr, "sherman1.mtx", "-ksp_type gmres -pc_type ilu -ksp_rtol 1e-10", 1e-10);
+        /* Issue 4: every SPD shared matrix with CG + BoomerAMG converges or says it did not. */
+        tl_spd_sweep(cp, cr, "CG+hypre",
+                     "x = solve(A, b, \"petsc.options = -ksp_type cg -pc_type hypre -ksp_rtol 1e-10 "
+                     "-ksp_max_it 20000\")", 1e-10);
         test_indefinite(cp);
         test_singular(cp);
         test_dense_declined(cp);

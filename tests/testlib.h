@@ -409,6 +409,79 @@ static inline double *tl_get_dense_checked(silc_context *c, const char *name, in
     silc_envelope_free(&e);
     return x;
 }
+
+/* The shared SPD matrices an iterative solver must handle (issue 4). */
+static const char *const tl_spd_files[] = {"bcsstk01", "bcsstk02", "LFAT5", "494_bus", "gr_30_30",
+                                           "1138_bus", "bcsstk13", "bcsstk16", NULL};
+
+/* Every SPD shared matrix, b = A * ones, solved in c by stmt (which assigns
+ * x, e.g. a solve() with the solver's options) and judged against the
+ * reference direct solve in ref: a converged answer must report a relative
+ * residual <= tol and lie within tol * cond of the reference (2-norm relative
+ * error); a failure must say "not converged" (or name a breakdown or
+ * divergence) and leave x unchanged.  label names the solver in messages. */
+static inline void tl_spd_sweep(silc_context *c, silc_context *ref, const char *label,
+                                const char *stmt, double tol)
+{
+    for (int f = 0; tl_spd_files[f]; f++) {
+        char path[512], err[256];
+        silc_envelope_t A;
+        double *ones, *b, *xref, *x, cond, t, d = 0, s = 0;
+        int64_t n;
+        int rc;
+        snprintf(path, sizeof path, "%s/%s.mtx", SILC_SHARED_MATRICES, tl_spd_files[f]);
+        if (silc_mm_read(&A, path, err, sizeof err)) {
+            CHECK(0, "read %s: %s", path, err);
+            continue;
+        }
+        n = A.n;
+        ones = malloc((size_t)n * sizeof *ones);
+        b = malloc((size_t)n * sizeof *b);
+        for (int64_t i = 0; i < n; i++) ones[i] = 1;
+        tl_csr_matvec(&A, ones, b);
+        tl_put_checked(c, "A", &A);
+        tl_put_dense_checked(c, "b", n, 1, b);
+        tl_put_checked(ref, "A", &A);
+        tl_put_dense_checked(ref, "b", n, 1, b);
+        CHECK(silc_exec(ref, "xr = A \\ b") == 0, "%s reference: %s", tl_spd_files[f], silc_context_errmsg(ref));
+        cond = tl_out_number(tl_out_info(ref, "xr"), "condition estimate: ");
+        xref = tl_get_dense_checked(ref, "xr", n, 1);
+        CHECK(silc_exec(c, "x = 7") == 0, "x = 7");
+        t = tl_now();
+        rc = silc_exec(c, stmt);
+        t = tl_now() - t;
+        if (rc) {
+            const char *msg = silc_context_errmsg(c);
+            CHECK(tl_contains(msg, "not converged") || tl_contains(msg, "breakdown") ||
+                      tl_contains(msg, "diverged") || tl_contains(msg, "DIVERGED"),
+                  "%s %s failed without an honest message: %s", tl_spd_files[f], label, msg);
+            x = tl_get_dense_checked(c, "x", 1, 1);
+            CHECK(x && x[0] == 7, "%s: a failed solve changed x", tl_spd_files[f]);
+            printf("  %-9s n=%-5lld %-12s %.3f s  not converged: %s\n", tl_spd_files[f], (long long)n,
+                   label, t, msg);
+            free(x);
+        } else if (xref && (x = tl_get_dense_checked(c, "x", n, 1)) != NULL) {
+            const char *in = tl_out_info(c, "x");
+            double it = tl_out_number(in, "iterations: "), res = tl_out_number(in, "final relative residual: ");
+            CHECK(res >= 0 && res <= tol, "%s %s: reported converged with residual %g", tl_spd_files[f],
+                  label, res);
+            for (int64_t i = 0; i < n; i++) {
+                d += (x[i] - xref[i]) * (x[i] - xref[i]);
+                s += xref[i] * xref[i];
+            }
+            d = s > 0 ? sqrt(d / s) : sqrt(d);
+            CHECK(d <= tol * (cond > 1 ? cond : 1), "%s %s: error %.3g vs reference > %g * cond %.3g",
+                  tl_spd_files[f], label, d, tol, cond);
+            printf("  %-9s n=%-5lld %-12s %.3f s  %6g iterations, residual %.2g, error vs reference %.2g "
+                   "(cond %.2g)\n", tl_spd_files[f], (long long)n, label, t, it, res, d, cond);
+            free(x);
+        }
+        free(xref);
+        free(ones);
+        free(b);
+        silc_envelope_free(&A);
+    }
+}
 #endif
 
 #endif

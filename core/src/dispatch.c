@@ -431,7 +431,13 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 sb_printf(&skipped, "%s declines: %s; ", b->full_name,
                           ctx.err[0] ? ctx.err : "no reason given");
             } else {
-                eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
+                /* The message is prefixed with the backend, unless the
+                 * plugin already named itself ("lis-style BiCG: ..."). */
+                size_t bl = strlen(b->full_name);
+                if (strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' '))
+                    eng_error(E, "%s", ctx.err);
+                else
+                    eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
                 call->host_private = NULL;
                 sb_free(&skipped);
                 return rc;
