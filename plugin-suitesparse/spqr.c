@@ -31,6 +31,7 @@ typedef struct qr_factor {
     SuiteSparseQR_C_factorization *QR;
     int64_t m, n, rank;
     double tol;
+    double cond;        /* ||A||_1 * est ||R^-1||_1, full-rank tall/square only; -1 = none */
     char method[64];
     char note[160];
 } qr_factor;
@@ -71,6 +72,27 @@ static int qr_fail(silc_call *call, const char *fn, int status)
                           : status == CHOLMOD_INVALID     ? "invalid input"
                                                           : "failed",
                           status);
+}
+
+/* R x = b or R' x = b in place, for the Hager-Higham estimate of ||R^-1||_1
+ * (called under the lock, by the host's estimator). */
+static int qr_apply_rinv(void *ctx, double *x, int trans)
+{
+    qr_factor *F = ctx;
+    cholmod_common *cc = ss_cholmod_common();
+    cholmod_dense *bh, *y;
+    /* SPQR's R is rank x n: R \ B takes B with m rows (only the first rank
+     * are read) and gives n; R' \ B takes n rows and gives m (the rest 0). */
+    int64_t rows = trans ? F->n : F->m;
+    bh = cholmod_l_zeros((size_t)rows, 1, CHOLMOD_REAL, cc);
+    if (!bh) return -1;
+    memcpy(bh->x, x, (size_t)F->n * sizeof *x);
+    y = SuiteSparseQR_C_solve(trans ? SPQR_RTX_EQUALS_B : SPQR_RX_EQUALS_B, F->QR, bh, cc);
+    cholmod_l_free_dense(&bh, cc);
+    if (!y) return -1;
+    memcpy(x, y->x, (size_t)F->n * sizeof *x);
+    cholmod_l_free_dense(&y, cc);
+    return 0;
 }
 
 /* Called under the lock. */
@@ -114,6 +136,14 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
     F->rank = cc->SPQR_istat[4]; /* rank estimate of the factorization */
     snprintf(F->method, sizeof F->method, "sparse QR (SuiteSparseQR, %s)",
              qr_ordering_name(cc->SPQR_istat[7]));
+    /* A = Q R E' with the same singular values in R as in A, so
+     * ||A||_1 ||R^-1||_1 estimates cond(A) within modest factors; only a
+     * full-rank tall or square R is invertible. */
+    F->cond = -1;
+    if (F->rank == F->n && F->m >= F->n) {
+        double inv = ss_inv_norm1(F->n, qr_apply_rinv, F);
+        if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv;
+    }
     if (F->rank < (F->m < F->n ? F->m : F->n) || F->m < F->n)
         snprintf(F->note, sizeof F->note,
                  "rank %lld of %lldx%lld (tol %.3g): basic solution (at most rank nonzeros), "
@@ -209,5 +239,7 @@ int ss_spqr_solve(silc_call *call)
     r->solve_seconds = ss_host->now() - t0;
     snprintf(r->method, sizeof r->method, "%s", F->method);
     snprintf(r->note, sizeof r->note, "%s", F->note);
+    r->cond_est = F->cond;
+    if (F->cond > 0) r->rcond = 1 / F->cond;
     return SILC_OK;
 }
