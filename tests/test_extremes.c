@@ -215,7 +215,7 @@ static void test_hilbert(void)
                     CHECK(tl_rel_diff(x, xref, n) <= 20.0 * n * ceps,
                           "hilbert %d, %s differs from the reference by %.3g (cond eps %.2g)", n,
                           label(B), tl_rel_diff(x, xref, n), ceps);
-                /* SPQR gives no condition estimate (docs/accuracy.md). */
+                /* SPQR estimates only when it finds full rank (docs/accuracy.md). */
                 CHECK((est == est && est > 0) || strcmp(B->name, "suitesparse.spqr") == 0,
                       "hilbert %d, %s: no condition estimate in info", n, label(B));
                 if (est == est && est > 0) {
@@ -225,8 +225,11 @@ static void test_hilbert(void)
                     /* SuiteSparse keeps its libraries' cheap pivot-ratio estimate
                      * below 1e6 (suitesparse.condest = auto): judged above only. */
                     int crude = strncmp(B->name, "suitesparse.", 12) == 0 && est < 1e6;
+                    /* SPQR estimates ||A||_1 ||R^-1||_1: R^-1 = A^-1 Q, so it may
+                     * exceed cond_1(A) by up to sqrt(m n) = n, not only fall short. */
+                    double over = strcmp(B->name, "suitesparse.spqr") == 0 ? n : 1.01;
                     if (ceps < 1e-2 && !crude)
-                        CHECK(est <= 1.01 * cond && est >= cond / 30,
+                        CHECK(est <= over * cond && est >= cond / 30,
                               "hilbert %d, %s: estimate %.3g, true cond %.3g", n, label(B), est, cond);
                     CHECK(warned == (est * DBL_EPSILON > 1e-4),
                           "hilbert %d, %s: estimate %.3g (cond eps %.2g) but warning '%s'", n,
