@@ -30,13 +30,10 @@
  * starts from a third operand when one is given (the language's solve() has
  * none today), else from zero, as the note says.
  *
- * Systems far from 1 in size are solved scaled.  Norms are scaled anyway
- * (lk_nrm2), but the methods' inner products (r, r), (p, A p) under- or
- * overflow once entries leave about 1e+-100; so when max |a_ij| (or a
- * column's max |b_i|) lies beyond 2^+-64, the driver solves
- * (2^sa A) y = 2^sb b, scaled by powers of two (which round nothing), and
- * returns x = 2^(sa - sb) y.  The relative residual of both systems is the
- * same, so tolerances mean what they mean unscaled.
+ * Norms are scaled (lk_nrm2), but the methods' inner products (r, r),
+ * (p, A p) would under- or overflow once entries leave about 1e+-100: systems
+ * that far from 1 arrive here already scaled by powers of two by the core
+ * (core/src/scale.c), which does it once for every backend.
  */
 #include "lis.h"
 
@@ -138,47 +135,6 @@ static lis_matrix *matrix_transpose(const lk_csr *A)
         }
     lis_host->free(next);
     return T;
-}
-
-/* The power-of-two exponent that brings m = max |entry| near 1, or 0 when m
- * is within 2^+-64 (or 0, or not finite) and no scaling is needed. */
-static int scale_exponent(double m)
-{
-    int e;
-    if (!(m > 0) || isinf(m) || (m >= 0x1p-64 && m <= 0x1p64)) return 0;
-    frexp(m, &e);
-    return -e;
-}
-
-/* 2^e A, sharing A's pattern (which outlives it: both belong to the value). */
-static lis_matrix *matrix_scaled(const lk_csr *A, int e)
-{
-    int64_t nnz = A->rp[A->m], k;
-    lis_matrix *M = lis_host->calloc(1, sizeof *M);
-    if (!M) return NULL;
-    if (!(M->v = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double)))) {
-        matrix_free(M);
-        return NULL;
-    }
-    for (k = 0; k < nnz; k++) M->v[k] = ldexp(A->v[k], e);
-    M->A = *A;
-    M->A.v = M->v;
-    return M;
-}
-
-static void scale_vec(int64_t n, double *x, int e)
-{
-    int64_t i;
-    if (e)
-        for (i = 0; i < n; i++) x[i] = ldexp(x[i], e);
-}
-
-static double max_abs(int64_t n, const double *x)
-{
-    double m = 0;
-    int64_t i;
-    for (i = 0; i < n; i++) m = fmax(m, fabs(x[i]));
-    return m;
 }
 
 /* ---- accepts ---------------------------------------------------------------------- */
@@ -350,7 +306,7 @@ static int solve_run(silc_call *call)
     char err[320], slabel[32], plabel[48], key[96];
     const char *text = H->option_string(call, "options", "");
     double t0 = H->now(), *bcol = NULL, *x0col = NULL;
-    int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0, sa;
+    int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0;
     int64_t j, max_iter = 0;
     double max_resid = 0;
 
@@ -379,20 +335,6 @@ static int solve_run(silc_call *call)
             if (H->attach_set(call->in[0], "lis-style.csr", M, matrix_free)) {
                 matrix_free(M);
                 return H->error(call, SILC_ENOMEM, "lis-style: cannot attach the CSR copy of A");
-            }
-        }
-        A = M->A;
-    }
-    /* Far from 1: the scaled copy (see the top of the file), an attachment too. */
-    sa = scale_exponent(H->props(call->in[0])->maxabs);
-    if (sa) {
-        lis_matrix *M = H->attach_get(call->in[0], "lis-style.scaled");
-        if (!M) {
-            if (!(M = matrix_scaled(&A, sa)))
-                return H->error(call, SILC_ENOMEM, "lis-style: out of memory scaling A");
-            if (H->attach_set(call->in[0], "lis-style.scaled", M, matrix_free)) {
-                matrix_free(M);
-                return H->error(call, SILC_ENOMEM, "lis-style: cannot attach the scaled A");
             }
         }
         A = M->A;
@@ -461,7 +403,6 @@ static int solve_run(silc_call *call)
     for (j = 0; j < B.n; j++) {
         char tag[32] = "";
         col_result res = {0, 0, 0};
-        int sb;
         if (B.n > 1) snprintf(tag, sizeof tag, " (column %lld)", (long long)j + 1);
         column(&B, j, bcol);
         if (use_x0) {
@@ -469,12 +410,8 @@ static int solve_run(silc_call *call)
             H->view(call->in[2], &X0);
             column(&X0, j, x0col);
         }
-        sb = scale_exponent(max_abs(a.n, bcol));
-        scale_vec(a.n, bcol, sb);
-        if (use_x0) scale_vec(a.n, x0col, sb - sa);
         rc = solve_column(call, &c, fn, bcol, use_x0 ? x0col : NULL, o.val + j * a.n, tag, &res);
         if (rc) goto done;
-        scale_vec(a.n, o.val + j * a.n, sa - sb);
         if (res.iterations > max_iter) max_iter = res.iterations;
         if (res.resid > max_resid) max_resid = res.resid;
         restarts += res.restarts;

@@ -267,21 +267,17 @@ static void test_matrix(double *A, int spd)
         }
 }
 
-/* x = A \\ b for a scaled system must be x1 * f, with a finite backward error
- * and the same condition estimate.  PETSc may instead stop with an error, or
- * return with the core's large-backward-error warning (docs/accuracy.md says
- * why): never silently wrong.  lis-style solves scaled systems scaled (see
- * plugin-lis-style/lis_style.c) and must get them right. */
+/* x = A \\ b for a scaled system must be x1 * f, with a small backward error
+ * and the same condition estimate, from every backend: the core solves
+ * systems near 1e+-300 scaled by powers of two (core/src/scale.c), so even
+ * backends whose norms or pivot tests assume moderate data (PETSc's ILU,
+ * CG's inner products) see moderate data. */
 static void check_scaled(const backend *B, double sc, const char *what, const double *x1, double f)
 {
     char warn[512];
     const char *info;
     double want[6], *x, be, est;
-    int i, rc = run(B, NULL), may_fail = B->iterative && strcmp(B->name, "lis-style") != 0;
-    if (may_fail && rc == RUN_ERR) {
-        CHECK(silc_context_errmsg(ctx)[0] != '\0', "scale %g (%s), %s: no message", sc, what, label(B));
-        return;
-    }
+    int i, rc = run(B, NULL);
     CHECK(rc == RUN_OK, "scale %g (%s), %s: %s", sc, what, label(B), silc_context_errmsg(ctx));
     if (rc != RUN_OK) return;
     snprintf(warn, sizeof warn, "%s", silc_context_warnings(ctx));
@@ -290,18 +286,13 @@ static void check_scaled(const backend *B, double sc, const char *what, const do
     info = tl_info(ctx, &cap, "x");
     be = tl_field(info, "backward error");
     est = tl_field(info, "condition estimate");
-    if (may_fail && tl_rel_diff(x, want, 6) >= 1e-10) {
-        CHECK(tl_contains(warn, "backward error"), "scale %g (%s), %s: wrong (%.3g) without a warning",
-              sc, what, label(B), tl_rel_diff(x, want, 6));
-    } else {
-        CHECK(tl_rel_diff(x, want, 6) < 1e-10, "scale %g (%s), %s: x differs by %.3g", sc, what,
-              label(B), tl_rel_diff(x, want, 6));
-        CHECK(be == be && be < 1e-12, "scale %g (%s), %s: backward error %.3g", sc, what, label(B), be);
-        if (!B->iterative && strcmp(B->name, "suitesparse.spqr") != 0)
-            CHECK(est == est && est > 1 && est < 100, "scale %g (%s), %s: condition estimate %.3g",
-                  sc, what, label(B), est);
-        CHECK(warn[0] == '\0', "scale %g (%s), %s: warning '%s'", sc, what, label(B), warn);
-    }
+    CHECK(tl_rel_diff(x, want, 6) < 1e-10, "scale %g (%s), %s: x differs by %.3g", sc, what, label(B),
+          tl_rel_diff(x, want, 6));
+    CHECK(be == be && be < 1e-12, "scale %g (%s), %s: backward error %.3g", sc, what, label(B), be);
+    if (!B->iterative && strcmp(B->name, "suitesparse.spqr") != 0)
+        CHECK(est == est && est > 1 && est < 100, "scale %g (%s), %s: condition estimate %.3g", sc, what,
+              label(B), est);
+    CHECK(warn[0] == '\0', "scale %g (%s), %s: warning '%s'", sc, what, label(B), warn);
     free(x);
 }
 
@@ -762,7 +753,10 @@ static void test_mixed(void)
     const backend lapack = {"lapack", 0, 0, ""};
     int c, i, j;
     for (c = 0; c < 4; c++) {
-        const char *info, *want = c >= 2 ? "fell back to double precision" : "factored in single precision";
+        /* The core scales the 1e300 system by 2^-997 before lapack sees it
+         * (scale.c), so single precision serves it too; only Hilbert's
+         * conditioning makes dsgesv fall back. */
+        const char *info, *want = c == 3 ? "fell back to double precision" : "factored in single precision";
         double tol = c == 3 ? 1e-3 : 1e-12, ref[N], *x;
         int n = c == 3 ? 8 : N, rc;
         for (j = 0; j < n; j++)

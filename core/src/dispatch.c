@@ -21,6 +21,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
 #include "refine.h"
+#include "scale.h"
 
 #include <float.h>
 #include <math.h>
@@ -477,9 +478,17 @@ int disp_run(silc_engine *E, silc_call *call)
         rc = SILC_EARG;
     } else {
         silc_report *saved = call->report;
-        if (call->op == SILC_OP_SOLVE && !call->report) call->report = &local;
-        resolve_list(E, chain, n, &L);
-        rc = walk(E, call, chain, n, &L);
+        scale_state S;
+        int scaling = call->op == SILC_OP_SOLVE;
+        if (scaling && !call->report) call->report = &local;
+        /* Hook (scale.c): systems near 1e+-300 are solved scaled by 2^k. */
+        if (scaling && scale_solve_begin(E, call, &S)) {
+            rc = SILC_ENOMEM;
+        } else {
+            resolve_list(E, chain, n, &L);
+            rc = walk(E, call, chain, n, &L);
+            if (scaling) scale_solve_end(call, &S);
+        }
         call->report = saved;
     }
     if (own_options) cfg_clear_call_options(E);

@@ -1,0 +1,117 @@
+/*
+ * scale.c -- power-of-two scaling of solves far from 1 in magnitude; see
+ * scale.h for why it exists and why it is exact.
+ */
+#include "scale.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SCALE_KEY "core.scaled"
+#define SCALE_LIMIT 64          /* scale when max |entry| is beyond 2^+-64 */
+
+typedef struct scaled_copy {
+    int e;
+    silc_value *v;
+} scaled_copy;
+
+static void scaled_free(void *p)
+{
+    scaled_copy *c = p;
+    if (!c) return;
+    val_release(c->v);
+    free(c);
+}
+
+/* The exponent that brings v's largest entry near 1, limited so that its
+ * smallest nonzero entry stays a normal number; 0 when v is moderate. */
+static int exponent_for(const silc_value *v)
+{
+    const silc_props *p = val_props(v);
+    silc_view w;
+    double minabs = INFINITY;
+    int64_t i;
+    int e, emin;
+    if (!(p->maxabs > 0) || !isfinite(p->maxabs)) return 0;
+    frexp(p->maxabs, &e);
+    if (e >= -SCALE_LIMIT && e <= SCALE_LIMIT) return 0;
+    val_view(v, &w);
+    for (i = 0; i < w.nnz; i++)
+        if (w.val[i] != 0 && fabs(w.val[i]) < minabs) minabs = fabs(w.val[i]);
+    frexp(minabs, &emin);
+    /* 2^-e scales the max to [0.5, 1); the smallest must stay >= DBL_MIN. */
+    if (emin - e < DBL_MIN_EXP) e = emin - DBL_MIN_EXP;
+    return -e;
+}
+
+/* 2^e v with v's storage and pattern. */
+static silc_value *scaled(const silc_value *v, int e)
+{
+    silc_value *s;
+    int64_t i;
+    switch (v->format) {
+    case SILC_FMT_DENSE: s = val_dense_new(v->m, v->n); break;
+    case SILC_FMT_CSR:
+        s = val_csr_new(v->m, v->n, v->nnz);
+        if (s) {
+            memcpy(s->rowptr, v->rowptr, (size_t)(v->m + 1) * sizeof *s->rowptr);
+            memcpy(s->colind, v->colind, (size_t)v->nnz * sizeof *s->colind);
+            val_csr_set_nnz(s, v->nnz);
+        }
+        break;
+    default: s = val_band_new(v->m, v->n, v->kl, v->ku); break;
+    }
+    if (!s) return NULL;
+    for (i = 0; i < v->nnz; i++) s->val[i] = ldexp(v->val[i], e);
+    return s;
+}
+
+int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S)
+{
+    const silc_value *A = call->in[0], *B = call->in[1];
+    memset(S, 0, sizeof *S);
+    S->A = A;
+    S->B = B;
+    S->ea = exponent_for(A);
+    S->eb = exponent_for(B);
+    if (S->ea) {
+        scaled_copy *c = val_attach_get(A, SCALE_KEY);
+        if (!c || c->e != S->ea) {
+            c = calloc(1, sizeof *c);
+            if (!c || !(c->v = scaled(A, S->ea))) {
+                free(c);
+                return eng_error(E, "out of memory scaling a system of extreme magnitude");
+            }
+            c->e = S->ea;
+            if (val_attach_set(A, SCALE_KEY, c, scaled_free)) {
+                scaled_free(c);
+                return eng_error(E, "out of memory scaling a system of extreme magnitude");
+            }
+        }
+        call->in[0] = c->v;
+    }
+    if (S->eb) {
+        if (!(S->Bs = scaled(B, S->eb))) {
+            call->in[0] = A;
+            return eng_error(E, "out of memory scaling a system of extreme magnitude");
+        }
+        call->in[1] = S->Bs;
+    }
+    return 0;
+}
+
+void scale_solve_end(silc_call *call, scale_state *S)
+{
+    silc_value *X = call->out;
+    call->in[0] = S->A;
+    call->in[1] = S->B;
+    val_release(S->Bs);
+    S->Bs = NULL;
+    if (X && S->ea != S->eb) {
+        int64_t i;
+        for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
+        X->props_ready = 0; /* the cache described the scaled solution */
+    }
+}
