@@ -811,30 +811,14 @@ static const silc_backend mumps_backends[] = {
      mumps_ops},
 };
 
-/* Sequential MUMPS is threaded only through BLAS: the OpenBLAS it was linked
- * with, found among this module's own dependencies (RTLD_LOCAL hides it from
- * a global look-up). */
-static blas_threads_fn openblas_threads;
-
-static void mumps_set_threads(int n)
-{
-    if (openblas_threads && n > 0) openblas_threads(n);
-}
-
 static silc_plugin mumps_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
     "mumps", "1.0 MUMPS " MUMPS_VERSION,
     1, mumps_backends,
     (int)(sizeof mumps_options / sizeof mumps_options[0]), mumps_options,
-    NULL, /* set_threads: filled in when OpenBLAS is found */
+    NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     NULL,
 };
-
-static void find_openblas(void)
-{
-    openblas_threads = blas_threads_find(&mumps_plugin);
-    if (openblas_threads) mumps_plugin.set_threads = mumps_set_threads;
-}
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg);
@@ -843,7 +827,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 {
     if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
     host = h;
-    find_openblas();
+    blas_threads_attach(&mumps_plugin); /* threaded only through its BLAS */
     *out = &mumps_plugin;
     return 0;
 }

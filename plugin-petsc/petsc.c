@@ -622,29 +622,14 @@ static const silc_option_spec petsc_options[] = {
      "2-10 extra triangular solves per factorization"},
 };
 
-/* PETSc is threaded only through BLAS (OpenBLAS here), found among this
- * module's own dependencies: RTLD_LOCAL hides it from a global look-up. */
-static blas_threads_fn openblas_threads;
-
-static void petsc_set_threads(int n)
-{
-    if (openblas_threads && n > 0) openblas_threads(n);
-}
-
 static silc_plugin petsc_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
     "petsc", "1.0 PETSc " PETSC_VERSION_TEXT,
     1, petsc_backends,
     (int)(sizeof petsc_options / sizeof petsc_options[0]), petsc_options,
-    NULL, /* set_threads: filled in when OpenBLAS is found */
+    NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     petsc_shutdown,
 };
-
-static void find_openblas(void)
-{
-    openblas_threads = blas_threads_find(&petsc_plugin);
-    if (openblas_threads) petsc_plugin.set_threads = petsc_set_threads;
-}
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg);
@@ -653,7 +638,7 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 {
     if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
     host = h;
-    find_openblas();
+    blas_threads_attach(&petsc_plugin); /* threaded only through its BLAS */
     *out = &petsc_plugin;
     return 0;
 }

@@ -11,6 +11,7 @@
  */
 #define _GNU_SOURCE /* dladdr, RTLD_DEFAULT, RTLD_NOLOAD */
 #include "blas_threads.h"
+#include "silc_plugin.h"
 
 #include <dlfcn.h>
 #include <string.h>
@@ -38,4 +39,19 @@ blas_threads_fn blas_threads_find(const void *anchor)
      * representation, so copy the bits. */
     if (sym) memcpy(&fn, &sym, sizeof fn);
     return fn;
+}
+
+/* Each plugin compiles its own copy of this file, so this is per plugin. */
+static blas_threads_fn attached;
+
+static void set_attached(int n)
+{
+    if (attached && n > 0) attached(n);
+}
+
+int blas_threads_attach(struct silc_plugin *pl)
+{
+    attached = blas_threads_find(pl);
+    if (attached) pl->set_threads = set_attached;
+    return attached != NULL;
 }

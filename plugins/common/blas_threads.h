@@ -10,4 +10,10 @@
 typedef void (*blas_threads_fn)(int);
 blas_threads_fn blas_threads_find(const void *anchor);
 
+struct silc_plugin;
+/* For a plugin threaded only through its BLAS: finds OpenBLAS from the
+ * plugin's own module and, if found, points pl->set_threads at it.  Returns 1
+ * when found, 0 when set_threads stays NULL (nothing to control). */
+int blas_threads_attach(struct silc_plugin *pl);
+
 #endif
