@@ -24,6 +24,7 @@ typedef struct srv_config {
     int io_timeout_ms;           /* a peer stalling inside a frame is dropped after this */
     int max_clients;
     int log_level;
+    uint64_t pool_bytes;         /* freed value arrays kept for reuse; 0 = none */
 } srv_config;
 
 extern srv_config srv_cfg;
@@ -42,5 +43,8 @@ void srv_log(int level, const char *fmt, ...)
 /* Serves one accepted connection until BYE, disconnect or shutdown, then
  * closes fd.  id numbers the session in the log. */
 void srv_session(int fd, unsigned long id);
+
+/* pool.c: makes value arrays recycle through silcd's pool (see there). */
+void srv_pool_install(void);
 
 #endif

@@ -33,7 +33,8 @@ srv_config srv_cfg = {
     (uint64_t)2 << 30,   /* max_value_bytes: 2 GiB */
     (uint64_t)4 << 30,   /* max_session_bytes: 4 GiB */
     (uint64_t)64 << 20,  /* max_text_bytes: 64 MiB */
-    30000, 256, LOG_INFO};
+    30000, 256, LOG_INFO,
+    (uint64_t)1 << 30};  /* pool_bytes: 1 GiB */
 pthread_mutex_t srv_compute_lock = PTHREAD_MUTEX_INITIALIZER;
 int srv_shutdown_fd = -1;
 
@@ -70,6 +71,7 @@ static void usage(FILE *f)
           "  --max-value-bytes N     largest value one PUT may carry (default 2G)\n"
           "  --max-session-bytes N   memory of the values bound in one session, 0 = no limit (default 4G)\n"
           "  --max-clients N         concurrent sessions (default 256)\n"
+          "  --array-pool N          freed value arrays kept for the next PUT, 0 = none (default 1G)\n"
           "  --io-timeout SECONDS    drop a peer that stalls inside a frame (default 30)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
@@ -170,6 +172,7 @@ static int parse_args(int argc, char **argv, const char **ready_file)
         else if (strcmp(name, "--token-file") == 0) ok = !read_token(val);
         else if (strcmp(name, "--max-value-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_value_bytes);
         else if (strcmp(name, "--max-session-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_session_bytes);
+        else if (strcmp(name, "--array-pool") == 0) ok = !parse_size(val, &srv_cfg.pool_bytes);
         else if (strcmp(name, "--max-clients") == 0) ok = !parse_int(val, 1, 65536, &srv_cfg.max_clients);
         else if (strcmp(name, "--io-timeout") == 0) {
             double s = strtod(val, NULL);
@@ -426,6 +429,7 @@ int main(int argc, char **argv)
     sa.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &sa, NULL);
     if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
+    srv_pool_install();
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,
             (unsigned long long)srv_cfg.max_value_bytes,
             (unsigned long long)srv_cfg.max_session_bytes, srv_cfg.token ? ", token required" : "");

@@ -28,11 +28,35 @@ static int64_t count_mul(int64_t a, int64_t b)
     return a * b;
 }
 
-/* malloc/calloc of count doubles or indices; never asks for zero bytes, so a
- * NULL result always means failure. */
-static void *alloc_zeroed(int64_t count, size_t size)
+/* The array pool (val_set_array_pool); NULL: plain calloc/malloc and free.
+ * Set once before the threads that use values start. */
+static void *(*pool_take)(size_t bytes);
+static int (*pool_give)(void *p);
+
+void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p))
 {
-    return calloc(count > 0 ? (size_t)count : 1, size);
+    pool_take = take;
+    pool_give = give;
+}
+
+/* An array of count doubles or indices, zero-filled when zero is set; never
+ * asks for zero bytes, so a NULL result always means failure.  A pooled
+ * array is already mapped: zeroing it in place is far cheaper than faulting
+ * in fresh pages, and an unset one costs nothing. */
+static void *alloc_array(int64_t count, size_t size, int zero)
+{
+    size_t bytes = (count > 0 ? (size_t)count : 1) * size;
+    void *p = pool_take ? pool_take(bytes) : NULL;
+    if (p) {
+        if (zero) memset(p, 0, bytes);
+        return p;
+    }
+    return zero ? calloc(bytes / size, size) : malloc(bytes);
+}
+
+static void free_array(void *p)
+{
+    if (p && !(pool_give && pool_give(p))) free(p);
 }
 
 static silc_value *val_alloc(int64_t m, int64_t n, int format)
@@ -52,18 +76,18 @@ static silc_value *val_alloc(int64_t m, int64_t n, int format)
 /* Frees the arrays and the struct of a value that has no attachments yet. */
 static void val_free_arrays(silc_value *v)
 {
-    free(v->val);
-    free(v->rowptr);
-    free(v->colind);
+    free_array(v->val);
+    free_array(v->rowptr);
+    free_array(v->colind);
     free(v);
 }
 
-silc_value *val_dense_new(int64_t m, int64_t n)
+static silc_value *dense_make(int64_t m, int64_t n, int zero)
 {
     int64_t count = count_mul(m, n);
     silc_value *v;
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
-    v->val = alloc_zeroed(count, sizeof(double));
+    v->val = alloc_array(count, sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;
@@ -72,14 +96,14 @@ silc_value *val_dense_new(int64_t m, int64_t n)
     return v;
 }
 
-silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity)
+static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero)
 {
     silc_value *v;
     if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
     if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
-    v->rowptr = alloc_zeroed(m + 1, sizeof(silc_index));
-    v->colind = alloc_zeroed(nnz_capacity, sizeof(silc_index));
-    v->val = alloc_zeroed(nnz_capacity, sizeof(double));
+    v->rowptr = alloc_array(m + 1, sizeof(silc_index), zero);
+    v->colind = alloc_array(nnz_capacity, sizeof(silc_index), zero);
+    v->val = alloc_array(nnz_capacity, sizeof(double), zero);
     if (!v->rowptr || !v->colind || !v->val) {
         val_free_arrays(v);
         return NULL;
@@ -88,7 +112,7 @@ silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity)
     return v;
 }
 
-silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
+static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int zero)
 {
     int64_t ld, count;
     silc_value *v;
@@ -96,7 +120,7 @@ silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
     ld = kl + ku + 1;
     count = count_mul(ld, n);
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_BAND))) return NULL;
-    v->val = alloc_zeroed(count, sizeof(double));
+    v->val = alloc_array(count, sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;
@@ -106,6 +130,31 @@ silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
     v->ld = ld;
     v->nnz = v->cap = count;
     return v;
+}
+
+silc_value *val_dense_new(int64_t m, int64_t n)
+{
+    return dense_make(m, n, 1);
+}
+
+silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity)
+{
+    return csr_make(m, n, nnz_capacity, 1);
+}
+
+silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
+{
+    return band_make(m, n, kl, ku, 1);
+}
+
+silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku)
+{
+    switch (format) {
+    case SILC_FMT_DENSE: return dense_make(m, n, 0);
+    case SILC_FMT_CSR: return csr_make(m, n, nnz, 0);
+    case SILC_FMT_BAND: return band_make(m, n, kl, ku, 0);
+    default: return NULL;
+    }
 }
 
 silc_value *val_scalar_new(double x)

@@ -48,6 +48,13 @@ silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity);
 silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku);
 silc_value *val_scalar_new(double x);
 int val_csr_set_nnz(silc_value *v, int64_t nnz);
+/* As the constructors, elements left unset: for a caller that writes them all. */
+silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
+/* Recycling of value arrays, process-wide (silcd installs a pool): take(bytes)
+ * returns an array of at least bytes with any contents, or NULL; give(p) gets
+ * every freed array and returns 1 when it kept it (then no longer to free).
+ * Install before any thread uses values; NULL hooks mean plain malloc/free. */
+void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p));
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
 void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */
