@@ -271,7 +271,7 @@ static const char *iter_reason(lapack_int iter)
  * refine in double, falling back to a double factorization themselves when
  * that fails (too ill-conditioned, out of single range).  The single factors
  * live inside the call, so nothing is attached and every solve factors anew;
- * the condition estimate exists only when the fallback left double factors. */
+ * the condition estimate comes from whichever factors the call ended with. */
 static int solve_mixed(silc_call *call, int route, const silc_view *A, const silc_view *B,
                        const silc_props *P)
 {
@@ -311,11 +311,25 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
         rc = lp_illegal(call, chol ? "dsposv" : "dsgesv", info);
         goto done;
     }
-    /* After a fallback a holds the double factors: estimate as the double path does. */
-    if (iter < 0 &&
-        (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
-              : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork)))
-        rcond = -1;
+    /* After a fallback a holds the double factors: estimate as the double path
+     * does.  Otherwise the single factors are still in swork (dsgesv / dsposv
+     * factor their single copy of A in place at its start, with ipiv), and
+     * sgecon / spocon estimate from them: as good as single precision, which
+     * is all a condition estimate needs, since a matrix too ill-conditioned
+     * for single precision makes LAPACK fall back to double anyway. */
+    if (iter < 0) {
+        if (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
+                 : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork))
+            rcond = -1;
+    } else {
+        float srcond = -1, *fwork = lp_alloc((size_t)4 * (size_t)n, sizeof(float));
+        if (fwork && !(chol ? LAPACKE_spocon_work(LAPACK_COL_MAJOR, 'L', n, swork, n, (float)P->norm1,
+                                                   &srcond, fwork, iwork)
+                            : LAPACKE_sgecon_work(LAPACK_COL_MAJOR, '1', n, swork, n, (float)P->norm1,
+                                                   &srcond, fwork, iwork)))
+            rcond = srcond;
+        lp_free(fwork);
+    }
     snprintf(r->method, sizeof r->method, "mixed precision %s (%s)", chol ? "Cholesky" : "LU",
              chol ? "dsposv" : "dsgesv");
     if (iter >= 0)

@@ -757,7 +757,7 @@ static void test_mixed(void)
          * (scale.c), so single precision serves it too; only Hilbert's
          * conditioning makes dsgesv fall back. */
         const char *info, *want = c == 3 ? "fell back to double precision" : "factored in single precision";
-        double tol = c == 3 ? 1e-3 : 1e-12, ref[N], *x;
+        double tol = c == 3 ? 1e-3 : 1e-12, ref[N], *x, est, est_double;
         int n = c == 3 ? 8 : N, rc;
         for (j = 0; j < n; j++)
             for (i = 0; i < n; i++)
@@ -773,6 +773,7 @@ static void test_mixed(void)
         x = get_x(NULL, NULL);
         memcpy(ref, x, (size_t)n * sizeof *x);
         free(x);
+        est_double = tl_field(tl_info(ctx, &cap, "x"), "condition estimate");
         put_matrix("A", n, n, As, 0, 0);
         tl_put_vector(ctx, "b", n, bs);
         rc = run(&lapack, "; lapack.precision = mixed");
@@ -786,6 +787,11 @@ static void test_mixed(void)
         if (c < 3)
             CHECK(tl_field(info, "backward error") < 1e-15, "mixed %s: backward error %.3g", cases[c],
                   tl_field(info, "backward error"));
+        /* An estimate from the single factors (or the fallback's double ones)
+         * agrees with the double path's to the accuracy an estimate has. */
+        est = tl_field(info, "condition estimate");
+        CHECK(est > est_double / 3 && est < est_double * 3, "mixed %s: condition estimate %.3g, double %.3g",
+              cases[c], est, est_double);
         free(x);
     }
     CHECK(run(&lapack, "; lapack.precision = half") == RUN_ERR &&
