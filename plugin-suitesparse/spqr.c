@@ -22,6 +22,7 @@
 
 #include <SuiteSparseQR_C.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -82,15 +83,16 @@ static int qr_apply_rinv(void *ctx, double *x, int trans)
     cholmod_common *cc = ss_cholmod_common();
     cholmod_dense *bh, *y;
     /* SPQR's R is rank x n: R \ B takes B with m rows (only the first rank
-     * are read) and gives n; R' \ B takes n rows and gives m (the rest 0). */
+     * are read) and gives n; R' \ B takes n rows and gives m.  The estimate
+     * works on the leading rank x rank block, so x has rank entries. */
     int64_t rows = trans ? F->n : F->m;
     bh = cholmod_l_zeros((size_t)rows, 1, CHOLMOD_REAL, cc);
     if (!bh) return -1;
-    memcpy(bh->x, x, (size_t)F->n * sizeof *x);
+    memcpy(bh->x, x, (size_t)F->rank * sizeof *x);
     y = SuiteSparseQR_C_solve(trans ? SPQR_RTX_EQUALS_B : SPQR_RX_EQUALS_B, F->QR, bh, cc);
     cholmod_l_free_dense(&bh, cc);
     if (!y) return -1;
-    memcpy(x, y->x, (size_t)F->n * sizeof *x);
+    memcpy(x, y->x, (size_t)F->rank * sizeof *x);
     cholmod_l_free_dense(&y, cc);
     return 0;
 }
@@ -136,12 +138,17 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
     F->rank = cc->SPQR_istat[4]; /* rank estimate of the factorization */
     snprintf(F->method, sizeof F->method, "sparse QR (SuiteSparseQR, %s)",
              qr_ordering_name(cc->SPQR_istat[7]));
-    /* A = Q R E' with the same singular values in R as in A, so
-     * ||A||_1 ||R^-1||_1 estimates cond(A) within modest factors; only a
-     * full-rank tall or square R is invertible. */
+    /* A = Q R E' with the same singular values in R as in A, so for a tall
+     * or square A of full rank ||A||_1 ||R^-1||_1 estimates cond(A) within
+     * modest factors; a rank-deficient A has no finite condition number (as
+     * the reference plugin reports it).  A wide A gets none: its R's leading
+     * block is ordered for sparsity, not conditioning, and measures only the
+     * basic solution's sensitivity (gemat1: 8.7e18 against cond 1.2e8). */
     F->cond = -1;
-    if (F->rank == F->n && F->m >= F->n) {
-        double inv = ss_inv_norm1(F->n, qr_apply_rinv, F);
+    if (F->rank < (F->m < F->n ? F->m : F->n)) {
+        F->cond = INFINITY;
+    } else if (F->rank > 0 && F->m >= F->n) {
+        double inv = ss_inv_norm1(F->rank, qr_apply_rinv, F);
         if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv;
     }
     if (F->rank < (F->m < F->n ? F->m : F->n) || F->m < F->n)
@@ -240,6 +247,6 @@ int ss_spqr_solve(silc_call *call)
     snprintf(r->method, sizeof r->method, "%s", F->method);
     snprintf(r->note, sizeof r->note, "%s", F->note);
     r->cond_est = F->cond;
-    if (F->cond > 0) r->rcond = 1 / F->cond;
+    if (F->cond > 0) r->rcond = isinf(F->cond) ? 0 : 1 / F->cond;
     return SILC_OK;
 }
