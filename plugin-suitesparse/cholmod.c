@@ -220,6 +220,15 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, ch_fa
     return SILC_OK;
 }
 
+
+/* ch_factor_new in the shape ss_attached_factor calls. */
+static int ch_make(silc_call *call, const silc_view *a, int condest, void **out)
+{
+    ch_factor *F = NULL;
+    int rc = ch_factor_new(call, a, condest, &F);
+    *out = F;
+    return rc;
+}
 int ss_cholmod_solve(silc_call *call)
 {
     cholmod_common *cc = ss_cholmod_common();
@@ -237,20 +246,12 @@ int ss_cholmod_solve(silc_call *call)
     k = b.n;
     if ((rc = ss_condest_mode(call, &condest))) return rc;
 
-    t0 = ss_host->now();
     if (n > 0) {
-        F = ss_host->attach_get(call->in[0], CH_KEY);
-        if (F) {
-            r->reused_factor = 1;
-        } else {
-            if ((rc = ch_factor_new(call, &a, condest, &F))) return rc;
-            if (ss_host->attach_set(call->in[0], CH_KEY, F, ch_factor_free)) {
-                ch_factor_free(F);
-                return ss_nomem(call, "attaching the CHOLMOD factor");
-            }
-        }
+        void *f;
+        if ((rc = ss_attached_factor(call, &a, CH_KEY, condest, ch_make, ch_factor_free, "attaching the CHOLMOD factor", &f)))
+            return rc;
+        F = f;
     }
-    r->factor_seconds = ss_host->now() - t0;
 
     t0 = ss_host->now();
     if (n == 0 || k == 0) {

@@ -201,6 +201,15 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, kl_fa
     return SILC_OK;
 }
 
+
+/* kl_factor_new in the shape ss_attached_factor calls. */
+static int kl_make(silc_call *call, const silc_view *a, int condest, void **out)
+{
+    kl_factor *F = NULL;
+    int rc = kl_factor_new(call, a, condest, &F);
+    *out = F;
+    return rc;
+}
 int ss_klu_solve(silc_call *call)
 {
     silc_report *r = call->report;
@@ -217,20 +226,12 @@ int ss_klu_solve(silc_call *call)
     k = b.n;
     if ((rc = ss_condest_mode(call, &condest))) return rc;
 
-    t0 = ss_host->now();
     if (n > 0) {
-        F = ss_host->attach_get(call->in[0], KL_KEY);
-        if (F) {
-            r->reused_factor = 1;
-        } else {
-            if ((rc = kl_factor_new(call, &a, condest, &F))) return rc;
-            if (ss_host->attach_set(call->in[0], KL_KEY, F, kl_factor_free)) {
-                kl_factor_free(F);
-                return ss_nomem(call, "attaching the KLU factors");
-            }
-        }
+        void *f;
+        if ((rc = ss_attached_factor(call, &a, KL_KEY, condest, kl_make, kl_factor_free, "attaching the KLU factors", &f)))
+            return rc;
+        F = f;
     }
-    r->factor_seconds = ss_host->now() - t0;
 
     t0 = ss_host->now();
     X = ss_rhs_dense(&b, 1, &owned); /* KLU solves in place */

@@ -52,6 +52,14 @@ void ss_unlock(void);
 cholmod_common *ss_cholmod_common(void); /* use only between ss_lock / ss_unlock */
 
 int ss_nomem(silc_call *call, const char *what);
+
+/* The factorization attached to A = call->in[0] under key, or a new one made
+ * by make() and attached (destroy frees it with A).  Sets report->
+ * reused_factor and factor_seconds.  what names it in an out-of-memory
+ * message.  Returns a silc_status. */
+typedef int (*ss_make_fn)(silc_call *call, const silc_view *a, int condest, void **out);
+int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int condest,
+                       ss_make_fn make, void (*destroy)(void *), const char *what, void **out);
 int ss_ends_with(const char *s, const char *suffix);
 /* Shared accepts: A must be CSR (and square when square is set). */
 int ss_accepts_csr(const silc_call *call, int square, const char **why);

@@ -178,6 +178,26 @@ double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), vo
     return ss_host->inv_norm1_est(n, ss_apply, &e, NULL);
 }
 
+int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int condest,
+                       ss_make_fn make, void (*destroy)(void *), const char *what, void **out)
+{
+    double t0 = ss_host->now();
+    int rc;
+    *out = ss_host->attach_get(call->in[0], key);
+    if (*out) {
+        call->report->reused_factor = 1;
+    } else {
+        if ((rc = make(call, a, condest, out))) return rc;
+        if (ss_host->attach_set(call->in[0], key, *out, destroy)) {
+            destroy(*out);
+            *out = NULL;
+            return ss_nomem(call, what);
+        }
+    }
+    call->report->factor_seconds = ss_host->now() - t0;
+    return SILC_OK;
+}
+
 /* ---- the symbolic cache ------------------------------------------------------ */
 
 static uint64_t pattern_hash(const silc_view *a)
