@@ -139,7 +139,8 @@ static const char *ch_ordering_name(int ordering)
     }
 }
 
-static int ch_factor_new(silc_call *call, const silc_view *a, int condest, ch_factor **out)
+/* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
+static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
 {
     cholmod_common *cc = ss_cholmod_common();
     cholmod_sparse A;
@@ -221,14 +222,6 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, ch_fa
 }
 
 
-/* ch_factor_new in the shape ss_attached_factor calls. */
-static int ch_make(silc_call *call, const silc_view *a, int condest, void **out)
-{
-    ch_factor *F = NULL;
-    int rc = ch_factor_new(call, a, condest, &F);
-    *out = F;
-    return rc;
-}
 int ss_cholmod_solve(silc_call *call)
 {
     cholmod_common *cc = ss_cholmod_common();
@@ -248,7 +241,8 @@ int ss_cholmod_solve(silc_call *call)
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, CH_KEY, condest, ch_make, ch_factor_free, "attaching the CHOLMOD factor", &f)))
+        if ((rc = ss_attached_factor(call, &a, CH_KEY, condest, ch_factor_new, ch_factor_free,
+                                     "attaching the CHOLMOD factor", &f)))
             return rc;
         F = f;
     }

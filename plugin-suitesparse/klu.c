@@ -138,7 +138,8 @@ static int kl_try_refactor(const silc_view *a, klu_l_symbolic *S, kl_numeric *nu
     return c.rcond > DBL_EPSILON && c.rcond >= 1e-3 * num->rcond0;
 }
 
-static int kl_factor_new(silc_call *call, const silc_view *a, int condest, kl_factor **out)
+/* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
+static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
 {
     klu_l_common c;
     klu_l_symbolic *S;
@@ -202,14 +203,6 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, kl_fa
 }
 
 
-/* kl_factor_new in the shape ss_attached_factor calls. */
-static int kl_make(silc_call *call, const silc_view *a, int condest, void **out)
-{
-    kl_factor *F = NULL;
-    int rc = kl_factor_new(call, a, condest, &F);
-    *out = F;
-    return rc;
-}
 int ss_klu_solve(silc_call *call)
 {
     silc_report *r = call->report;
@@ -228,7 +221,8 @@ int ss_klu_solve(silc_call *call)
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, KL_KEY, condest, kl_make, kl_factor_free, "attaching the KLU factors", &f)))
+        if ((rc = ss_attached_factor(call, &a, KL_KEY, condest, kl_factor_new, kl_factor_free,
+                                     "attaching the KLU factors", &f)))
             return rc;
         F = f;
     }
