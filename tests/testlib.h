@@ -65,6 +65,42 @@ static inline int tl_laplacian2d(silc_envelope_t *e, int64_t k)
     return tl_grid2d(e, k, 0, 4);
 }
 
+/* An exactly singular SPD-looking matrix: the 5-point Laplacian on a k x k
+ * grid whose last two unknowns are cut off into the block [1 1; 1 1].
+ * Symmetric with a positive diagonal, so Cholesky is tried first and meets
+ * the zero pivot, then LU meets it too. */
+static inline int tl_singular_block_laplacian(silc_envelope_t *e, int64_t k)
+{
+    int64_t n = k * k, nz = 0, r, q;
+    int64_t *rp = malloc((size_t)(n + 1) * sizeof *rp), *ci = malloc((size_t)(5 * n) * sizeof *ci);
+    double *v = malloc((size_t)(5 * n) * sizeof *v);
+    int rc = -1;
+    if (rp && ci && v) {
+        for (r = 0; r < n; r++) {
+            int64_t i = r / k, j = r % k, cols[5], m = 0;
+            rp[r] = nz;
+            if (r >= n - 2) {
+                ci[nz] = n - 2, v[nz++] = 1;
+                ci[nz] = n - 1, v[nz++] = 1;
+                continue;
+            }
+            if (i > 0) cols[m++] = r - k;
+            if (j > 0) cols[m++] = r - 1;
+            cols[m++] = r;
+            if (j < k - 1) cols[m++] = r + 1;
+            if (i < k - 1) cols[m++] = r + k;
+            for (q = 0; q < m; q++)
+                if (cols[q] < n - 2) ci[nz] = cols[q], v[nz++] = cols[q] == r ? 4 : -1;
+        }
+        rp[n] = nz;
+        rc = silc_envelope_csr(e, n, n, rp, ci, v);
+    }
+    free(rp);
+    free(ci);
+    free(v);
+    return rc;
+}
+
 /* y = A x for A in CSR. */
 static inline void tl_csr_matvec(const silc_envelope_t *A, const double *x, double *y)
 {
