@@ -219,23 +219,43 @@ static int envelope_csr_own(silc_envelope_t *e, const char *fn, int64_t m, int64
     return 0;
 }
 
+/* The checks both CSR constructors make before copying: the envelope, the
+ * size, and rowptr[m] (read only once rowptr is known to exist) as an entry
+ * count with colind present when it is non-zero.  fn names the caller. */
+static int csr_args(const char *fn, silc_envelope_t *e, int64_t m, int64_t n, const void *rowptr,
+                    int64_t (*last)(const void *rowptr, int64_t m),
+                    const void *colind, int64_t *nnz)
+{
+    if (!e) return env_error("%s: NULL envelope", fn);
+    memset(e, 0, sizeof *e);
+    if (m < 0 || n < 0 || dense_count(m + 1, 1) < 0)
+        return env_error("%s: invalid size %lldx%lld", fn, (long long)m, (long long)n);
+    if (!rowptr) return env_error("%s: rowptr is NULL", fn);
+    /* rowptr[m] is only trusted after the structure check; copying up to it
+     * first is safe because a negative or huge count is rejected here. */
+    *nnz = last(rowptr, m);
+    if (*nnz < 0 || dense_count(*nnz, 1) < 0)
+        return env_error("%s: rowptr[m] = %lld is not a valid entry count", fn, (long long)*nnz);
+    if (*nnz > 0 && !colind)
+        return env_error("%s: colind is NULL but rowptr[m] = %lld", fn, (long long)*nnz);
+    return 0;
+}
+
+static int64_t last64(const void *rowptr, int64_t m)
+{
+    return ((const int64_t *)rowptr)[m];
+}
+
+static int64_t last32(const void *rowptr, int64_t m)
+{
+    return ((const int32_t *)rowptr)[m];
+}
+
 int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
                       const int64_t *colind, const double *values)
 {
     int64_t *rp, *ci, nnz;
-    if (!e) return env_error("silc_envelope_csr: NULL envelope");
-    memset(e, 0, sizeof *e);
-    if (m < 0 || n < 0 || dense_count(m + 1, 1) < 0)
-        return env_error("silc_envelope_csr: invalid size %lldx%lld", (long long)m, (long long)n);
-    if (!rowptr) return env_error("silc_envelope_csr: rowptr is NULL");
-    /* rowptr[m] is only trusted after the structure check; copying up to it
-     * first is safe because a negative or huge count is rejected here. */
-    nnz = rowptr[m];
-    if (nnz < 0 || dense_count(nnz, 1) < 0)
-        return env_error("silc_envelope_csr: rowptr[m] = %lld is not a valid entry count",
-                         (long long)nnz);
-    if (nnz > 0 && !colind) return env_error("silc_envelope_csr: colind is NULL but rowptr[m] = %lld",
-                                             (long long)nnz);
+    if (csr_args("silc_envelope_csr", e, m, n, rowptr, last64, colind, &nnz)) return -1;
     rp = copy_array(rowptr, m + 1, sizeof *rp);
     ci = copy_array(colind, nnz, sizeof *ci);
     if (!rp || !ci) {
@@ -249,17 +269,8 @@ int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t 
                         const int32_t *colind, const double *values)
 {
     int64_t *rp, *ci, nnz, k;
-    if (!e) return env_error("silc_envelope_csr32: NULL envelope");
-    memset(e, 0, sizeof *e);
-    if (m < 0 || n < 0 || dense_count(m + 1, 1) < 0)
-        return env_error("silc_envelope_csr32: invalid size %lldx%lld", (long long)m, (long long)n);
-    if (!rowptr) return env_error("silc_envelope_csr32: rowptr is NULL");
-    nnz = rowptr[m];
-    if (nnz < 0)
-        return env_error("silc_envelope_csr32: rowptr[m] = %lld is not a valid entry count",
-                         (long long)nnz);
-    if (nnz > 0 && !colind) return env_error("silc_envelope_csr32: colind is NULL but rowptr[m] = %lld",
-                                             (long long)nnz);
+    if (csr_args("silc_envelope_csr32", e, m, n, rowptr, last32, colind, &nnz))
+        return -1;
     rp = copy_array(NULL, m + 1, sizeof *rp);
     ci = copy_array(NULL, nnz, sizeof *ci);
     if (!rp || !ci) {
