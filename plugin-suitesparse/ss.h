@@ -94,7 +94,7 @@ double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), vo
  * matrix with the same pattern each step (A = K + dt*M) gets a new value, so
  * the attachment of the old one is no help; the last symbolic object of each
  * backend is kept here with an exact copy of the pattern it was made for and
- * handed to the next value whose pattern matches (hash first, then memcmp).
+ * handed to the next value whose pattern matches (sizes first, then memcmp).
  * Entries are reference-counted: the cache holds one reference and every
  * factorization that needs its symbolic object (KLU's) holds another.  An
  * entry may also keep one spare numeric object donated by a factorization
@@ -106,7 +106,6 @@ typedef struct ss_symbolic {
     int refs;
     int tag;                    /* backend variant the analysis was made for */
     int64_t m, n, nnz;
-    uint64_t hash;
     silc_index *rowptr, *colind;
     void *obj;                  /* the library's symbolic object */
     void (*destroy)(void *obj);

@@ -200,20 +200,14 @@ int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int
 
 /* ---- the symbolic cache ------------------------------------------------------ */
 
-static uint64_t pattern_hash(const silc_view *a)
-{
-    /* FNV-1a over the index arrays: a quick reject before the exact compare. */
-    uint64_t h = 1469598103934665603ull;
-    int64_t i;
-    for (i = 0; i <= a->m; i++) h = (h ^ (uint64_t)a->rowptr[i]) * 1099511628211ull;
-    for (i = 0; i < a->rowptr[a->m]; i++) h = (h ^ (uint64_t)a->colind[i]) * 1099511628211ull;
-    return h;
-}
-
-static int same_pattern(const ss_symbolic *e, const silc_view *a, int tag, uint64_t h)
+/* Each slot holds one pattern, so there is nothing to look up: the sizes
+ * reject most strangers and memcmp, which stops at the first difference and
+ * runs at memory speed, settles the rest (a hash of the arrays cost more than
+ * the compare, on every miss). */
+static int same_pattern(const ss_symbolic *e, const silc_view *a, int tag)
 {
     int64_t nnz = a->rowptr[a->m];
-    return e->tag == tag && e->m == a->m && e->n == a->n && e->nnz == nnz && e->hash == h &&
+    return e->tag == tag && e->m == a->m && e->n == a->n && e->nnz == nnz &&
            memcmp(e->rowptr, a->rowptr, (size_t)(a->m + 1) * sizeof(silc_index)) == 0 &&
            (nnz == 0 || memcmp(e->colind, a->colind, (size_t)nnz * sizeof(silc_index)) == 0);
 }
@@ -229,11 +223,10 @@ static void sym_free(ss_symbolic *e)
 
 ss_symbolic *ss_sym_find(int slot, const silc_view *a, int tag)
 {
-    uint64_t h = pattern_hash(a);
     ss_symbolic *e;
     ss_lock();
     e = ss_cache[slot];
-    if (e && same_pattern(e, a, tag, h)) e->refs++;
+    if (e && same_pattern(e, a, tag)) e->refs++;
     else e = NULL;
     ss_unlock();
     return e;
@@ -259,7 +252,6 @@ ss_symbolic *ss_sym_remember(int slot, const silc_view *a, int tag, void *obj,
     e->m = a->m;
     e->n = a->n;
     e->nnz = nnz;
-    e->hash = pattern_hash(a);
     e->obj = obj;
     e->destroy = destroy;
     e->refs = 2; /* the cache's and the caller's */

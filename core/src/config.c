@@ -5,8 +5,9 @@
  *
  * A key is "section.name": dispatch.<class> (an ordered list of backends),
  * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads,
- * solve.refine / solve.refine_residual (iterative refinement, refine.c; per call
- * they may be written without the section: "refine = 2"), and
+ * solve.refine / solve.refine_residual (iterative refinement, refine.c) and
+ * solve.backward_error (always | deferred, accuracy.h) -- per call these may be
+ * written without the section: "refine = 2" --, and
  * <plugin>.<option> for the typed options a loaded plugin lists.  The INI file
  * (read with inih) spells the same keys as [section] name = value.  Every key
  * and value is checked when it is set, not when it is used, so a typo is
@@ -39,12 +40,20 @@ struct cfg_db {
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
-static const char *const solve_keys[] = {"refine", "refine_residual"};
+static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error"};
 
 /* Longest list a dispatch key may name; more would only repeat names. */
 #define CFG_MAX_LIST 32
 
 /* ---- small text helpers --------------------------------------------------- */
+
+static int in_list(const char *s, const char *const *list, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (strcmp(s, list[i]) == 0) return 1;
+    return 0;
+}
 
 static size_t count_names(const char *const *list)
 {
@@ -360,8 +369,12 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
             if (strcmp(value, "double") != 0 && strcmp(value, "extended") != 0)
                 return eng_error(E, "solve.refine_residual expects 'double' or 'extended', got '%s'",
                                  value);
+        } else if (strcmp(name, "backward_error") == 0) {
+            if (strcmp(value, "always") != 0 && strcmp(value, "deferred") != 0)
+                return eng_error(E, "solve.backward_error expects 'always' or 'deferred', got '%s'",
+                                 value);
         } else {
-            return unknown_key(E, section, name, solve_keys, 2);
+            return unknown_key(E, section, name, solve_keys, 3);
         }
         return sb_puts(norm, value);
     }
@@ -466,9 +479,9 @@ int cfg_set(silc_engine *E, int scope, const char *key, const char *value)
     trim_copy(v, sizeof v, value, strlen(value));
     if (!k[0]) return eng_error(E, "empty option key");
     dot = strchr(k, '.');
-    /* The refinement knobs read naturally without their section:
+    /* The solve knobs read naturally without their section:
      * solve(A, b, "refine = 2"). */
-    if (!dot && (strcmp(k, solve_keys[0]) == 0 || strcmp(k, solve_keys[1]) == 0))
+    if (!dot && in_list(k, solve_keys, sizeof solve_keys / sizeof solve_keys[0]))
         return set_parts(E, scope, "solve", k, v);
     if (!dot) return set_parts(E, scope, "", k, v);
     trim_copy(section, sizeof section, k, (size_t)(dot - k));

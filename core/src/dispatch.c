@@ -15,11 +15,11 @@
  * operation always has somewhere to go.
  *
  * Every solve gets the same accuracy report whoever ran it: the backward error
- * is computed here with the reference plugin's operations, so backends are
- * judged by one yardstick.
+ * comes from accuracy.c, so backends are judged by one yardstick.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "accuracy.h"
 #include "refine.h"
 #include "scale.h"
 
@@ -221,100 +221,6 @@ static const char *status_text(int status)
 
 /* ---- the accuracy report --------------------------------------------------- */
 
-/* Runs one reference operation for the report; NULL if it cannot. */
-static silc_value *ref_run(silc_engine *E, const ld_backend *ref, silc_call *c)
-{
-    host_call_ctx ctx;
-    memset(&ctx, 0, sizeof ctx);
-    ctx.E = E;
-    ctx.backend = ref;
-    c->host_private = &ctx;
-    c->op_class = NULL;
-    c->out = NULL;
-    if (!provides(ref, c->op)) return NULL;
-    if (ref->backend->ops[c->op].run(c) != SILC_OK) {
-        val_release(c->out);
-        return NULL;
-    }
-    return c->out;
-}
-
-static silc_value *ref_op(silc_engine *E, const ld_backend *ref, int op, int sub,
-                          const silc_value *a, const silc_value *b, double alpha, double beta)
-{
-    silc_call c;
-    memset(&c, 0, sizeof c);
-    c.op = op;
-    c.sub = sub;
-    c.in[0] = a;
-    c.in[1] = b;
-    c.nin = b ? 2 : 1;
-    c.alpha = alpha;
-    c.beta = beta;
-    return ref_run(E, ref, &c);
-}
-
-/* a*b, where MATMUL takes no 1x1 operand (the language turns that into SCALE). */
-static silc_value *ref_mul(silc_engine *E, const ld_backend *ref, const silc_value *a,
-                           const silc_value *b)
-{
-    if (val_is_scalar(a)) return ref_op(E, ref, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0);
-    if (val_is_scalar(b)) return ref_op(E, ref, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0);
-    return ref_op(E, ref, SILC_OP_MATMUL, 0, a, b, 1, 0);
-}
-
-static double ref_norminf(silc_engine *E, const ld_backend *ref, const silc_value *v)
-{
-    silc_value *r = ref_op(E, ref, SILC_OP_REDUCE, SILC_RED_NORMINF, v, NULL, 1, 0);
-    double x = r && val_is_scalar(r) ? val_scalar(r) : NAN;
-    val_release(r);
-    return x;
-}
-
-/*
- * Normwise backward error of X as a solution of A X = B, in the infinity norm:
- *
- *   square A:        ||B - A X|| / (||A|| ||X|| + ||B||)
- *   rectangular A:   ||A'(B - A X)|| / (||A|| (||A|| ||X|| + ||B||))
- *
- * The first is the Rigal-Gaches backward error of a linear system.  A least
- * squares solution does not make B - A X small, only orthogonal to the range
- * of A, so the second measures the normal equations' residual A'R, scaled so
- * that it is invariant under scaling A and B, as the first is.  Returns -1 when
- * it cannot be computed (the reference plugin lacks an operation).
- */
-static double backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
-                             const silc_value *X)
-{
-    const ld_backend *ref = ld_find(E, "reference");
-    silc_value *AX = NULL, *R = NULL, *At = NULL, *G = NULL;
-    double nA, nX, nB, nR, be = -1;
-    if (!ref) return -1;
-    nA = val_props(A)->norminf;
-    nB = val_props(B)->norminf;
-    nX = ref_norminf(E, ref, X);
-    AX = ref_mul(E, ref, A, X);
-    if (AX) R = ref_op(E, ref, SILC_OP_ADD, 0, B, AX, 1, -1);
-    if (R && A->m == A->n) {
-        nR = ref_norminf(E, ref, R);
-        be = nR / (nA * nX + nB);
-    } else if (R) {
-        At = ref_op(E, ref, SILC_OP_TRANSPOSE, 0, A, NULL, 1, 0);
-        if (At) G = ref_mul(E, ref, At, R);
-        if (G) {
-            nR = ref_norminf(E, ref, G);
-            be = nR / (nA * (nA * nX + nB));
-        }
-    }
-    /* 0/0: X = 0 solves B = 0 exactly. */
-    if (R && isnan(be) && !isnan(nX)) be = 0;
-    val_release(AX);
-    val_release(R);
-    val_release(At);
-    val_release(G);
-    return be;
-}
-
 static int has_nonfinite(const silc_value *v)
 {
     silc_view w;
@@ -327,7 +233,7 @@ static int has_nonfinite(const silc_value *v)
 
 /* Completes the report of a solve that succeeded and warns about a result that
  * deserves distrust. */
-static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed)
+static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
 {
     silc_report *r = call->report;
     double eps_cond;
@@ -337,7 +243,6 @@ static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed)
                  r->note[0] ? "; " : "", r->note);
         memcpy(r->note, note, sizeof note);
     }
-    r->backward_error = backward_error(E, call->in[0], call->in[1], call->out);
     eps_cond = r->cond_est * DBL_EPSILON;
     if (r->cond_est > 0 && eps_cond >= 1)
         eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
@@ -345,11 +250,7 @@ static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed)
     else if (r->cond_est > 0 && eps_cond > 1e-4)
         eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
                  r->cond_est);
-    /* Hook (issue 7): a result that does not solve the system is never
-     * returned silently, whatever the backend claimed. */
-    if (r->backward_error > 1e-3)
-        eng_warn(E, "'\\': the result of %s has backward error %.2g: it does not solve the system",
-                 r->backend, r->backward_error);
+    acc_report(E, call, may_defer);
     if (has_nonfinite(call->out))
         eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
 }
@@ -382,7 +283,7 @@ static int run_one(silc_call *call, const ld_backend *b)
 }
 
 static int walk(silc_engine *E, silc_call *call, const char *const *chain, int nchain,
-                const blist *L)
+                const blist *L, int may_defer)
 {
     strbuf skipped;
     int ci, i, rc, cholesky_failed = 0;
@@ -420,7 +321,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report. */
                 if (call->op == SILC_OP_SOLVE) refine_solve(E, call, b);
-                if (call->op == SILC_OP_SOLVE) finish_solve(E, call, cholesky_failed);
+                if (call->op == SILC_OP_SOLVE) finish_solve(E, call, cholesky_failed, may_defer);
                 call->host_private = NULL;
                 sb_free(&skipped);
                 return 0;
@@ -486,7 +387,9 @@ int disp_run(silc_engine *E, silc_call *call)
             rc = SILC_ENOMEM;
         } else {
             resolve_list(E, chain, n, &L);
-            rc = walk(E, call, chain, n, &L);
+            /* A scaled solve's deferred residual would be formed unscaled,
+             * where it may overflow: no deferral then. */
+            rc = walk(E, call, chain, n, &L, E->accuracy_defer && !S.ea && !S.eb);
             if (scaling) scale_solve_end(call, &S);
         }
         call->report = saved;

@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "accuracy.h"
 #include "tuner.h"
 
 #include <stdarg.h>
@@ -96,6 +97,7 @@ static void info_entry_free(eng_info_entry *e)
 {
     free(e->name);
     free(e->info.statement);
+    acc_pending_release(&e->info.pending);
     free(e);
 }
 
@@ -146,13 +148,15 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     sb_puts(&E->warnings, "\n");
 }
 
-int eng_info_set(silc_engine *E, const char *name, const eng_info *info)
+int eng_info_set(silc_engine *E, const char *name, eng_info *info)
 {
     eng_info_entry *e;
     char *stmt = NULL;
     if (!E || !name || !info) return -1;
-    if (info->statement && !(stmt = util_strdup(info->statement)))
+    if (info->statement && !(stmt = util_strdup(info->statement))) {
+        acc_pending_release(&info->pending);
         return eng_error(E, "out of memory recording info for '%s'", name);
+    }
     for (e = E->infos; e; e = e->next)
         if (strcmp(e->name, name) == 0) break;
     if (!e) {
@@ -160,21 +164,23 @@ int eng_info_set(silc_engine *E, const char *name, const eng_info *info)
         if (!e || !(e->name = util_strdup(name))) {
             free(e);
             free(stmt);
+            acc_pending_release(&info->pending);
             return eng_error(E, "out of memory recording info for '%s'", name);
         }
         e->next = E->infos;
         E->infos = e;
     } else {
         free(e->info.statement);
+        acc_pending_release(&e->info.pending);
     }
     e->info = *info;
     e->info.statement = stmt;
     return 0;
 }
 
-const eng_info *eng_info_get(const silc_engine *E, const char *name)
+eng_info *eng_info_get(const silc_engine *E, const char *name)
 {
-    const eng_info_entry *e;
+    eng_info_entry *e;
     if (!E || !name) return NULL;
     for (e = E->infos; e; e = e->next)
         if (strcmp(e->name, name) == 0) return &e->info;

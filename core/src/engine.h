@@ -27,6 +27,12 @@ typedef struct silc_engine silc_engine;
 typedef struct cfg_db cfg_db;
 typedef struct ld_set ld_set;
 
+/* The operands and result of a solve whose backward error is deferred
+ * (accuracy.h); all NULL when none is. */
+typedef struct acc_pending {
+    silc_value *A, *B, *X;
+} acc_pending;
+
 /* How a value bound to a name was last computed (`info x`). */
 typedef struct eng_info {
     char *statement;        /* text of the statement that bound it */
@@ -34,6 +40,7 @@ typedef struct eng_info {
     silc_report report;     /* of the last solve in the statement */
     double seconds;         /* wall time of the whole statement */
     char backends[128];     /* backends that ran, comma separated, deduplicated */
+    acc_pending pending;    /* report.backward_error == ACC_DEFERRED: owned refs */
 } eng_info;
 
 typedef struct eng_info_entry {
@@ -52,6 +59,8 @@ struct silc_engine {
     silc_output_fn output;              /* NULL = stdout */
     void *output_user;
     int threads;                        /* thread budget granted to plugins */
+    int accuracy_defer;                 /* solves may defer their backward error
+                                           (accuracy.h); set by the evaluator */
     uint64_t rand_state;                /* rand() seed state */
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     char err[4096];
@@ -76,8 +85,9 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
-int eng_info_set(silc_engine *E, const char *name, const eng_info *info); /* copies */
-const eng_info *eng_info_get(const silc_engine *E, const char *name);
+/* Copies info; takes over its pending references (also on failure). */
+int eng_info_set(silc_engine *E, const char *name, eng_info *info);
+eng_info *eng_info_get(const silc_engine *E, const char *name);
 void eng_info_remove(silc_engine *E, const char *name);
 
 /* ---- config.c -------------------------------------------------------------- */

@@ -16,6 +16,7 @@
 #include "lang.h"
 #include "tuner.h"
 #include "refine.h"
+#include "accuracy.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -176,7 +177,10 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
             return *out ? 0 : eng_error(E, "out of memory");
         }
     }
+    /* The evaluator records what a deferred backward error needs (bind). */
+    E->accuracy_defer = 1;
     rc = disp_run(E, call);
+    E->accuracy_defer = 0;
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
         call->out = NULL;
@@ -186,6 +190,8 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     if (call->op == SILC_OP_SOLVE) {
         V->has_solve = 1;
         V->report = rep;
+        if (rep.backward_error == ACC_DEFERRED) acc_pending_hold(&V->pending, call);
+        else acc_pending_release(&V->pending);
         add_backend(V, rep.backend);
         tuner_note_solve(E, call);
     }
@@ -586,6 +592,8 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
     info.statement = stmt_text(V, stmt);
     info.has_solve = V->has_solve;
     if (V->has_solve) info.report = V->report;
+    info.pending = V->pending; /* handed over */
+    memset(&V->pending, 0, sizeof V->pending);
     info.seconds = util_now() - t0;
     snprintf(info.backends, sizeof info.backends, "%s", V->backends);
     eng_info_set(V->E, name, &info);
@@ -747,7 +755,7 @@ static int exec_info(lang_ev *V, const ast_node *s)
 {
     silc_engine *E = V->E;
     silc_value *v = store_get(&E->store, s->name);
-    const eng_info *in;
+    eng_info *in;
     strbuf b;
     char shape[48], num[40];
     if (!v) return undefined_name(V, s->name);
@@ -760,6 +768,9 @@ static int exec_info(lang_ev *V, const ast_node *s)
         sb_puts(&b, "  deposited by PUT (no statement of this session computed it)\n");
     } else {
         const silc_report *r = &in->report;
+        int deferred = in->has_solve && r->backward_error == ACC_DEFERRED;
+        if (deferred)
+            in->report.backward_error = acc_pending_resolve(E, &in->pending, r->backend);
         sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
         sb_printf(&b, "  wall time: %.3g s\n", in->seconds);
         if (!in->has_solve) {
@@ -767,7 +778,8 @@ static int exec_info(lang_ev *V, const ast_node *s)
         } else {
             sb_printf(&b, "  solve: %s\n", r->method[0] ? r->method : "(method not reported)");
             sb_printf(&b, "  backend: %s\n", in->backends[0] ? in->backends : r->backend);
-            sb_printf(&b, "  backward error: %.3g\n", r->backward_error);
+            sb_printf(&b, "  backward error: %.3g%s\n", r->backward_error,
+                      deferred ? " (computed now: the solve reused a factorization)" : "");
             if (r->backward_error_unrefined >= 0)
                 sb_printf(&b, "  refinement: %d step%s, backward error before: %.3g\n",
                           r->refine_steps, r->refine_steps == 1 ? "" : "s",
@@ -865,6 +877,7 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
     *flow = FLOW_NEXT;
     V->has_solve = 0;
     V->backends[0] = 0;
+    acc_pending_release(&V->pending);
     switch (s->kind) {
     case ST_EXPR: {
         silc_value *v;
@@ -936,6 +949,7 @@ int lang_exec(silc_engine *E, const char *text)
         int flow;
         E->err[0] = 0;
         if (exec_stmt(&V, prog->stmts[i], &flow)) {
+            acc_pending_release(&V.pending);
             if (prog->nstmts > 1) {
                 char msg[sizeof E->err];
                 memcpy(msg, E->err, sizeof msg);
@@ -944,6 +958,7 @@ int lang_exec(silc_engine *E, const char *text)
             return -1;
         }
     }
+    acc_pending_release(&V.pending);
     tuner_observe(E, text, util_now() - t0);
     return 0;
 }

@@ -99,6 +99,7 @@ typedef struct lang_ev {
     int in_subscript;
     int has_solve;         /* the current statement ran a solve */
     silc_report report;    /* its last solve report */
+    acc_pending pending;   /* its operands when its backward error is deferred */
     char backends[128];    /* solve backends of the current statement */
 } lang_ev;
 

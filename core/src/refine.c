@@ -28,6 +28,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "refine.h"
+#include "accuracy.h"
 
 #include <float.h>
 #include <math.h>
@@ -65,86 +66,6 @@ int refine_check_finite(silc_engine *E, const silc_value *v, const char *name)
                              (long long)j + 1);
         }
     return 0;
-}
-
-/* ---- residuals ------------------------------------------------------------- */
-
-/* (*hi + *lo) -= a * x.  Plain: *hi -= a x.  Extended: the product is split
- * exactly (a x = p + e by fma) and added with TwoSum, so hi + lo carries the
- * sum to about twice the working precision. */
-static void acc_sub(double *hi, double *lo, double a, double x, int extended)
-{
-    double p = a * x, s, bb, err, e;
-    if (!extended) {
-        *hi -= p;
-        return;
-    }
-    e = fma(a, x, -p);
-    s = *hi - p;
-    bb = s - *hi;
-    err = (*hi - (s - bb)) + (-p - bb);
-    *hi = s;
-    *lo += err - e;
-}
-
-/* R = B - A X for k columns (A m x n; X n x k, B and R m x k, column-major). */
-static void residual(const silc_value *A, const double *B, const double *X, int64_t k,
-                     int extended, double *R, double *lo)
-{
-    silc_view a;
-    int64_t i, j, c, p;
-    val_view(A, &a);
-    memcpy(R, B, (size_t)(a.m * k) * sizeof *R);
-    memset(lo, 0, (size_t)(a.m * k) * sizeof *lo);
-    for (c = 0; c < k; c++) {
-        double *r = R + c * a.m, *l = lo + c * a.m;
-        const double *x = X + c * a.n;
-        if (a.format == SILC_FMT_CSR) {
-            for (i = 0; i < a.m; i++)
-                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++)
-                    acc_sub(&r[i], &l[i], a.val[p], x[a.colind[p]], extended);
-        } else if (a.format == SILC_FMT_BAND) {
-            for (j = 0; j < a.n; j++) {
-                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
-                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
-                for (i = lo_i; i < hi_i; i++)
-                    acc_sub(&r[i], &l[i], a.val[(a.ku + i - j) + j * a.ld], x[j], extended);
-            }
-        } else {
-            for (j = 0; j < a.n; j++)
-                for (i = 0; i < a.m; i++) acc_sub(&r[i], &l[i], a.val[i + j * a.m], x[j], extended);
-        }
-        if (extended)
-            for (i = 0; i < a.m; i++) r[i] += l[i];
-    }
-}
-
-/* Infinity norm of the m x k column-major array (max row sum of |.|). */
-static double norm_inf(const double *x, int64_t m, int64_t k)
-{
-    double best = 0;
-    int64_t i, c;
-    for (i = 0; i < m; i++) {
-        double s = 0;
-        for (c = 0; c < k; c++) s += fabs(x[i + c * m]);
-        if (!(s <= best)) best = s; /* NaN wins */
-    }
-    return best;
-}
-
-/* Dense copy of any value (m x n, column-major). */
-static double *dense_copy(const silc_value *v)
-{
-    double *x = malloc((size_t)(v->m * v->n > 0 ? v->m * v->n : 1) * sizeof *x);
-    int64_t i, j;
-    if (!x) return NULL;
-    if (v->format == SILC_FMT_DENSE) {
-        if (v->m * v->n > 0) memcpy(x, v->val, (size_t)(v->m * v->n) * sizeof *x);
-        return x;
-    }
-    for (j = 0; j < v->n; j++)
-        for (i = 0; i < v->m; i++) x[i + j * v->m] = val_get(v, i, j);
-    return x;
 }
 
 /* ---- the loop -------------------------------------------------------------- */
@@ -213,18 +134,18 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
         add_note(r, "refinement skipped: iterative solver (tighten its tolerance instead)");
         return;
     }
-    B = dense_copy(Bv);
-    X = dense_copy(call->out);
+    B = acc_dense_copy(Bv);
+    X = acc_dense_copy(call->out);
     R = malloc((size_t)(n * k) * sizeof *R);
-    lo = malloc((size_t)(n * k) * sizeof *lo);
-    if (!B || !X || !R || !lo) {
+    lo = extended ? malloc((size_t)(n * k) * sizeof *lo) : NULL;
+    if (!B || !X || !R || (extended && !lo)) {
         add_note(r, "refinement skipped: out of memory");
         goto done;
     }
     nA = val_props(A)->norminf;
-    nB = norm_inf(B, n, k);
-    residual(A, B, X, k, extended, R, lo);
-    be = be0 = norm_inf(R, n, k) / (nA * norm_inf(X, n, k) + nB);
+    nB = acc_norm_inf(B, n, k);
+    acc_residual(A, B, X, k, extended, R, lo);
+    be = be0 = acc_norm_inf(R, n, k) / (nA * acc_norm_inf(X, n, k) + nB);
     for (step = 0; step < want; step++) {
         silc_value *Rv, *D;
         double *Xn, ben, dn;
@@ -249,16 +170,16 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
             stop = why;
             break;
         }
-        Xn = dense_copy(D); /* becomes the candidate x + d */
+        Xn = acc_dense_copy(D); /* becomes the candidate x + d */
         val_release(D);
         if (!Xn) {
             stop = "out of memory";
             break;
         }
-        dn = norm_inf(Xn, n, k) / norm_inf(X, n, k);
+        dn = acc_norm_inf(Xn, n, k) / acc_norm_inf(X, n, k);
         for (i = 0; i < n * k; i++) Xn[i] += X[i];
-        residual(A, B, Xn, k, extended, R, lo);
-        ben = norm_inf(R, n, k) / (nA * norm_inf(Xn, n, k) + nB);
+        acc_residual(A, B, Xn, k, extended, R, lo);
+        ben = acc_norm_inf(R, n, k) / (nA * acc_norm_inf(Xn, n, k) + nB);
         if (extended ? !(dn < dprev) : !(ben < be)) {
             /* Not an improvement: the previous x stays. */
             free(Xn);

@@ -303,78 +303,76 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
 
 /* ---- structural properties ------------------------------------------------ */
 
-typedef void (*entry_fn)(void *acc, int64_t i, int64_t j, double a);
+/* One pass gathers the structure and the norms.  The norms are first summed
+ * unscaled, which is exact enough and cannot overflow or underflow harmfully
+ * while every |a| lies in [2^-NORM_SAFE_EXP, 2^NORM_SAFE_EXP] (squares stay
+ * normal, and 2^63 of them stay finite); only a value with entries beyond
+ * that gets a second pass on entries multiplied by a power of two chosen
+ * from maxabs (the idea of LAPACK's dlassq; a power of two keeps the scaling
+ * itself exact). */
+#define NORM_SAFE_EXP 450
 
-/* Calls fn for every stored entry (explicit zeros included). */
-static void for_each_entry(const silc_value *v, entry_fn fn, void *acc)
+typedef struct props_acc {
+    silc_props *p;
+    int64_t pos_diag_count;
+    int structure;           /* this pass also gathers the structure */
+    double scale;
+    double *colsum, *rowsum; /* NULL if they could not be allocated */
+    double total, sumsq;
+} props_acc;
+
+static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
+{
+    double x = fabs(a), xs = x * acc->scale;
+    if (acc->structure) {
+        silc_props *p = acc->p;
+        if (!isfinite(a)) p->has_nonfinite = 1;
+        if (x != x) p->maxabs = x; /* NaN is sticky: x > NaN is false from then on */
+        else if (x > p->maxabs) p->maxabs = x;
+        if (i == j && a > 0) acc->pos_diag_count++;
+        if (a != 0) {
+            p->nnz++;
+            if (i != j) p->diagonal = 0;
+            if (j > i) {
+                p->lower = 0;
+                if (j - i > p->ku) p->ku = j - i;
+            }
+            if (i > j) {
+                p->upper = 0;
+                if (i - j > p->kl) p->kl = i - j;
+            }
+        }
+    }
+    acc->total += xs;
+    acc->sumsq += xs * xs;
+    if (acc->colsum) acc->colsum[j] += xs;
+    if (acc->rowsum) acc->rowsum[i] += xs;
+}
+
+/* props_entry on every stored entry (explicit zeros included); called
+ * directly, not through a pointer, so that it inlines into each loop. */
+static void props_pass(const silc_value *v, props_acc *acc)
 {
     int64_t i, j, k;
     switch (v->format) {
     case SILC_FMT_DENSE:
         for (j = 0; j < v->n; j++)
-            for (i = 0; i < v->m; i++) fn(acc, i, j, v->val[i + j * v->m]);
+            for (i = 0; i < v->m; i++) props_entry(acc, i, j, v->val[i + j * v->m]);
         break;
     case SILC_FMT_CSR:
         for (i = 0; i < v->m; i++)
-            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) fn(acc, i, v->colind[k], v->val[k]);
+            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) props_entry(acc, i, v->colind[k], v->val[k]);
         break;
     case SILC_FMT_BAND:
         for (j = 0; j < v->n; j++) {
             int64_t lo = j - v->ku > 0 ? j - v->ku : 0;
             int64_t hi = j + v->kl < v->m - 1 ? j + v->kl : v->m - 1;
-            for (i = lo; i <= hi; i++) fn(acc, i, j, v->val[(v->ku + i - j) + j * v->ld]);
+            for (i = lo; i <= hi; i++) props_entry(acc, i, j, v->val[(v->ku + i - j) + j * v->ld]);
         }
         break;
     default:
         break;
     }
-}
-
-/* First pass: everything that needs no scale. */
-typedef struct structure_acc {
-    silc_props *p;
-    int64_t pos_diag_count;
-} structure_acc;
-
-static void structure_entry(void *accp, int64_t i, int64_t j, double a)
-{
-    structure_acc *acc = accp;
-    silc_props *p = acc->p;
-    double x = fabs(a);
-    if (!isfinite(a)) p->has_nonfinite = 1;
-    if (x != x) p->maxabs = x; /* NaN is sticky: x > NaN is false from then on */
-    else if (x > p->maxabs) p->maxabs = x;
-    if (i == j && a > 0) acc->pos_diag_count++;
-    if (a == 0) return;
-    p->nnz++;
-    if (i != j) p->diagonal = 0;
-    if (j > i) {
-        p->lower = 0;
-        if (j - i > p->ku) p->ku = j - i;
-    }
-    if (i > j) {
-        p->upper = 0;
-        if (i - j > p->kl) p->kl = i - j;
-    }
-}
-
-/* Second pass: norms, on entries multiplied by a power of two chosen from
- * maxabs so that no partial sum or square can overflow (the idea of LAPACK's
- * dlassq; a power of two keeps the scaling itself exact). */
-typedef struct norm_acc {
-    double scale;
-    double *colsum, *rowsum; /* NULL if they could not be allocated */
-    double total, sumsq;
-} norm_acc;
-
-static void norm_entry(void *accp, int64_t i, int64_t j, double a)
-{
-    norm_acc *acc = accp;
-    double x = fabs(a) * acc->scale;
-    acc->total += x;
-    acc->sumsq += x * x;
-    if (acc->colsum) acc->colsum[j] += x;
-    if (acc->rowsum) acc->rowsum[i] += x;
 }
 
 static double max_of(const double *x, int64_t n)
@@ -389,45 +387,37 @@ static double max_of(const double *x, int64_t n)
 }
 
 /* Exact value symmetry of a CSR matrix: the numerically nonzero entries of A
- * and of A' must coincide.  Builds A' of the nonzeros by a counting sort,
- * which leaves its rows sorted, and compares row by row.  Returns -1 when out
- * of memory. */
+ * and of A' must coincide.  Rows are sorted, so walking the rows in order
+ * meets the entries (j, i), i > j, of row j in increasing i: next[j] is the
+ * next such entry row i must find as the mirror of its (i, j).  One pass,
+ * stopping at the first mismatch.  Returns -1 when out of memory. */
 static int csr_symmetric(const silc_value *v)
 {
-    int64_t n = v->n, i, k, t, nz = 0;
-    int64_t *tp, *ti, *next;
-    double *tx;
+    int64_t n = v->n, i, j, k, q;
+    int64_t *next = malloc((size_t)(n ? n : 1) * sizeof *next);
     int sym = 1;
-    for (k = 0; k < v->nnz; k++) nz += v->val[k] != 0;
-    tp = calloc((size_t)n + 1, sizeof *tp);
-    next = calloc((size_t)n + 1, sizeof *next);
-    ti = malloc((size_t)(nz ? nz : 1) * sizeof *ti);
-    tx = malloc((size_t)(nz ? nz : 1) * sizeof *tx);
-    if (!tp || !next || !ti || !tx) {
-        free(tp), free(next), free(ti), free(tx);
-        return -1;
+    if (!next) return -1;
+    for (j = 0; j < n; j++) {
+        for (q = v->rowptr[j]; q < v->rowptr[j + 1] && v->colind[q] <= j; q++) {}
+        next[j] = q;
     }
-    for (k = 0; k < v->nnz; k++)
-        if (v->val[k] != 0) tp[v->colind[k] + 1]++;
-    for (i = 0; i < n; i++) tp[i + 1] += tp[i];
-    memcpy(next, tp, (size_t)(n + 1) * sizeof *tp);
-    for (i = 0; i < v->m; i++)
-        for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++)
-            if (v->val[k] != 0) {
-                int64_t c = v->colind[k];
-                ti[next[c]] = i;
-                tx[next[c]++] = v->val[k];
-            }
-    for (i = 0; i < v->m && sym; i++) {
-        t = tp[i];
+    for (i = 0; i < n && sym; i++)
         for (k = v->rowptr[i]; k < v->rowptr[i + 1] && sym; k++) {
+            if (v->colind[k] >= i) break;
             if (v->val[k] == 0) continue;
-            if (t >= tp[i + 1] || ti[t] != v->colind[k] || tx[t] != v->val[k]) sym = 0;
-            t++;
+            j = v->colind[k];
+            for (q = next[j]; q < v->rowptr[j + 1] && v->val[q] == 0; q++) {}
+            if (q >= v->rowptr[j + 1] || v->colind[q] != i || v->val[q] != v->val[k]) sym = 0;
+            next[j] = q + 1;
         }
-        if (t != tp[i + 1]) sym = 0;
-    }
-    free(tp), free(next), free(ti), free(tx);
+    /* Every nonzero above the diagonal must have been met as a mirror. */
+    for (j = 0; j < n && sym; j++)
+        for (q = next[j]; q < v->rowptr[j + 1]; q++)
+            if (v->val[q] != 0) {
+                sym = 0;
+                break;
+            }
+    free(next);
     return sym;
 }
 
@@ -464,38 +454,45 @@ static int value_symmetric(const silc_value *v)
  * bound sum|a_ij|) and the caller does not cache them. */
 static int compute_props(const silc_value *v, silc_props *p)
 {
-    structure_acc sacc;
-    norm_acc nacc;
+    props_acc acc;
     int exp2 = 0, sym, rc = 0;
     memset(p, 0, sizeof *p);
     p->square = v->m == v->n;
     p->diagonal = p->lower = p->upper = 1;
-    sacc.p = p;
-    sacc.pos_diag_count = 0;
-    for_each_entry(v, structure_entry, &sacc);
-    p->pos_diag = p->square && v->n > 0 && sacc.pos_diag_count == v->n;
-
-    memset(&nacc, 0, sizeof nacc);
+    memset(&acc, 0, sizeof acc);
+    acc.p = p;
+    acc.structure = 1;
+    acc.scale = 1;
+    acc.colsum = calloc((size_t)(v->n ? v->n : 1), sizeof(double));
+    acc.rowsum = calloc((size_t)(v->m ? v->m : 1), sizeof(double));
+    props_pass(v, &acc);
+    p->pos_diag = p->square && v->n > 0 && acc.pos_diag_count == v->n;
     if (isfinite(p->maxabs) && p->maxabs > 0) {
         frexp(p->maxabs, &exp2);
-        /* Clamped so that the scale itself and its inverse are finite normals. */
-        if (exp2 > 1021) exp2 = 1021;
-        if (exp2 < -1021) exp2 = -1021;
+        if (exp2 > -NORM_SAFE_EXP && exp2 < NORM_SAFE_EXP) {
+            exp2 = 0;
+        } else {
+            /* Clamped so that the scale itself and its inverse are finite normals. */
+            if (exp2 > 1021) exp2 = 1021;
+            if (exp2 < -1021) exp2 = -1021;
+            acc.structure = 0;
+            acc.scale = ldexp(1.0, -exp2);
+            acc.total = acc.sumsq = 0;
+            if (acc.colsum) memset(acc.colsum, 0, (size_t)v->n * sizeof(double));
+            if (acc.rowsum) memset(acc.rowsum, 0, (size_t)v->m * sizeof(double));
+            props_pass(v, &acc);
+        }
     }
-    nacc.scale = ldexp(1.0, -exp2);
-    nacc.colsum = calloc((size_t)(v->n ? v->n : 1), sizeof(double));
-    nacc.rowsum = calloc((size_t)(v->m ? v->m : 1), sizeof(double));
-    for_each_entry(v, norm_entry, &nacc);
-    if (nacc.colsum && nacc.rowsum) {
-        p->norm1 = ldexp(max_of(nacc.colsum, v->n), exp2);
-        p->norminf = ldexp(max_of(nacc.rowsum, v->m), exp2);
+    if (acc.colsum && acc.rowsum) {
+        p->norm1 = ldexp(max_of(acc.colsum, v->n), exp2);
+        p->norminf = ldexp(max_of(acc.rowsum, v->m), exp2);
     } else {
-        p->norm1 = p->norminf = ldexp(nacc.total, exp2);
+        p->norm1 = p->norminf = ldexp(acc.total, exp2);
         rc = -1;
     }
-    p->normfro = ldexp(sqrt(nacc.sumsq), exp2);
-    free(nacc.colsum);
-    free(nacc.rowsum);
+    p->normfro = ldexp(sqrt(acc.sumsq), exp2);
+    free(acc.colsum);
+    free(acc.rowsum);
 
     sym = value_symmetric(v);
     if (sym < 0) rc = -1;

@@ -1,0 +1,237 @@
+/*
+ * accuracy.c -- residuals and the backward error of a solve, computed here
+ * for every backend alike (so backends are judged by one yardstick), and the
+ * deferral of that number for back-substitutions that reuse a factorization
+ * (accuracy.h says why that is safe).  refine.c forms its residuals with the
+ * same kernel.
+ */
+#include "accuracy.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* (*hi + *lo) -= a * x.  Plain: *hi -= a x.  Extended: the product is split
+ * exactly (a x = p + e by fma) and added with TwoSum, so hi + lo carries the
+ * sum to about twice the working precision. */
+static void sub_product(double *hi, double *lo, double a, double x, int extended)
+{
+    double p = a * x, s, bb, err, e;
+    if (!extended) {
+        *hi -= p;
+        return;
+    }
+    e = fma(a, x, -p);
+    s = *hi - p;
+    bb = s - *hi;
+    err = (*hi - (s - bb)) + (-p - bb);
+    *hi = s;
+    *lo += err - e;
+}
+
+void acc_residual(const silc_value *A, const double *B, const double *X, int64_t k, int extended,
+                  double *R, double *lo)
+{
+    silc_view a;
+    double dummy = 0;
+    int64_t i, j, c, p;
+    val_view(A, &a);
+    memcpy(R, B, (size_t)(a.m * k) * sizeof *R);
+    if (extended) memset(lo, 0, (size_t)(a.m * k) * sizeof *lo);
+    for (c = 0; c < k; c++) {
+        double *r = R + c * a.m, *l = extended ? lo + c * a.m : &dummy;
+        const double *x = X + c * a.n;
+        if (a.format == SILC_FMT_CSR) {
+            for (i = 0; i < a.m; i++)
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++)
+                    sub_product(&r[i], extended ? &l[i] : l, a.val[p], x[a.colind[p]], extended);
+        } else if (a.format == SILC_FMT_BAND) {
+            for (j = 0; j < a.n; j++) {
+                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
+                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
+                for (i = lo_i; i < hi_i; i++)
+                    sub_product(&r[i], extended ? &l[i] : l, a.val[(a.ku + i - j) + j * a.ld], x[j],
+                                extended);
+            }
+        } else {
+            for (j = 0; j < a.n; j++)
+                for (i = 0; i < a.m; i++)
+                    sub_product(&r[i], extended ? &l[i] : l, a.val[i + j * a.m], x[j], extended);
+        }
+        if (extended)
+            for (i = 0; i < a.m; i++) r[i] += l[i];
+    }
+}
+
+double acc_norm_inf(const double *x, int64_t m, int64_t k)
+{
+    double best = 0;
+    int64_t i, c;
+    for (i = 0; i < m; i++) {
+        double s = 0;
+        for (c = 0; c < k; c++) s += fabs(x[i + c * m]);
+        if (s > best || isnan(s)) best = s;
+        if (isnan(best)) break; /* NaN wins */
+    }
+    return best;
+}
+
+double *acc_dense_copy(const silc_value *v)
+{
+    double *x = malloc((size_t)(v->m * v->n > 0 ? v->m * v->n : 1) * sizeof *x);
+    int64_t i, j;
+    if (!x) return NULL;
+    if (v->format == SILC_FMT_DENSE) {
+        if (v->m * v->n > 0) memcpy(x, v->val, (size_t)(v->m * v->n) * sizeof *x);
+        return x;
+    }
+    for (j = 0; j < v->n; j++)
+        for (i = 0; i < v->m; i++) x[i + j * v->m] = val_get(v, i, j);
+    return x;
+}
+
+/* ||B - A X||_inf for CSR A and dense B, X in one pass, nothing allocated:
+ * the common case, whose cost is one sparse product. */
+static double residual_norm_csr(const silc_value *A, const double *B, const double *X, int64_t k)
+{
+    silc_view a;
+    double best = 0;
+    int64_t i, c, p;
+    val_view(A, &a);
+    for (i = 0; i < a.m; i++) {
+        double s = 0;
+        for (c = 0; c < k; c++) {
+            const double *x = X + c * a.n;
+            double r = B[i + c * a.m];
+            for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) r -= a.val[p] * x[a.colind[p]];
+            s += fabs(r);
+        }
+        if (s > best || isnan(s)) best = s;
+        if (isnan(best)) break;
+    }
+    return best;
+}
+
+/* G = A' R (A m x n, R m x k, G n x k zeroed by the caller). */
+static void transpose_times(const silc_value *A, const double *R, int64_t k, double *G)
+{
+    silc_view a;
+    int64_t i, j, c, p;
+    val_view(A, &a);
+    for (c = 0; c < k; c++) {
+        const double *r = R + c * a.m;
+        double *g = G + c * a.n;
+        if (a.format == SILC_FMT_CSR) {
+            for (i = 0; i < a.m; i++)
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) g[a.colind[p]] += a.val[p] * r[i];
+        } else if (a.format == SILC_FMT_BAND) {
+            for (j = 0; j < a.n; j++) {
+                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
+                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
+                for (i = lo_i; i < hi_i; i++) g[j] += a.val[(a.ku + i - j) + j * a.ld] * r[i];
+            }
+        } else {
+            for (j = 0; j < a.n; j++)
+                for (i = 0; i < a.m; i++) g[j] += a.val[i + j * a.m] * r[i];
+        }
+    }
+}
+
+/*
+ * Normwise backward error of X as a solution of A X = B, in the infinity norm:
+ *
+ *   square A:        ||B - A X|| / (||A|| ||X|| + ||B||)
+ *   rectangular A:   ||A'(B - A X)|| / (||A|| (||A|| ||X|| + ||B||))
+ *
+ * The first is the Rigal-Gaches backward error of a linear system.  A least
+ * squares solution does not make B - A X small, only orthogonal to the range
+ * of A, so the second measures the normal equations' residual A'R, scaled so
+ * that it is invariant under scaling A and B, as the first is.
+ */
+double acc_backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
+                          const silc_value *X)
+{
+    double nA = val_props(A)->norminf, nB = val_props(B)->norminf, nX, nR, be = -1;
+    const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
+    const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
+    double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL;
+    int64_t k = X->n;
+    (void)E;
+    if (!b) b = bc = acc_dense_copy(B);
+    if (!x) x = xc = acc_dense_copy(X);
+    if (!b || !x) goto out;
+    nX = acc_norm_inf(x, X->m, k);
+    if (A->m == A->n && A->format == SILC_FMT_CSR) {
+        nR = residual_norm_csr(A, b, x, k);
+    } else {
+        R = malloc((size_t)(A->m * k > 0 ? A->m * k : 1) * sizeof *R);
+        if (!R) goto out;
+        acc_residual(A, b, x, k, 0, R, NULL);
+        if (A->m == A->n) {
+            nR = acc_norm_inf(R, A->m, k);
+        } else {
+            G = calloc((size_t)(A->n * k > 0 ? A->n * k : 1), sizeof *G);
+            if (!G) goto out;
+            transpose_times(A, R, k, G);
+            nR = acc_norm_inf(G, A->n, k);
+        }
+    }
+    if (isnan(nR) || isnan(nX)) be = NAN;
+    else if (nR == 0) be = 0; /* also 0/0: X = 0 solves B = 0 exactly */
+    else if (A->m == A->n) be = nR / (nA * nX + nB);
+    else be = nR / (nA * (nA * nX + nB));
+out:
+    free(bc);
+    free(xc);
+    free(R);
+    free(G);
+    return be;
+}
+
+/* ---- when -------------------------------------------------------------------- */
+
+static void warn_if_unsolved(silc_engine *E, const char *backend, double be)
+{
+    /* A result that does not solve the system is never returned silently,
+     * whatever the backend claimed. */
+    if (be > 1e-3)
+        eng_warn(E, "'\\': the result of %s has backward error %.2g: it does not solve the system",
+                 backend, be);
+}
+
+void acc_report(silc_engine *E, silc_call *call, int may_defer)
+{
+    silc_report *r = call->report;
+    const char *when = cfg_get(E, "solve.backward_error");
+    if (may_defer && r->reused_factor && r->iterations == 0 && r->backward_error_unrefined < 0 &&
+        !(when && strcmp(when, "always") == 0)) {
+        r->backward_error = ACC_DEFERRED;
+        return;
+    }
+    r->backward_error = acc_backward_error(E, call->in[0], call->in[1], call->out);
+    warn_if_unsolved(E, r->backend, r->backward_error);
+}
+
+void acc_pending_hold(acc_pending *p, const silc_call *call)
+{
+    acc_pending_release(p);
+    p->A = val_retain((silc_value *)call->in[0]);
+    p->B = val_retain((silc_value *)call->in[1]);
+    p->X = val_retain(call->out);
+}
+
+void acc_pending_release(acc_pending *p)
+{
+    val_release(p->A);
+    val_release(p->B);
+    val_release(p->X);
+    memset(p, 0, sizeof *p);
+}
+
+double acc_pending_resolve(silc_engine *E, acc_pending *p, const char *backend)
+{
+    double be = p->A && p->B && p->X ? acc_backward_error(E, p->A, p->B, p->X) : -1;
+    warn_if_unsolved(E, backend, be);
+    acc_pending_release(p);
+    return be;
+}

@@ -1,0 +1,55 @@
+/*
+ * accuracy.h -- the backward error every solve reports, computed by the core
+ * the same way whichever backend solved, and when it is computed.
+ *
+ * A solve that factors or iterates gets its backward error at once: one
+ * residual is cheap next to a factorization, and it catches a bad factor or a
+ * solver that claims convergence it did not reach.  A back-substitution that
+ * reuses a factorization (the body of a time loop) costs about as much as
+ * that residual, so by default its backward error is deferred: the solve
+ * keeps its operands (values are immutable, so they cannot change under it)
+ * and `info` computes the number when someone asks.  Deferring loses nothing
+ * that matters: LU and Cholesky are backward stable for every right-hand side
+ * with the same bound (|dA| <= c n eps |L||U|), a property of the factors
+ * that the first, checked solve already measured.  solve.backward_error =
+ * always (a key, or per call "backward_error = always") computes it on every
+ * solve, and with it the "does not solve the system" warning.
+ */
+#ifndef SILC_ACCURACY_H
+#define SILC_ACCURACY_H
+
+#include "engine.h"
+
+/* report->backward_error of a solve whose backward error is deferred. */
+#define ACC_DEFERRED (-2.0)
+
+/* R = B - A X for k columns (A m x n; X n x k, B and R m x k, column-major).
+ * extended: the sums are carried in double-double (lo, m x k, receives the
+ * low parts' contribution; NULL when not extended). */
+void acc_residual(const silc_value *A, const double *B, const double *X, int64_t k, int extended,
+                  double *R, double *lo);
+/* Infinity norm of the m x k column-major array (max row sum of |.|); NaN wins. */
+double acc_norm_inf(const double *x, int64_t m, int64_t k);
+/* Dense copy of any value (m x n, column-major); NULL when out of memory. */
+double *acc_dense_copy(const silc_value *v);
+
+/* Normwise backward error of X as a solution of A X = B (infinity norm; the
+ * normal equations' residual for rectangular A).  -1 when it cannot be
+ * computed. */
+double acc_backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
+                          const silc_value *X);
+
+/* Fills call->report->backward_error after a successful solve: at once, or
+ * ACC_DEFERRED when the solve only reused a factorization, the caller allows
+ * deferral (may_defer) and solve.backward_error is not "always".  Warns when
+ * the result does not solve the system. */
+void acc_report(silc_engine *E, silc_call *call, int may_defer);
+
+/* Holds references to the solve's operands and result. */
+void acc_pending_hold(acc_pending *p, const silc_call *call);
+void acc_pending_release(acc_pending *p);
+/* The deferred backward error, computed now (with the warning a bad one
+ * deserves); releases p. */
+double acc_pending_resolve(silc_engine *E, acc_pending *p, const char *backend);
+
+#endif
