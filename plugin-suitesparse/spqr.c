@@ -1,22 +1,31 @@
 /*
  * spqr.c -- suitesparse.spqr: sparse least squares by SuiteSparseQR.
  *
- * SuiteSparseQR_C_factorize computes A*E = Q*R, with Q kept as Householder
- * vectors and rank detection by the column-norm tolerance (spqr_tol).  The
- * factorization is an attachment of A, so each solve is
+ * Tall or square A (m >= n): SuiteSparseQR_C_factorize computes A*E = Q*R,
+ * with Q kept as Householder vectors and rank detection by the column-norm
+ * tolerance (spqr_tol), and each solve is
  *     Y = Q' * B                      SuiteSparseQR_C_qmult (SPQR_QTX)
  *     X = E * (R \ Y)                 SuiteSparseQR_C_solve (SPQR_RETX_EQUALS_B)
- * which is what SuiteSparseQR_C_backslash does in one call.  For m >= n of
- * full rank this is the least-squares solution.  When A is rank deficient or
- * underdetermined (m < n), R \ Y solves with the leading rank x rank block of
- * R and sets the other entries to zero: a *basic* solution (at most rank
- * nonzeros), as MATLAB's backslash gives, not the minimum-norm one.  A
- * square matrix of deficient rank is refused as singular instead, as the LU
- * backends would.
+ * which is what SuiteSparseQR_C_backslash does in one call: for full rank the
+ * least-squares solution.  When a tall A is rank deficient, R \ Y solves with
+ * the leading rank x rank block of R and sets the other entries to zero: a
+ * *basic* solution (at most rank nonzeros), as MATLAB's backslash gives.  A
+ * square matrix of deficient rank is refused as singular, as the LU backends
+ * would.
  *
- * SPQR needs A itself in compressed columns, so unlike the other backends it
- * transposes the CSR arrays (cholmod_l_transpose, O(nnz)).  All calls use the
- * plugin's cholmod_common, under the plugin lock.
+ * Wide A (m < n) is factored transposed, A'*E = Q*R, which is what the CSR
+ * arrays already are (A' in compressed columns: no transpose).  Then
+ * A = E R' Q', and for full row rank the minimum-norm solution is
+ *     Y = R' \ (E' * B)               SuiteSparseQR_C_solve (SPQR_RTX_EQUALS_ETB)
+ *     X = Q * Y                       SuiteSparseQR_C_qmult (SPQR_QX)
+ * -- the same solution as the reference and LAPACK's dgels, and R has A's
+ * singular values, so its condition estimate means what it says.  A wide A of
+ * deficient row rank has no such formula: it is factored again as A*E = Q*R
+ * and gets the basic solution, with an infinite condition number.
+ *
+ * SPQR needs the factored matrix in compressed columns, so a tall A is
+ * transposed (cholmod_l_transpose, O(nnz)).  All calls use the plugin's
+ * cholmod_common, under the plugin lock.
  */
 #include "ss.h"
 
@@ -31,8 +40,9 @@
 typedef struct qr_factor {
     SuiteSparseQR_C_factorization *QR;
     int64_t m, n, rank;
+    int transposed;     /* QR of A' (wide A of full row rank): minimum-norm solves */
     double tol;
-    double cond;        /* ||A||_1 * est ||R^-1||_1, full-rank tall/square only; -1 = none */
+    double cond;        /* ||A|| * est ||R^-1||_1 for full rank, Inf if deficient */
     char method[64];
     char note[160];
 } qr_factor;
@@ -82,10 +92,12 @@ static int qr_apply_rinv(void *ctx, double *x, int trans)
     qr_factor *F = ctx;
     cholmod_common *cc = ss_cholmod_common();
     cholmod_dense *bh, *y;
-    /* SPQR's R is rank x n: R \ B takes B with m rows (only the first rank
-     * are read) and gives n; R' \ B takes n rows and gives m.  The estimate
-     * works on the leading rank x rank block, so x has rank entries. */
-    int64_t rows = trans ? F->n : F->m;
+    /* For the factored p x q matrix SPQR's R is rank x q: R \ B takes B with p
+     * rows (only the first rank are read) and gives q; R' \ B takes q rows
+     * and gives p.  The estimate works on the leading rank x rank block, so
+     * x has rank entries. */
+    int64_t p = F->transposed ? F->n : F->m, q = F->transposed ? F->m : F->n;
+    int64_t rows = trans ? q : p;
     bh = cholmod_l_zeros((size_t)rows, 1, CHOLMOD_REAL, cc);
     if (!bh) return -1;
     memcpy(bh->x, x, (size_t)F->rank * sizeof *x);
@@ -97,17 +109,14 @@ static int qr_apply_rinv(void *ctx, double *x, int trans)
     return 0;
 }
 
-/* Called under the lock. */
-static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_factor **out)
+/* QR of A (transposed = 0: cholmod_l_transpose of the CSR arrays) or of A'
+ * (the CSR arrays as they are).  NULL with *status on failure. */
+static SuiteSparseQR_C_factorization *qr_of(const silc_view *a, double tol, int transposed,
+                                            int *status, const char **fn)
 {
     cholmod_common *cc = ss_cholmod_common();
-    cholmod_sparse At, *A;
-    qr_factor *F;
-    int status;
-    *out = NULL;
-    F = ss_host->calloc(1, sizeof *F);
-    if (!F) return ss_nomem(call, "SPQR factor");
-    /* The CSR arrays are A' in compressed columns; SPQR wants A. */
+    cholmod_sparse At, *A = NULL;
+    SuiteSparseQR_C_factorization *QR;
     memset(&At, 0, sizeof At);
     At.nrow = (size_t)a->n;
     At.ncol = (size_t)a->m;
@@ -120,38 +129,59 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
     At.dtype = CHOLMOD_DOUBLE;
     At.sorted = 1;
     At.packed = 1;
-    A = cholmod_l_transpose(&At, 1, cc);
-    if (!A) {
-        ss_host->free(F);
-        return qr_fail(call, "cholmod_l_transpose", cc->status);
+    if (!transposed && !(A = cholmod_l_transpose(&At, 1, cc))) {
+        *status = cc->status;
+        *fn = "cholmod_l_transpose";
+        return NULL;
     }
-    F->QR = SuiteSparseQR_C_factorize(SPQR_ORDERING_DEFAULT, tol, A, cc);
-    status = cc->status;
+    QR = SuiteSparseQR_C_factorize(SPQR_ORDERING_DEFAULT, tol, transposed ? &At : A, cc);
+    *status = cc->status;
+    *fn = "SuiteSparseQR_C_factorize";
     cholmod_l_free_sparse(&A, cc);
-    if (!F->QR) {
-        ss_host->free(F);
-        return qr_fail(call, "SuiteSparseQR_C_factorize", status);
-    }
+    return QR;
+}
+
+/* Called under the lock. */
+static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_factor **out)
+{
+    cholmod_common *cc = ss_cholmod_common();
+    qr_factor *F;
+    const char *fn;
+    int status, full;
+    *out = NULL;
+    F = ss_host->calloc(1, sizeof *F);
+    if (!F) return ss_nomem(call, "SPQR factor");
     F->m = a->m;
     F->n = a->n;
     F->tol = tol;
-    F->rank = cc->SPQR_istat[4]; /* rank estimate of the factorization */
-    snprintf(F->method, sizeof F->method, "sparse QR (SuiteSparseQR, %s)",
-             qr_ordering_name(cc->SPQR_istat[7]));
-    /* A = Q R E' with the same singular values in R as in A, so for a tall
-     * or square A of full rank ||A||_1 ||R^-1||_1 estimates cond(A) within
-     * modest factors; a rank-deficient A has no finite condition number (as
-     * the reference plugin reports it).  A wide A gets none: its R's leading
-     * block is ordered for sparsity, not conditioning, and measures only the
-     * basic solution's sensitivity (gemat1: 8.7e18 against cond 1.2e8). */
-    F->cond = -1;
-    if (F->rank < (F->m < F->n ? F->m : F->n)) {
-        F->cond = INFINITY;
-    } else if (F->rank > 0 && F->m >= F->n) {
-        double inv = ss_inv_norm1(F->rank, qr_apply_rinv, F);
-        if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv;
+    F->transposed = a->m < a->n;
+    F->QR = qr_of(a, tol, F->transposed, &status, &fn);
+    F->rank = F->QR ? cc->SPQR_istat[4] : 0; /* rank estimate of the factorization */
+    if (F->QR && F->transposed && F->rank < a->m) {
+        /* Deficient row rank: no minimum-norm formula from A'; basic solution. */
+        SuiteSparseQR_C_free(&F->QR, cc);
+        F->transposed = 0;
+        F->QR = qr_of(a, tol, 0, &status, &fn);
+        F->rank = F->QR ? cc->SPQR_istat[4] : 0;
     }
-    if (F->rank < (F->m < F->n ? F->m : F->n) || F->m < F->n)
+    if (!F->QR) {
+        ss_host->free(F);
+        return qr_fail(call, fn, status);
+    }
+    snprintf(F->method, sizeof F->method, "sparse QR (SuiteSparseQR%s, %s)",
+             F->transposed ? " of A'" : "", qr_ordering_name(cc->SPQR_istat[7]));
+    /* R has the singular values of the factored matrix, so for full rank
+     * ||A|| ||R^-1||_1 estimates cond(A) within modest factors (the 1-norm of
+     * the factored matrix: ||A||_1 for A, ||A||_inf for A'); a rank-deficient
+     * A has no finite condition number (as the reference plugin reports). */
+    full = F->rank == (a->m < a->n ? a->m : a->n);
+    F->cond = INFINITY;
+    if (full && F->rank > 0) {
+        const silc_props *p = ss_host->props(call->in[0]);
+        double inv = ss_inv_norm1(F->rank, qr_apply_rinv, F);
+        F->cond = inv >= 0 ? (F->transposed ? p->norminf : p->norm1) * inv : -1;
+    }
+    if (!full)
         snprintf(F->note, sizeof F->note,
                  "rank %lld of %lldx%lld (tol %.3g): basic solution (at most rank nonzeros), "
                  "not minimum norm",
@@ -159,7 +189,9 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
     else
         snprintf(F->note, sizeof F->note, "full rank %lld of %lldx%lld (tol %.3g)%s",
                  (long long)F->rank, (long long)F->m, (long long)F->n, cc->SPQR_tol_used,
-                 F->m > F->n ? ": least-squares solution" : "");
+                 F->m > F->n   ? ": least-squares solution"
+                 : F->m < F->n ? ": minimum-norm solution"
+                               : "");
     *out = F;
     return SILC_OK;
 }
@@ -227,12 +259,23 @@ int ss_spqr_solve(silc_call *call)
     Bh.xtype = CHOLMOD_REAL;
     Bh.dtype = CHOLMOD_DOUBLE;
     ss_lock();
-    Y = SuiteSparseQR_C_qmult(SPQR_QTX, F->QR, &Bh, cc);
-    status = cc->status;
-    if (Y) {
+    if (F->transposed) { /* X = Q (R' \ (E' B)) */
         fn = "SuiteSparseQR_C_solve";
-        X = SuiteSparseQR_C_solve(SPQR_RETX_EQUALS_B, F->QR, Y, cc);
+        Y = SuiteSparseQR_C_solve(SPQR_RTX_EQUALS_ETB, F->QR, &Bh, cc);
         status = cc->status;
+        if (Y) {
+            fn = "SuiteSparseQR_C_qmult";
+            X = SuiteSparseQR_C_qmult(SPQR_QX, F->QR, Y, cc);
+            status = cc->status;
+        }
+    } else { /* X = E (R \ (Q' B)) */
+        Y = SuiteSparseQR_C_qmult(SPQR_QTX, F->QR, &Bh, cc);
+        status = cc->status;
+        if (Y) {
+            fn = "SuiteSparseQR_C_solve";
+            X = SuiteSparseQR_C_solve(SPQR_RETX_EQUALS_B, F->QR, Y, cc);
+            status = cc->status;
+        }
     }
     cholmod_l_free_dense(&Y, cc);
     ss_unlock();

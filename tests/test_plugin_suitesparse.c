@@ -20,7 +20,8 @@
  *     same pattern (A2 = 2 * A): the note says the symbolic analysis was
  *     reused; KLU refactors into the factors of a value that died (A = 3 * A);
  *   - several and sparse right-hand sides; least squares (tall, inconsistent)
- *     and the basic solution of an underdetermined system.
+ *     and the minimum-norm (full row rank) or basic (deficient) solution of
+ *     an underdetermined system.
  * Every `info` must name the backend.  Timings are printed.
  */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
@@ -348,7 +349,8 @@ static void test_not_spd(void)
     silc_close(&c);
 }
 
-/* Least squares: tall inconsistent vs reference, wide basic solution. */
+/* Least squares: tall inconsistent vs reference; wide: minimum norm, or basic
+ * when the row rank is deficient. */
 static void test_rect_extra(silc_context *c, silc_context *r)
 {
     silc_envelope_t A;
@@ -381,22 +383,55 @@ static void test_rect_extra(silc_context *c, silc_context *r)
     free(g);
     silc_envelope_free(&A);
 
-    /* Underdetermined: A = ash219' is 85 x 219 of full row rank. */
+    /* Underdetermined: A = ash219' is 85 x 219 of full row rank.  SPQR
+     * factors A' and returns the minimum-norm solution, as the reference
+     * does, with a condition estimate near the reference's. */
     if (read_shared("ash219.mtx", &A)) return;
     tl_put_checked(c, "B", &A);
+    tl_put_checked(r, "B", &A);
     CHECK(silc_exec(c, "A = trans(B); b = A * ones(cols(A), 1); x = A \\ b; r = b - A * x") == 0,
           "spqr wide: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(r, "A = trans(B); b = A * ones(cols(A), 1); x = A \\ b") == 0,
+          "reference wide: %s", silc_context_errmsg(r));
     in = tl_out_info(c, "x");
-    CHECK(tl_contains(in, "basic solution"), "spqr wide: note should say basic solution:\n%s", in);
+    CHECK(tl_contains(in, "minimum-norm solution") && tl_contains(in, "of A'"),
+          "spqr wide: note should say minimum norm, QR of A':\n%s", in);
+    cond = tl_out_number(in, "condition estimate: ");
+    {
+        double cref = tl_out_number(tl_out_info(r, "x"), "condition estimate: ");
+        CHECK(cond > cref / 10 && cond < cref * 10, "spqr wide: condition estimate %.3g, reference %.3g",
+              cond, cref);
+    }
     x = tl_get_dense_checked(c, "x", A.m, 1);
+    xr = tl_get_dense_checked(r, "x", A.m, 1);
     g = tl_get_dense_checked(c, "r", A.n, 1);
+    if (x && xr && g) {
+        double rn = 0;
+        for (int64_t i = 0; i < A.n; i++) rn = fmax(rn, fabs(g[i]));
+        CHECK(rn < 1e-12, "spqr wide: residual %.3g", rn);
+        CHECK(tl_rel_diff(x, xr, A.m) < 1e-10, "spqr wide: not the minimum-norm solution (%.3g from the reference)",
+              tl_rel_diff(x, xr, A.m));
+    }
+    free(x);
+    free(xr);
+    free(g);
+    /* Deficient row rank (a row repeated): no minimum-norm formula from A';
+     * SPQR factors A and gives a basic solution, rank and cond = Inf said. */
+    CHECK(silc_exec(c, "W = [A; A[1, :]]; c = W * ones(cols(W), 1); x = W \\ c; r = c - W * x") == 0,
+          "spqr wide deficient: %s", silc_context_errmsg(c));
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "basic solution") && tl_contains(in, "rank 85 of 86x219") &&
+              tl_contains(in, "condition estimate: inf"),
+          "spqr wide deficient: note should say basic solution, rank 85:\n%s", in);
+    x = tl_get_dense_checked(c, "x", A.m, 1);
+    g = tl_get_dense_checked(c, "r", A.n + 1, 1);
     if (x && g) {
         double rn = 0;
         for (int64_t i = 0; i < A.m; i++) nnz += x[i] != 0;
-        for (int64_t i = 0; i < A.n; i++) rn = fmax(rn, fabs(g[i]));
-        CHECK(rn < 1e-12, "spqr wide: residual %.3g", rn);
-        CHECK(nnz <= A.n, "spqr wide: basic solution has %lld nonzeros > rank %lld", (long long)nnz,
-              (long long)A.n);
+        for (int64_t i = 0; i <= A.n; i++) rn = fmax(rn, fabs(g[i]));
+        CHECK(rn < 1e-12, "spqr wide deficient: residual %.3g", rn);
+        CHECK(nnz <= A.n, "spqr wide deficient: basic solution has %lld nonzeros > rank %lld",
+              (long long)nnz, (long long)A.n);
     }
     free(x);
     free(g);
