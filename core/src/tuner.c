@@ -84,6 +84,7 @@ typedef struct tuner {
     int sample_steps;
     tuner_model model;
     int have_model, p_opt, from_wisdom;
+    char choice[160];       /* why p_opt is not the model's, or "" */
     char stop[160];
     int expect_steps;
     double loo_tol, rep_tol;
@@ -816,8 +817,24 @@ static void finish(silc_engine *E, tuner *T, const char *why)
         if (t[i] < t[best]) best = i;
     }
     T->have_model = T->npts >= 3 && !tuner_fit(p, t, T->npts, lo, hi, &T->model);
+    T->choice[0] = 0;
     if (T->have_model) {
+        /* A measurement beats the model where there is one: the model's p_opt
+         * is judged by its own sample when it was sampled, else by f, and the
+         * best sample wins if it was faster.  This matters when f cannot
+         * follow the data (past the core count OpenMP's time jumps instead of
+         * growing like b p) and puts sqrt(a/b) on the wrong side of a sample. */
+        double est = tuner_model_eval(&T->model, T->model.p_opt);
+        int measured = 0;
+        for (i = 0; i < T->npts; i++)
+            if (T->pts[i].p == T->model.p_opt) est = t[i], measured = 1;
         T->p_opt = T->model.p_opt;
+        if (T->npts && t[best] < est && T->pts[best].p != T->model.p_opt) {
+            T->p_opt = T->pts[best].p;
+            snprintf(T->choice, sizeof T->choice,
+                     "the best sample (p = %d, %.6g s) beat the model's p_opt = %d (%.6g s %s)",
+                     T->p_opt, t[best], T->model.p_opt, est, measured ? "measured" : "predicted");
+        }
     } else if (T->npts) {
         T->p_opt = T->pts[best].p;
     }
@@ -944,6 +961,7 @@ static void reset(tuner *T)
     T->ntab = 0;
     T->nhist = T->period = T->pos = T->step_open = T->steps = 0;
     T->npts = T->ci = T->sample_steps = T->have_model = T->from_wisdom = T->warmup = 0;
+    T->choice[0] = 0;
     T->sample_total = 0;
     T->stop[0] = T->signature[0] = 0;
     memset(&T->model, 0, sizeof T->model);
@@ -1078,7 +1096,8 @@ static void describe(silc_engine *E, const tuner *T, strbuf *b)
     }
     if (T->phase == PH_DONE) {
         sb_printf(b, "p_opt = %d\n", T->p_opt);
-        if (T->have_model)
+        if (T->choice[0]) sb_printf(b, "chosen because = %s\n", T->choice);
+        else if (T->have_model)
             sb_printf(b, "predicted step time = %.6g s\n", tuner_model_eval(&T->model, T->p_opt));
         sb_printf(b, "stopped because = %s\n", T->stop);
     }
