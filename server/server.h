@@ -44,7 +44,5 @@ void srv_log(int level, const char *fmt, ...)
  * closes fd.  id numbers the session in the log. */
 void srv_session(int fd, unsigned long id);
 
-/* pool.c: makes value arrays recycle through silcd's pool (see there). */
-void srv_pool_install(void);
 
 #endif

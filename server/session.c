@@ -451,6 +451,7 @@ static int await_request(int fd)
     p[0].events = POLLIN;
     p[1].fd = srv_shutdown_fd;
     p[1].events = POLLIN;
+    if (proto_spin(p, 2)) return p[1].revents ? -1 : 0;
     for (;;) {
         p[0].revents = p[1].revents = 0;
         if (poll(p, 2, -1) < 0) continue;

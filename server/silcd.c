@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "server.h"
+#include "pool.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -429,7 +430,7 @@ int main(int argc, char **argv)
     sa.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &sa, NULL);
     if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
-    srv_pool_install();
+    pool_install((size_t)srv_cfg.pool_bytes); /* core/src/pool.c */
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,
             (unsigned long long)srv_cfg.max_value_bytes,
             (unsigned long long)srv_cfg.max_session_bytes, srv_cfg.token ? ", token required" : "");

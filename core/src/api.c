@@ -24,6 +24,7 @@
 #include "api.h"
 #include "engine.h"
 #include "envelope.h"
+#include "pool.h"
 #include "remote.h"
 
 struct silc_context {
@@ -135,6 +136,7 @@ int silc_open_remote(silc_context **out, const char *url)
     int failed;
     if (!out) return env_error("silc_open_remote: NULL context pointer");
     *out = NULL;
+    pool_install_default();
     if (!url || !*url) return env_error("silc_open_remote: no server address");
     if (!(ctx = calloc(1, sizeof *ctx))) return env_error("silc_open_remote: out of memory");
     sb_init(&ctx->warnings);
@@ -155,6 +157,7 @@ int silc_open(silc_context **out, const char *config_path)
     silc_context *ctx;
     const char *server = getenv("SILC_SERVER");
     char err[4096];
+    pool_install_default();
     /* Remote mode: the server's configuration applies, not config_path. */
     if (server && *server) return silc_open_remote(out, server);
     if (!out) return env_error("silc_open: NULL context pointer");

@@ -49,7 +49,7 @@ static int64_t dense_count(int64_t m, int64_t n)
  * for zero bytes, so NULL means out of memory. */
 static void *copy_array(const void *src, int64_t count, size_t size)
 {
-    void *p = calloc(count > 0 ? (size_t)count : 1, size);
+    void *p = val_array_alloc(count, size, src == NULL);
     if (p && src && count > 0) memcpy(p, src, (size_t)count * size);
     return p;
 }
@@ -361,9 +361,9 @@ int silc_envelope_to_dense(const silc_envelope_t *e, double *out)
 void silc_envelope_free(silc_envelope_t *e)
 {
     if (!e) return;
-    free(e->values);
-    free(e->rowptr);
-    free(e->colind);
+    val_array_free(e->values);
+    val_array_free(e->rowptr);
+    val_array_free(e->colind);
     memset(e, 0, sizeof *e);
 }
 

@@ -22,6 +22,7 @@
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "envelope.h"
@@ -285,16 +286,31 @@ static struct iovec *iov_advance(struct iovec *iov, int *iovcnt, size_t n)
     return iov;
 }
 
-/* Waits until fd is ready; 0, or PROTO_BROKEN on timeout or error. */
+int proto_spin(struct pollfd *p, int n)
+{
+    struct timespec t0, t;
+    int64_t waited;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    do {
+        int i;
+        for (i = 0; i < n; i++) p[i].revents = 0;
+        if (poll(p, (nfds_t)n, 0) > 0) return 1;
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        waited = (int64_t)(t.tv_sec - t0.tv_sec) * 1000000000 + (t.tv_nsec - t0.tv_nsec);
+    } while (waited < PROTO_SPIN_NS);
+    return 0;
+}
+
+/* Waits until fd is ready (spinning first, see PROTO_SPIN_NS; timeout_ms < 0
+ * waits for ever); 0, or PROTO_BROKEN on timeout or error. */
 static int wait_fd(int fd, short events, int timeout_ms, char *err, size_t errlen)
 {
     struct pollfd p;
     int rc;
-    if (timeout_ms < 0) return 0;
     p.fd = fd;
     p.events = events;
-    p.revents = 0;
-    do rc = poll(&p, 1, timeout_ms);
+    if (proto_spin(&p, 1)) return 0;
+    do rc = poll(&p, 1, timeout_ms < 0 ? -1 : timeout_ms);
     while (rc < 0 && errno == EINTR);
     if (rc == 0)
         return perr(PROTO_BROKEN, err, errlen, "timed out after %d ms waiting for the peer",
@@ -303,9 +319,14 @@ static int wait_fd(int fd, short events, int timeout_ms, char *err, size_t errle
     return 0;
 }
 
+/* Both directions try the socket first and wait only when it is not ready:
+ * the bytes of a small request have usually arrived already, and a poll per
+ * read would double the system calls.  A wait spins before it sleeps, which
+ * on a bulk transfer (the peer is busy filling or draining the socket) means
+ * it never sleeps: waking a sleeping thread cost more than the copy of the
+ * chunk it waited for. */
 int proto_recv(proto_stream *s, struct iovec *iov, int iovcnt, char *err, size_t errlen)
 {
-    int partial = 0;
     while (iovcnt > 0 && iov->iov_len == 0) iov++, iovcnt--;
     while (iovcnt > 0) {
         ssize_t got;
@@ -321,15 +342,7 @@ int proto_recv(proto_stream *s, struct iovec *iov, int iovcnt, char *err, size_t
             memset(&msg, 0, sizeof msg);
             msg.msg_iov = iov;
             msg.msg_iovlen = (size_t)(iovcnt > 64 ? 64 : iovcnt);
-            /* Try first, wait only when nothing is there: the bytes of a
-             * small request have usually arrived already, and a poll per read
-             * doubles its system calls.  After a short read of a large body
-             * the rest is still on its way, so wait before reading again. */
-            if (partial) {
-                int rc = wait_fd(s->fd, POLLIN, s->timeout_ms, err, errlen);
-                if (rc) return rc;
-            }
-            got = recvmsg(s->fd, &msg, s->timeout_ms < 0 ? 0 : MSG_DONTWAIT);
+            got = recvmsg(s->fd, &msg, MSG_DONTWAIT);
             if (got < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
                 int rc = wait_fd(s->fd, POLLIN, s->timeout_ms, err, errlen);
                 if (rc) return rc;
@@ -340,7 +353,6 @@ int proto_recv(proto_stream *s, struct iovec *iov, int iovcnt, char *err, size_t
             if (got == 0) return perr(PROTO_BROKEN, err, errlen, "connection closed by peer");
         }
         iov = iov_advance(iov, &iovcnt, (size_t)got);
-        partial = s->fd >= 0 && s->timeout_ms >= 0;
     }
     return 0;
 }
@@ -354,9 +366,8 @@ int proto_send(int fd, struct iovec *iov, int iovcnt, int timeout_ms, char *err,
         memset(&msg, 0, sizeof msg);
         msg.msg_iov = iov;
         msg.msg_iovlen = (size_t)(iovcnt > 64 ? 64 : iovcnt);
-        /* MSG_NOSIGNAL: a vanished peer is an error to report, not SIGPIPE.
-         * As in proto_recv, wait only when the socket buffer is full. */
-        put = sendmsg(fd, &msg, MSG_NOSIGNAL | (timeout_ms < 0 ? 0 : MSG_DONTWAIT));
+        /* MSG_NOSIGNAL: a vanished peer is an error to report, not SIGPIPE. */
+        put = sendmsg(fd, &msg, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (put < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
             int rc = wait_fd(fd, POLLOUT, timeout_ms, err, errlen);
             if (rc) return rc;
@@ -730,11 +741,12 @@ int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, c
         if (L.total != len - PROTO_DESC_BYTES)
             return perr(PROTO_FATAL, err, errlen, "VALUE reply of %llu bytes, its descriptor "
                         "needs %llu", (unsigned long long)len, (unsigned long long)L.total);
-        /* Never ask malloc for 0 bytes: NULL must mean failure. */
-        e->values = malloc(L.values_bytes ? (size_t)L.values_bytes : 1);
+        /* From the pool: a GET of the same size each step receives into the
+         * array the last one freed. */
+        e->values = val_array_alloc((int64_t)L.values_bytes, 1, 0);
         if (desc.format == SILC_CSR) {
-            e->rowptr = malloc((size_t)L.rowptr_bytes);
-            e->colind = malloc(L.colind_bytes ? (size_t)L.colind_bytes : 1);
+            e->rowptr = val_array_alloc((int64_t)L.rowptr_bytes, 1, 0);
+            e->colind = val_array_alloc((int64_t)L.colind_bytes, 1, 0);
         }
         if (!e->values || (desc.format == SILC_CSR && (!e->rowptr || !e->colind))) {
             silc_envelope_free(e);

@@ -127,6 +127,19 @@ const char *proto_op_name(uint32_t op);
  * saying why ("connection closed by peer", "timed out after 30 s", ...). */
 int proto_recv(proto_stream *s, struct iovec *iov, int iovcnt, char *err, size_t errlen);
 int proto_send(int fd, struct iovec *iov, int iovcnt, int timeout_ms, char *err, size_t errlen);
+
+/* How long a reader or writer busy-waits before it sleeps in poll.  Waking a
+ * sleeping thread costs ~10 us on the 2-core VM (more than the whole server
+ * side of a small EXEC, and more than copying the 64 KiB a bulk transfer
+ * waits for), so every wait spins this long first, and so does silcd waiting
+ * for the next request of a session: a ping-pong of small requests and a
+ * bulk transfer never sleep; a client that is computing costs the server one
+ * core for 50 us per request. */
+#define PROTO_SPIN_NS 50000
+/* Polls the n descriptors (for their events) without blocking until one is
+ * ready (1) or PROTO_SPIN_NS have passed (0); revents are set as by poll. */
+struct pollfd;
+int proto_spin(struct pollfd *p, int n);
 /* Sends one frame whose body is the concatenation of body[0..n). */
 int proto_send_frame(int fd, uint32_t op, const struct iovec *body, int n, int timeout_ms,
                      char *err, size_t errlen);

@@ -39,11 +39,9 @@ void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p))
     pool_give = give;
 }
 
-/* An array of count doubles or indices, zero-filled when zero is set; never
- * asks for zero bytes, so a NULL result always means failure.  A pooled
- * array is already mapped: zeroing it in place is far cheaper than faulting
- * in fresh pages, and an unset one costs nothing. */
-static void *alloc_array(int64_t count, size_t size, int zero)
+/* A pooled array is already mapped: zeroing it in place is far cheaper than
+ * faulting in fresh pages, and an unset one costs nothing. */
+void *val_array_alloc(int64_t count, size_t size, int zero)
 {
     size_t bytes = (count > 0 ? (size_t)count : 1) * size;
     void *p = pool_take ? pool_take(bytes) : NULL;
@@ -54,7 +52,7 @@ static void *alloc_array(int64_t count, size_t size, int zero)
     return zero ? calloc(bytes / size, size) : malloc(bytes);
 }
 
-static void free_array(void *p)
+void val_array_free(void *p)
 {
     if (p && !(pool_give && pool_give(p))) free(p);
 }
@@ -76,9 +74,9 @@ static silc_value *val_alloc(int64_t m, int64_t n, int format)
 /* Frees the arrays and the struct of a value that has no attachments yet. */
 static void val_free_arrays(silc_value *v)
 {
-    free_array(v->val);
-    free_array(v->rowptr);
-    free_array(v->colind);
+    val_array_free(v->val);
+    val_array_free(v->rowptr);
+    val_array_free(v->colind);
     free(v);
 }
 
@@ -87,7 +85,7 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
     int64_t count = count_mul(m, n);
     silc_value *v;
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
-    v->val = alloc_array(count, sizeof(double), zero);
+    v->val = val_array_alloc(count, sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;
@@ -101,9 +99,9 @@ static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero
     silc_value *v;
     if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
     if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
-    v->rowptr = alloc_array(m + 1, sizeof(silc_index), zero);
-    v->colind = alloc_array(nnz_capacity, sizeof(silc_index), zero);
-    v->val = alloc_array(nnz_capacity, sizeof(double), zero);
+    v->rowptr = val_array_alloc(m + 1, sizeof(silc_index), zero);
+    v->colind = val_array_alloc(nnz_capacity, sizeof(silc_index), zero);
+    v->val = val_array_alloc(nnz_capacity, sizeof(double), zero);
     if (!v->rowptr || !v->colind || !v->val) {
         val_free_arrays(v);
         return NULL;
@@ -120,7 +118,7 @@ static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int z
     ld = kl + ku + 1;
     count = count_mul(ld, n);
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_BAND))) return NULL;
-    v->val = alloc_array(count, sizeof(double), zero);
+    v->val = val_array_alloc(count, sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;

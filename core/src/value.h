@@ -55,6 +55,11 @@ silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t
  * every freed array and returns 1 when it kept it (then no longer to free).
  * Install before any thread uses values; NULL hooks mean plain malloc/free. */
 void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p));
+/* An array of count elements of size bytes, zero-filled when zero is set,
+ * from the pool when it has one; never asks for zero bytes, so NULL always
+ * means failure.  Value and envelope arrays are made and freed with these. */
+void *val_array_alloc(int64_t count, size_t size, int zero);
+void val_array_free(void *p);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
 void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */

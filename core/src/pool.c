@@ -1,23 +1,26 @@
 /*
- * pool.c -- silcd's pool of recently freed large value arrays.
+ * pool.c -- the process's pool of recently freed large arrays: value arrays
+ * and the arrays of envelopes (val_array_alloc / val_array_free).
  *
  * glibc serves every array above 32 MiB with its own mmap, so without this a
  * PUT receives into freshly mapped pages (the kernel zeroes and faults in
- * each 4 KiB page) and the value it replaces is unmapped afterwards (a TLB
- * shootdown across cores).  A client that PUTs a same-sized vector each step
- * of a time loop pays that every step; with the pool the array freed by one
- * step is the one the next step receives into.
+ * each 4 KiB page), a GET of the same size each step does the same on the
+ * client, and the array each replaces is unmapped afterwards (a TLB shootdown
+ * across cores).  With the pool the array freed by one step is the one the
+ * next step receives into.
  *
  * Values are immutable and reference-counted, so an array reaches the pool
- * only when its last value is freed (value.c offers the pool every array it
- * frees).  The pool keeps at most POOL_SLOTS arrays of at least
- * POOL_MIN_BYTES, srv_cfg.pool_bytes in all, and hands an array out only for
- * a request of at least 3/4 of its size, so little memory is wasted.  Pooled
- * memory is the server's, not any session's: session limits never see it.
- * An array idle for POOL_IDLE_SECONDS is freed at the next pool call.
+ * only when its last value is freed.  The pool keeps at most POOL_SLOTS
+ * arrays of at least POOL_MIN_BYTES, the cap given to pool_install in all,
+ * and hands an array out only for a request of at least 3/4 of its size, so
+ * little memory is wasted.  In silcd pooled memory is the server's, not any
+ * session's: session limits never see it.  An array idle for
+ * POOL_IDLE_SECONDS is freed at the next pool call.
  */
 #define _GNU_SOURCE 1 /* malloc_usable_size */
-#include "server.h"
+#include "pool.h"
+
+#include <pthread.h>
 
 #include <malloc.h>
 #include <stdlib.h>
@@ -36,7 +39,20 @@ typedef struct slot {
 
 static pthread_mutex_t pool_lock = PTHREAD_MUTEX_INITIALIZER;
 static slot slots[POOL_SLOTS];
-static size_t pooled_bytes;
+static size_t pooled_bytes, cap_bytes;
+static int installed; /* pool_install was called: the default does not override it */
+
+static void install_from_env(void)
+{
+    if (installed) return;
+    {
+    const char *v = getenv("SILC_ARRAY_POOL");
+    char *end;
+    double mib = v && *v ? strtod(v, &end) : POOL_DEFAULT_MIB;
+    if (v && *v && (*end || !(mib >= 0))) mib = POOL_DEFAULT_MIB; /* not a number: the default */
+    pool_install((size_t)(mib * 1048576.0));
+    }
+}
 
 static time_t now_s(void)
 {
@@ -89,7 +105,7 @@ static int pool_give(void *p)
     size_t bytes = malloc_usable_size(p);
     time_t t;
     int i, kept = 0;
-    if (bytes < POOL_MIN_BYTES || bytes > srv_cfg.pool_bytes) return 0;
+    if (bytes < POOL_MIN_BYTES || bytes > cap_bytes) return 0;
     t = now_s();
     pthread_mutex_lock(&pool_lock);
     drop_idle(t);
@@ -99,7 +115,7 @@ static int pool_give(void *p)
             if (!slots[i].p) free_slot = i;
             else if (oldest < 0 || slots[i].freed < slots[oldest].freed) oldest = i;
         }
-        if (free_slot >= 0 && pooled_bytes + bytes <= srv_cfg.pool_bytes) {
+        if (free_slot >= 0 && pooled_bytes + bytes <= cap_bytes) {
             slots[free_slot].p = p;
             slots[free_slot].bytes = bytes;
             slots[free_slot].freed = t;
@@ -114,7 +130,15 @@ static int pool_give(void *p)
     return kept;
 }
 
-void srv_pool_install(void)
+void pool_install(size_t cap)
 {
-    if (srv_cfg.pool_bytes > 0) val_set_array_pool(pool_take, pool_give);
+    installed = 1;
+    cap_bytes = cap;
+    if (cap > 0) val_set_array_pool(pool_take, pool_give);
+}
+
+void pool_install_default(void)
+{
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, install_from_env);
 }
