@@ -205,7 +205,7 @@ int ss_spqr_solve(silc_call *call)
     cholmod_dense Bh, *Y = NULL, *X = NULL;
     double *B, tol, t0;
     int64_t m, n, k;
-    const char *fn = "SuiteSparseQR_C_qmult";
+    const char *fn;
     int owned, rc, status, fresh = 0;
     ss_host->view(call->in[0], &a);
     ss_host->view(call->in[1], &b);
@@ -259,23 +259,16 @@ int ss_spqr_solve(silc_call *call)
     Bh.xtype = CHOLMOD_REAL;
     Bh.dtype = CHOLMOD_DOUBLE;
     ss_lock();
-    if (F->transposed) { /* X = Q (R' \ (E' B)) */
-        fn = "SuiteSparseQR_C_solve";
-        Y = SuiteSparseQR_C_solve(SPQR_RTX_EQUALS_ETB, F->QR, &Bh, cc);
+    /* Two steps either way: X = Q (R' \ (E' B)) for A', X = E (R \ (Q' B)) for A. */
+    fn = F->transposed ? "SuiteSparseQR_C_solve" : "SuiteSparseQR_C_qmult";
+    Y = F->transposed ? SuiteSparseQR_C_solve(SPQR_RTX_EQUALS_ETB, F->QR, &Bh, cc)
+                      : SuiteSparseQR_C_qmult(SPQR_QTX, F->QR, &Bh, cc);
+    status = cc->status;
+    if (Y) {
+        fn = F->transposed ? "SuiteSparseQR_C_qmult" : "SuiteSparseQR_C_solve";
+        X = F->transposed ? SuiteSparseQR_C_qmult(SPQR_QX, F->QR, Y, cc)
+                          : SuiteSparseQR_C_solve(SPQR_RETX_EQUALS_B, F->QR, Y, cc);
         status = cc->status;
-        if (Y) {
-            fn = "SuiteSparseQR_C_qmult";
-            X = SuiteSparseQR_C_qmult(SPQR_QX, F->QR, Y, cc);
-            status = cc->status;
-        }
-    } else { /* X = E (R \ (Q' B)) */
-        Y = SuiteSparseQR_C_qmult(SPQR_QTX, F->QR, &Bh, cc);
-        status = cc->status;
-        if (Y) {
-            fn = "SuiteSparseQR_C_solve";
-            X = SuiteSparseQR_C_solve(SPQR_RETX_EQUALS_B, F->QR, Y, cc);
-            status = cc->status;
-        }
     }
     cholmod_l_free_dense(&Y, cc);
     ss_unlock();
