@@ -29,6 +29,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/lsan_interface.h>
+#endif
+
 /* The reference plugin is compiled into libsilc (plugin-reference/). */
 extern int silc_reference_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                       const char **errmsg);
@@ -126,6 +130,26 @@ static void shutdown_all(void)
     g_loaded.n = 0;
     pthread_mutex_unlock(&g_lock);
 }
+
+#if defined(__SANITIZE_ADDRESS__)
+/* AddressSanitizer builds check for leaks here, at the plugins' shutdown,
+ * instead of at the very end of the process.  The libraries the plugins pull
+ * in register exit handlers of their own when they are loaded (libstdc++'s
+ * stream flush, GnuTLS under OpenMPI), and once those have touched their
+ * thread-local storage, gcc 12's LeakSanitizer can misread the dynamic TLS
+ * vector and crash in its tracer ("Tracer caught signal 11"), depending only
+ * on how many TLS modules are loaded.  Registered after every new plugin, so
+ * the last registration (which runs first) follows the last dlopen: the
+ * check sees the process before any library's exit handler runs. */
+static void shutdown_then_check_leaks(void)
+{
+    static int done;
+    if (done) return;
+    done = 1;
+    shutdown_all();
+    __lsan_do_leak_check();
+}
+#endif
 
 /* The process-wide entry of an accepted plugin (caller holds g_lock). */
 static ld_plugin *register_plugin(const silc_plugin *pl, void *handle, const char *path)
@@ -276,6 +300,9 @@ static ld_plugin *open_plugin(silc_engine *E, const char *path, const char *real
         dlclose(handle);
         return NULL;
     }
+#if defined(__SANITIZE_ADDRESS__)
+    atexit(shutdown_then_check_leaks);
+#endif
     if (!(p = register_plugin(pl, handle, real))) {
         eng_error(E, "out of memory loading plugin %s", path);
         if (pl->shutdown) pl->shutdown();
