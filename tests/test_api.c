@@ -518,6 +518,37 @@ static void test_exec_plumbing(void)
     silc_envelope_free(&e);
 }
 
+/* Large arrays recycle through the process's pool (core/src/pool.c): one
+ * asked for zeroed must be zero even when it last held other numbers, and
+ * one about to be overwritten must hold exactly what was written. */
+static void test_recycled_arrays(void)
+{
+    enum { N = 1 << 18 }; /* 2 MiB of doubles: above the pool's 1 MiB floor */
+    silc_envelope_t e, z, back;
+    double *sevens = malloc(N * sizeof *sevens);
+    int64_t i, bad = 0;
+    if (!sevens) return;
+    for (i = 0; i < N; i++) sevens[i] = 7.0 + (double)i;
+    for (int round = 0; round < 3; round++) {
+        CHECK(silc_envelope_vector(&e, N, sevens) == 0 && SILC_PUT("big", &e) == 0, "put: %s",
+              silc_errmsg());
+        silc_envelope_free(&e); /* the envelope's array goes to the pool */
+        CHECK(SILC_EXEC("clear big; z = zeros(262144, 1); w = z + 1") == 0, "zeros: %s", silc_errmsg());
+        CHECK(silc_envelope_dense(&z, N, 1, NULL) == 0, "zeroed envelope: %s", silc_errmsg());
+        for (i = 0; i < N; i++) bad += z.values[i] != 0;
+        silc_envelope_free(&z);
+        CHECK(SILC_GET(&back, "z") == 0 && back.m == N, "get z: %s", silc_errmsg());
+        for (i = 0; i < N && back.values; i++) bad += back.values[i] != 0;
+        silc_envelope_free(&back);
+        CHECK(SILC_GET(&back, "w") == 0 && back.m == N, "get w: %s", silc_errmsg());
+        for (i = 0; i < N && back.values; i++) bad += back.values[i] != 1;
+        silc_envelope_free(&back);
+    }
+    CHECK(bad == 0, "%lld entries of recycled arrays were not what was asked for", (long long)bad);
+    CHECK(SILC_EXEC("clear z w") == 0, "clear: %s", silc_errmsg());
+    free(sevens);
+}
+
 int main(void)
 {
     test_before_init();
@@ -534,6 +565,7 @@ int main(void)
     test_names();
     test_contexts();
     test_exec_plumbing();
+    test_recycled_arrays();
     CHECK(SILC_FINALIZE() == 0, "SILC_FINALIZE");
     CHECK(silc_default_context() == NULL, "default context survives SILC_FINALIZE");
     CHECK(SILC_FINALIZE() != 0, "second SILC_FINALIZE succeeded");
