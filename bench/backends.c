@@ -430,30 +430,30 @@ static int load_problem(problem *P, const opts *o)
 /* SILC's row and, where the library can be called directly, the direct row
  * and the ratio, for nsolve solves with one A.  The two alternate, best of
  * reps each, so that a burst of load on the machine hits both alike.
- * "mumps, condest off" is MUMPS with mumps.condest = false: SILC's cost
- * without the condition estimate, the one part of the report that is not
- * O(nnz). */
+ * condest_off: the same backend with its plugin's condest option false (the
+ * Hager-Higham estimate, the one part of the report that is not O(nnz), is
+ * not made), compared with the same direct call: SILC's own cost. */
 static void compare(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
-                    const char *label, int nsolve, double *x)
+                    const char *b, int condest_off, int nsolve, double *x)
 {
-    int condest_off = strstr(label, "condest off") != NULL;
-    const char *b = condest_off ? "mumps" : label;
     double (*direct)(const problem *, int, double *) = direct_for(b);
     double be = NAN, t = -1, td = -1;
-    char ran[64], who[64];
+    char ran[64], who[64], set[96];
     int r;
     if (!strcmp(b, "suitesparse.cholmod") && !P->spd) return;
     snprintf(ran, sizeof ran, "%s", b);
-    if (condest_off) silc_exec(c, "set mumps.condest = false");
+    /* the plugin's name: "suitesparse" of "suitesparse.klu", "mumps" of "mumps" */
+    snprintf(set, sizeof set, "set %.*s.condest = ", (int)strcspn(b, "."), b);
+    if (condest_off) silc_exec(c, strcat(strcpy(who, set), "false"));
     for (r = 0; r < o->reps; r++) {
         double ts = silc_time(c, cap, P, b, 1, nsolve, &be, ran, sizeof ran), d;
         if (ts < 0) break;
         if (t < 0 || ts < t) t = ts;
         if (direct && (d = direct(P, nsolve, x)) >= 0 && (td < 0 || d < td)) td = d;
     }
-    if (condest_off) silc_exec(c, "set mumps.condest = true");
+    if (condest_off) silc_exec(c, strcat(strcpy(who, set), !strcmp(b, "mumps") ? "true" : "auto"));
     snprintf(who, sizeof who, "SILC  %s%s", nsolve > 1 ? "loop, " : "",
-             !strcmp(label, "default") ? "default" : condest_off ? "condest off" : "forced");
+             !strcmp(b, "default") ? "default" : condest_off ? "condest off" : "forced");
     /* condest off is compared with the same direct call, which estimates nothing. */
     row(who, ran, t, be, condest_off && td > 0 && t > 0 ? t / td : -1);
     if (direct && !condest_off) {
@@ -480,8 +480,8 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
            "SILC/dir");
     for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++) {
         if (!strcmp(silc_backends[i], "lapack") && P->A.n > 5000) continue;
-        compare(c, cap, P, o, silc_backends[i], 1, x);
-        if (!strcmp(silc_backends[i], "mumps")) compare(c, cap, P, o, "mumps, condest off", 1, x);
+        compare(c, cap, P, o, silc_backends[i], 0, 1, x);
+        if (direct_for(silc_backends[i])) compare(c, cap, P, o, silc_backends[i], 1, 1, x);
     }
     if (P->file) snprintf(src, sizeof src, "%s/%s", SILC_SHARED_MATRICES, P->file);
     else snprintf(src, sizeof src, "laplace:%lld", (long long)o->grid);
@@ -508,7 +508,7 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
     printf("  %d solves, same A (factor reuse)\n", o->loop);
     for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++)
         if (strcmp(silc_backends[i], "lapack") != 0 && strcmp(silc_backends[i], "reference") != 0)
-            compare(c, cap, P, o, silc_backends[i], o->loop, x);
+            compare(c, cap, P, o, silc_backends[i], 0, o->loop, x);
     if (have_scipy) row("SciPy splu + solve loop", "SuperLU (COLAMD)", scipy_lt[0], scipy_lt[1], -1);
     if (have_octave) row("Octave loop of A\\b", "Octave", lt[0], lt[1], -1);
     silc_exec(c, "clear A b x");

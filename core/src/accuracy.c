@@ -148,15 +148,13 @@ static void transpose_times(const silc_value *A, const double *R, int64_t k, dou
  * of A, so the second measures the normal equations' residual A'R, scaled so
  * that it is invariant under scaling A and B, as the first is.
  */
-double acc_backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
-                          const silc_value *X)
+double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
 {
     double nA = val_props(A)->norminf, nB = val_props(B)->norminf, nX, nR, be = -1;
     const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
     const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
     double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL;
     int64_t k = X->n;
-    (void)E;
     if (!b) b = bc = acc_dense_copy(B);
     if (!x) x = xc = acc_dense_copy(X);
     if (!b || !x) goto out;
@@ -208,7 +206,7 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer)
         r->backward_error = ACC_DEFERRED;
         return;
     }
-    r->backward_error = acc_backward_error(E, call->in[0], call->in[1], call->out);
+    r->backward_error = acc_backward_error(call->in[0], call->in[1], call->out);
     warn_if_unsolved(E, r->backend, r->backward_error);
 }
 
@@ -230,7 +228,7 @@ void acc_pending_release(acc_pending *p)
 
 double acc_pending_resolve(silc_engine *E, acc_pending *p, const char *backend)
 {
-    double be = p->A && p->B && p->X ? acc_backward_error(E, p->A, p->B, p->X) : -1;
+    double be = p->A && p->B && p->X ? acc_backward_error(p->A, p->B, p->X) : -1;
     warn_if_unsolved(E, backend, be);
     acc_pending_release(p);
     return be;

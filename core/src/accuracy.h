@@ -36,8 +36,7 @@ double *acc_dense_copy(const silc_value *v);
 /* Normwise backward error of X as a solution of A X = B (infinity norm; the
  * normal equations' residual for rectangular A).  -1 when it cannot be
  * computed. */
-double acc_backward_error(silc_engine *E, const silc_value *A, const silc_value *B,
-                          const silc_value *X);
+double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X);
 
 /* Fills call->report->backward_error after a successful solve: at once, or
  * ACC_DEFERRED when the solve only reused a factorization, the caller allows
