@@ -637,6 +637,15 @@ static void test_deferred_backward_error(void)
           "bad value: %s", silc_context_errmsg(c));
     CHECK(silc_exec(c, "z = solve(G, g, \"backward_error = always\"); z = solve(G, g, \"backward_error = always\")") == 0,
           "per call: %s", silc_context_errmsg(c));
+    /* A system the core solves scaled (entries near 1e300) is not deferred:
+     * its residual, formed unscaled later, could overflow. */
+    CHECK(silc_exec(c, "set solve.backward_error = deferred; H = 1e300 * G; h = 1e300 * g\n"
+                       "u = H \\ h; u = H \\ h") == 0, "scaled: %s", silc_context_errmsg(c));
+    captured[0] = 0;
+    CHECK(silc_exec(c, "info u") == 0 && strstr(captured, "reused factorization: yes") &&
+              !strstr(captured, "computed now") && (p = strstr(captured, "  backward error: ")) &&
+              strtod(p + 18, NULL) < 1e-15,
+          "scaled solve deferred or inaccurate:\n%s", captured);
     silc_close(&c);
 }
 
