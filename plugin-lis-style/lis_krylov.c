@@ -40,6 +40,11 @@
         st = lis_fail(c, (v), (why));              \
         goto out;                                  \
     } while (0)
+/* Breakdown: a quantity the method divides by is zero or NaN. */
+#define FAIL_IF_ZERO(v, why)                       \
+    do {                                           \
+        if (s_zero(v) || (v).hi != (v).hi) FAIL((v), (why)); \
+    } while (0)
 
 /* y = A M^-1 x (right preconditioning); t is scratch. */
 static void apply_am(lis_ctx *c, const lis_vec *x, lis_vec *t, lis_vec *y)
@@ -81,7 +86,7 @@ int lis_cg(lis_ctx *c, lis_vec *x)
         STEP(lv_nrm2(c, r));
         lv_psolve(c, r, z);
         rho1 = lv_dot(c, r, z);
-        if (s_zero(rho1) || rho1.hi != rho1.hi) FAIL(rho1, "r'M^-1 r = 0");
+        FAIL_IF_ZERO(rho1, "r'M^-1 r = 0");
         lv_xpay(c, z, s_div(c, rho1, rho), p);
         rho = rho1;
     }
@@ -106,7 +111,7 @@ int lis_bicg(lis_ctx *c, lis_vec *x)
         lv_psolve(c, r, z);
         lv_psolve_t(c, rt, zt);
         rho = lv_dot(c, z, rt);
-        if (s_zero(rho) || rho.hi != rho.hi) FAIL(rho, "rho = (M^-1 r, r~) = 0");
+        FAIL_IF_ZERO(rho, "rho = (M^-1 r, r~) = 0");
         if (first) {
             lv_copy(c, z, p);
             lv_copy(c, zt, pt);
@@ -119,7 +124,7 @@ int lis_bicg(lis_ctx *c, lis_vec *x)
         lv_matvec(c, p, q);
         lv_matvec_t(c, pt, qt);
         ptq = lv_dot(c, pt, q);
-        if (s_zero(ptq) || ptq.hi != ptq.hi) FAIL(ptq, "(p~, A p) = 0");
+        FAIL_IF_ZERO(ptq, "(p~, A p) = 0");
         alpha = s_div(c, rho, ptq);
         lv_axpy(c, alpha, p, x);
         lv_axpy(c, dd_neg(alpha), q, r);
@@ -146,7 +151,7 @@ int lis_cgs(lis_ctx *c, lis_vec *x)
     lv_copy(c, r, rt);
     while (!lis_limit(c)) {
         rho = lv_dot(c, rt, r);
-        if (s_zero(rho) || rho.hi != rho.hi) FAIL(rho, "rho = (r~, r) = 0");
+        FAIL_IF_ZERO(rho, "rho = (r~, r) = 0");
         if (first) {
             lv_copy(c, r, u);
             lv_copy(c, u, p);
@@ -160,7 +165,7 @@ int lis_cgs(lis_ctx *c, lis_vec *x)
         lv_psolve(c, p, ph);
         lv_matvec(c, ph, vh);
         sig = lv_dot(c, rt, vh);
-        if (s_zero(sig) || sig.hi != sig.hi) FAIL(sig, "(r~, A M^-1 p) = 0");
+        FAIL_IF_ZERO(sig, "(r~, A M^-1 p) = 0");
         alpha = s_div(c, rho, sig);
         lv_waxpby(c, dd_d(1), u, dd_neg(alpha), vh, q); /* q = u - alpha vh */
         lv_waxpby(c, dd_d(1), u, dd_d(1), q, t);        /* t = u + q */
@@ -190,7 +195,7 @@ int lis_bicgstab(lis_ctx *c, lis_vec *x)
     lv_copy(c, r, rt);
     while (!lis_limit(c)) {
         rho = lv_dot(c, rt, r);
-        if (s_zero(rho) || rho.hi != rho.hi) FAIL(rho, "rho = (r~, r) = 0");
+        FAIL_IF_ZERO(rho, "rho = (r~, r) = 0");
         if (first) {
             lv_copy(c, r, p);
             first = 0;
@@ -202,7 +207,7 @@ int lis_bicgstab(lis_ctx *c, lis_vec *x)
         lv_psolve(c, p, ph);
         lv_matvec(c, ph, w);
         sig = lv_dot(c, rt, w);
-        if (s_zero(sig) || sig.hi != sig.hi) FAIL(sig, "(r~, A M^-1 p) = 0");
+        FAIL_IF_ZERO(sig, "(r~, A M^-1 p) = 0");
         alpha = s_div(c, rho, sig);
         lv_waxpby(c, dd_d(1), r, dd_neg(alpha), w, s);
         snrm = lv_nrm2(c, s);
@@ -214,7 +219,7 @@ int lis_bicgstab(lis_ctx *c, lis_vec *x)
         lv_psolve(c, s, sh);
         lv_matvec(c, sh, t);
         tt = lv_dot(c, t, t);
-        if (s_zero(tt) || tt.hi != tt.hi) FAIL(tt, "(t, t) = 0");
+        FAIL_IF_ZERO(tt, "(t, t) = 0");
         omega = s_div(c, lv_dot(c, t, s), tt);
         lv_axpy(c, alpha, ph, x);
         lv_axpy(c, omega, sh, x);
@@ -251,13 +256,13 @@ int lis_bicgstabl(lis_ctx *c, lis_vec *x)
         /* The BiCG part: l steps, each one counted as an iteration. */
         for (j = 0; j < l; j++) {
             rho1 = lv_dot(c, &r[j], rt);
-            if (s_zero(rho1) || rho1.hi != rho1.hi) FAIL(rho1, "rho = (r_j, r~) = 0");
+            FAIL_IF_ZERO(rho1, "rho = (r_j, r~) = 0");
             beta = s_div(c, s_mul(c, alpha, rho1), rho0);
             rho0 = rho1;
             for (i = 0; i <= j; i++) lv_xpay(c, &r[i], dd_neg(beta), &u[i]);
             apply_am(c, &u[j], t, &u[j + 1]);
             gam = lv_dot(c, &u[j + 1], rt);
-            if (s_zero(gam) || gam.hi != gam.hi) FAIL(gam, "(A M^-1 u_j, r~) = 0");
+            FAIL_IF_ZERO(gam, "(A M^-1 u_j, r~) = 0");
             alpha = s_div(c, rho0, gam);
             for (i = 0; i <= j; i++) lv_axpy(c, dd_neg(alpha), &u[i + 1], &r[i]);
             apply_am(c, &r[j], t, &r[j + 1]);
@@ -271,7 +276,7 @@ int lis_bicgstabl(lis_ctx *c, lis_vec *x)
                 lv_axpy(c, dd_neg(tau[i][j]), &r[i], &r[j]);
             }
             sigma[j] = lv_dot(c, &r[j], &r[j]);
-            if (s_zero(sigma[j]) || sigma[j].hi != sigma[j].hi) FAIL(sigma[j], "(r_j, r_j) = 0 in the MR part");
+            FAIL_IF_ZERO(sigma[j], "(r_j, r_j) = 0 in the MR part");
             gp[j] = s_div(c, lv_dot(c, &r[0], &r[j]), sigma[j]);
         }
         g[l] = gp[l];
@@ -325,7 +330,7 @@ int lis_gpbicg(lis_ctx *c, lis_vec *x)
         lv_xpay(c, r, beta, p);
         apply_am(c, p, tmp, ap);
         sig = lv_dot(c, rt, ap);
-        if (s_zero(sig) || sig.hi != sig.hi) FAIL(sig, "(r~, A M^-1 p) = 0");
+        FAIL_IF_ZERO(sig, "(r~, A M^-1 p) = 0");
         if (s_zero(rtr)) FAIL(rtr, "(r~, r) = 0");
         alpha = s_div(c, rtr, sig);
         lv_waxpby(c, dd_d(1), tp, dd_d(-1), r, y);      /* y = t_prev - r - alpha w + alpha Ap */
@@ -335,18 +340,18 @@ int lis_gpbicg(lis_ctx *c, lis_vec *x)
         apply_am(c, t, tmp, at);
         if (first) {
             dd atat = lv_dot(c, at, at);
-            if (s_zero(atat) || atat.hi != atat.hi) FAIL(atat, "(At, At) = 0");
+            FAIL_IF_ZERO(atat, "(At, At) = 0");
             zeta = s_div(c, lv_dot(c, at, t), atat);
             eta = dd_d(0);
         } else {
             dd atat = lv_dot(c, at, at), yy = lv_dot(c, y, y), yat = lv_dot(c, y, at);
             dd att = lv_dot(c, at, t), yt = lv_dot(c, y, t);
             dd den = s_sub(c, s_mul(c, atat, yy), s_mul(c, yat, yat));
-            if (s_zero(den) || den.hi != den.hi) FAIL(den, "the 2x2 minimisation is singular");
+            FAIL_IF_ZERO(den, "the 2x2 minimisation is singular");
             zeta = s_div(c, s_sub(c, s_mul(c, yy, att), s_mul(c, yt, yat)), den);
             eta = s_div(c, s_sub(c, s_mul(c, atat, yt), s_mul(c, yat, att)), den);
         }
-        if (s_zero(zeta) || zeta.hi != zeta.hi) FAIL(zeta, "zeta = 0");
+        FAIL_IF_ZERO(zeta, "zeta = 0");
         /* u = zeta Ap + eta (t_prev - r + beta u) */
         lv_scale(c, beta, u);
         lv_axpy(c, dd_d(1), tp, u);
@@ -397,7 +402,7 @@ int lis_tfqmr(lis_ctx *c, lis_vec *x)
     rho = lv_dot(c, rt, r);
     while (!lis_limit(c)) {
         sig = lv_dot(c, rt, vv);
-        if (s_zero(sig) || sig.hi != sig.hi) FAIL(sig, "(r~, v) = 0");
+        FAIL_IF_ZERO(sig, "(r~, v) = 0");
         alpha = s_div(c, rho, sig);
         for (j = 1; j <= 2; j++) {
             lis_vec *yj = j == 1 ? y1 : y2, *uj = j == 1 ? u1 : u2;
@@ -418,7 +423,7 @@ int lis_tfqmr(lis_ctx *c, lis_vec *x)
             if (lis_limit(c)) goto out;
         }
         rho_new = lv_dot(c, rt, w);
-        if (s_zero(rho_new) || rho_new.hi != rho_new.hi) FAIL(rho_new, "rho = (r~, w) = 0");
+        FAIL_IF_ZERO(rho_new, "rho = (r~, w) = 0");
         beta = s_div(c, rho_new, rho);
         rho = rho_new;
         lv_waxpby(c, dd_d(1), w, beta, y2, y1);
@@ -478,7 +483,7 @@ int lis_minres(lis_ctx *c, lis_vec *x)
         epsln = s_mul(c, sn, beta);
         dbar = dd_neg(s_mul(c, cs, beta));
         gamma = s_sqrt(c, s_add(c, s_mul(c, gbar, gbar), s_mul(c, beta, beta)));
-        if (s_zero(gamma) || gamma.hi != gamma.hi) FAIL(gamma, "gamma = 0 (A is singular on the Krylov space)");
+        FAIL_IF_ZERO(gamma, "gamma = 0 (A is singular on the Krylov space)");
         cs = s_div(c, gbar, gamma);
         sn = s_div(c, beta, gamma);
         phi = s_mul(c, cs, phibar);
@@ -582,8 +587,7 @@ int lis_idrs(lis_ctx *c, lis_vec *x)
                 lv_axpy(c, dd_neg(a), &U[i], &U[k]);
             }
             for (i = k; i < s; i++) Ms[i * s + k] = lv_dot(c, &P[i], &G[k]);
-            if (s_zero(Ms[k * s + k]) || Ms[k * s + k].hi != Ms[k * s + k].hi)
-                FAIL(Ms[k * s + k], "(P_k, G_k) = 0");
+            FAIL_IF_ZERO(Ms[k * s + k], "(P_k, G_k) = 0");
             beta = s_div(c, f[k], Ms[k * s + k]);
             lv_axpy(c, dd_neg(beta), &G[k], r);
             lv_axpy(c, beta, &U[k], x);
@@ -596,14 +600,14 @@ int lis_idrs(lis_ctx *c, lis_vec *x)
         lv_psolve(c, r, vv);
         lv_matvec(c, vv, t);
         tt = lv_dot(c, t, t);
-        if (s_zero(tt) || tt.hi != tt.hi) FAIL(tt, "(t, t) = 0");
+        FAIL_IF_ZERO(tt, "(t, t) = 0");
         tr = lv_dot(c, t, r);
         nt = s_sqrt(c, tt);
         nr = lv_nrm2(c, r);
         om = s_div(c, tr, tt);
         rho = s_div(c, tr, s_mul(c, nt, nr));
         if (fabs(rho.hi) < 0.7) om = s_mul(c, om, dd_d(0.7 / fabs(rho.hi)));
-        if (s_zero(om) || om.hi != om.hi) FAIL(om, "omega = 0");
+        FAIL_IF_ZERO(om, "omega = 0");
         lv_axpy(c, dd_neg(om), t, r);
         lv_axpy(c, om, vv, x);
         STEP(lv_nrm2(c, r));
