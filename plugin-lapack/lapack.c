@@ -485,8 +485,6 @@ static silc_plugin lp_plugin = {
     set_threads, NULL};
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
-                                        const char **errmsg);
-SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)
 {
     const char *config;

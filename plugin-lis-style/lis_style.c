@@ -488,8 +488,6 @@ static const silc_plugin lis_plugin = {
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
-                                        const char **errmsg);
-SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)
 {
     if (silc_host_check(host, SILC_HOST_NEEDS(threads), errmsg) || !out) return 1;

@@ -303,8 +303,6 @@ int silc_reference_plugin_init(const silc_host_api *host, const silc_plugin **ou
 }
 #else
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
-                                        const char **errmsg);
-SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)
 {
     return ref_init(host, out, errmsg);

@@ -294,6 +294,9 @@ static inline int silc_host_check(const silc_host_api *h, size_t needed, const c
 typedef int (*silc_plugin_init_fn)(const silc_host_api *host, const silc_plugin **out,
                                    const char **errmsg);
 #define SILC_PLUGIN_INIT_SYMBOL "silc_plugin_init"
+/* Declared here once, so that a plugin only defines it. */
+SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
+                                        const char **errmsg);
 
 #ifdef __cplusplus
 }
