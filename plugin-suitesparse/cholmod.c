@@ -29,9 +29,7 @@
 typedef struct ch_factor {
     cholmod_factor *L;
     ss_symbolic *entry;         /* the analysis L was copied from, or NULL */
-    double rcond, cond;
-    char method[64];
-    char note[160];
+    ss_factor_info info;
 } ch_factor;
 
 static void ch_free_L(void *p)
@@ -190,7 +188,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
     status = cc->status;
     minor = (long long)L->minor;
     F->L = L;
-    F->rcond = status == CHOLMOD_OK ? cholmod_l_rcond(L, cc) : 0;
+    F->info.rcond = status == CHOLMOD_OK ? cholmod_l_rcond(L, cc) : 0;
     ss_unlock();
     if (status == CHOLMOD_NOT_POSDEF) {
         /* The factor is not donated: only complete factorizations refactor. */
@@ -207,14 +205,14 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
         ch_factor_free(F);
         return rc;
     }
-    F->cond = F->rcond > 0 ? 1.0 / F->rcond : INFINITY;
-    if (ss_use_condest(condest, F->cond)) {
+    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
+    if (ss_use_condest(condest, F->info.cond)) {
         double inv = ss_inv_norm1(a->n, ch_apply_inv, F);
-        if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
+        if (inv >= 0) F->info.cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
     }
-    snprintf(F->method, sizeof F->method, "sparse Cholesky (CHOLMOD, %s, %s)",
+    snprintf(F->info.method, sizeof F->info.method, "sparse Cholesky (CHOLMOD, %s, %s)",
              L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
-    snprintf(F->note, sizeof F->note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",
+    snprintf(F->info.note, sizeof F->info.note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",
              crude ? "condition estimate is CHOLMOD's crude 1/rcond (diagonal of L)"
                    : "1-norm condition estimate (Hager/Higham)");
     *out = F;
@@ -232,12 +230,9 @@ int ss_cholmod_solve(silc_call *call)
     double *B, t0;
     int64_t n, k;
     int owned, rc, condest, status;
-    ss_host->view(call->in[0], &a);
-    ss_host->view(call->in[1], &b);
-    if (a.format != SILC_FMT_CSR || a.m != a.n) return SILC_EDECLINE;
+    if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
-    if ((rc = ss_condest_mode(call, &condest))) return rc;
 
     if (n > 0) {
         void *f;
@@ -267,9 +262,6 @@ int ss_cholmod_solve(silc_call *call)
     ss_unlock();
     if (!call->out) return ss_nomem(call, "CHOLMOD result");
     r->solve_seconds = ss_host->now() - t0;
-    snprintf(r->method, sizeof r->method, "%s", F->method);
-    r->rcond = F->rcond;
-    r->cond_est = F->cond;
-    snprintf(r->note, sizeof r->note, "%s", F->note);
+    ss_report_factor(r, &F->info);
     return SILC_OK;
 }

@@ -45,9 +45,7 @@ typedef struct kl_factor {
     ss_symbolic *entry;         /* cached analysis (holds a reference), or NULL */
     klu_l_symbolic *local;      /* the analysis when it could not be cached */
     kl_numeric *num;
-    double rcond, cond;
-    char method[64];
-    char note[160];
+    ss_factor_info info;
 } kl_factor;
 
 static void kl_common(klu_l_common *c)
@@ -164,7 +162,7 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
     }
     S = kl_symbolic(F);
     if (F->entry) spare = ss_sym_take_spare(F->entry);
-    if (spare && kl_try_refactor(a, S, spare, &F->rcond)) {
+    if (spare && kl_try_refactor(a, S, spare, &F->info.rcond)) {
         F->num = spare;
         refactored = 1;
     } else {
@@ -182,17 +180,17 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
             kl_factor_free(F);
             return rc;
         }
-        F->rcond = F->num->rcond0 = c.rcond;
+        F->info.rcond = F->num->rcond0 = c.rcond;
     }
-    F->cond = F->rcond > 0 ? 1.0 / F->rcond : INFINITY;
-    if (ss_use_condest(condest, F->cond)) {
+    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
+    if (ss_use_condest(condest, F->info.cond)) {
         kl_apply u = {F, a->n};
         double inv = ss_inv_norm1(a->n, kl_apply_inv, &u);
-        if (inv >= 0) F->cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
+        if (inv >= 0) F->info.cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
     }
-    snprintf(F->method, sizeof F->method, "sparse LU (KLU, BTF + AMD, %lld block%s)",
+    snprintf(F->info.method, sizeof F->info.method, "sparse LU (KLU, BTF + AMD, %lld block%s)",
              (long long)S->nblocks, S->nblocks == 1 ? "" : "s");
-    snprintf(F->note, sizeof F->note, "%s%s",
+    snprintf(F->info.note, sizeof F->info.note, "%s%s",
              refactored   ? "numeric refactor (klu_l_refactor, pivot order reused); "
              : sym_reused ? "symbolic analysis reused (same pattern); "
                           : "",
@@ -212,12 +210,9 @@ int ss_klu_solve(silc_call *call)
     double *X, t0;
     int64_t n, k;
     int owned, rc, condest;
-    ss_host->view(call->in[0], &a);
-    ss_host->view(call->in[1], &b);
-    if (a.format != SILC_FMT_CSR || a.m != a.n) return SILC_EDECLINE;
+    if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
-    if ((rc = ss_condest_mode(call, &condest))) return rc;
 
     if (n > 0) {
         void *f;
@@ -240,11 +235,6 @@ int ss_klu_solve(silc_call *call)
     ss_host->free(X);
     if (!call->out) return ss_nomem(call, "KLU result");
     r->solve_seconds = ss_host->now() - t0;
-    if (F) {
-        snprintf(r->method, sizeof r->method, "%s", F->method);
-        r->rcond = F->rcond;
-        r->cond_est = F->cond;
-        snprintf(r->note, sizeof r->note, "%s", F->note);
-    }
+    if (F) ss_report_factor(r, &F->info);
     return SILC_OK;
 }

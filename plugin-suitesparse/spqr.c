@@ -42,9 +42,7 @@ typedef struct qr_factor {
     int64_t m, n, rank;
     int transposed;     /* QR of A' (wide A of full row rank): minimum-norm solves */
     double tol;
-    double cond;        /* ||A|| * est ||R^-1||_1 for full rank, Inf if deficient */
-    char method[64];
-    char note[160];
+    ss_factor_info info; /* cond: ||A|| * est ||R^-1||_1 for full rank, Inf if deficient */
 } qr_factor;
 
 static void qr_factor_free(void *p)
@@ -168,26 +166,27 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
         ss_host->free(F);
         return qr_fail(call, fn, status);
     }
-    snprintf(F->method, sizeof F->method, "sparse QR (SuiteSparseQR%s, %s)",
+    snprintf(F->info.method, sizeof F->info.method, "sparse QR (SuiteSparseQR%s, %s)",
              F->transposed ? " of A'" : "", qr_ordering_name(cc->SPQR_istat[7]));
     /* R has the singular values of the factored matrix, so for full rank
      * ||A|| ||R^-1||_1 estimates cond(A) within modest factors (the 1-norm of
      * the factored matrix: ||A||_1 for A, ||A||_inf for A'); a rank-deficient
      * A has no finite condition number (as the reference plugin reports). */
     full = F->rank == (a->m < a->n ? a->m : a->n);
-    F->cond = INFINITY;
+    F->info.cond = INFINITY;
     if (full && F->rank > 0) {
         const silc_props *p = ss_host->props(call->in[0]);
         double inv = ss_inv_norm1(F->rank, qr_apply_rinv, F);
-        F->cond = inv >= 0 ? (F->transposed ? p->norminf : p->norm1) * inv : -1;
+        F->info.cond = inv >= 0 ? (F->transposed ? p->norminf : p->norm1) * inv : -1;
     }
+    F->info.rcond = F->info.cond > 0 ? (isinf(F->info.cond) ? 0 : 1 / F->info.cond) : -1;
     if (!full)
-        snprintf(F->note, sizeof F->note,
+        snprintf(F->info.note, sizeof F->info.note,
                  "rank %lld of %lldx%lld (tol %.3g): basic solution (at most rank nonzeros), "
                  "not minimum norm",
                  (long long)F->rank, (long long)F->m, (long long)F->n, cc->SPQR_tol_used);
     else
-        snprintf(F->note, sizeof F->note, "full rank %lld of %lldx%lld (tol %.3g)%s",
+        snprintf(F->info.note, sizeof F->info.note, "full rank %lld of %lldx%lld (tol %.3g)%s",
                  (long long)F->rank, (long long)F->m, (long long)F->n, cc->SPQR_tol_used,
                  F->m > F->n   ? ": least-squares solution"
                  : F->m < F->n ? ": minimum-norm solution"
@@ -280,9 +279,6 @@ int ss_spqr_solve(silc_call *call)
     ss_unlock();
     if (!call->out) return ss_nomem(call, "SPQR result");
     r->solve_seconds = ss_host->now() - t0;
-    snprintf(r->method, sizeof r->method, "%s", F->method);
-    snprintf(r->note, sizeof r->note, "%s", F->note);
-    r->cond_est = F->cond;
-    if (F->cond > 0) r->rcond = isinf(F->cond) ? 0 : 1 / F->cond;
+    ss_report_factor(r, &F->info);
     return SILC_OK;
 }

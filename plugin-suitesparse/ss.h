@@ -102,6 +102,21 @@ double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), vo
  */
 enum { SS_UMFPACK = 0, SS_CHOLMOD, SS_KLU, SS_NCACHE };
 
+/* What a factorization tells every solve that uses it. */
+typedef struct ss_factor_info {
+    double rcond;               /* the library's reciprocal estimate, -1 = none */
+    double cond;                /* the condition estimate reported, -1 = none */
+    char method[64];
+    char note[160];
+} ss_factor_info;
+
+/* The start every square solve shares: views of A and B, a decline unless A
+ * is square CSR, and the condest option.  0, SILC_EDECLINE or an error. */
+int ss_square_solve_begin(silc_call *call, silc_view *a, silc_view *b, int *condest);
+
+/* Copies a factorization's method, note and estimates into the report. */
+void ss_report_factor(silc_report *r, const ss_factor_info *fi);
+
 typedef struct ss_symbolic {
     int refs;
     int tag;                    /* backend variant the analysis was made for */

@@ -198,6 +198,22 @@ int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int
     return SILC_OK;
 }
 
+int ss_square_solve_begin(silc_call *call, silc_view *a, silc_view *b, int *condest)
+{
+    ss_host->view(call->in[0], a);
+    ss_host->view(call->in[1], b);
+    if (a->format != SILC_FMT_CSR || a->m != a->n) return SILC_EDECLINE;
+    return ss_condest_mode(call, condest);
+}
+
+void ss_report_factor(silc_report *r, const ss_factor_info *fi)
+{
+    snprintf(r->method, sizeof r->method, "%s", fi->method);
+    snprintf(r->note, sizeof r->note, "%s", fi->note);
+    r->rcond = fi->rcond;
+    r->cond_est = fi->cond;
+}
+
 /* ---- the symbolic cache ------------------------------------------------------ */
 
 /* Each slot holds one pattern, so there is nothing to look up: the sizes

@@ -37,10 +37,8 @@ typedef struct um_symbolic {
 
 typedef struct um_factor {
     void *numeric;
-    double rcond, cond;
-    int crude;                  /* cond is 1/rcond, not Hager/Higham's estimate */
-    char method[64];
-    char note[128];
+    ss_factor_info info;
+    int crude;                  /* info.cond is 1/rcond, not Hager/Higham's estimate */
 } um_factor;
 
 static void um_symbolic_free(void *p)
@@ -201,15 +199,15 @@ static int um_factor_new(silc_call *call, const silc_view *a, int tag, int conde
         um_factor_free(F);
         goto done;
     }
-    F->rcond = info[UMFPACK_RCOND];
-    F->cond = F->rcond > 0 ? 1.0 / F->rcond : INFINITY;
+    F->info.rcond = info[UMFPACK_RCOND];
+    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
     F->crude = 1;
-    if (ss_use_condest(condest, F->cond)) {
+    if (ss_use_condest(condest, F->info.cond)) {
         double c = um_condest(a, F->numeric, ss_host->props(call->in[0])->norm1);
-        if (c >= 0) F->cond = c, F->crude = 0;
+        if (c >= 0) F->info.cond = c, F->crude = 0;
     }
-    snprintf(F->method, sizeof F->method, "%s", s->method);
-    snprintf(F->note, sizeof F->note, "%s%s",
+    snprintf(F->info.method, sizeof F->info.method, "%s", s->method);
+    snprintf(F->info.note, sizeof F->info.note, "%s%s",
              reused ? "symbolic analysis reused (same pattern); " : "",
              F->crude ? "condition estimate is UMFPACK's crude 1/rcond (pivot ratio)"
                       : "1-norm condition estimate (Hager/Higham)");
@@ -229,12 +227,9 @@ int ss_umfpack_solve(silc_call *call)
     SuiteSparse_long *Wi = NULL;
     int64_t n, k, j, irstep;
     int owned = 0, rc, condest, st;
-    ss_host->view(call->in[0], &a);
-    ss_host->view(call->in[1], &b);
-    if (a.format != SILC_FMT_CSR || a.m != a.n) return SILC_EDECLINE;
+    if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
-    if ((rc = ss_condest_mode(call, &condest))) return rc;
     if ((rc = ss_host->option_int(call, "umfpack_irstep", 2, &irstep))) return rc;
 
     t0 = ss_host->now();
@@ -280,12 +275,7 @@ int ss_umfpack_solve(silc_call *call)
         goto done;
     }
     r->solve_seconds = ss_host->now() - t0;
-    if (F) {
-        snprintf(r->method, sizeof r->method, "%s", F->method);
-        r->rcond = F->rcond;
-        r->cond_est = F->cond;
-        snprintf(r->note, sizeof r->note, "%s", F->note);
-    }
+    if (F) ss_report_factor(r, &F->info);
     rc = SILC_OK;
 done:
     if (owned) ss_host->free(B);
