@@ -483,7 +483,7 @@ static void test_shared(silc_context *L, silc_context *R)
     printf("%-18s %6s %6s  %-13s %9s %9s %9s %9s %9s\n", "matrix", "rows", "cols", "class", "lapack s",
            "ref s", "cond", "berr", "|xl-xr|");
     while (fgets(line, sizeof line, idx)) {
-        char file[128], field[32], sym[32], cls[32], err[256];
+        char file[128], field[32], sym[32], cls[32];
         long long m, n, nnz;
         silc_envelope_t e;
         double *b, *xt, *xl = NULL, *xr = NULL, tl, tr, cond, berr = -1, diff = -1;
@@ -491,11 +491,7 @@ static void test_shared(silc_context *L, silc_context *R)
         if (sscanf(line, "%127s %lld %lld %lld %31s %31s %31s", file, &m, &n, &nnz, field, sym, cls) != 7 ||
             strcmp(file, "file") == 0 || m > 2000 || strcmp(field, "complex") == 0)
             continue;
-        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
-        if (silc_mm_read(&e, path, err, sizeof err)) {
-            CHECK(0, "%s: %s", file, err);
-            continue;
-        }
+        if (tl_read_shared(file, &e)) continue;
         xt = malloc((size_t)n * sizeof(double));
         b = calloc((size_t)m, sizeof(double));
         if (!xt || !b) {

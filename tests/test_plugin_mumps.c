@@ -120,13 +120,8 @@ out:
 /* mumps and reference on a shared matrix: both right, and close to each other. */
 static void test_shared(silc_context *cm, silc_context *cr, const char *file)
 {
-    char path[1024], err[256];
     silc_envelope_t A;
-    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
-    if (silc_mm_read(&A, path, err, sizeof err)) {
-        CHECK(0, "%s: %s", file, err);
-        return;
-    }
+    if (tl_read_shared(file, &A)) return;
     int64_t n = A.m;
     double *xs = malloc((size_t)n * sizeof *xs), *b = malloc((size_t)n * sizeof *b),
            *xm = malloc((size_t)n * sizeof *xm), *xr = malloc((size_t)n * sizeof *xr);
@@ -193,13 +188,8 @@ static void check_singular(silc_context *cm, const char *what)
 
 static void test_singular(silc_context *cm)
 {
-    char path[1024], err[256];
     silc_envelope_t A, eb;
-    snprintf(path, sizeof path, "%s/neumann.mtx", SILC_SHARED_MATRICES);
-    if (silc_mm_read(&A, path, err, sizeof err)) {
-        CHECK(0, "neumann: %s", err);
-        return;
-    }
+    if (tl_read_shared("neumann.mtx", &A)) return;
     double *b = malloc((size_t)A.m * sizeof *b);
     for (int64_t i = 0; b && i < A.m; i++) b[i] = (double)(i % 7) - 3;
     if (b && silc_put(cm, "N", &A) == 0 && silc_envelope_vector(&eb, A.m, b) == 0) {
@@ -355,12 +345,7 @@ static void test_single(silc_context *cm)
 
     static const char *files[] = {"west0479.mtx", "sherman1.mtx"};
     for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
-        char path[1024], err[256];
-        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, files[f]);
-        if (silc_mm_read(&A, path, err, sizeof err)) {
-            CHECK(0, "%s: %s", files[f], err);
-            continue;
-        }
+        if (tl_read_shared(files[f], &A)) continue;
         if (A.m <= n && put_system(cm, &A, xs, b) == 0)
             single_solve(cm, &A, b, x, files[f]);
         else

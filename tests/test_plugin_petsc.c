@@ -287,13 +287,8 @@ static void test_singular(silc_context *cp)
 
 static void test_shared(silc_context *cp, silc_context *cr, const char *file, const char *opts, double rtol)
 {
-    char path[1024], err[256];
     silc_envelope_t A;
-    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
-    if (silc_mm_read(&A, path, err, sizeof err)) {
-        CHECK(0, "%s: %s", file, err);
-        return;
-    }
+    if (tl_read_shared(file, &A)) return;
     int64_t n = A.m;
     double *ones = malloc((size_t)n * sizeof *ones), *b = malloc((size_t)n * sizeof *b),
            *xp = malloc((size_t)n * sizeof *xp), *xr = malloc((size_t)n * sizeof *xr);

@@ -244,17 +244,6 @@ static void test_multi_rhs(silc_context *c, const char *backend)
 
 /* ---- shared matrices ------------------------------------------------------------ */
 
-static int read_shared(const char *file, silc_envelope_t *A)
-{
-    char path[512], err[256];
-    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
-    if (silc_mm_read(A, path, err, sizeof err)) {
-        CHECK(0, "%s: %s", path, err);
-        return -1;
-    }
-    return 0;
-}
-
 /* Solves with the backend in c and the reference in r; they must agree. */
 static void test_shared(silc_context *c, silc_context *r, const char *backend, const char *file)
 {
@@ -262,7 +251,7 @@ static void test_shared(silc_context *c, silc_context *r, const char *backend, c
     double *x, *xr, cond, mine, be, t, tr;
     const char *in;
     int64_t n;
-    if (read_shared(file, &A)) return;
+    if (tl_read_shared(file, &A)) return;
     n = A.n;
     tl_put_checked(c, "A", &A);
     tl_put_checked(r, "A", &A);
@@ -302,7 +291,7 @@ static void test_shared(silc_context *c, silc_context *r, const char *backend, c
 static void test_singular(silc_context *c, const char *backend, const char *fn, const char *file)
 {
     silc_envelope_t A;
-    if (read_shared(file, &A)) return;
+    if (tl_read_shared(file, &A)) return;
     tl_put_checked(c, "A", &A);
     if (silc_exec(c, "b = A * ones(cols(A), 1); x = A \\ b")) {
         const char *msg = silc_context_errmsg(c);
@@ -357,7 +346,7 @@ static void test_rect_extra(silc_context *c, silc_context *r)
     double *x, *xr, *g, cond;
     int64_t m, n, nnz = 0;
     const char *in;
-    if (read_shared("illc1033.mtx", &A)) return;
+    if (tl_read_shared("illc1033.mtx", &A)) return;
     m = A.m;
     n = A.n;
     g = malloc((size_t)m * sizeof *g);
@@ -386,7 +375,7 @@ static void test_rect_extra(silc_context *c, silc_context *r)
     /* Underdetermined: A = ash219' is 85 x 219 of full row rank.  SPQR
      * factors A' and returns the minimum-norm solution, as the reference
      * does, with a condition estimate near the reference's. */
-    if (read_shared("ash219.mtx", &A)) return;
+    if (tl_read_shared("ash219.mtx", &A)) return;
     tl_put_checked(c, "B", &A);
     tl_put_checked(r, "B", &A);
     CHECK(silc_exec(c, "A = trans(B); b = A * ones(cols(A), 1); x = A \\ b; r = b - A * x") == 0,
@@ -444,7 +433,7 @@ static void test_condest(silc_context *c, silc_context *r, const char *backend)
     silc_envelope_t A;
     double cond, cref;
     const char *in;
-    if (read_shared("sherman1.mtx", &A)) return;
+    if (tl_read_shared("sherman1.mtx", &A)) return;
     tl_put_checked(c, "A", &A);
     tl_put_checked(r, "A", &A);
     CHECK(silc_exec(c, "b = A * ones(cols(A), 1); x = solve(A, b, \"suitesparse.condest = true\")") == 0,

@@ -389,6 +389,17 @@ static inline double tl_now(void)
 /* ---- with check.h: helpers that record their own failures -------------------- */
 
 #ifdef SILC_CHECK_H
+
+/* Reads SILC_SHARED_MATRICES/file into *A; a failure is a failed check. */
+static inline int tl_read_shared(const char *file, silc_envelope_t *A)
+{
+    char path[1024], err[256];
+    snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, file);
+    if (tl_read_mtx(A, path, err, sizeof err) == 0) return 0;
+    CHECK(0, "%s: %s", path, err);
+    return -1;
+}
+
 /* A context printing into tl_out() whose sparse solve classes (solve.sparse
  * and solve.sparse.spd) are forced to backend; NULL with a failed check. */
 static inline silc_context *tl_open_forced(const char *backend)
@@ -460,16 +471,13 @@ static inline void tl_spd_sweep(silc_context *c, silc_context *ref, const char *
                                 const char *stmt, double tol)
 {
     for (int f = 0; tl_spd_files[f]; f++) {
-        char path[512], err[256];
+        char file[256];
         silc_envelope_t A;
         double *ones, *b, *xref, *x, cond, t, d = 0, s = 0;
         int64_t n;
         int rc;
-        snprintf(path, sizeof path, "%s/%s.mtx", SILC_SHARED_MATRICES, tl_spd_files[f]);
-        if (silc_mm_read(&A, path, err, sizeof err)) {
-            CHECK(0, "read %s: %s", path, err);
-            continue;
-        }
+        snprintf(file, sizeof file, "%s.mtx", tl_spd_files[f]);
+        if (tl_read_shared(file, &A)) continue;
         n = A.n;
         ones = malloc((size_t)n * sizeof *ones);
         b = malloc((size_t)n * sizeof *b);
