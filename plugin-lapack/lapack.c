@@ -43,6 +43,16 @@ void lp_free(void *p)
     if (p) lp_host->free(p);
 }
 
+int lp_con_scratch(lapack_int n, lapack_int nwork, double **work, lapack_int **iwork)
+{
+    *work = lp_alloc((size_t)LP_LD(nwork), sizeof(double));
+    *iwork = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
+    if (*work && *iwork) return 0;
+    lp_free(*work);
+    lp_free(*iwork);
+    return -1;
+}
+
 lp_factor *lp_factor_new(int kind, lapack_int m, lapack_int n)
 {
     lp_factor *F = lp_host->calloc(1, sizeof *F);

@@ -58,6 +58,11 @@ typedef struct lp_factor {
 /* Memory through the host, with overflow checks.  NULL on failure. */
 void *lp_alloc(size_t count, size_t size);
 void lp_free(void *p);
+/* A leading dimension (or count) LAPACK accepts: at least 1. */
+#define LP_LD(n) ((n) > 1 ? (n) : 1)
+/* Scratch for the *con estimators: nwork doubles and n integers; -1 when out
+ * of memory (nothing left allocated). */
+int lp_con_scratch(lapack_int n, lapack_int nwork, double **work, lapack_int **iwork);
 lp_factor *lp_factor_new(int kind, lapack_int m, lapack_int n);
 void lp_factor_free(void *F);   /* attachment destructor; NULL is fine */
 int lp_nomem(silc_call *call);  /* host->error(SILC_ENOMEM, ...) */

@@ -26,17 +26,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#define LD(n) ((n) > 1 ? (n) : 1)
-
-static int con_scratch(lapack_int n, lapack_int nwork, double **work, lapack_int **iwork)
-{
-    *work = lp_alloc((size_t)LD(nwork), sizeof(double));
-    *iwork = lp_alloc((size_t)LD(n), sizeof(lapack_int));
-    if (*work && *iwork) return 0;
-    lp_free(*work);
-    lp_free(*iwork);
-    return -1;
-}
 
 /* 1 / (||A||_1 * est ||A^{-1}||_1) for a GB or PB factor; -1 if it fails.
  * work holds 2n doubles, iwork n integers. */
@@ -76,10 +65,10 @@ static int try_pt(silc_call *call, const silc_view *A, double norm1, lp_factor *
 {
     lapack_int n = F->n, i, info;
     double *d, *e, *work;
-    F->a = lp_alloc((size_t)2 * (size_t)LD(n), sizeof(double));
+    F->a = lp_alloc((size_t)2 * (size_t)LP_LD(n), sizeof(double));
     if (!F->a) return -lp_nomem(call);
     d = F->a;
-    e = F->a + LD(n);
+    e = F->a + LP_LD(n);
     for (i = 0; i < n; i++) {
         d[i] = lp_get(A, i, i);
         if (i + 1 < n) e[i] = lp_get(A, i + 1, i);
@@ -93,7 +82,7 @@ static int try_pt(silc_call *call, const silc_view *A, double norm1, lp_factor *
                  (int)info);
         return 0;
     }
-    work = lp_alloc((size_t)LD(n), sizeof(double));
+    work = lp_alloc((size_t)LP_LD(n), sizeof(double));
     if (!work) return -lp_nomem(call);
     if (LAPACKE_dptcon_work(n, d, e, norm1, &F->rcond, work)) F->rcond = -1;
     lp_free(work);
@@ -106,7 +95,7 @@ static int factor_gt(silc_call *call, const silc_view *A, double norm1, lp_facto
 {
     lapack_int n = F->n, i, info, *iwork;
     double *dl, *d, *du, *du2, *work;
-    size_t ln = (size_t)LD(n);
+    size_t ln = (size_t)LP_LD(n);
     F->a = lp_alloc(4 * ln, sizeof(double));
     F->ipiv = lp_alloc(ln, sizeof(lapack_int));
     if (!F->a || !F->ipiv) {
@@ -126,7 +115,7 @@ static int factor_gt(silc_call *call, const silc_view *A, double norm1, lp_facto
     }
     info = LAPACKE_dgttrf_work(n, dl, d, du, du2, F->ipiv);
     if (info) return singular(call, F, "dgttrf", info);
-    if (con_scratch(n, 2 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 2 * n, &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
@@ -143,7 +132,7 @@ static int try_pb(silc_call *call, const silc_view *A, double norm1, lp_factor *
 {
     lapack_int n = F->n, kd = F->ku, ld = kd + 1, i, j, info, *iwork;
     double *work;
-    F->a = lp_alloc((size_t)ld * (size_t)LD(n), sizeof(double));
+    F->a = lp_alloc((size_t)ld * (size_t)LP_LD(n), sizeof(double));
     if (!F->a) return -lp_nomem(call);
     for (j = 0; j < n; j++)
         for (i = j - kd > 0 ? j - kd : 0; i <= j; i++) F->a[(kd + i - j) + (size_t)j * ld] = lp_get(A, i, j);
@@ -158,7 +147,7 @@ static int try_pb(silc_call *call, const silc_view *A, double norm1, lp_factor *
     }
     F->kind = LP_PB;
     F->ld = ld;
-    if (con_scratch(n, 2 * n, &work, &iwork)) return -lp_nomem(call);
+    if (lp_con_scratch(n, 2 * n, &work, &iwork)) return -lp_nomem(call);
     F->rcond = band_rcond(F, norm1, work, iwork);
     lp_free(work);
     lp_free(iwork);
@@ -170,8 +159,8 @@ static int factor_gb(silc_call *call, const silc_view *A, double norm1, lp_facto
 {
     lapack_int n = F->n, kl = F->kl, ku = F->ku, ld = 2 * kl + ku + 1, i, j, info, *iwork;
     double *work;
-    F->a = lp_host->calloc((size_t)ld * (size_t)LD(n), sizeof(double));
-    F->ipiv = lp_alloc((size_t)LD(n), sizeof(lapack_int));
+    F->a = lp_host->calloc((size_t)ld * (size_t)LP_LD(n), sizeof(double));
+    F->ipiv = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
     if (!F->a || !F->ipiv) {
         lp_factor_free(F);
         return lp_nomem(call);
@@ -185,7 +174,7 @@ static int factor_gb(silc_call *call, const silc_view *A, double norm1, lp_facto
     if (info) return singular(call, F, "dgbtrf", info);
     F->kind = LP_GB;
     F->ld = ld;
-    if (con_scratch(n, 2 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 2 * n, &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
@@ -224,7 +213,7 @@ int lp_band(silc_call *call, const silc_view *A, int64_t kl, int64_t ku, int spd
 int lp_band_solve(silc_call *call, const lp_factor *F, double *B, lapack_int ldb, lapack_int nrhs)
 {
     lapack_int n = F->n, info;
-    size_t ln = (size_t)LD(n);
+    size_t ln = (size_t)LP_LD(n);
     const char *fn;
     switch (F->kind) {
     case LP_GB:

@@ -20,18 +20,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#define LD(n) ((n) > 1 ? (n) : 1)
-
-/* Scratch for the *con estimators: nwork doubles and n integers. */
-static int con_scratch(lapack_int n, lapack_int nwork, double **work, lapack_int **iwork)
-{
-    *work = lp_alloc((size_t)LD(nwork), sizeof(double));
-    *iwork = lp_alloc((size_t)LD(n), sizeof(lapack_int));
-    if (*work && *iwork) return 0;
-    lp_free(*work);
-    lp_free(*iwork);
-    return -1;
-}
 
 /* A new factor of kind with a copy of the dense m x n matrix A in F->a. */
 static lp_factor *factor_with_copy(int kind, const silc_view *A, int pivots)
@@ -39,9 +27,9 @@ static lp_factor *factor_with_copy(int kind, const silc_view *A, int pivots)
     lapack_int m = (lapack_int)A->m, n = (lapack_int)A->n;
     lp_factor *F = lp_factor_new(kind, m, n);
     if (!F) return NULL;
-    F->ld = LD(m);
+    F->ld = LP_LD(m);
     F->a = lp_alloc((size_t)m * (size_t)n, sizeof(double));
-    F->ipiv = pivots ? lp_alloc((size_t)LD(n), sizeof(lapack_int)) : NULL;
+    F->ipiv = pivots ? lp_alloc((size_t)LP_LD(n), sizeof(lapack_int)) : NULL;
     if (!F->a || (pivots && !F->ipiv)) {
         lp_factor_free(F);
         return NULL;
@@ -71,7 +59,7 @@ int lp_dense_lu(silc_call *call, const silc_view *A, double norm1, lp_factor **o
                                   (int)info, (int)info, (int)info);
         return lp_illegal(call, "dgetrf", info);
     }
-    if (con_scratch(n, 4 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 4 * n, &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
@@ -106,7 +94,7 @@ int lp_dense_chol(silc_call *call, const silc_view *A, double norm1, lp_factor *
         lp_factor_free(F);
         return lp_illegal(call, "dpotrf", info);
     }
-    if (con_scratch(n, 3 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 3 * n, &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
@@ -127,8 +115,8 @@ int lp_dense_ldlt(silc_call *call, const silc_view *A, double norm1, lp_factor *
     if (!F) return lp_nomem(call);
     info = LAPACKE_dsytrf_work(LAPACK_COL_MAJOR, 'L', n, F->a, F->ld, F->ipiv, &q, -1);
     lwork = lwork_of(q);
-    work = lp_alloc((size_t)(lwork > 2 * n ? lwork : LD(2 * n)), sizeof(double));
-    iwork = lp_alloc((size_t)LD(n), sizeof(lapack_int));
+    work = lp_alloc((size_t)(lwork > 2 * n ? lwork : LP_LD(2 * n)), sizeof(double));
+    iwork = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
     if (info != 0 || !work || !iwork) {
         lp_free(work);
         lp_free(iwork);
@@ -165,12 +153,12 @@ int lp_dense_tri(silc_call *call, const silc_view *A, char uplo, lp_factor **out
     double *work;
     lapack_int *iwork;
     if (!F) return lp_nomem(call);
-    if (con_scratch(n, 3 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 3 * n, &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
     F->uplo = uplo;
-    F->ld = LD(n);
+    F->ld = LP_LD(n);
     if (LAPACKE_dtrcon_work(LAPACK_COL_MAJOR, '1', uplo, 'N', n, A->val, F->ld, &F->rcond, work,
                             iwork))
         F->rcond = -1;
@@ -194,7 +182,7 @@ int lp_dense_qr(silc_call *call, const silc_view *A, double rank_tol, lp_factor 
     lapack_int *iwork;
     const char *fn = tall ? "dgeqrf" : "dgelqf";
     if (!F) return lp_nomem(call);
-    F->tau = lp_alloc((size_t)LD(k), sizeof(double));
+    F->tau = lp_alloc((size_t)LP_LD(k), sizeof(double));
     if (!F->tau) {
         lp_factor_free(F);
         return lp_nomem(call);
@@ -202,9 +190,9 @@ int lp_dense_qr(silc_call *call, const silc_view *A, double rank_tol, lp_factor 
     info = tall ? LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, m, n, F->a, F->ld, F->tau, &q, -1)
                 : LAPACKE_dgelqf_work(LAPACK_COL_MAJOR, m, n, F->a, F->ld, F->tau, &q, -1);
     lwork = lwork_of(q);
-    if (lwork < 3 * k) lwork = LD(3 * k); /* the same array serves dtrcon below */
+    if (lwork < 3 * k) lwork = LP_LD(3 * k); /* the same array serves dtrcon below */
     work = lp_alloc((size_t)lwork, sizeof(double));
-    iwork = lp_alloc((size_t)LD(k), sizeof(lapack_int));
+    iwork = lp_alloc((size_t)LP_LD(k), sizeof(lapack_int));
     if (info == 0 && work && iwork)
         info = tall ? LAPACKE_dgeqrf_work(LAPACK_COL_MAJOR, m, n, F->a, F->ld, F->tau, work, lwork)
                     : LAPACKE_dgelqf_work(LAPACK_COL_MAJOR, m, n, F->a, F->ld, F->tau, work, lwork);
@@ -271,7 +259,7 @@ static int solve_lsy(silc_call *call, lp_factor *F, const silc_view *A, double *
 {
     lapack_int m = F->m, n = F->n, info, lwork, rank = 0;
     double q = 0, *a = lp_alloc((size_t)m * (size_t)n, sizeof(double)), *work = NULL;
-    lapack_int *jpvt = lp_alloc((size_t)LD(n), sizeof(lapack_int));
+    lapack_int *jpvt = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
     int rc = SILC_OK;
     if (!a || !jpvt) {
         lp_free(a);
@@ -279,12 +267,12 @@ static int solve_lsy(silc_call *call, lp_factor *F, const silc_view *A, double *
         return lp_nomem(call);
     }
     if (m > 0 && n > 0) memcpy(a, A->val, (size_t)m * (size_t)n * sizeof(double));
-    memset(jpvt, 0, (size_t)LD(n) * sizeof(lapack_int)); /* all columns free to move */
-    info = LAPACKE_dgelsy_work(LAPACK_COL_MAJOR, m, n, nrhs, a, LD(m), B, ldb, jpvt, F->rank_tol,
+    memset(jpvt, 0, (size_t)LP_LD(n) * sizeof(lapack_int)); /* all columns free to move */
+    info = LAPACKE_dgelsy_work(LAPACK_COL_MAJOR, m, n, nrhs, a, LP_LD(m), B, ldb, jpvt, F->rank_tol,
                                &rank, &q, -1);
     lwork = lwork_of(q);
     if (info == 0 && (work = lp_alloc((size_t)lwork, sizeof(double))) != NULL)
-        info = LAPACKE_dgelsy_work(LAPACK_COL_MAJOR, m, n, nrhs, a, LD(m), B, ldb, jpvt,
+        info = LAPACKE_dgelsy_work(LAPACK_COL_MAJOR, m, n, nrhs, a, LP_LD(m), B, ldb, jpvt,
                                    F->rank_tol, &rank, work, lwork);
     if (info) rc = lp_illegal(call, "dgelsy", info);
     else if (!work) rc = lp_nomem(call);

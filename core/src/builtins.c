@@ -103,16 +103,9 @@ static void note_core(lang_ev *V, const ast_node *call, const silc_value *r)
 static int run_call(lang_ev *V, const ast_node *call, int op, int sub, silc_value *a,
                     silc_value *b, silc_value **out)
 {
-    silc_call c;
     char what[128];
-    memset(&c, 0, sizeof c);
-    c.op = op;
-    c.sub = sub;
-    c.nin = b ? 2 : 1;
-    c.in[0] = a;
-    c.in[1] = b;
     call_text(V, call, what, sizeof what);
-    return ev_run(V, &c, what, out);
+    return ev_run_op(V, op, sub, a, b, 0, 0, what, out);
 }
 
 /* ---- structure built by the core --------------------------------------------- */

@@ -200,9 +200,8 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     return 0;
 }
 
-/* Shorthand for the common one- and two-operand calls. */
-static int run2(lang_ev *V, int op, int sub, const silc_value *a, const silc_value *b,
-                double alpha, double beta, const char *what, silc_value **out)
+int ev_run_op(lang_ev *V, int op, int sub, const silc_value *a, const silc_value *b,
+              double alpha, double beta, const char *what, silc_value **out)
 {
     silc_call c;
     memset(&c, 0, sizeof c);
@@ -357,14 +356,14 @@ static int matrix_power(lang_ev *V, const silc_value *a, double k, const char *w
             if (!result) {
                 result = val_retain(base);
             } else {
-                if (run2(V, SILC_OP_MATMUL, 0, result, base, 1, 0, what, &t)) goto fail;
+                if (ev_run_op(V, SILC_OP_MATMUL, 0, result, base, 1, 0, what, &t)) goto fail;
                 val_release(result);
                 result = t;
             }
         }
         e >>= 1;
         if (e) {
-            if (run2(V, SILC_OP_MATMUL, 0, base, base, 1, 0, what, &t)) goto fail;
+            if (ev_run_op(V, SILC_OP_MATMUL, 0, base, base, 1, 0, what, &t)) goto fail;
             val_release(base);
             base = t;
         }
@@ -388,47 +387,47 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
     case TK_PLUS: case TK_PLUSEQ: case TK_MINUS: case TK_MINUSEQ:
         if (!same_or_scalar(a, b))
             return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
-        return run2(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
+        return ev_run_op(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
                     o->what, out);
     case TK_STAR: case TK_STAREQ:
-        if (val_is_scalar(a)) return run2(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
-        if (val_is_scalar(b)) return run2(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
+        if (val_is_scalar(a)) return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
+        if (val_is_scalar(b)) return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
         if (a->n != b->m) return shape_error(V, "inner dimensions differ", op, o, a, b);
-        return run2(V, SILC_OP_MATMUL, 0, a, b, 1, 0, o->what, out);
+        return ev_run_op(V, SILC_OP_MATMUL, 0, a, b, 1, 0, o->what, out);
     case TK_SLASH: case TK_SLASHEQ: {
         silc_value *at, *bt, *x;
         int rc;
         if (val_is_scalar(b))
-            return run2(V, SILC_OP_SCALE, 0, a, NULL, 1.0 / val_scalar(b), 0, o->what, out);
+            return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, 1.0 / val_scalar(b), 0, o->what, out);
         if (a->n != b->n)
             return shape_error(V, "needs operands with the same number of columns", op, o, a, b);
         /* a / B = (B' \ a')' */
-        if (run2(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, o->what, &at)) return -1;
-        if (run2(V, SILC_OP_TRANSPOSE, 0, b, NULL, 0, 0, o->what, &bt)) {
+        if (ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, o->what, &at)) return -1;
+        if (ev_run_op(V, SILC_OP_TRANSPOSE, 0, b, NULL, 0, 0, o->what, &bt)) {
             val_release(at);
             return -1;
         }
-        rc = run2(V, SILC_OP_SOLVE, 0, bt, at, 0, 0, o->what, &x);
+        rc = ev_run_op(V, SILC_OP_SOLVE, 0, bt, at, 0, 0, o->what, &x);
         val_release(at);
         val_release(bt);
         if (rc) return -1;
-        rc = run2(V, SILC_OP_TRANSPOSE, 0, x, NULL, 0, 0, o->what, out);
+        rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, x, NULL, 0, 0, o->what, out);
         val_release(x);
         return rc;
     }
     case TK_BACKSLASH:
         if (val_is_scalar(a))
-            return run2(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
+            return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
         if (a->m != b->m)
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
         /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
          * repeats the check with role names for every other route). */
         if (refine_check_finite(V->E, a, o->lname) || refine_check_finite(V->E, b, o->rname))
             return -1;
-        return run2(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
+        return ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
     case TK_CARET:
         if (val_is_scalar(a) && val_is_scalar(b))
-            return run2(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);
+            return ev_run_op(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);
         if (a->m != a->n) {
             ev_shape(a, sa, sizeof sa);
             return eng_error(E, "%s is %s but '^' needs a square matrix", o->lname, sa);
@@ -451,7 +450,7 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
     default:
         if (!same_or_scalar(a, b))
             return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
-        return run2(V, SILC_OP_EWISE, ewise_sub(op), a, b, 0, 0, o->what, out);
+        return ev_run_op(V, SILC_OP_EWISE, ewise_sub(op), a, b, 0, 0, o->what, out);
     }
 }
 
@@ -507,9 +506,9 @@ static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
     }
     node_text(V, n, what, sizeof what);
     if (n->kind == AST_TRANSPOSE)
-        rc = run2(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
+        rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
     else
-        rc = run2(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
+        rc = ev_run_op(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
                   what, out);
     val_release(a);
     return rc;

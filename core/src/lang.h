@@ -110,6 +110,9 @@ void ev_operand_name(const lang_ev *V, const ast_node *n, int side, char *out, s
  * it and runs it only when it is not a solve).  what names the operation for
  * explain ("A \ b").  Returns 0 with *out set (owned), or -1 with E->err set. */
 int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out);
+/* ev_run of the common one- and two-operand call (b may be NULL). */
+int ev_run_op(lang_ev *V, int op, int sub, const silc_value *a, const silc_value *b,
+              double alpha, double beta, const char *what, silc_value **out);
 /* "3x4" */
 void ev_shape(const silc_value *v, char *out, size_t outlen);
 
