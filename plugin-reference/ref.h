@@ -51,6 +51,8 @@ int64_t ref_sp_nnz(const ref_sp *A);
 int ref_sp_from_view(const silc_view *v, ref_sp *A);
 /* Compressed-column form of v' : borrowed from a CSR value, copied otherwise. */
 int ref_spt_from_view(const silc_view *v, ref_sp *At);
+/* Both operands of a binary operation that way; on failure neither is held. */
+int ref_spt_pair(const silc_view *a, const silc_view *b, ref_sp *At, ref_sp *Bt);
 int ref_sp_transpose(const ref_sp *A, ref_sp *T);
 /* Dense column-major copy of any format. */
 double *ref_dense_from_view(const silc_view *v);

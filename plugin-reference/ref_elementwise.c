@@ -189,11 +189,7 @@ int ref_op_add(silc_call *call)
     }
     if (a.format != SILC_FMT_DENSE && b.format != SILC_FMT_DENSE) {
         ref_sp A, B;
-        if (ref_spt_from_view(&a, &A)) return ref_nomem(call);
-        if (ref_spt_from_view(&b, &B)) {
-            ref_sp_free(&A);
-            return ref_nomem(call);
-        }
+        if (ref_spt_pair(&a, &b, &A, &B)) return ref_nomem(call);
         lin_ctx c = {al, be};
         int st = merge_rows(call, &A, &B, 0, lin, &c);
         ref_sp_free(&A);

@@ -90,11 +90,7 @@ int ref_op_matmul(silc_call *call)
     int64_t m = a.m, n = b.n, kk = a.n;
     if (a.format != SILC_FMT_DENSE && b.format != SILC_FMT_DENSE) {
         ref_sp A, B;
-        if (ref_spt_from_view(&a, &A)) return ref_nomem(call);
-        if (ref_spt_from_view(&b, &B)) {
-            ref_sp_free(&A);
-            return ref_nomem(call);
-        }
+        if (ref_spt_pair(&a, &b, &A, &B)) return ref_nomem(call);
         int st = gustavson(call, &A, &B, m, n);
         ref_sp_free(&A);
         ref_sp_free(&B);

@@ -152,6 +152,16 @@ int ref_spt_from_view(const silc_view *v, ref_sp *At)
     return st;
 }
 
+int ref_spt_pair(const silc_view *a, const silc_view *b, ref_sp *At, ref_sp *Bt)
+{
+    if (ref_spt_from_view(a, At)) return SILC_ENOMEM;
+    if (ref_spt_from_view(b, Bt)) {
+        ref_sp_free(At);
+        return SILC_ENOMEM;
+    }
+    return 0;
+}
+
 int ref_sp_from_view(const silc_view *v, ref_sp *A)
 {
     if (v->format != SILC_FMT_CSR) return sp_from_full(v, A);
