@@ -35,31 +35,70 @@ static double *diag_inverse(lis_ctx *c)
     return d;
 }
 
-int lis_jacobi(lis_ctx *c, lis_vec *x)
+/* x += D^-1 r, all rows at once from the last residual r. */
+static void jacobi_sweep(lis_ctx *c, lis_vec *x, const lis_vec *r, const double *dinv, double omega)
+{
+    int64_t n = c->n, i;
+    (void)omega;
+    if (c->quad) {
+#pragma omp parallel for schedule(static) if (n > 4096)
+        for (i = 0; i < n; i++) {
+            dd xi = {x->h[i], x->l[i]}, ri = {r->h[i], r->l[i]};
+            xi = dd_add(xi, dd_mul_d(ri, dinv[i]));
+            x->h[i] = xi.hi;
+            x->l[i] = xi.lo;
+        }
+    } else {
+#pragma omp parallel for schedule(static) if (n > 4096)
+        for (i = 0; i < n; i++) x->h[i] += dinv[i] * r->h[i];
+    }
+}
+
+/* x_i += omega (b_i - sum_j a_ij x_j) / a_ii, row after row with the new x. */
+static void sor_sweep(lis_ctx *c, lis_vec *x, const lis_vec *r, const double *dinv, double omega)
+{
+    const lk_csr *A = c->A;
+    (void)r;
+    for (int64_t i = 0; i < c->n; i++) {
+        if (c->quad) {
+            dd s = {c->b.h[i], c->b.l ? c->b.l[i] : 0.0}, xi;
+            for (int64_t k = A->rp[i]; k < A->rp[i + 1]; k++) {
+                int64_t j = A->ci[k];
+                dd p = dd_two_prod(A->v[k], x->h[j]);
+                p.lo += A->v[k] * x->l[j];
+                s = dd_sub(s, p);
+            }
+            xi.hi = x->h[i];
+            xi.lo = x->l[i];
+            xi = dd_add(xi, dd_mul_d(s, omega * dinv[i]));
+            x->h[i] = xi.hi;
+            x->l[i] = xi.lo;
+        } else {
+            double s = c->b.h[i];
+            for (int64_t k = A->rp[i]; k < A->rp[i + 1]; k++) s -= A->v[k] * x->h[A->ci[k]];
+            x->h[i] += omega * dinv[i] * s;
+        }
+    }
+}
+
+typedef void (*sweep_fn)(lis_ctx *c, lis_vec *x, const lis_vec *r, const double *dinv, double omega);
+
+/* The loop every stationary method shares: a sweep, then the residual for
+ * the convergence test.  A sweep that reads the residual gets it from the
+ * start. */
+static int stationary(lis_ctx *c, lis_vec *x, sweep_fn sweep, int reads_residual, double omega)
 {
     lis_vec r;
     double *dinv;
     int st = LIS_MAXITER;
-    int64_t n = c->n, i;
     if (lv_new(c, &r)) return LIS_NOMEM;
     if (!(dinv = diag_inverse(c))) {
         lv_free(&r);
         return c->why[0] ? LIS_BREAKDOWN : LIS_NOMEM;
     }
-    lv_residual(c, x, &r);
+    if (reads_residual) lv_residual(c, x, &r);
     while (!lis_limit(c)) {
-        if (c->quad) {
-#pragma omp parallel for schedule(static) if (n > 4096)
-            for (i = 0; i < n; i++) {
-                dd xi = {x->h[i], x->l[i]}, ri = {r.h[i], r.l[i]};
-                xi = dd_add(xi, dd_mul_d(ri, dinv[i]));
-                x->h[i] = xi.hi;
-                x->l[i] = xi.lo;
-            }
-        } else {
-#pragma omp parallel for schedule(static) if (n > 4096)
-            for (i = 0; i < n; i++) x->h[i] += dinv[i] * r.h[i];
-        }
+        sweep(c, x, &r, dinv, omega);
         lv_residual(c, x, &r);
         st = lis_step(c, lv_nrm2(c, &r));
         if (st >= 0) break;
@@ -70,54 +109,17 @@ int lis_jacobi(lis_ctx *c, lis_vec *x)
     return st;
 }
 
-static int sor(lis_ctx *c, lis_vec *x, double omega)
+int lis_jacobi(lis_ctx *c, lis_vec *x)
 {
-    const lk_csr *A = c->A;
-    lis_vec r;
-    double *dinv;
-    int st = LIS_MAXITER;
-    if (lv_new(c, &r)) return LIS_NOMEM;
-    if (!(dinv = diag_inverse(c))) {
-        lv_free(&r);
-        return c->why[0] ? LIS_BREAKDOWN : LIS_NOMEM;
-    }
-    while (!lis_limit(c)) {
-        for (int64_t i = 0; i < c->n; i++) {
-            if (c->quad) {
-                dd s = {c->b.h[i], c->b.l ? c->b.l[i] : 0.0}, xi;
-                for (int64_t k = A->rp[i]; k < A->rp[i + 1]; k++) {
-                    int64_t j = A->ci[k];
-                    dd p = dd_two_prod(A->v[k], x->h[j]);
-                    p.lo += A->v[k] * x->l[j];
-                    s = dd_sub(s, p);
-                }
-                xi.hi = x->h[i];
-                xi.lo = x->l[i];
-                xi = dd_add(xi, dd_mul_d(s, omega * dinv[i]));
-                x->h[i] = xi.hi;
-                x->l[i] = xi.lo;
-            } else {
-                double s = c->b.h[i];
-                for (int64_t k = A->rp[i]; k < A->rp[i + 1]; k++) s -= A->v[k] * x->h[A->ci[k]];
-                x->h[i] += omega * dinv[i] * s;
-            }
-        }
-        lv_residual(c, x, &r);
-        st = lis_step(c, lv_nrm2(c, &r));
-        if (st >= 0) break;
-        st = LIS_MAXITER;
-    }
-    lis_host->free(dinv);
-    lv_free(&r);
-    return st;
+    return stationary(c, x, jacobi_sweep, 1, 1.0);
 }
 
 int lis_gs(lis_ctx *c, lis_vec *x)
 {
-    return sor(c, x, 1.0);
+    return stationary(c, x, sor_sweep, 0, 1.0);
 }
 
 int lis_sor(lis_ctx *c, lis_vec *x)
 {
-    return sor(c, x, c->o->omega);
+    return stationary(c, x, sor_sweep, 0, c->o->omega);
 }
