@@ -427,6 +427,15 @@ static int load_problem(problem *P, const opts *o)
     return 0;
 }
 
+/* Sets the condest option of backend b's plugin ("suitesparse" of
+ * "suitesparse.klu", "mumps" of "mumps") for the session. */
+static void set_condest(silc_context *c, const char *b, const char *value)
+{
+    char stmt[96];
+    snprintf(stmt, sizeof stmt, "set %.*s.condest = %s", (int)strcspn(b, "."), b, value);
+    silc_exec(c, stmt);
+}
+
 /* SILC's row and, where the library can be called directly, the direct row
  * and the ratio, for nsolve solves with one A.  The two alternate, best of
  * reps each, so that a burst of load on the machine hits both alike.
@@ -438,20 +447,18 @@ static void compare(silc_context *c, tl_capture *cap, const problem *P, const op
 {
     double (*direct)(const problem *, int, double *) = direct_for(b);
     double be = NAN, t = -1, td = -1;
-    char ran[64], who[64], set[96];
+    char ran[64], who[64];
     int r;
     if (!strcmp(b, "suitesparse.cholmod") && !P->spd) return;
     snprintf(ran, sizeof ran, "%s", b);
-    /* the plugin's name: "suitesparse" of "suitesparse.klu", "mumps" of "mumps" */
-    snprintf(set, sizeof set, "set %.*s.condest = ", (int)strcspn(b, "."), b);
-    if (condest_off) silc_exec(c, strcat(strcpy(who, set), "false"));
+    if (condest_off) set_condest(c, b, "false");
     for (r = 0; r < o->reps; r++) {
         double ts = silc_time(c, cap, P, b, 1, nsolve, &be, ran, sizeof ran), d;
         if (ts < 0) break;
         if (t < 0 || ts < t) t = ts;
         if (direct && (d = direct(P, nsolve, x)) >= 0 && (td < 0 || d < td)) td = d;
     }
-    if (condest_off) silc_exec(c, strcat(strcpy(who, set), !strcmp(b, "mumps") ? "true" : "auto"));
+    if (condest_off) set_condest(c, b, !strcmp(b, "mumps") ? "true" : "auto"); /* the defaults */
     snprintf(who, sizeof who, "SILC  %s%s", nsolve > 1 ? "loop, " : "",
              !strcmp(b, "default") ? "default" : condest_off ? "condest off" : "forced");
     /* condest off is compared with the same direct call, which estimates nothing. */

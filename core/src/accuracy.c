@@ -11,56 +11,59 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* (*hi + *lo) -= a * x.  Plain: *hi -= a x.  Extended: the product is split
- * exactly (a x = p + e by fma) and added with TwoSum, so hi + lo carries the
- * sum to about twice the working precision. */
-static void sub_product(double *hi, double *lo, double a, double x, int extended)
+/* (r[i] + l[i]) -= a * x.  l NULL: plain r[i] -= a x.  Otherwise the product
+ * is split exactly (a x = p + e by fma) and added with TwoSum, so r + l
+ * carries the sum to about twice the working precision. */
+static void sub_product(double *r, double *l, int64_t i, double a, double x)
 {
     double p = a * x, s, bb, err, e;
-    if (!extended) {
-        *hi -= p;
+    if (!l) {
+        r[i] -= p;
         return;
     }
     e = fma(a, x, -p);
-    s = *hi - p;
-    bb = s - *hi;
-    err = (*hi - (s - bb)) + (-p - bb);
-    *hi = s;
-    *lo += err - e;
+    s = r[i] - p;
+    bb = s - r[i];
+    err = (r[i] - (s - bb)) + (-p - bb);
+    r[i] = s;
+    l[i] += err - e;
 }
 
 void acc_residual(const silc_value *A, const double *B, const double *X, int64_t k, int extended,
                   double *R, double *lo)
 {
     silc_view a;
-    double dummy = 0;
     int64_t i, j, c, p;
     val_view(A, &a);
     memcpy(R, B, (size_t)(a.m * k) * sizeof *R);
     if (extended) memset(lo, 0, (size_t)(a.m * k) * sizeof *lo);
     for (c = 0; c < k; c++) {
-        double *r = R + c * a.m, *l = extended ? lo + c * a.m : &dummy;
+        double *r = R + c * a.m, *l = extended ? lo + c * a.m : NULL;
         const double *x = X + c * a.n;
         if (a.format == SILC_FMT_CSR) {
             for (i = 0; i < a.m; i++)
                 for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++)
-                    sub_product(&r[i], extended ? &l[i] : l, a.val[p], x[a.colind[p]], extended);
+                    sub_product(r, l, i, a.val[p], x[a.colind[p]]);
         } else if (a.format == SILC_FMT_BAND) {
             for (j = 0; j < a.n; j++) {
                 int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
                 int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
                 for (i = lo_i; i < hi_i; i++)
-                    sub_product(&r[i], extended ? &l[i] : l, a.val[(a.ku + i - j) + j * a.ld], x[j],
-                                extended);
+                    sub_product(r, l, i, a.val[(a.ku + i - j) + j * a.ld], x[j]);
             }
         } else {
             for (j = 0; j < a.n; j++)
-                for (i = 0; i < a.m; i++)
-                    sub_product(&r[i], extended ? &l[i] : l, a.val[i + j * a.m], x[j], extended);
+                for (i = 0; i < a.m; i++) sub_product(r, l, i, a.val[i + j * a.m], x[j]);
         }
-        if (extended)
+        if (l)
             for (i = 0; i < a.m; i++) r[i] += l[i];
     }
+}
+
+/* The larger of best and s, where a NaN wins and stays. */
+static double max_nan(double best, double s)
+{
+    return s > best || s != s ? s : best;
 }
 
 double acc_norm_inf(const double *x, int64_t m, int64_t k)
@@ -70,8 +73,8 @@ double acc_norm_inf(const double *x, int64_t m, int64_t k)
     for (i = 0; i < m; i++) {
         double s = 0;
         for (c = 0; c < k; c++) s += fabs(x[i + c * m]);
-        if (s > best || isnan(s)) best = s;
-        if (isnan(best)) break; /* NaN wins */
+        best = max_nan(best, s);
+        if (isnan(best)) break;
     }
     return best;
 }
@@ -106,7 +109,7 @@ static double residual_norm_csr(const silc_value *A, const double *B, const doub
             for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) r -= a.val[p] * x[a.colind[p]];
             s += fabs(r);
         }
-        if (s > best || isnan(s)) best = s;
+        best = max_nan(best, s);
         if (isnan(best)) break;
     }
     return best;

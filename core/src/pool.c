@@ -42,16 +42,15 @@ static slot slots[POOL_SLOTS];
 static size_t pooled_bytes, cap_bytes;
 static int installed; /* pool_install was called: the default does not override it */
 
+/* $SILC_ARRAY_POOL MiB; unset or not a number: the default. */
 static void install_from_env(void)
 {
-    if (installed) return;
-    {
     const char *v = getenv("SILC_ARRAY_POOL");
-    char *end;
+    char *end = NULL;
     double mib = v && *v ? strtod(v, &end) : POOL_DEFAULT_MIB;
-    if (v && *v && (*end || !(mib >= 0))) mib = POOL_DEFAULT_MIB; /* not a number: the default */
+    if (installed) return;
+    if (end && (*end || !(mib >= 0))) mib = POOL_DEFAULT_MIB;
     pool_install((size_t)(mib * 1048576.0));
-    }
 }
 
 static time_t now_s(void)
