@@ -203,11 +203,12 @@ static void warn_if_unsolved(silc_engine *E, const char *backend, double be)
 void acc_report(silc_engine *E, silc_call *call, int may_defer)
 {
     silc_report *r = call->report;
-    const char *when = cfg_get(E, "solve.backward_error");
-    if (may_defer && r->reused_factor && r->iterations == 0 && r->backward_error_unrefined < 0 &&
-        !(when && strcmp(when, "always") == 0)) {
-        r->backward_error = ACC_DEFERRED;
-        return;
+    if (may_defer && r->reused_factor && r->iterations == 0 && r->backward_error_unrefined < 0) {
+        const char *when = cfg_get(E, "solve.backward_error");
+        if (!(when && strcmp(when, "always") == 0)) {
+            r->backward_error = ACC_DEFERRED;
+            return;
+        }
     }
     r->backward_error = acc_backward_error(call->in[0], call->in[1], call->out);
     warn_if_unsolved(E, r->backend, r->backward_error);
