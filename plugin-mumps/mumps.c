@@ -11,19 +11,21 @@
  * later solves only run JOB=3; the attachment is destroyed with JOB=-2.
  *
  * Every ICNTL(1..40) and CNTL(1..15) is a typed option (mumps.icntl_7 = 5).
- * Defaults differ from MUMPS's in three ways: output is silenced, the ordering
- * is AMF (ICNTL(7)=2; SCOTCH and PORD were 1.5-3x slower on 2-D grids here),
- * and MUMPS's error analysis (ICNTL(11)=2: its backward errors; 1 adds
- * condition numbers) runs once per factorization, on the first single-column
- * solve, and `info` shows it from then on.  Once, because it is not free:
- * on the 250,000-unknown Laplacian it added a quarter to a solve with a
- * reused factorization (0.135 s against 0.11 s of CPU), and the engine
- * computes the backward error of every solve anyway.  A 1-norm condition
- * estimate (Hager-Higham, a few extra solves) is made once per factorization
- * for the engine's "singular to working precision" warning; it added 20% to
- * the first solve there (1.50 s against 1.26 s), and mumps.condest = false
- * turns it off.  Workspace errors (the -9 class) double ICNTL(14) and retry
- * up to four times.
+ * Defaults differ from MUMPS's in two ways: output is silenced, and the
+ * ordering is AMF (ICNTL(7)=2; SCOTCH and PORD were 1.5-3x slower on 2-D
+ * grids here).  MUMPS's own error analysis stays off as in MUMPS (ICNTL(11)=0):
+ * the engine computes every solve's backward error anyway, and the analysis
+ * doubled the solve phase on bcsstk16 (1.48 against 0.73 ms, 4% of a whole
+ * one-shot solve).  Asked for (mumps.icntl_11 = 2: its backward errors; 1 adds
+ * condition numbers), it runs once per factorization, on the first
+ * one-column solve, and `info` shows it from then on.
+ *
+ * A 1-norm condition estimate is made once per factorization for the
+ * engine's report and its "fewer than 4 correct digits" warning: the host's
+ * block estimator with two columns and two steps (estimate_cond below), whose
+ * first block rides along with the first solve, so it costs two more solve
+ * phases.  mumps.condest = false turns it off.  Workspace errors (the -9
+ * class) double ICNTL(14) and retry up to four times.
  *
  * mumps.precision = single factors with smumps_c instead (mixed precision):
  * the entries are scaled by a power of two so the largest is near 1 and
@@ -91,8 +93,8 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
     IC(8, "", "scaling strategy (77: automatic)"),
     IC(9, "1", "1 solves A x = b (the only value '\\' can use)"),
     IC(10, "", "iterative refinement steps (0: none)"),
-    IC(11, "2", "error analysis on the first solve of a factorization: 0 none, 1 full (condition "
-                "numbers), 2 backward errors"),
+    IC(11, "0", "error analysis on the first one-column solve of a factorization: 0 none (the core "
+                "computes every solve's backward error), 1 full (condition numbers), 2 backward errors"),
     IC(12, "", "ordering strategy for symmetric matrices (SYM=2)"),
     IC(13, "", "root front: ScaLAPACK use (parallel only)"),
     IC(14, "", "percentage increase of the estimated workspace"),
@@ -138,7 +140,8 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
     C(14, "reserved"),
     C(15, "reserved"),
     {"condest", SILC_OPT_BOOL, "true",
-     "estimate the 1-norm condition number (Hager-Higham, 2-10 extra solves per factorization)"},
+     "estimate the 1-norm condition number (block Hager-Higham: 2 extra two-column solves per "
+     "factorization, the first block rides with the first solve)"},
     {"precision", SILC_OPT_STRING, "double",
      "factorization precision: double, or single (smumps factor, refined in double by the core)"},
 };
@@ -460,50 +463,55 @@ static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs
     return SOLVE_AGAIN;
 }
 
-/* out = A^-1 in (trans: A^-T in) for one vector. */
-static int solve_vec(silc_call *call, mumps_factor *F, const double *in, double *out, int trans)
-{
-    int rc;
-    do {
-        memcpy(out, in, (size_t)ID_N(F) * sizeof(double));
-        ICNTL(F, 9) = trans ? 2 : 1;
-        rc = run_solve(call, F, out, 1);
-        ICNTL(F, 9) = 1;
-    } while (rc == SOLVE_AGAIN);
-    return rc;
-}
+/* The condition estimate is the host's block estimator (ABI 1.3) with two
+ * columns and two steps: MUMPS's solve phase costs about the same for two
+ * columns as for one (6.2 against 6.0 ms on memplus, where the work proper
+ * is a tenth of that), so the block costs no more than a single vector, and
+ * its first block rides along with the user's first solve.  Two steps (start,
+ * gradient, improvement) are what Hager's method settles on almost always;
+ * the conformance test compares the estimates with the exact cond_1. */
+#define EST_COLS 2
+#define EST_STEPS 2
 
-/* The host's Hager-Higham estimator (ABI 1.1) drives solves with A and A'
- * through this callback. */
 typedef struct est_ctx {
     silc_call *call;
     mumps_factor *F;
-    int rc;
+    double *keep;               /* the block, for a solve that must be redone */
+    int rc;                     /* a failed solve's status (its message is set) */
 } est_ctx;
 
-static int apply_inverse(void *ctx, double *x, int trans, double *work)
+static int apply_block(void *ctx, double *X, int t, int trans)
 {
     est_ctx *c = ctx;
-    if ((c->rc = solve_vec(c->call, c->F, x, work, trans))) return c->rc;
-    memcpy(x, work, (size_t)ID_N(c->F) * sizeof *x);
-    return 0;
+    size_t bytes = (size_t)ID_N(c->F) * (size_t)t * sizeof *X;
+    int rc;
+    memcpy(c->keep, X, bytes);
+    do {
+        memcpy(X, c->keep, bytes);
+        ICNTL(c->F, 9) = trans ? 2 : 1;
+        rc = run_solve(c->call, c->F, X, t);
+        ICNTL(c->F, 9) = 1;
+    } while (rc == SOLVE_AGAIN);
+    return c->rc = rc;
 }
 
-/* Estimate of ||A^-1||_1 from a few solves with the factors.  The error
- * analysis is switched off meanwhile (it would run on every solve). */
-static int estimate_inv_norm1(silc_call *call, mumps_factor *F, double *est_out)
+/* F->cond_est from the block estimator; Y0 = A^{-1} X0 if the first block
+ * was folded into a solve, else NULL.  The error analysis is switched off
+ * meanwhile (it would run on every solve). */
+static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
 {
     int icntl11 = (int)ICNTL(F, 11);
-    double *work;
-    est_ctx c = {call, F, 0};
-    *est_out = -1;
-    work = host->alloc((size_t)ID_N(F) * sizeof *work);
-    if (!work) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    double inv;
+    est_ctx c = {call, F, host->alloc((size_t)ID_N(F) * EST_COLS * sizeof(double)), 0};
+    if (!c.keep) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     ICNTL(F, 11) = 0;
-    *est_out = host->inv_norm1_est(ID_N(F), apply_inverse, &c, work);
+    inv = host->inv_norm1_est_block(ID_N(F), EST_COLS, EST_STEPS, apply_block, &c, Y0);
     ICNTL(F, 11) = icntl11;
-    host->free(work);
-    return c.rc;
+    host->free(c.keep);
+    if (inv < 0)
+        return c.rc ? c.rc : host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    F->cond_est = host->props(call->in[0])->norm1 * inv;
+    return SILC_OK;
 }
 
 /* mumps.precision = single: af = 2^scale_a a in float, the largest entry near
@@ -617,15 +625,6 @@ static int factor_new(silc_call *call, const silc_view *v, int sym, const settin
                          F->single ? "smumps_c" : "dmumps_c", (int)INFOG(F, 12));
         factor_free(F);
         return rc;
-    }
-    if (s->condest) {
-        double inv;
-        rc = estimate_inv_norm1(call, F, &inv);
-        if (rc) {
-            factor_free(F);
-            return rc;
-        }
-        F->cond_est = host->props(call->in[0])->norm1 * inv;
     }
     F->factor_seconds = host->now() - t0;
     *out = F;
@@ -741,9 +740,9 @@ static int solve_run(silc_call *call)
     settings s;
     mumps_factor *F;
     silc_value *X;
-    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse;
+    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse, fold;
     const char *key;
-    double t0;
+    double t0, *rhs;
     const char *why = NULL;
     if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
     if ((rc = read_settings(call, &s))) return rc;
@@ -782,19 +781,32 @@ static int solve_run(silc_call *call)
     icntl11 = (int)ICNTL(F, 11);
     analyse = !F->analysed && b.n == 1 && icntl11 > 0;
     if (!analyse) ICNTL(F, 11) = 0;
-    do dense_copy(&b, o.val);
-    while ((rc = run_solve(call, F, o.val, b.n)) == SOLVE_AGAIN);
+    /* The first solve of a factorization carries the estimator's first block
+     * along (MUMPS analyses one column only, so not with the analysis). */
+    fold = s.condest && F->cond_est < 0 && !analyse;
+    rhs = o.val;
+    if (fold && !(rhs = host->alloc((size_t)a.n * (size_t)(b.n + EST_COLS) * sizeof *rhs))) {
+        host->release(X);
+        return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    }
+    do {
+        dense_copy(&b, rhs);
+        if (fold) host->inv_norm1_start(a.n, EST_COLS, rhs + a.n * b.n);
+    } while ((rc = run_solve(call, F, rhs, b.n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
     ICNTL(F, 11) = icntl11;
     if (!rc && analyse) {
         F->analysed = 1;
         int k;
         for (k = 0; k < 11; k++) F->rinfog[k] = F->single ? F->id.s.rinfog[k] : F->id.d.rinfog[k];
     }
+    if (!rc && fold) memcpy(o.val, rhs, (size_t)(a.n * b.n) * sizeof *rhs);
+    r->solve_seconds = host->now() - t0;
+    if (!rc && s.condest && F->cond_est < 0) rc = estimate_cond(call, F, fold ? rhs + a.n * b.n : NULL);
+    if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);
         return rc;
     }
-    r->solve_seconds = host->now() - t0;
     fill_report(r, F);
     call->out = X;
     return SILC_OK;
@@ -823,7 +835,7 @@ static silc_plugin mumps_plugin = {
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
+    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est_block), errmsg) || !out) return 1;
     host = h;
     blas_threads_attach(&mumps_plugin); /* threaded only through its BLAS */
     *out = &mumps_plugin;

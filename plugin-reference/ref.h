@@ -96,6 +96,13 @@ void ref_factor_free(void *f);  /* attachment destructor */
  * inverse applied in place (trans selects M^{-T}).  Returns -1 on failure. */
 double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                          void *ctx, double *work);
+/* The block form (silc_plugin.h, ABI 1.3): t columns per solve (t <= 64),
+ * at most itmax solves with M^{-1}; Y0, if not NULL, is M^{-1} times the
+ * starting block that ref_inv_norm1_start writes. */
+void ref_inv_norm1_start(int64_t n, int t, double *X0);
+double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
+                               int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
+                               const double *Y0);
 double ref_cond_from(double anorm, double inv_est); /* guards 0 and non-finite */
 
 /* ref_dense.c: factor an n x n (or m x n for QR) column-major matrix.  On

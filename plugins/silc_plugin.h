@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 2
+#define SILC_ABI_MINOR 3
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -245,6 +245,20 @@ typedef struct silc_host_api {
      * cond_1(A) ~ props(A)->norm1 * estimate. */
     double (*inv_norm1_est)(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                             void *ctx, double *work);
+
+    /* ABI 1.3: the block form (Higham-Tisseur, MATLAB's normest1) for a
+     * library whose solve phase costs about the same for a few columns as
+     * for one.  apply(ctx, X, t, trans) overwrites the n x t column-major X
+     * with A^{-1} X (A^{-T} X when trans is 1); at most itmax applications
+     * of A^{-1} (2: the start, one gradient step, one improvement; 5 is
+     * dlacon's limit), t <= 64 columns.  A backend can fold the first block
+     * into a solve it makes anyway: inv_norm1_start writes the starting block
+     * X0 (n x t), and Y0 = A^{-1} X0 is passed in; Y0 = NULL makes the
+     * estimator apply it.  Returns -1 if a solve failed. */
+    void (*inv_norm1_start)(int64_t n, int t, double *X0);
+    double (*inv_norm1_est_block)(int64_t n, int t, int itmax,
+                                  int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
+                                  const double *Y0);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

@@ -189,6 +189,10 @@ static int h_attach_set(const silc_value *v, const char *key, void *data, void (
  * backend that needs it. */
 extern double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                                 void *ctx, double *work);
+extern void ref_inv_norm1_start(int64_t n, int t, double *X0);
+extern double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
+                                      int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
+                                      const double *Y0);
 
 static const silc_host_api host_table = {
     SILC_ABI_MAJOR,
@@ -217,6 +221,8 @@ static const silc_host_api host_table = {
     util_now,
     h_threads,
     ref_inv_norm1_est,
+    ref_inv_norm1_start,
+    ref_inv_norm1_est_block,
 };
 
 const silc_host_api *host_api(void)
