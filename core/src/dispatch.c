@@ -221,25 +221,6 @@ static const char *status_text(int status)
 
 /* ---- the accuracy report --------------------------------------------------- */
 
-/* Any NaN or Inf among the stored entries.  Runs after every solve, so it is
- * written to vectorize: an OR over "exponent bits all ones" has no early exit
- * and no floating-point compare (a branch per entry cost 5 us of a 130 us
- * KLU back-substitution at n = 17758). */
-static int has_nonfinite(const silc_value *v)
-{
-    const uint64_t exp_mask = 0x7ff0000000000000u;
-    silc_view w;
-    uint64_t any = 0;
-    int64_t i;
-    val_view(v, &w);
-    for (i = 0; i < w.nnz; i++) {
-        uint64_t u;
-        memcpy(&u, &w.val[i], sizeof u);
-        any |= (u & exp_mask) == exp_mask;
-    }
-    return any != 0;
-}
-
 /* Completes the report of a solve that succeeded and warns about a result that
  * deserves distrust. */
 static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
@@ -260,7 +241,7 @@ static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, i
         eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
                  r->cond_est);
     acc_report(E, call, may_defer);
-    if (has_nonfinite(call->out))
+    if (val_has_nonfinite(call->out))
         eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
 }
 

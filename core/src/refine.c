@@ -42,7 +42,7 @@ int refine_check_finite(silc_engine *E, const silc_value *v, const char *name)
 {
     silc_view w;
     int64_t i, j, p;
-    if (!v || !val_props(v)->has_nonfinite) return 0;
+    if (!v || !val_has_nonfinite(v)) return 0;
     val_view(v, &w);
     for (i = 0; i < w.m; i++)
         for (j = 0; j < w.n; j++) {

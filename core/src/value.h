@@ -66,6 +66,8 @@ void val_release(silc_value *v);          /* frees at zero, attachments first; N
 
 void val_view(const silc_value *v, silc_view *out);
 const silc_props *val_props(const silc_value *v); /* computes and caches on first call */
+/* Any NaN or Inf among the stored entries, without computing the properties. */
+int val_has_nonfinite(const silc_value *v);
 int val_is_scalar(const silc_value *v);   /* 1x1 */
 double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
 double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
