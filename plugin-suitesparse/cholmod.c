@@ -247,7 +247,7 @@ int ss_cholmod_solve(silc_call *call)
         call->out = ss_host->dense_new(n, k);
         return call->out ? SILC_OK : ss_nomem(call, "CHOLMOD result");
     }
-    B = ss_rhs_dense(&b, 0, &owned);
+    B = ss_rhs_dense(&b, &owned);
     if (!B) return ss_nomem(call, "CHOLMOD right-hand side");
     ch_dense(n, k, B, &Bh);
     ss_lock();

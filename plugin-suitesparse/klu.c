@@ -204,12 +204,13 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
 int ss_klu_solve(silc_call *call)
 {
     silc_report *r = call->report;
-    silc_view a, b;
+    silc_view a, b, o;
     kl_factor *F = NULL;
     klu_l_common c;
-    double *X, t0;
+    silc_value *out;
+    double t0;
     int64_t n, k;
-    int owned, rc, condest;
+    int rc, condest;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
@@ -223,17 +224,16 @@ int ss_klu_solve(silc_call *call)
     }
 
     t0 = ss_host->now();
-    X = ss_rhs_dense(&b, 1, &owned); /* KLU solves in place */
-    if (!X) return ss_nomem(call, "KLU right-hand side");
+    /* KLU solves in place: straight in the result, as a caller of KLU would. */
+    if (!(out = ss_host->dense_new_uninit(n, k))) return ss_nomem(call, "KLU result");
+    ss_host->view(out, &o);
+    ss_rhs_copy(&b, o.val);
     kl_common(&c);
-    if (n > 0 && k > 0 && !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k, X, &c)) {
-        rc = kl_fail(call, "klu_l_tsolve", &c);
-        ss_host->free(X);
-        return rc;
+    if (n > 0 && k > 0 && !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k, o.val, &c)) {
+        ss_host->release(out);
+        return kl_fail(call, "klu_l_tsolve", &c);
     }
-    call->out = ss_dense_value(n, k, X, n);
-    ss_host->free(X);
-    if (!call->out) return ss_nomem(call, "KLU result");
+    call->out = out;
     r->solve_seconds = ss_host->now() - t0;
     if (F) ss_report_factor(r, &F->info);
     return SILC_OK;

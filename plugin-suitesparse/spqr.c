@@ -247,7 +247,7 @@ int ss_spqr_solve(silc_call *call)
     r->factor_seconds = ss_host->now() - t0;
 
     t0 = ss_host->now();
-    B = ss_rhs_dense(&b, 0, &owned);
+    B = ss_rhs_dense(&b, &owned);
     if (!B) return ss_nomem(call, "SPQR right-hand side");
     memset(&Bh, 0, sizeof Bh);
     Bh.nrow = (size_t)m;

@@ -64,9 +64,11 @@ int ss_ends_with(const char *s, const char *suffix);
 /* Shared accepts: A must be CSR (and square when square is set). */
 int ss_accepts_csr(const silc_call *call, int square, const char **why);
 
-/* The right-hand side as a dense column-major m x k array.  A dense B is
- * borrowed (*owned = 0) unless writable is set; anything else is copied. */
-double *ss_rhs_dense(const silc_view *b, int writable, int *owned);
+/* B as a dense column-major m x k array: x gets every entry. */
+void ss_rhs_copy(const silc_view *b, double *x);
+/* The right-hand side as a dense column-major m x k array: a dense B is
+ * borrowed (*owned = 0), anything else copied. */
+double *ss_rhs_dense(const silc_view *b, int *owned);
 /* A new dense m x k value filled from x (column-major, leading dimension ld). */
 silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld);
 

@@ -100,34 +100,40 @@ int ss_accepts_csr(const silc_call *call, int square, const char **why)
 
 /* ---- operands --------------------------------------------------------------- */
 
-double *ss_rhs_dense(const silc_view *b, int writable, int *owned)
+void ss_rhs_copy(const silc_view *b, double *x)
 {
     int64_t m = b->m, k = b->n, i, j;
-    size_t len = (size_t)(m > 0 ? m : 1) * (size_t)(k > 0 ? k : 1);
-    double *x;
-    *owned = 0;
-    if (b->format == SILC_FMT_DENSE && !writable) return b->val;
-    x = ss_host->calloc(len, sizeof(double));
-    if (!x) return NULL;
-    *owned = 1;
     if (b->format == SILC_FMT_DENSE) {
         if (m > 0 && k > 0) memcpy(x, b->val, (size_t)(m * k) * sizeof(double));
     } else if (b->format == SILC_FMT_CSR) {
+        memset(x, 0, (size_t)(m * k) * sizeof(double));
         for (i = 0; i < m; i++)
             for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) x[i + b->colind[j] * m] += b->val[j];
     } else {
+        memset(x, 0, (size_t)(m * k) * sizeof(double));
         for (j = 0; j < k; j++) {
             int64_t lo = j - b->ku > 0 ? j - b->ku : 0;
             int64_t hi = j + b->kl + 1 < m ? j + b->kl + 1 : m;
             for (i = lo; i < hi; i++) x[i + j * m] = b->val[(b->ku + i - j) + j * b->ld];
         }
     }
+}
+
+double *ss_rhs_dense(const silc_view *b, int *owned)
+{
+    size_t len = (size_t)(b->m > 0 ? b->m : 1) * (size_t)(b->n > 0 ? b->n : 1);
+    double *x;
+    *owned = 0;
+    if (b->format == SILC_FMT_DENSE) return b->val;
+    if (!(x = ss_host->alloc(len * sizeof(double)))) return NULL;
+    *owned = 1;
+    ss_rhs_copy(b, x);
     return x;
 }
 
 silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld)
 {
-    silc_value *out = ss_host->dense_new(m, k);
+    silc_value *out = ss_host->dense_new_uninit(m, k); /* every column is copied below */
     silc_view o;
     int64_t j;
     if (!out) return NULL;

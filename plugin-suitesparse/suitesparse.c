@@ -99,7 +99,7 @@ static const silc_plugin ss_plugin = {
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est), errmsg) || !out) return 1;
+    if (silc_host_check(h, SILC_HOST_NEEDS(dense_new_uninit), errmsg) || !out) return 1;
     pthread_mutex_lock(&users_mutex);
     if (ss_users == 0) {
         ss_host = h;

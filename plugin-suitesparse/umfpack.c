@@ -221,7 +221,8 @@ done:
 int ss_umfpack_solve(silc_call *call)
 {
     silc_report *r = call->report;
-    silc_view a, b;
+    silc_view a, b, o;
+    silc_value *out = NULL;
     um_factor *F;
     double control[UMFPACK_CONTROL], info[UMFPACK_INFO], *B = NULL, *X = NULL, *W = NULL, t0;
     SuiteSparse_long *Wi = NULL;
@@ -251,14 +252,16 @@ int ss_umfpack_solve(silc_call *call)
     r->factor_seconds = ss_host->now() - t0;
 
     t0 = ss_host->now();
-    B = ss_rhs_dense(&b, 0, &owned);
-    X = ss_host->alloc((size_t)(n > 0 ? n : 1) * (size_t)(k > 0 ? k : 1) * sizeof(double));
+    B = ss_rhs_dense(&b, &owned);
+    out = ss_host->dense_new_uninit(n, k); /* umfpack_dl_wsolve writes every column */
     W = ss_host->alloc((size_t)(n > 0 ? n : 1) * 5 * sizeof(double));
     Wi = ss_host->alloc((size_t)(n > 0 ? n : 1) * sizeof(SuiteSparse_long));
-    if (!B || !X || !W || !Wi) {
+    if (!B || !out || !W || !Wi) {
         rc = ss_nomem(call, "UMFPACK solve");
         goto done;
     }
+    ss_host->view(out, &o);
+    X = o.val;
     umfpack_dl_defaults(control);
     control[UMFPACK_IRSTEP] = (double)(irstep < 0 ? 0 : irstep);
     for (j = 0; j < k && n > 0; j++) {
@@ -269,17 +272,14 @@ int ss_umfpack_solve(silc_call *call)
             goto done;
         }
     }
-    call->out = ss_dense_value(n, k, X, n);
-    if (!call->out) {
-        rc = ss_nomem(call, "UMFPACK result");
-        goto done;
-    }
+    call->out = out;
+    out = NULL;
     r->solve_seconds = ss_host->now() - t0;
     if (F) ss_report_factor(r, &F->info);
     rc = SILC_OK;
 done:
+    if (out) ss_host->release(out);
     if (owned) ss_host->free(B);
-    ss_host->free(X);
     ss_host->free(W);
     ss_host->free(Wi);
     return rc;

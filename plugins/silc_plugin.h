@@ -259,6 +259,11 @@ typedef struct silc_host_api {
     double (*inv_norm1_est_block)(int64_t n, int t, int itmax,
                                   int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
                                   const double *Y0);
+    /* ABI 1.3: dense_new without zeroing, for a result the plugin writes
+     * entirely (a solve copying b into it and solving in place): zeroing a
+     * vector the size of a back-substitution's output costs a few per cent
+     * of the back-substitution. */
+    silc_value *(*dense_new_uninit)(int64_t m, int64_t n);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

@@ -139,6 +139,11 @@ static silc_value *h_dense_new(int64_t m, int64_t n)
     return val_dense_new(m, n);
 }
 
+static silc_value *h_dense_new_uninit(int64_t m, int64_t n)
+{
+    return val_new_unset(SILC_FMT_DENSE, m, n, 0, 0, 0);
+}
+
 static silc_value *h_csr_new(int64_t m, int64_t n, int64_t cap)
 {
     return val_csr_new(m, n, cap);
@@ -223,6 +228,7 @@ static const silc_host_api host_table = {
     ref_inv_norm1_est,
     ref_inv_norm1_start,
     ref_inv_norm1_est_block,
+    h_dense_new_uninit,
 };
 
 const silc_host_api *host_api(void)
