@@ -514,8 +514,10 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
     printf("  %-30s %-22s %10s %10s %9s\n", "", "", "", "", "");
     printf("  %d solves, same A (factor reuse)\n", o->loop);
     for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++)
-        if (strcmp(silc_backends[i], "lapack") != 0 && strcmp(silc_backends[i], "reference") != 0)
+        if (strcmp(silc_backends[i], "lapack") != 0 && strcmp(silc_backends[i], "reference") != 0) {
             compare(c, cap, P, o, silc_backends[i], 0, o->loop, x);
+            if (direct_for(silc_backends[i])) compare(c, cap, P, o, silc_backends[i], 1, o->loop, x);
+        }
     if (have_scipy) row("SciPy splu + solve loop", "SuperLU (COLAMD)", scipy_lt[0], scipy_lt[1], -1);
     if (have_octave) row("Octave loop of A\\b", "Octave", lt[0], lt[1], -1);
     silc_exec(c, "clear A b x");
