@@ -5,14 +5,19 @@
  * to reference.  Checked here, with every number computed by this program:
  *   - 2-D Laplacian (SPD, so MUMPS's SYM=1 LDL'): x close to the exact
  *     solution within eps * cond * 100, cond being the condition estimate
- *     `info` shows; info names mumps, the LDL' method and MUMPS's backward
- *     errors; a second solve with the same A reuses the factorization; several
- *     right-hand sides at once;
+ *     `info` shows; info names mumps and the LDL' method, and MUMPS's own
+ *     error analysis only when asked (mumps.icntl_11 = 1 or 2); a second
+ *     solve with the same A reuses the factorization; several right-hand
+ *     sides at once;
  *   - a shifted Laplacian (symmetric, positive diagonal, indefinite): SYM=1
  *     meets negative pivots, the dispatcher falls back to LU (SYM=0), and the
  *     result is still right;
  *   - west0479, sherman1, memplus from ../shared/matrices: mumps and reference
  *     agree within eps * cond * 100 and both have small backward errors;
+ *   - the condition estimate (the host's block estimator, first block folded
+ *     into the first solve) on fifteen shared matrices: a lower bound of the
+ *     exact cond_1 = ||A||_1 ||A^-1||_1 (A^-1 from the reference's LU) and
+ *     within a factor 3 of it;
  *   - options: `set mumps.icntl_7 = 5` is taken, `mumps.icntl_99` is refused
  *     with a suggestion, a layout-fixing ICNTL (icntl_5 = 1) is refused at
  *     solve time with the reason;
