@@ -29,13 +29,13 @@ static void scaled_free(void *p)
  * smallest nonzero entry stays a normal number; 0 when v is moderate. */
 static int exponent_for(const silc_value *v)
 {
-    const silc_props *p = val_props(v);
+    double maxabs = val_max_abs(v); /* a right-hand side needs no more than this scan */
     silc_view w;
     double minabs = INFINITY;
     int64_t i;
     int e, emin;
-    if (!(p->maxabs > 0) || !isfinite(p->maxabs)) return 0;
-    frexp(p->maxabs, &e);
+    if (!(maxabs > 0) || !isfinite(maxabs)) return 0;
+    frexp(maxabs, &e);
     if (e >= -SCALE_LIMIT && e <= SCALE_LIMIT) return 0;
     val_view(v, &w);
     for (i = 0; i < w.nnz; i++)
@@ -112,6 +112,6 @@ void scale_solve_end(silc_call *call, scale_state *S)
     if (X && S->ea != S->eb) {
         int64_t i;
         for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
-        X->props_ready = 0; /* the cache described the scaled solution */
+        val_forget_caches(X); /* they described the scaled solution */
     }
 }

@@ -39,6 +39,9 @@ struct silc_value {
     int64_t kl, ku, ld;
     int props_ready;
     silc_props props;
+    int scan_ready;          /* val_scan: max |entry| and NaN/Inf, cached */
+    int scan_nonfinite;
+    double scan_maxabs;
     val_attachment *attach;
 };
 
@@ -66,8 +69,14 @@ void val_release(silc_value *v);          /* frees at zero, attachments first; N
 
 void val_view(const silc_value *v, silc_view *out);
 const silc_props *val_props(const silc_value *v); /* computes and caches on first call */
-/* Any NaN or Inf among the stored entries, without computing the properties. */
+/* Any NaN or Inf among the stored entries, and the largest |entry| (NaN if
+ * any is NaN), from one cached scan: what a solve needs of its right-hand
+ * side, without computing the properties. */
 int val_has_nonfinite(const silc_value *v);
+double val_max_abs(const silc_value *v);
+/* After changing a value's entries in place (only before it is shared):
+ * forget what the caches said. */
+void val_forget_caches(silc_value *v);
 int val_is_scalar(const silc_value *v);   /* 1x1 */
 double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
 double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
