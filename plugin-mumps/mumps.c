@@ -745,6 +745,8 @@ static void fill_report(silc_report *r, const mumps_factor *F)
     if (F->analysed && ICNTL(F, 11) == 1)
         note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
                  F->rinfog[8]);
+    if (F->cond_est >= 0)
+        note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
     if (F->retries)
         note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
                  F->retries, F->retries == 1 ? "y" : "ies");

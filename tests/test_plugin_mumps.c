@@ -68,6 +68,7 @@ static void test_laplacian(silc_context *cm)
     CHECK(strstr(t, "  backend: mumps\n") != NULL, "laplacian backend:\n%s", t);
     CHECK(strstr(t, "LDL'") && strstr(t, "SYM=1") && strstr(t, "AMF"), "laplacian method:\n%s", t);
     CHECK(strstr(t, "omega1") == NULL, "MUMPS's error analysis is off by default:\n%s", t);
+    CHECK(strstr(t, "block Hager-Higham (2 columns, 2 steps)") != NULL, "the note names the estimate:\n%s", t);
     CHECK(strstr(t, "reused factorization: no") != NULL, "first solve factors:\n%s", t);
     cond = tl_out_number(t, "condition estimate: ");
     /* The 1-norm condition of the 40x40 Laplacian is about 1e3. */
@@ -181,6 +182,10 @@ static void test_options(silc_context *cm)
     CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.icntl_11 = 2\")") == 0, "icntl_11 = 2: %s",
           silc_context_errmsg(cm));
     CHECK(strstr(tl_out_info(cm, "x"), "omega1") != NULL, "error analysis shows omega1:\n%s", tl_out());
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.condest = false\")") == 0, "condest = false: %s",
+          silc_context_errmsg(cm));
+    CHECK(strstr(tl_out_info(cm, "x"), "condition estimate: not available") && !strstr(tl_out(), "Hager"),
+          "condest = false: no estimate, and info says so:\n%s", tl_out());
 }
 
 /* The condition estimate (the host's block estimator, two columns, two
