@@ -494,10 +494,10 @@ static int sparse_block(mumps_factor *F, const double *X, int t, void *arrays[3]
     double *val;
     int j;
     for (i = 0; i < n * t; i++) nz += X[i] != 0;
-    if (F->single || nz * 8 > n * t) return 0;
+    if (F->single || nz == 0 || nz * 8 > n * t) return 0; /* an all-zero block: nothing to prune */
     arrays[0] = ptr = host->alloc((size_t)(t + 1) * sizeof *ptr);
-    arrays[1] = idx = host->alloc((size_t)(nz ? nz : 1) * sizeof *idx);
-    arrays[2] = val = host->alloc((size_t)(nz ? nz : 1) * sizeof *val);
+    arrays[1] = idx = host->alloc((size_t)nz * sizeof *idx);
+    arrays[2] = val = host->alloc((size_t)nz * sizeof *val);
     if (!ptr || !idx || !val) {
         for (j = 0; j < 3; j++) host->free(arrays[j]);
         return 0; /* the dense solve needs no more memory */
