@@ -153,7 +153,10 @@ static void transpose_times(const silc_value *A, const double *R, int64_t k, dou
  */
 double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
 {
-    double nA = val_props(A)->norminf, nB = val_props(B)->norminf, nX, nR, be = -1;
+    /* A one-column B's infinity norm is its largest entry: the scan the
+     * solve already made of it (val_max_abs), not a properties pass. */
+    double nA = val_props(A)->norminf, nB = B->n == 1 ? val_max_abs(B) : val_props(B)->norminf;
+    double nX, nR, be = -1;
     const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
     const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
     double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL;
