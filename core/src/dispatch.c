@@ -363,8 +363,8 @@ int disp_run(silc_engine *E, silc_call *call)
         eng_error(E, "solve needs a right-hand side");
         rc = SILC_EARG;
     } else if (call->op == SILC_OP_SOLVE &&
-               (refine_check_finite(E, call->in[0], "the matrix") ||
-                refine_check_finite(E, call->in[1], "the right-hand side"))) {
+               (refine_check_finite(E, call->in[0], 1, "the matrix") ||
+                refine_check_finite(E, call->in[1], 0, "the right-hand side"))) {
         /* Hook (refine.c): NaN/Inf operands are an error before any backend runs. */
         rc = SILC_EARG;
     } else {

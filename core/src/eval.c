@@ -422,7 +422,7 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
         /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
          * repeats the check with role names for every other route). */
-        if (refine_check_finite(V->E, a, o->lname) || refine_check_finite(V->E, b, o->rname))
+        if (refine_check_finite(V->E, a, 1, o->lname) || refine_check_finite(V->E, b, 0, o->rname))
             return -1;
         return ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
     case TK_CARET:

@@ -23,8 +23,11 @@
 #define REFINE_SINGLE_CONVERGED 1e-12
 
 /* If v stores a NaN or Inf, sets E->err to "<name> has NaN at (i, j)" (1-based)
- * and returns -1; else 0.  Cheap when v is finite (the cached props say so). */
-int refine_check_finite(silc_engine *E, const silc_value *v, const char *name);
+ * and returns -1; else 0.  Cheap when v is finite.  matrix: v is a solve's
+ * matrix, whose properties the dispatcher computes anyway, so they answer
+ * (one pass over it, not a scan and then the properties); else v is a
+ * right-hand side and gets val_has_nonfinite's scan. */
+int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const char *name);
 
 /* Refines call->out, a solution just computed by backend b, as the
  * configuration and call->report->single_factor ask; replaces call->out when
