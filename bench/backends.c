@@ -286,35 +286,31 @@ static void flush_pattern_caches(silc_context *c)
     silc_exec(c, "z = solve(Z, zb, \"backend = mumps\")");
 }
 
-/* One solve on a fresh A, best of reps; be and the backend that ran are
- * filled.  nsolve > 1: that many solves with the same A, timed together. */
+/* One run on a fresh A: nsolve solves with it, timed together; be and the
+ * backend that ran are filled.  compare() takes the best of several. */
 static double silc_time(silc_context *c, tl_capture *cap, const problem *P, const char *backend,
-                        int reps, int nsolve, double *be, char *ran, size_t ranlen)
+                        int nsolve, double *be, char *ran, size_t ranlen)
 {
     char stmt[160];
-    double best = -1;
-    int r, k;
+    double t0, t;
+    int k;
     if (!strcmp(backend, "default")) snprintf(stmt, sizeof stmt, "x = A \\ b");
     else snprintf(stmt, sizeof stmt, "x = solve(%s, b, \"backend = %s\")",
                   strcmp(backend, "lapack") ? "A" : "Ad", backend);
-    for (r = 0; r < reps; r++) {
-        double t0, t;
-        flush_pattern_caches(c);
-        if (silc_put(c, "A", &P->A) || (!strcmp(backend, "lapack") && silc_exec(c, "Ad = dense(A)"))) {
-            fprintf(stderr, "backends: %s: %s\n", P->name, silc_context_errmsg(c));
+    flush_pattern_caches(c);
+    if (silc_put(c, "A", &P->A) || (!strcmp(backend, "lapack") && silc_exec(c, "Ad = dense(A)"))) {
+        fprintf(stderr, "backends: %s: %s\n", P->name, silc_context_errmsg(c));
+        return -1;
+    }
+    t0 = tl_now();
+    for (k = 0; k < nsolve; k++)
+        if (silc_exec(c, stmt)) {
+            const char *e = silc_context_errmsg(c);
+            snprintf(ran, ranlen, "%s", tl_contains(e, "not installed") ? "not built" : "error");
+            if (!tl_contains(e, "not installed")) fprintf(stderr, "  %s %s: %s\n", P->name, backend, e);
             return -1;
         }
-        t0 = tl_now();
-        for (k = 0; k < nsolve; k++)
-            if (silc_exec(c, stmt)) {
-                const char *e = silc_context_errmsg(c);
-                snprintf(ran, ranlen, "%s", tl_contains(e, "not installed") ? "not built" : "error");
-                if (!tl_contains(e, "not installed")) fprintf(stderr, "  %s %s: %s\n", P->name, backend, e);
-                return -1;
-            }
-        t = tl_now() - t0;
-        if (best < 0 || t < best) best = t;
-    }
+    t = tl_now() - t0;
     {
         const char *info = tl_info(c, cap, "x");
         const char *p = strstr(info, "  backend: ");
@@ -322,7 +318,7 @@ static double silc_time(silc_context *c, tl_capture *cap, const problem *P, cons
         if (p) sscanf(p + 11, "%63s", ran);
     }
     silc_exec(c, "clear Ad");
-    return best;
+    return t;
 }
 
 /* ---- SciPy and Octave ------------------------------------------------------------ */
@@ -449,24 +445,23 @@ static void set_condest(silc_context *c, const char *b, const char *value)
     silc_exec(c, stmt);
 }
 
-/* SILC's row and, where the library can be called directly, the direct row
+/* One SILC row and, where the library can be called directly, the direct row
  * and the ratio, for nsolve solves with one A.  The two alternate, best of
  * reps each, so that a burst of load on the machine hits both alike.
  * condest_off: the same backend with its plugin's condest option false (the
  * Hager-Higham estimate, the one part of the report that is not O(nnz), is
  * not made), compared with the same direct call: SILC's own cost. */
-static void compare(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
-                    const char *b, int condest_off, int nsolve, double *x)
+static void compare_one(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
+                        const char *b, int condest_off, int nsolve, double *x)
 {
     double (*direct)(const problem *, int, double *) = direct_for(b);
     double be = NAN, t = -1, td = -1;
     char ran[64], who[64];
     int r;
-    if (!strcmp(b, "suitesparse.cholmod") && !P->spd) return;
     snprintf(ran, sizeof ran, "%s", b);
     if (condest_off) set_condest(c, b, "false");
     for (r = 0; r < reps_for(P, o); r++) {
-        double ts = silc_time(c, cap, P, b, 1, nsolve, &be, ran, sizeof ran), d;
+        double ts = silc_time(c, cap, P, b, nsolve, &be, ran, sizeof ran), d;
         if (ts < 0) break;
         if (t < 0 || ts < t) t = ts;
         if (direct && (d = direct(P, nsolve, x)) >= 0 && (td < 0 || d < td)) td = d;
@@ -482,6 +477,16 @@ static void compare(silc_context *c, tl_capture *cap, const problem *P, const op
         row(who, b, td, td >= 0 ? backward_error(P, x) : NAN, td > 0 && t > 0 ? t / td : -1);
     }
     fflush(stdout);
+}
+
+/* Backend b's rows: SILC as configured against the direct call, then, where
+ * there is a direct call, SILC with the condition estimate off against it. */
+static void compare(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
+                    const char *b, int nsolve, double *x)
+{
+    if (!strcmp(b, "suitesparse.cholmod") && !P->spd) return;
+    compare_one(c, cap, P, o, b, 0, nsolve, x);
+    if (direct_for(b)) compare_one(c, cap, P, o, b, 1, nsolve, x);
 }
 
 static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const opts *o)
@@ -500,8 +505,7 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
            "SILC/dir");
     for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++) {
         if (!strcmp(silc_backends[i], "lapack") && P->A.n > 5000) continue;
-        compare(c, cap, P, o, silc_backends[i], 0, 1, x);
-        if (direct_for(silc_backends[i])) compare(c, cap, P, o, silc_backends[i], 1, 1, x);
+        compare(c, cap, P, o, silc_backends[i], 1, x);
     }
     if (P->file) snprintf(src, sizeof src, "%s/%s", SILC_SHARED_MATRICES, P->file);
     else snprintf(src, sizeof src, "laplace:%lld", (long long)o->grid);
@@ -528,10 +532,8 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
     printf("  %-30s %-22s %10s %10s %9s\n", "", "", "", "", "");
     printf("  %d solves, same A (factor reuse)\n", o->loop);
     for (i = 0; i < sizeof silc_backends / sizeof silc_backends[0]; i++)
-        if (strcmp(silc_backends[i], "lapack") != 0 && strcmp(silc_backends[i], "reference") != 0) {
-            compare(c, cap, P, o, silc_backends[i], 0, o->loop, x);
-            if (direct_for(silc_backends[i])) compare(c, cap, P, o, silc_backends[i], 1, o->loop, x);
-        }
+        if (strcmp(silc_backends[i], "lapack") != 0 && strcmp(silc_backends[i], "reference") != 0)
+            compare(c, cap, P, o, silc_backends[i], o->loop, x);
     if (have_scipy) row("SciPy splu + solve loop", "SuperLU (COLAMD)", scipy_lt[0], scipy_lt[1], -1);
     if (have_octave) row("Octave loop of A\\b", "Octave", lt[0], lt[1], -1);
     silc_exec(c, "clear A b x");
