@@ -469,7 +469,7 @@ static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs
  * is a tenth of that), so the block costs no more than a single vector, and
  * its first block rides along with the user's first solve.  Two steps (start,
  * gradient, improvement) are what Hager's method settles on almost always;
- * the conformance test compares the estimates with the exact cond_1. */
+ * test_plugin_mumps compares the estimates with the exact cond_1. */
 #define EST_COLS 2
 #define EST_STEPS 2
 

@@ -143,14 +143,13 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
         }
         for (int j = 0; j < t; j++) {
             int64_t i = largest(n, h, used, taken);
-            if (i < 0) { /* fewer than t untried indices left */
+            if (i < 0) { /* fewer than t untried left (at least one: see above) */
                 t = j;
                 break;
             }
             taken[i] = 1;
             ind[j] = i;
         }
-        if (t == 0) break;
         memset(taken, 0, (size_t)n);
         memcpy(Sold, S, nt * sizeof(double));
         nt = (size_t)n * (size_t)t;

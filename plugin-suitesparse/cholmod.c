@@ -219,7 +219,6 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
     return SILC_OK;
 }
 
-
 int ss_cholmod_solve(silc_call *call)
 {
     cholmod_common *cc = ss_cholmod_common();

@@ -200,7 +200,6 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
     return SILC_OK;
 }
 
-
 int ss_klu_solve(silc_call *call)
 {
     silc_report *r = call->report;

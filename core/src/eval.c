@@ -388,7 +388,7 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
         if (!same_or_scalar(a, b))
             return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
         return ev_run_op(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
-                    o->what, out);
+                         o->what, out);
     case TK_STAR: case TK_STAREQ:
         if (val_is_scalar(a)) return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
         if (val_is_scalar(b)) return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
@@ -509,7 +509,7 @@ static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
         rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
     else
         rc = ev_run_op(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
-                  what, out);
+                       what, out);
     val_release(a);
     return rc;
 }

@@ -495,9 +495,6 @@ static int value_symmetric(const silc_value *v)
     }
 }
 
-/* Fills *p.  Returns 0, or -1 when memory ran short: then the answers are
- * conservative (not symmetric; both operator norms replaced by the upper
- * bound sum|a_ij|) and the caller does not cache them. */
 /* Readies acc for a pass: zero sums, and for a pass that also gathers the
  * structure, the structure's starting answers. */
 static void props_start(const silc_value *v, props_acc *acc, int structure, double scale)
@@ -516,6 +513,9 @@ static void props_start(const silc_value *v, props_acc *acc, int structure, doub
     if (acc->rowsum) memset(acc->rowsum, 0, (size_t)v->m * sizeof(double));
 }
 
+/* Fills *p.  Returns 0, or -1 when memory ran short: then the answers are
+ * conservative (not symmetric; both operator norms replaced by the upper
+ * bound sum|a_ij|) and the caller does not cache them. */
 static int compute_props(const silc_value *v, silc_props *p)
 {
     props_acc acc;
