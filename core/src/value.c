@@ -562,43 +562,90 @@ static int compute_props(const silc_value *v, silc_props *p)
     return rc;
 }
 
-/* One pass for val_has_nonfinite and val_max_abs.  A band array's corners
- * outside the matrix are not entries (LAPACK leaves them unreferenced), so
- * band values ask the properties, whose pass skips them. */
-static void val_scan(const silc_value *cv)
+/* What val_scan has cached (value.h's scan_ready). */
+enum { SCAN_FINITE = 1, SCAN_MAXABS = 2 };
+
+/* Non-zero when an entry of x is NaN or Inf: x - x is +0 for every finite x
+ * and NaN otherwise, and four independent sums of it keep the loop free of
+ * branches and of one long dependency chain.  2.6 us on 17758 entries where
+ * a compare-and-branch loop took 8.2 (-O2): this runs on every solve's
+ * result, next to a back-substitution of ~120 us. */
+static int any_nonfinite(const double *x, int64_t n)
+{
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    int64_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += x[i] - x[i];
+        s1 += x[i + 1] - x[i + 1];
+        s2 += x[i + 2] - x[i + 2];
+        s3 += x[i + 3] - x[i + 3];
+    }
+    for (; i < n; i++) s0 += x[i] - x[i];
+    return s0 + s1 + s2 + s3 != 0;
+}
+
+/* The largest |x_i| as its bit pattern: with the sign bit cleared, the
+ * patterns of doubles order as their magnitudes do, with Inf above every
+ * finite number and NaN above Inf, so one integer maximum answers both
+ * "largest entry" and "any NaN or Inf" (5.1 us on 17758 entries where the
+ * compare-and-branch loop took 8.2). */
+static uint64_t max_abs_bits(const double *x, int64_t n)
+{
+    const uint64_t magnitude = 0x7fffffffffffffffULL;
+    uint64_t m0 = 0, m1 = 0, m2 = 0, m3 = 0, b[4];
+    int64_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        memcpy(b, x + i, sizeof b);
+        b[0] &= magnitude, b[1] &= magnitude, b[2] &= magnitude, b[3] &= magnitude;
+        m0 = b[0] > m0 ? b[0] : m0;
+        m1 = b[1] > m1 ? b[1] : m1;
+        m2 = b[2] > m2 ? b[2] : m2;
+        m3 = b[3] > m3 ? b[3] : m3;
+    }
+    for (; i < n; i++) {
+        memcpy(b, x + i, sizeof b[0]);
+        b[0] &= magnitude;
+        m0 = b[0] > m0 ? b[0] : m0;
+    }
+    m0 = m1 > m0 ? m1 : m0;
+    m2 = m3 > m2 ? m3 : m2;
+    return m2 > m0 ? m2 : m0;
+}
+
+/* Fills the scan cache up to level (SCAN_FINITE or SCAN_MAXABS).  A band
+ * array's corners outside the matrix are not entries (LAPACK leaves them
+ * unreferenced), so band values ask the properties, whose pass skips them. */
+static void val_scan(const silc_value *cv, int level)
 {
     silc_value *v = (silc_value *)cv; /* the cache is not part of the contents */
-    double m = 0;
-    int bad = 0, nan = 0;
-    int64_t i;
-    if (v->scan_ready) return;
+    if (v->scan_ready >= level) return;
     if (v->props_ready || v->format == SILC_FMT_BAND) {
         const silc_props *p = val_props(v);
-        m = p->maxabs;
-        bad = p->has_nonfinite;
+        v->scan_maxabs = p->maxabs;
+        v->scan_nonfinite = p->has_nonfinite;
+        v->scan_ready = SCAN_MAXABS;
+    } else if (level == SCAN_FINITE) {
+        v->scan_nonfinite = any_nonfinite(v->val, v->nnz);
+        v->scan_ready = SCAN_FINITE;
     } else {
-        for (i = 0; i < v->nnz; i++) {
-            double x = fabs(v->val[i]);
-            if (x > m) m = x;
-            else if (x != x) nan = 1;
-        }
-        bad = nan || m > DBL_MAX;
-        if (nan) m = NAN;
+        const uint64_t inf = 0x7ff0000000000000ULL;
+        uint64_t m = max_abs_bits(v->val, v->nnz);
+        memcpy(&v->scan_maxabs, &m, sizeof m);
+        if (m > inf) v->scan_maxabs = NAN; /* one NaN's payload, not a max */
+        v->scan_nonfinite = m >= inf;
+        v->scan_ready = SCAN_MAXABS;
     }
-    v->scan_maxabs = m;
-    v->scan_nonfinite = bad;
-    v->scan_ready = 1;
 }
 
 int val_has_nonfinite(const silc_value *v)
 {
-    val_scan(v);
+    val_scan(v, SCAN_FINITE);
     return v->scan_nonfinite;
 }
 
 double val_max_abs(const silc_value *v)
 {
-    val_scan(v);
+    val_scan(v, SCAN_MAXABS);
     return v->scan_maxabs;
 }
 

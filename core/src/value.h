@@ -39,7 +39,7 @@ struct silc_value {
     int64_t kl, ku, ld;
     int props_ready;
     silc_props props;
-    int scan_ready;          /* val_scan: max |entry| and NaN/Inf, cached */
+    int scan_ready;          /* SCAN_FINITE: scan_nonfinite is known; SCAN_MAXABS: both */
     int scan_nonfinite;
     double scan_maxabs;
     val_attachment *attach;
