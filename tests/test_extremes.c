@@ -373,6 +373,30 @@ static void test_nonfinite(void)
     /* Nothing was bound by the failing statements. */
     CHECK(silc_exec(ctx, "clear x; y = A \\ rhs") != 0 && silc_exec(ctx, "z = x") != 0,
           "a failed solve bound x");
+    /* The scans work four entries at a time: a NaN or Inf in the leftover
+     * tail (n = 7) and in the last full group is found too. */
+    {
+        double v[7] = {1, 2, 3, 4, 5, 6, 7};
+        const int at[] = {7, 4};
+        for (i = 0; i < 2; i++) {
+            v[at[i] - 1] = i ? -INFINITY : NAN;
+            tl_put_vector(ctx, "rhs7", 7, v);
+            v[at[i] - 1] = 1;
+            CHECK(silc_exec(ctx, "x = eye(7) \\ rhs7") != 0 &&
+                      strstr(silc_context_errmsg(ctx), i ? "'rhs7' has -Inf at (4, 1)"
+                                                         : "'rhs7' has NaN at (7, 1)"),
+                  "non-finite entry %d of 7: '%s'", at[i], silc_context_errmsg(ctx));
+        }
+    }
+    /* A solution beyond the largest double: the scaled solve represents it,
+     * the caller's cannot; Inf is returned with a warning, never silently. */
+    CHECK(silc_exec(ctx, "x = (1e-300 * eye(3)) \\ (1e300 * ones(3, 1))") == 0 &&
+              strstr(silc_context_warnings(ctx), "beyond the largest double (returned as Inf)"),
+          "overflowing solution: '%s' / warnings '%s'", silc_context_errmsg(ctx),
+          silc_context_warnings(ctx));
+    CHECK(silc_exec(ctx, "x = (1e-150 * eye(3)) \\ (1e150 * ones(3, 1))") == 0 &&
+              !strstr(silc_context_warnings(ctx), "largest double"),
+          "1e300 is representable: '%s'", silc_context_warnings(ctx));
 }
 
 /* ---- singular ------------------------------------------------------------------ */

@@ -380,7 +380,10 @@ int disp_run(silc_engine *E, silc_call *call)
             /* A scaled solve's deferred residual would be formed unscaled,
              * where it may overflow: no deferral then. */
             rc = walk(E, call, chain, n, &L, E->accuracy_defer && !S.ea && !S.eb);
-            if (scaling) scale_solve_end(call, &S);
+            if (scaling && scale_solve_end(call, &S))
+                eng_warn(E, "'\\': the solution has entries beyond the largest double (returned as Inf); "
+                            "the backward error was measured before the final scaling by 2^%d",
+                         S.ea - S.eb);
         }
         call->report = saved;
     }

@@ -102,16 +102,20 @@ int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S)
     return 0;
 }
 
-void scale_solve_end(silc_call *call, scale_state *S)
+int scale_solve_end(silc_call *call, scale_state *S)
 {
     silc_value *X = call->out;
+    int was_finite;
     call->in[0] = S->A;
     call->in[1] = S->B;
     val_release(S->Bs);
     S->Bs = NULL;
-    if (X && S->ea != S->eb) {
+    if (!X || S->ea == S->eb) return 0;
+    was_finite = !val_has_nonfinite(X);
+    {
         int64_t i;
         for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
-        val_forget_caches(X); /* they described the scaled solution */
     }
+    val_forget_caches(X); /* they described the scaled solution */
+    return was_finite && val_has_nonfinite(X);
 }

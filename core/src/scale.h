@@ -26,7 +26,9 @@ typedef struct scale_state {
  * 2^+-64.  Returns 0 (with nothing to undo when no scaling was needed), or -1
  * with E->err set on allocation failure. */
 int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S);
-/* Restores the operands and scales call->out (a fresh value) back. */
-void scale_solve_end(silc_call *call, scale_state *S);
+/* Restores the operands and scales call->out (a fresh value) back.  Returns
+ * 1 when that overflowed (a solution beyond the largest double, which the
+ * scaled solve could represent but the caller's cannot), else 0. */
+int scale_solve_end(silc_call *call, scale_state *S);
 
 #endif
