@@ -94,24 +94,37 @@ double *acc_dense_copy(const silc_value *v)
 }
 
 /* ||B - A X||_inf for CSR A and dense B, X in one pass, nothing allocated:
- * the common case, whose cost is one sparse product. */
-static double residual_norm_csr(const silc_value *A, const double *B, const double *X, int64_t k)
+ * the common case, whose cost is one sparse product.  With norm_a, also
+ * ||A||_inf, summed unscaled while the entries pass by (the properties'
+ * norms would cost a pass of their own); +Inf when that sum overflowed, and
+ * not complete when the residual is NaN. */
+static double residual_norm_csr(const silc_value *A, const double *B, const double *X, int64_t k,
+                                double *norm_a)
 {
     silc_view a;
-    double best = 0;
+    double best = 0, best_a = 0;
     int64_t i, c, p;
     val_view(A, &a);
     for (i = 0; i < a.m; i++) {
         double s = 0;
         for (c = 0; c < k; c++) {
             const double *x = X + c * a.n;
-            double r = B[i + c * a.m];
-            for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) r -= a.val[p] * x[a.colind[p]];
+            double r = B[i + c * a.m], row_a = 0;
+            if (c == 0 && norm_a) {
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) {
+                    r -= a.val[p] * x[a.colind[p]];
+                    row_a += fabs(a.val[p]);
+                }
+                best_a = row_a > best_a ? row_a : best_a;
+            } else {
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) r -= a.val[p] * x[a.colind[p]];
+            }
             s += fabs(r);
         }
         best = max_nan(best, s);
         if (isnan(best)) break;
     }
+    if (norm_a) *norm_a = best_a;
     return best;
 }
 
@@ -154,8 +167,11 @@ static void transpose_times(const silc_value *A, const double *R, int64_t k, dou
 double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
 {
     /* A one-column B's infinity norm is its largest entry: the scan the
-     * solve already made of it (val_max_abs), not a properties pass. */
-    double nA = val_props(A)->norminf, nB = B->n == 1 ? val_max_abs(B) : val_props(B)->norminf;
+     * solve already made of it (val_max_abs), not a properties pass.  A's
+     * comes from its properties when they hold it, else from the residual's
+     * pass over A. */
+    double nA = (A->props_have & PROPS_NORMS) ? A->props.norminf : -1;
+    double nB = B->n == 1 ? val_max_abs(B) : val_props(B)->norminf;
     double nX, nR, be = -1;
     const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
     const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
@@ -166,7 +182,8 @@ double acc_backward_error(const silc_value *A, const silc_value *B, const silc_v
     if (!b || !x) goto out;
     nX = acc_norm_inf(x, X->m, k);
     if (A->m == A->n && A->format == SILC_FMT_CSR) {
-        nR = residual_norm_csr(A, b, x, k);
+        nR = residual_norm_csr(A, b, x, k, nA < 0 ? &nA : NULL);
+        if (!isfinite(nA)) nA = -1; /* overflowed: the scaled sums below */
     } else {
         R = malloc((size_t)(A->m * k > 0 ? A->m * k : 1) * sizeof *R);
         if (!R) goto out;
@@ -180,6 +197,7 @@ double acc_backward_error(const silc_value *A, const silc_value *B, const silc_v
             nR = acc_norm_inf(G, A->n, k);
         }
     }
+    if (nA < 0) nA = val_props(A)->norminf;
     if (isnan(nR) || isnan(nX)) be = NAN;
     else if (nR == 0) be = 0; /* also 0/0: X = 0 solves B = 0 exactly */
     else if (A->m == A->n) be = nR / (nA * nX + nB);

@@ -1,0 +1,296 @@
+/*
+ * test_props.c -- a value's structural properties (value.c), computed in
+ * parts on demand, against a brute-force answer computed here from the
+ * list of the same matrix's stored entries.
+ *
+ * For every real shared matrix, in CSR and (when small) dense storage, and
+ * for hand-made CSR edge cases (explicit zeros at the ends of rows and on the
+ * diagonal, empty rows, one asymmetric entry at the very end, a mirror with
+ * a different value, a rectangular matrix, NaN and Inf in the last entry, a
+ * 1x1 and a 0x0 matrix, entries near 1e+-300 that need the scaled norms):
+ *   - asking for the shape alone fills exactly the shape (nnz, triangles,
+ *     band widths, positive diagonal, NaN/Inf) and marks only it known, and
+ *     its pass leaves the right answers in the scan cache (largest entry,
+ *     NaN/Inf);
+ *   - symmetry alone, then the norms, each agree with brute force, and so
+ *     does val_props on a fresh copy that computes everything at once;
+ *   - the backward error's ||A||_inf, taken from the residual's pass when
+ *     the norms are not known, equals the one from the properties.
+ */
+#include "check.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accuracy.h"
+#include "envelope.h"
+#include "value.h"
+#include "silc.h"
+
+typedef struct truth {
+    int symmetric, pos_diag, diagonal, lower, upper, has_nonfinite;
+    int64_t kl, ku, nnz;
+    double norm1, norminf, normfro, maxabs;
+} truth;
+
+typedef struct entry {
+    int64_t i, j;
+    double a;
+} entry;
+
+static int by_position(const void *x, const void *y)
+{
+    const entry *p = x, *q = y;
+    if (p->i != q->i) return p->i < q->i ? -1 : 1;
+    return p->j < q->j ? -1 : p->j > q->j;
+}
+
+/* Everything by the definitions, from the list of stored entries (long
+ * double sums, so the reference is more accurate than what it checks):
+ * symmetry by sorting the nonzeros and their mirror images and comparing
+ * the two lists, which shares nothing with value.c's row walk. */
+static truth brute(const silc_value *v)
+{
+    truth t;
+    int64_t m = v->m, n = v->n, i, j, k, ne = 0, nz = 0;
+    int64_t stored = v->format == SILC_FMT_CSR ? v->rowptr[m] : m * n;
+    entry *e = malloc((size_t)(stored ? stored : 1) * sizeof *e);
+    entry *mir = malloc((size_t)(stored ? stored : 1) * sizeof *mir);
+    long double *row = calloc((size_t)(m ? m : 1), sizeof *row), *col = calloc((size_t)(n ? n : 1), sizeof *col);
+    long double fro = 0;
+    int64_t pos = 0;
+    memset(&t, 0, sizeof t);
+    if (!e || !mir || !row || !col) {
+        CHECK(0, "out of memory");
+        goto out;
+    }
+    for (i = 0; i < m; i++)
+        if (v->format == SILC_FMT_CSR)
+            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) e[ne++] = (entry){i, v->colind[k], v->val[k]};
+        else
+            for (j = 0; j < n; j++) e[ne++] = (entry){i, j, v->val[i + j * m]};
+    t.diagonal = t.lower = t.upper = 1;
+    for (k = 0; k < ne; k++) {
+        double a = e[k].a;
+        i = e[k].i, j = e[k].j;
+        row[i] += fabsl((long double)a);
+        col[j] += fabsl((long double)a);
+        fro += (long double)a * a;
+        if (!isfinite(a)) t.has_nonfinite = 1;
+        if (fabs(a) > t.maxabs) t.maxabs = fabs(a);
+        if (i == j && a > 0) pos++;
+        if (a == 0) continue;
+        mir[nz] = (entry){j, i, a};
+        e[nz++] = e[k]; /* compacts the nonzeros in place (nz <= k) */
+        if (i != j) t.diagonal = 0;
+        if (j > i) t.lower = 0, t.ku = j - i > t.ku ? j - i : t.ku;
+        if (i > j) t.upper = 0, t.kl = i - j > t.kl ? i - j : t.kl;
+    }
+    t.nnz = nz;
+    t.pos_diag = m == n && n > 0 && pos == n;
+    for (i = 0; i < m; i++) t.norminf = (double)row[i] > t.norminf ? (double)row[i] : t.norminf;
+    for (j = 0; j < n; j++) t.norm1 = (double)col[j] > t.norm1 ? (double)col[j] : t.norm1;
+    t.normfro = (double)sqrtl(fro);
+    qsort(e, (size_t)nz, sizeof *e, by_position);
+    qsort(mir, (size_t)nz, sizeof *mir, by_position);
+    t.symmetric = m == n;
+    for (k = 0; k < nz && t.symmetric; k++)
+        if (e[k].i != mir[k].i || e[k].j != mir[k].j || !(e[k].a == mir[k].a)) t.symmetric = 0;
+out:
+    free(e);
+    free(mir);
+    free(row);
+    free(col);
+    return t;
+}
+
+/* Sums of k non-negative terms in double are within k eps of the exact sum
+ * (recursive summation, Higham 4.2), so that is the tolerance, with k the
+ * stored entries; the brute-force sums are long double. */
+static double tol_terms = 1;
+
+static int close_to(double got, double want)
+{
+    return got == want || fabs(got - want) <= (tol_terms + 2) * DBL_EPSILON * fabs(want);
+}
+
+static void check_shape(const char *what, const silc_props *p, const truth *t)
+{
+    CHECK(p->nnz == t->nnz && p->diagonal == t->diagonal && p->lower == t->lower &&
+              p->upper == t->upper && p->kl == t->kl && p->ku == t->ku && p->pos_diag == t->pos_diag &&
+              p->has_nonfinite == t->has_nonfinite,
+          "%s: shape nnz %lld/%lld diag %d/%d lower %d/%d upper %d/%d kl %lld/%lld ku %lld/%lld "
+          "posdiag %d/%d nonfinite %d/%d",
+          what, (long long)p->nnz, (long long)t->nnz, p->diagonal, t->diagonal, p->lower, t->lower,
+          p->upper, t->upper, (long long)p->kl, (long long)t->kl, (long long)p->ku, (long long)t->ku,
+          p->pos_diag, t->pos_diag, p->has_nonfinite, t->has_nonfinite);
+}
+
+static void check_norms(const char *what, const silc_props *p, const truth *t)
+{
+    if (t->has_nonfinite) return; /* the norms of a NaN matrix are not a contract */
+    CHECK(close_to(p->norm1, t->norm1) && close_to(p->norminf, t->norminf) &&
+              close_to(p->normfro, t->normfro) && p->maxabs == t->maxabs,
+          "%s: norms 1 %.17g/%.17g inf %.17g/%.17g fro %.17g/%.17g max %.17g/%.17g", what, p->norm1,
+          t->norm1, p->norminf, t->norminf, p->normfro, t->normfro, p->maxabs, t->maxabs);
+}
+
+static silc_value *value_of(const silc_envelope_t *e)
+{
+    silc_value *v = NULL;
+    char err[256];
+    if (env_to_value(e, &v, err, sizeof err)) {
+        CHECK(0, "env_to_value: %s", err);
+        return NULL;
+    }
+    return v;
+}
+
+/* All the checks on one matrix given as an envelope. */
+static void check_matrix(const char *what, const silc_envelope_t *e)
+{
+    silc_value *v = value_of(e), *w = value_of(e);
+    truth t;
+    const silc_props *p;
+    if (!v || !w) goto out;
+    t = brute(v);
+    tol_terms = (double)(v->format == SILC_FMT_CSR ? v->rowptr[v->m] : v->m * v->n);
+    p = val_props_part(v, PROPS_SHAPE);
+    check_shape(what, p, &t);
+    CHECK(v->format != SILC_FMT_CSR || v->props_have == PROPS_SHAPE,
+          "%s: asking for the shape computed more (%d)", what, v->props_have);
+    /* The shape's pass also filled the scan a right-hand side or the scaling
+     * hook asks for. */
+    CHECK(val_has_nonfinite(v) == t.has_nonfinite &&
+              (t.has_nonfinite ? !(val_max_abs(v) < INFINITY) : val_max_abs(v) == t.maxabs),
+          "%s: scan max %.17g nonfinite %d, truth %.17g %d", what, val_max_abs(v), val_has_nonfinite(v),
+          t.maxabs, t.has_nonfinite);
+    p = val_props_part(v, PROPS_SYMMETRY);
+    CHECK(p->symmetric == t.symmetric, "%s: symmetric %d, truth %d", what, p->symmetric, t.symmetric);
+    /* The backward error before the norms are known (||A||_inf from the
+     * residual's pass) and after (from the properties) must agree. */
+    if (v->m == v->n && v->m > 0 && !t.has_nonfinite) {
+        silc_value *x = val_dense_new(v->n, 1), *b = val_dense_new(v->n, 1);
+        if (x && b) {
+            double be1, be2;
+            int64_t i;
+            for (i = 0; i < v->n; i++) x->val[i] = 1 + (double)(i % 7) / 8, b->val[i] = (double)(i % 3);
+            be1 = acc_backward_error(v, b, x);
+            CHECK(!(v->props_have & PROPS_NORMS) || v->format != SILC_FMT_CSR,
+                  "%s: the backward error computed the norms", what);
+            p = val_props(v);
+            be2 = acc_backward_error(v, b, x);
+            CHECK(close_to(be1, be2), "%s: backward error %.17g with the residual's ||A||, %.17g with "
+                                      "the properties'", what, be1, be2);
+        }
+        val_release(x);
+        val_release(b);
+    }
+    p = val_props(v);
+    check_shape(what, p, &t);
+    check_norms(what, p, &t);
+    CHECK(v->props_have == PROPS_ALL, "%s: not all parts known (%d)", what, v->props_have);
+    p = val_props(w); /* everything at once, in the other order */
+    check_shape(what, p, &t);
+    check_norms(what, p, &t);
+    CHECK(p->symmetric == t.symmetric, "%s: symmetric (all at once) %d, truth %d", what, p->symmetric,
+          t.symmetric);
+out:
+    val_release(v);
+    val_release(w);
+}
+
+static void check_csr(const char *what, int64_t m, int64_t n, const int64_t *rp, const int64_t *ci,
+                      const double *x)
+{
+    silc_envelope_t e;
+    if (silc_envelope_csr(&e, m, n, rp, ci, x)) {
+        CHECK(0, "%s: envelope", what);
+        return;
+    }
+    check_matrix(what, &e);
+    silc_envelope_free(&e);
+}
+
+static void edge_cases(void)
+{
+    /* 4x4, symmetric, with explicit zeros first and last in rows and a
+     * stored zero on row 2's diagonal; empty row 3. */
+    static const int64_t rp[] = {0, 3, 7, 7, 9}, ci[] = {0, 1, 3, 0, 1, 2, 3, 0, 1};
+    double x[] = {2, 1, 0, 1, 3, 0, 0, 0, 0};
+    static const int64_t rp2[] = {0, 2, 4, 6}, ci2[] = {0, 2, 1, 2, 0, 2};
+    double y[] = {1, 2, 4, 5, 2, 7};
+    static const int64_t rp3[] = {0, 1, 3}, ci3[] = {1, 0, 2};
+    static const double z[] = {1, 2, 3};
+    static const int64_t rp1[] = {0, 1}, ci1[] = {0}, rp0[] = {0};
+    static const double one[] = {-1};
+    check_csr("zeros at row ends and on the diagonal", 4, 4, rp, ci, x);
+    x[2] = 0.5; /* (0, 3) now nonzero, its mirror (3, 0) is 0 */
+    check_csr("unmatched upper entry", 4, 4, rp, ci, x);
+    x[2] = 0, x[7] = 0.5; /* (3, 0) nonzero, mirror (0, 3) is a stored zero */
+    check_csr("unmatched lower entry", 4, 4, rp, ci, x);
+    x[7] = 0;
+    x[4] = 5; /* positive diagonal on rows 0, 1 */
+    check_csr("symmetric again", 4, 4, rp, ci, x);
+    check_csr("3x3 symmetric, pos diag", 3, 3, rp2, ci2, y);
+    y[5] = -7;
+    check_csr("3x3, negative last diagonal", 3, 3, rp2, ci2, y);
+    y[5] = 7, y[4] = 2.5;
+    check_csr("3x3, mirror differs in value only", 3, 3, rp2, ci2, y);
+    y[4] = 2, y[5] = NAN;
+    check_csr("NaN as the last entry", 3, 3, rp2, ci2, y);
+    y[5] = INFINITY;
+    check_csr("Inf as the last entry", 3, 3, rp2, ci2, y);
+    y[5] = 7;
+    y[0] = 1e300, y[5] = 1e-300;
+    check_csr("entries near 1e+-300 (scaled norms)", 3, 3, rp2, ci2, y);
+    check_csr("rectangular 2x3", 2, 3, rp3, ci3, z);
+    check_csr("1x1 negative", 1, 1, rp1, ci1, one);
+    check_csr("0x0", 0, 0, rp0, ci1, one);
+}
+
+static void shared_matrices(void)
+{
+    char path[1024], line[512];
+    FILE *f;
+    int count = 0;
+    snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
+    f = fopen(path, "r");
+    CHECK(f != NULL, "cannot open %s", path);
+    if (!f) return;
+    while (fgets(line, sizeof line, f)) {
+        char name[256], err[256];
+        silc_envelope_t e;
+        if (sscanf(line, "%255s", name) != 1 || !strstr(name, ".mtx")) continue;
+        snprintf(path, sizeof path, "%s/%s", SILC_SHARED_MATRICES, name);
+        if (silc_mm_read(&e, path, err, sizeof err)) continue; /* complex: refused elsewhere */
+        {
+            check_matrix(name, &e);
+            if (e.m * e.n <= 250000) { /* and dense, where that is small */
+                silc_envelope_t d;
+                double *a = malloc((size_t)(e.m * e.n > 0 ? e.m * e.n : 1) * sizeof *a);
+                if (a && !silc_envelope_to_dense(&e, a) && !silc_envelope_dense(&d, e.m, e.n, a)) {
+                    char label[300];
+                    snprintf(label, sizeof label, "%s (dense)", name);
+                    check_matrix(label, &d);
+                    silc_envelope_free(&d);
+                }
+                free(a);
+            }
+            count++;
+        }
+        silc_envelope_free(&e);
+    }
+    fclose(f);
+    CHECK(count >= 20, "only %d shared matrices checked", count);
+}
+
+int main(void)
+{
+    edge_cases();
+    shared_matrices();
+    return check_done();
+}
