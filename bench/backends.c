@@ -445,21 +445,35 @@ static void set_condest(silc_context *c, const char *b, const char *value)
     silc_exec(c, stmt);
 }
 
+/* How much of the accuracy report a SILC row makes. */
+enum report_mode {
+    REPORT_FULL,        /* as configured: backward error and condition estimate */
+    REPORT_NO_CONDEST,  /* the plugin's condest option false: the Hager-Higham
+                           estimate, the one part of the report that is not
+                           O(nnz), is not made */
+    REPORT_BARE         /* also solve.backward_error = on_request: the library's
+                           work and SILC's dispatch, classification and NaN/Inf
+                           checks, the backward error computed after the clock
+                           stops (by the info this bench reads) */
+};
+
 /* One SILC row and, where the library can be called directly, the direct row
  * and the ratio, for nsolve solves with one A.  The two alternate, best of
- * reps each, so that a burst of load on the machine hits both alike.
- * condest_off: the same backend with its plugin's condest option false (the
- * Hager-Higham estimate, the one part of the report that is not O(nnz), is
- * not made), compared with the same direct call: SILC's own cost. */
+ * reps each, so that a burst of load on the machine hits both alike.  The
+ * rows with less of the report are compared with the same direct call, which
+ * computes neither a backward error nor an estimate: REPORT_BARE against it
+ * is SILC's own cost, the others add the report's price. */
 static void compare_one(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
-                        const char *b, int condest_off, int nsolve, double *x)
+                        const char *b, enum report_mode mode, int nsolve, double *x)
 {
+    static const char *const mode_names[] = {"forced", "condest off", "bare (no report)"};
     double (*direct)(const problem *, int, double *) = direct_for(b);
     double be = NAN, t = -1, td = -1;
     char ran[64], who[64];
-    int r;
+    int r, condest_off = mode != REPORT_FULL;
     snprintf(ran, sizeof ran, "%s", b);
     if (condest_off) set_condest(c, b, "false");
+    if (mode == REPORT_BARE) silc_exec(c, "set solve.backward_error = on_request");
     for (r = 0; r < reps_for(P, o); r++) {
         double ts = silc_time(c, cap, P, b, nsolve, &be, ran, sizeof ran), d;
         if (ts < 0) break;
@@ -467,8 +481,9 @@ static void compare_one(silc_context *c, tl_capture *cap, const problem *P, cons
         if (direct && (d = direct(P, nsolve, x)) >= 0 && (td < 0 || d < td)) td = d;
     }
     if (condest_off) set_condest(c, b, !strcmp(b, "mumps") ? "true" : "auto"); /* the defaults */
+    if (mode == REPORT_BARE) silc_exec(c, "set solve.backward_error = deferred");
     snprintf(who, sizeof who, "SILC  %s%s", nsolve > 1 ? "loop, " : "",
-             !strcmp(b, "default") ? "default" : condest_off ? "condest off" : "forced");
+             !strcmp(b, "default") ? "default" : mode_names[mode]);
     /* condest off is compared with the same direct call, which estimates nothing. */
     row(who, ran, t, be, condest_off && td > 0 && t > 0 ? t / td : -1);
     if (direct && !condest_off) {
@@ -480,13 +495,17 @@ static void compare_one(silc_context *c, tl_capture *cap, const problem *P, cons
 }
 
 /* Backend b's rows: SILC as configured against the direct call, then, where
- * there is a direct call, SILC with the condition estimate off against it. */
+ * there is a direct call, SILC with less of the report against it (bare only
+ * for one solve: in a loop every solve but the first defers its backward
+ * error anyway). */
 static void compare(silc_context *c, tl_capture *cap, const problem *P, const opts *o,
                     const char *b, int nsolve, double *x)
 {
     if (!strcmp(b, "suitesparse.cholmod") && !P->spd) return;
-    compare_one(c, cap, P, o, b, 0, nsolve, x);
-    if (direct_for(b)) compare_one(c, cap, P, o, b, 1, nsolve, x);
+    compare_one(c, cap, P, o, b, REPORT_FULL, nsolve, x);
+    if (!direct_for(b)) return;
+    compare_one(c, cap, P, o, b, REPORT_NO_CONDEST, nsolve, x);
+    if (nsolve == 1) compare_one(c, cap, P, o, b, REPORT_BARE, nsolve, x);
 }
 
 static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const opts *o)

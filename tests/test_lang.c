@@ -633,10 +633,23 @@ static void test_deferred_backward_error(void)
     CHECK(be == strtod(eager, NULL), "deferred %g, eager %s", be, eager);
     CHECK(silc_exec(c, "set solve.backward_error = sometimes") != 0 &&
               !strcmp(silc_context_errmsg(c),
-                      "solve.backward_error expects 'always' or 'deferred', got 'sometimes'"),
+                      "solve.backward_error expects 'deferred', 'always' or 'on_request', got 'sometimes'"),
           "bad value: %s", silc_context_errmsg(c));
     CHECK(silc_exec(c, "z = solve(G, g, \"backward_error = always\"); z = solve(G, g, \"backward_error = always\")") == 0,
           "per call: %s", silc_context_errmsg(c));
+    /* on_request: a solve that factors defers too, and info computes the
+     * same number; the setting does not outlive the call it was given to. */
+    CHECK(silc_exec(c, "clear G; G = sparse([4, -1, 0; -2, 5, 1; 0, 1, 3])\n"
+                       "w = solve(G, g, \"backward_error = on_request\"); w2 = G \\ g") == 0,
+          "on_request: %s", silc_context_errmsg(c));
+    captured[0] = 0;
+    CHECK(silc_exec(c, "info w") == 0 && strstr(captured, "reused factorization: no") &&
+              (p = strstr(captured, "  backward error: ")) &&
+              strstr(p, "(computed now: solve.backward_error = on_request)\n") && strtod(p + 18, NULL) == be,
+          "on_request info (want %g):\n%s", be, captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "info w2") == 0 && strstr(captured, "reused factorization: yes") &&
+              !strstr(captured, "computed now"), "after on_request, always again:\n%s", captured);
     /* A system the core solves scaled (entries near 1e300) is not deferred:
      * its residual, formed unscaled later, could overflow. */
     CHECK(silc_exec(c, "set solve.backward_error = deferred; H = 1e300 * G; h = 1e300 * g\n"

@@ -14,6 +14,15 @@
  * that the first, checked solve already measured.  solve.backward_error =
  * always (a key, or per call "backward_error = always") computes it on every
  * solve, and with it the "does not solve the system" warning.
+ * solve.backward_error = on_request defers it for every direct solve, the
+ * first of a factorization too: for a program of many millisecond solves
+ * whose residual pass, next to a factorization of a few ns per nonzero,
+ * would cost a few per cent.  It gives up the check of the factors at
+ * solve time (the "does not solve" warning then comes with `info`); the
+ * library's own failure codes, the condition-estimate warnings and the
+ * NaN/Inf check of the result stay.  Iterative and refined solves keep
+ * theirs at once: there it checks a convergence claim, for the price of one
+ * of the iteration's products.
  */
 #ifndef SILC_ACCURACY_H
 #define SILC_ACCURACY_H
@@ -39,9 +48,10 @@ double *acc_dense_copy(const silc_value *v);
 double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X);
 
 /* Fills call->report->backward_error after a successful solve: at once, or
- * ACC_DEFERRED when the solve only reused a factorization, the caller allows
- * deferral (may_defer) and solve.backward_error is not "always".  Warns when
- * the result does not solve the system. */
+ * ACC_DEFERRED when the caller allows deferral (may_defer), the solve
+ * neither iterated nor refined, and either it only reused a factorization
+ * and solve.backward_error is not "always", or solve.backward_error is
+ * "on_request".  Warns when the result does not solve the system. */
 void acc_report(silc_engine *E, silc_call *call, int may_defer);
 
 /* Holds references to the solve's operands and result. */

@@ -6,7 +6,7 @@
  * A key is "section.name": dispatch.<class> (an ordered list of backends),
  * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads,
  * solve.refine / solve.refine_residual (iterative refinement, refine.c) and
- * solve.backward_error (always | deferred, accuracy.h) -- per call these may be
+ * solve.backward_error (deferred | always | on_request, accuracy.h) -- per call these may be
  * written without the section: "refine = 2" --, and
  * <plugin>.<option> for the typed options a loaded plugin lists.  The INI file
  * (read with inih) spells the same keys as [section] name = value.  Every key
@@ -370,9 +370,10 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
                 return eng_error(E, "solve.refine_residual expects 'double' or 'extended', got '%s'",
                                  value);
         } else if (strcmp(name, "backward_error") == 0) {
-            if (strcmp(value, "always") != 0 && strcmp(value, "deferred") != 0)
-                return eng_error(E, "solve.backward_error expects 'always' or 'deferred', got '%s'",
-                                 value);
+            if (strcmp(value, "always") != 0 && strcmp(value, "deferred") != 0 &&
+                strcmp(value, "on_request") != 0)
+                return eng_error(E, "solve.backward_error expects 'deferred', 'always' or "
+                                    "'on_request', got '%s'", value);
         } else {
             return unknown_key(E, section, name, solve_keys, 3);
         }

@@ -778,7 +778,9 @@ static int exec_info(lang_ev *V, const ast_node *s)
             sb_printf(&b, "  solve: %s\n", r->method[0] ? r->method : "(method not reported)");
             sb_printf(&b, "  backend: %s\n", in->backends[0] ? in->backends : r->backend);
             sb_printf(&b, "  backward error: %.3g%s\n", r->backward_error,
-                      deferred ? " (computed now: the solve reused a factorization)" : "");
+                      !deferred          ? ""
+                      : r->reused_factor ? " (computed now: the solve reused a factorization)"
+                                         : " (computed now: solve.backward_error = on_request)");
             if (r->backward_error_unrefined >= 0)
                 sb_printf(&b, "  refinement: %d step%s, backward error before: %.3g\n",
                           r->refine_steps, r->refine_steps == 1 ? "" : "s",
