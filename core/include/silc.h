@@ -42,6 +42,17 @@ extern "C" {
 
 #define SILC_VERSION "0.1.0"
 
+/* What libsilc exports: the functions below and nothing else (the engine
+ * is compiled with hidden visibility), so no name of its internals can clash
+ * with one of the program's. */
+#if defined(_WIN32)
+#define SILC_API
+#elif defined(__GNUC__)
+#define SILC_API __attribute__((visibility("default")))
+#else
+#define SILC_API
+#endif
+
 /* Storage formats of an envelope (the same codes as the plugin ABI). */
 typedef enum {
     SILC_DENSE = 0, /* column-major m*n */
@@ -65,30 +76,30 @@ typedef struct silc_envelope_t {
 /* ---- envelopes ------------------------------------------------------------- */
 /* Dense, column-major; a vector is n x 1, a scalar 1 x 1.  colmajor may be NULL
  * for zeros.  Copies. */
-int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor);
-int silc_envelope_scalar(silc_envelope_t *e, double x);
-int silc_envelope_vector(silc_envelope_t *e, int64_t n, const double *x);
+SILC_API int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor);
+SILC_API int silc_envelope_scalar(silc_envelope_t *e, double x);
+SILC_API int silc_envelope_vector(silc_envelope_t *e, int64_t n, const double *x);
 /* CSR, 0-based, copies.  Rows need not be sorted: columns are sorted on copy and
  * duplicates are an error (use sparse(i,j,v,m,n) in the language to sum them). */
-int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
-                      const int64_t *colind, const double *values);
-int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t *rowptr,
-                        const int32_t *colind, const double *values);
+SILC_API int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
+                               const int64_t *colind, const double *values);
+SILC_API int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t *rowptr,
+                                 const int32_t *colind, const double *values);
 /* Band, LAPACK layout with ld = kl+ku+1.  Copies. */
-int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
-                       const double *band);
-int64_t silc_envelope_rows(const silc_envelope_t *e);
-int64_t silc_envelope_cols(const silc_envelope_t *e);
+SILC_API int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
+                                const double *band);
+SILC_API int64_t silc_envelope_rows(const silc_envelope_t *e);
+SILC_API int64_t silc_envelope_cols(const silc_envelope_t *e);
 /* Writes all m*n entries column-major into colmajor_out (caller's array). */
-int silc_envelope_to_dense(const silc_envelope_t *e, double *colmajor_out);
+SILC_API int silc_envelope_to_dense(const silc_envelope_t *e, double *colmajor_out);
 /* Frees the arrays and zeroes the envelope; NULL and zeroed envelopes are fine. */
-void silc_envelope_free(silc_envelope_t *e);
+SILC_API void silc_envelope_free(silc_envelope_t *e);
 
 /* Matrix Market: read coordinate (real, integer, pattern; general, symmetric,
  * skew-symmetric) into CSR, or array into dense.  Complex files are refused with
  * a message.  Write: dense as array, CSR/band as coordinate general, %.17g. */
-int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
-int silc_mm_write(const silc_envelope_t *e, FILE *out);
+SILC_API int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
+SILC_API int silc_mm_write(const silc_envelope_t *e, FILE *out);
 
 /* ---- contexts -------------------------------------------------------------- */
 typedef struct silc_context silc_context;
@@ -97,7 +108,7 @@ typedef struct silc_context silc_context;
  * ./silc.conf if it exists, else built-in defaults.  On failure returns non-zero
  * and, if *out was set, silc_context_errmsg(*out) says why (else the message is
  * in silc_errmsg()). */
-int silc_open(silc_context **out, const char *config_path);
+SILC_API int silc_open(silc_context **out, const char *config_path);
 /* Opens a remote context on a silcd server: url is tcp://host:port or
  * unix:/path/to/socket.  The token, when the server wants one, comes from
  * SILC_TOKEN, else the first line of the file named by SILC_TOKEN_FILE.
@@ -106,30 +117,32 @@ int silc_open(silc_context **out, const char *config_path);
  * call behaves as on an embedded context: same results, same messages; a lost
  * connection is reported by the call that meets it.  On failure the message is
  * in silc_errmsg(). */
-int silc_open_remote(silc_context **out, const char *url);
-void silc_close(silc_context **ctx);
-int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
-int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
-int silc_exec(silc_context *ctx, const char *statements);
-const char *silc_context_errmsg(const silc_context *ctx);
+SILC_API int silc_open_remote(silc_context **out, const char *url);
+SILC_API void silc_close(silc_context **ctx);
+SILC_API int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
+SILC_API int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
+SILC_API int silc_exec(silc_context *ctx, const char *statements);
+SILC_API const char *silc_context_errmsg(const silc_context *ctx);
 /* Warnings of the last silc_exec (one per line, "" if none): results that were
  * computed but deserve distrust, e.g. "matrix is singular to working precision
  * (1-norm condition estimate 3.2e+17)".  Valid until the next call. */
-const char *silc_context_warnings(const silc_context *ctx);
+SILC_API const char *silc_context_warnings(const silc_context *ctx);
 /* Where `who`, `info` and `explain` print (default: stdout).  The callback gets
  * one complete piece of text at a time; NULL restores stdout. */
 typedef void (*silc_output_fn)(void *user, const char *text);
-void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
+SILC_API void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
 
 /* ---- the default context (the seeds' calls) -------------------------------- */
-int SILC_INIT(void);
-int SILC_FINALIZE(void);
-int SILC_PUT(const char *name, const silc_envelope_t *e);
-int SILC_GET(silc_envelope_t *e, const char *name);
-int SILC_EXEC(const char *statements);
-const char *silc_errmsg(void);        /* message of the last failure on the default context */
-const char *silc_warnings(void);      /* warnings of the last SILC_EXEC on the default context */
-silc_context *silc_default_context(void); /* NULL before SILC_INIT */
+SILC_API int SILC_INIT(void);
+SILC_API int SILC_FINALIZE(void);
+SILC_API int SILC_PUT(const char *name, const silc_envelope_t *e);
+SILC_API int SILC_GET(silc_envelope_t *e, const char *name);
+SILC_API int SILC_EXEC(const char *statements);
+/* The message of the last failure, and the warnings of the last SILC_EXEC,
+ * on the default context. */
+SILC_API const char *silc_errmsg(void);
+SILC_API const char *silc_warnings(void);
+SILC_API silc_context *silc_default_context(void); /* NULL before SILC_INIT */
 
 #ifdef __cplusplus
 }
