@@ -6,7 +6,8 @@
  * For every real shared matrix, in CSR and (when small) dense storage, and
  * for hand-made CSR edge cases (explicit zeros at the ends of rows and on the
  * diagonal, empty rows, one asymmetric entry at the very end, a mirror with
- * a different value, a rectangular matrix, NaN and Inf in the last entry, a
+ * a different value, an asymmetric entry in rows the symmetry probe samples
+ * and in rows it does not, a rectangular matrix, NaN and Inf in the last entry, a
  * 1x1 and a 0x0 matrix, entries near 1e+-300 that need the scaled norms):
  *   - asking for the shape alone fills exactly the shape (nnz, triangles,
  *     band widths, positive diagonal, NaN/Inf) and marks only it known, and
@@ -215,6 +216,31 @@ static void check_csr(const char *what, int64_t m, int64_t n, const int64_t *rp,
     silc_envelope_free(&e);
 }
 
+/* A 200 x 200 tridiagonal matrix, symmetric, then with one entry off in
+ * rows (98, 99) that the symmetry probe's sample (every third row from 1)
+ * does not visit, so the full walk must find it; then one it does visit. */
+static void tridiagonal(void)
+{
+    enum { N = 200 };
+    static int64_t rp[N + 1], ci[3 * N];
+    static double x[3 * N];
+    int64_t i, k = 0, at = -1, probed = -1;
+    for (i = 0; i < N; i++) {
+        rp[i] = k;
+        if (i > 0) ci[k] = i - 1, x[k++] = -1 - 0.01 * (double)i;
+        ci[k] = i, x[k++] = 4;
+        if (i < N - 1) ci[k] = i + 1, x[k++] = -1 - 0.01 * (double)(i + 1);
+        if (i == 99) at = k - 3;     /* (99, 98) */
+        if (i == 100) probed = k - 3; /* (100, 99) */
+    }
+    rp[N] = k;
+    check_csr("tridiagonal 200, symmetric", N, N, rp, ci, x);
+    x[at] = -5;
+    check_csr("tridiagonal 200, (99, 98) off (not in the probe's rows)", N, N, rp, ci, x);
+    x[at] = -1 - 0.01 * 99, x[probed] = -5;
+    check_csr("tridiagonal 200, (100, 99) off (in the probe's rows)", N, N, rp, ci, x);
+}
+
 static void edge_cases(void)
 {
     /* 4x4, symmetric, with explicit zeros first and last in rows and a
@@ -249,6 +275,7 @@ static void edge_cases(void)
     check_csr("entries near 1e+-300 (scaled norms)", 3, 3, rp2, ci2, y);
     check_csr("rectangular 2x3", 2, 3, rp3, ci3, z);
     check_csr("1x1 negative", 1, 1, rp1, ci1, one);
+    tridiagonal();
     check_csr("0x0", 0, 0, rp0, ci1, one);
 }
 

@@ -500,11 +500,39 @@ static double max_of(const double *x, int64_t n)
  * walk stops where its upper part begins, which is where next[j] starts, so
  * one pass sets and uses it and an unsymmetric matrix costs only the rows
  * before its first mismatch.  Returns -1 when out of memory. */
+/* The stored value at (i, j) of a CSR matrix with sorted rows, 0 if absent. */
+static double csr_at(const silc_value *v, int64_t i, int64_t j)
+{
+    int64_t lo = v->rowptr[i], hi = v->rowptr[i + 1];
+    while (lo < hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (v->colind[mid] < j) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < v->rowptr[i + 1] && v->colind[lo] == j ? v->val[lo] : 0;
+}
+
+/* A matrix that is unsymmetric is usually so all over (memplus: its walk
+ * below met the first mismatch only after a third of the rows, 0.9% of a
+ * KLU solve): 64 rows spread over the matrix, each entry compared with its
+ * mirror by bisection, settle most of them in microseconds.  0 when a
+ * mismatch was found, 1 when none was (which proves nothing). */
+static int csr_symmetric_probe(const silc_value *v)
+{
+    int64_t n = v->n, r, k, step = n / 64 > 0 ? n / 64 : 1;
+    for (r = step / 2; r < n; r += step)
+        for (k = v->rowptr[r]; k < v->rowptr[r + 1]; k++)
+            if (v->colind[k] != r && v->val[k] != csr_at(v, v->colind[k], r)) return 0;
+    return 1;
+}
+
 static int csr_symmetric(const silc_value *v)
 {
     int64_t n = v->n, i, j, k, q;
-    int64_t *next = malloc((size_t)(n ? n : 1) * sizeof *next);
+    int64_t *next;
     int sym = 1;
+    if (!csr_symmetric_probe(v)) return 0;
+    next = malloc((size_t)(n ? n : 1) * sizeof *next);
     if (!next) return -1;
     for (i = 0; i < n && sym; i++) {
         for (k = v->rowptr[i]; k < v->rowptr[i + 1] && v->colind[k] < i && sym; k++) {
