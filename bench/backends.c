@@ -18,8 +18,11 @@
  * Laplacian, 10 for the shared matrices), wall time of the whole
  * silc_exec (dispatch, analysis, factorization, solve, and the core's backward
  * error) and the backward error ||b - A x||inf / (||A||inf ||x||inf + ||b||inf).
- * The row "default" is plain `x = A \ b`.  "direct" is the same library
- * called here with the same settings as the plugin (UMFPACK, KLU on the CSR
+ * The row "default" is plain `x = A \ b`; each library with a direct call
+ * also gets rows with less of the accuracy report, "condest off" and "bare"
+ * (no estimate, backward error on request: SILC's own cost; compare_one).
+ * "direct" is the same library called here with the same settings as the
+ * plugin (UMFPACK, KLU on the CSR
  * arrays as A' and the transposed solve, as the plugin does; CHOLMOD
  * supernodal on the upper triangle; MUMPS with AMF ordering, SYM=1 for SPD),
  * its input already in the library's own format (what a direct user holds),
