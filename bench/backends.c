@@ -16,17 +16,18 @@
  * One solve: for every backend, `x = solve(A, b, "backend = NAME")` on a
  * freshly put A (so nothing is reused), best of R runs (default 3 for the
  * Laplacian, 10 for the shared matrices), wall time of the whole
- * silc_exec (dispatch, analysis, factorization, solve, and the core's backward
- * error) and the backward error ||b - A x||inf / (||A||inf ||x||inf + ||b||inf).
- * The row "default" is plain `x = A \ b`; each library with a direct call
- * also gets rows with less of the accuracy report, "condest off" and "bare"
- * (no estimate, backward error on request: SILC's own cost; compare_one).
+ * silc_exec (dispatch, analysis, factorization, solve, and in the rows that
+ * make them the condition estimate and the core's backward error) and the
+ * backward error ||b - A x||inf / (||A||inf ||x||inf + ||b||inf).  The row
+ * "default" is plain `x = A \ b`; each library with a direct call also gets
+ * rows with less of the accuracy report, "condest off" and "bare" (no
+ * estimate, backward error on request: SILC's own cost; compare_one).
  * "direct" is the same library called here with the same settings as the
- * plugin (UMFPACK, KLU on the CSR
- * arrays as A' and the transposed solve, as the plugin does; CHOLMOD
- * supernodal on the upper triangle; MUMPS with AMF ordering, SYM=1 for SPD),
- * its input already in the library's own format (what a direct user holds),
- * timed from analysis to solution.  overhead = SILC / direct.
+ * plugin (UMFPACK, KLU on the CSR arrays as A' and the transposed solve, as
+ * the plugin does; CHOLMOD supernodal on the upper triangle; MUMPS with AMF
+ * ordering, SYM=1 for SPD), its input already in the library's own format
+ * (what a direct user holds), timed from analysis to solution.  overhead =
+ * SILC / direct.
  * SciPy: scipy.sparse.linalg.spsolve (SuperLU, COLAMD) via /usr/bin/python3;
  * Octave: A\b via octave-cli; both read the matrix from a file this program
  * writes, and time only the solve.
@@ -487,7 +488,7 @@ static void compare_one(silc_context *c, tl_capture *cap, const problem *P, cons
     if (mode == REPORT_BARE) silc_exec(c, "set solve.backward_error = deferred");
     snprintf(who, sizeof who, "SILC  %s%s", nsolve > 1 ? "loop, " : "",
              !strcmp(b, "default") ? "default" : mode_names[mode]);
-    /* condest off is compared with the same direct call, which estimates nothing. */
+    /* Rows with less of the report get a ratio against the same direct call. */
     row(who, ran, t, be, condest_off && td > 0 && t > 0 ? t / td : -1);
     if (direct && !condest_off) {
         snprintf(who, sizeof who, "direct %s%s", strchr(b, '.') ? strchr(b, '.') + 1 : b,

@@ -226,9 +226,10 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer)
     silc_report *r = call->report;
     if (may_defer && r->iterations == 0 && r->backward_error_unrefined < 0) {
         const char *when = cfg_get(E, "solve.backward_error");
-        if (when && strcmp(when, "on_request") == 0 ? 1
-            : r->reused_factor                      ? !(when && strcmp(when, "always") == 0)
-                                                    : 0) {
+        int defer;
+        if (when && strcmp(when, "on_request") == 0) defer = 1;
+        else defer = r->reused_factor && !(when && strcmp(when, "always") == 0);
+        if (defer) {
             r->backward_error = ACC_DEFERRED;
             return;
         }

@@ -105,6 +105,7 @@ int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S)
 int scale_solve_end(silc_call *call, scale_state *S)
 {
     silc_value *X = call->out;
+    int64_t i;
     int was_finite;
     call->in[0] = S->A;
     call->in[1] = S->B;
@@ -112,10 +113,7 @@ int scale_solve_end(silc_call *call, scale_state *S)
     S->Bs = NULL;
     if (!X || S->ea == S->eb) return 0;
     was_finite = !val_has_nonfinite(X);
-    {
-        int64_t i;
-        for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
-    }
+    for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
     val_forget_caches(X); /* they described the scaled solution */
     return was_finite && val_has_nonfinite(X);
 }
