@@ -755,6 +755,12 @@ double val_max_abs(const silc_value *v)
     return v->scan_maxabs;
 }
 
+void val_mutated(silc_value *v)
+{
+    val_forget_caches(v);
+    v->id = atomic_fetch_add(&next_id, 1);
+}
+
 void val_forget_caches(silc_value *v)
 {
     v->props_have = 0;

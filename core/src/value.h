@@ -8,7 +8,10 @@
  * with it.  Immutability is what makes attachments safe: `A` keeps its id and
  * its factorization until the name is rebound.  Values are built mutable by the
  * constructors below, filled, and then frozen by being handed to the store or
- * returned from an operation; nothing writes to a value after that.
+ * returned from an operation; nothing writes to a value after that, with one
+ * exception that no one can observe: `x += ...` updates x's dense value in
+ * place when the store's binding is its only reference and it has no
+ * attachments (copy-on-write, eval.c), and then gives it a new id.
  *
  * The store maps names to values for one context.  Binding retains, rebinding
  * or clearing releases.
@@ -82,6 +85,10 @@ double val_max_abs(const silc_value *v);
 /* After changing a value's entries in place (only before it is shared):
  * forget what the caches said. */
 void val_forget_caches(silc_value *v);
+/* After updating an unshared value in place (copy-on-write, eval.c): forget
+ * the caches and take a new id, so that nothing keyed by the old id can
+ * mistake the new contents for the old. */
+void val_mutated(silc_value *v);
 int val_is_scalar(const silc_value *v);   /* 1x1 */
 double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
 double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
