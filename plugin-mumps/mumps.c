@@ -543,17 +543,14 @@ static int apply_block(void *ctx, double *X, int t, int trans)
 }
 
 /* F->cond_est from the block estimator; Y0 = A^{-1} X0 if the first block
- * was folded into a solve, else NULL.  The error analysis is switched off
- * meanwhile (it would run on every solve). */
+ * was folded into a solve, else NULL.  The caller has the error analysis
+ * switched off (it would run on every one of these solves). */
 static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
 {
-    int icntl11 = (int)ICNTL(F, 11);
     double inv;
     est_ctx c = {call, F, host->alloc((size_t)ID_N(F) * EST_COLS * sizeof(double)), 0};
     if (!c.keep) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
-    ICNTL(F, 11) = 0;
     inv = host->inv_norm1_est_block(ID_N(F), EST_COLS, EST_STEPS, apply_block, &c, Y0);
-    ICNTL(F, 11) = icntl11;
     host->free(c.keep);
     if (inv < 0)
         return c.rc ? c.rc : host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
@@ -789,7 +786,7 @@ static int solve_run(silc_call *call)
     settings s;
     mumps_factor *F;
     silc_value *X;
-    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse, fold;
+    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse, estimate, fold;
     const char *key;
     double t0, *rhs;
     const char *why = NULL;
@@ -821,7 +818,8 @@ static int solve_run(silc_call *call)
         }
         r->factor_seconds = F->factor_seconds;
     }
-    X = host->dense_new_uninit(b.m, b.n); /* dense_copy writes every entry */
+    /* dense_copy, or the copy after a folded solve, writes every entry. */
+    X = host->dense_new_uninit(b.m, b.n);
     if (!X) return host->error(call, SILC_ENOMEM, "mumps: cannot allocate the %lldx%lld solution",
                                (long long)b.m, (long long)b.n);
     host->view(X, &o);
@@ -829,20 +827,20 @@ static int solve_run(silc_call *call)
     /* The error analysis runs once per factorization (see the top of the file). */
     icntl11 = (int)ICNTL(F, 11);
     analyse = !F->analysed && b.n == 1 && icntl11 > 0;
-    if (!analyse) ICNTL(F, 11) = 0;
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    fold = s.condest && F->cond_est < 0 && !analyse;
+    estimate = s.condest && F->cond_est < 0;
+    fold = estimate && !analyse;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)a.n * (size_t)(b.n + EST_COLS) * sizeof *rhs))) {
         host->release(X);
         return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     }
+    if (!analyse) ICNTL(F, 11) = 0; /* restored below, after the estimate */
     do {
         dense_copy(&b, rhs);
         if (fold) host->inv_norm1_start(a.n, EST_COLS, rhs + a.n * b.n);
     } while ((rc = run_solve(call, F, rhs, b.n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
-    ICNTL(F, 11) = icntl11;
     if (!rc && analyse) {
         F->analysed = 1;
         int k;
@@ -850,7 +848,9 @@ static int solve_run(silc_call *call)
     }
     if (!rc && fold) memcpy(o.val, rhs, (size_t)(a.n * b.n) * sizeof *rhs);
     r->solve_seconds = host->now() - t0;
-    if (!rc && s.condest && F->cond_est < 0) rc = estimate_cond(call, F, fold ? rhs + a.n * b.n : NULL);
+    ICNTL(F, 11) = 0; /* the estimate's solves, if any, without it */
+    if (!rc && estimate) rc = estimate_cond(call, F, fold ? rhs + a.n * b.n : NULL);
+    ICNTL(F, 11) = icntl11;
     if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);

@@ -304,11 +304,7 @@ static int cond_apply(void *ctx, double *x, int trans, double *work)
     VecResetArray(c->in);
     VecResetArray(c->out);
     if (ierr) return -1;
-    {
-        PetscInt n = 0;
-        MatGetSize(c->F, &n, NULL);
-        memcpy(x, work, (size_t)n * sizeof *x);
-    }
+    memcpy(x, work, (size_t)c->n * sizeof *x);
     return 0;
 }
 
@@ -330,9 +326,10 @@ static int cond_apply_block(void *ctx, double *X, int t, int trans)
 }
 
 /* A block of right-hand sides costs MUMPS one solve phase, dominated by
- * per-front overhead, so its factors get the block estimate: three or four
- * block solves instead of up to five single ones (memplus, -pc_type lu with
- * MUMPS: 82 -> 67 ms, 43 without an estimate; bcsstk16 40 -> 37, 33).
+ * per-front overhead, so its factors get the block estimate: at most three
+ * block solves where the one-column form makes four to ten single ones
+ * (memplus, -pc_type lu with MUMPS: 82 -> 67 ms, 43 without an estimate;
+ * bcsstk16 40 -> 37, 33).
  * Every other package solves a block column by column, where the
  * one-column estimate needs fewer solves. */
 static int block_estimate_pays(Mat F, int symmetric)
@@ -360,15 +357,15 @@ static double condition_estimate(psc_solver *S, int64_t n, double norm1)
         est = host->inv_norm1_est_block(n, COND_COLS, COND_STEPS, cond_apply_block, &c, NULL);
         host->free(c.block);
         S->cond_block = est >= 0;
-        if (S->cond_block) return isfinite(est) ? norm1 * est : -1;
     }
-    if (!(work = host->alloc((size_t)n * sizeof *work))) return -1;
-    if (!VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.in) &&
-        !VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.out))
-        est = host->inv_norm1_est(n, cond_apply, &c, work);
-    VecDestroy(&c.in);
-    VecDestroy(&c.out);
-    host->free(work);
+    if (!S->cond_block && (work = host->alloc((size_t)n * sizeof *work))) {
+        if (!VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.in) &&
+            !VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.out))
+            est = host->inv_norm1_est(n, cond_apply, &c, work);
+        VecDestroy(&c.in);
+        VecDestroy(&c.out);
+        host->free(work);
+    }
     return est >= 0 && isfinite(est) ? norm1 * est : -1;
 }
 
@@ -631,9 +628,13 @@ static int solve_run(silc_call *call)
     r->cond_est = S->cond_est;
     if (S->cond_est >= 0) {
         size_t len = strlen(r->note);
-        snprintf(r->note + len, sizeof r->note - len, "; 1-norm condition estimate: %s",
-                 S->cond_block ? "block Hager-Higham (2 columns, 2 steps; MatMatSolve)"
-                               : "Hager-Higham (MatSolve)");
+        if (S->cond_block)
+            snprintf(r->note + len, sizeof r->note - len,
+                     "; 1-norm condition estimate: block Hager-Higham (%d columns, %d steps; MatMatSolve)",
+                     COND_COLS, COND_STEPS);
+        else
+            snprintf(r->note + len, sizeof r->note - len,
+                     "; 1-norm condition estimate: Hager-Higham (MatSolve)");
     }
     if (fresh) {
         if (pushed) PetscOptionsPop();

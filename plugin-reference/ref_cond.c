@@ -88,7 +88,7 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
     double *Sold = ref_alloc(nt, sizeof(double)), *h = ref_alloc((size_t)n, sizeof(double));
     unsigned char *used = ref_alloc((size_t)n, 1), *taken = ref_alloc((size_t)n, 1);
     int64_t ind[64], ind_best = -1;
-    double est = -1.0, est_old = 0.0;
+    double est = -1.0;
     if (!X || !S || !Sold || !h || !used || !taken) goto done;
     memset(used, 0, (size_t)n);
     memset(taken, 0, (size_t)n);
@@ -110,11 +110,8 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
             }
             if (s > cur) cur = s, jbest = j;
         }
-        if (k >= 2 && cur <= est_old) {
-            est = est_old;
-            break;
-        }
-        est = est_old = cur;
+        if (k >= 2 && cur <= est) break;
+        est = cur;
         if (k >= 2) ind_best = ind[jbest];
         if (k >= itmax || n == 1) break;
         for (size_t q = 0; q < nt; q++) S[q] = X[q] >= 0 ? 1.0 : -1.0;
@@ -133,12 +130,13 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
         /* The t most promising unit vectors; if all were tried, converged. */
         {
             int fresh = 0;
+            int64_t top[64];
             for (int j = 0; j < t; j++) {
-                int64_t i = largest(n, h, NULL, taken);
-                taken[i] = 1;
-                fresh |= !used[i];
+                top[j] = largest(n, h, NULL, taken);
+                taken[top[j]] = 1;
+                fresh |= !used[top[j]];
             }
-            memset(taken, 0, (size_t)n);
+            for (int j = 0; j < t; j++) taken[top[j]] = 0; /* t marks, not an O(n) clear */
             if (!fresh) break;
         }
         for (int j = 0; j < t; j++) {
@@ -150,7 +148,7 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
             taken[i] = 1;
             ind[j] = i;
         }
-        memset(taken, 0, (size_t)n);
+        for (int j = 0; j < t; j++) taken[ind[j]] = 0;
         memcpy(Sold, S, nt * sizeof(double));
         nt = (size_t)n * (size_t)t;
         memset(X, 0, nt * sizeof(double));

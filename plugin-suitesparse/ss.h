@@ -106,7 +106,7 @@ enum { SS_UMFPACK = 0, SS_CHOLMOD, SS_KLU, SS_NCACHE };
 
 /* What a factorization tells every solve that uses it. */
 typedef struct ss_factor_info {
-    double rcond;               /* the library's reciprocal estimate, -1 = none */
+    double rcond;               /* the library's reciprocal estimate (SPQR: 1/cond), -1 = none */
     double cond;                /* the condition estimate reported, -1 = none */
     char method[64];
     char note[160];

@@ -38,7 +38,6 @@ typedef struct um_symbolic {
 typedef struct um_factor {
     void *numeric;
     ss_factor_info info;
-    int crude;                  /* info.cond is 1/rcond, not Hager/Higham's estimate */
 } um_factor;
 
 static void um_symbolic_free(void *p)
@@ -178,7 +177,7 @@ static int um_factor_new(silc_call *call, const silc_view *a, int tag, int conde
     ss_symbolic *entry;
     um_symbolic *local, *s;
     um_factor *F;
-    int reused, st, rc;
+    int reused, st, rc, crude = 1; /* info.cond is 1/rcond, not Hager/Higham's estimate */
     *out = NULL;
     umfpack_dl_defaults(control);
     control[UMFPACK_STRATEGY] = tag;
@@ -201,16 +200,15 @@ static int um_factor_new(silc_call *call, const silc_view *a, int tag, int conde
     }
     F->info.rcond = info[UMFPACK_RCOND];
     F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
-    F->crude = 1;
     if (ss_use_condest(condest, F->info.cond)) {
         double c = um_condest(a, F->numeric, ss_host->props(call->in[0])->norm1);
-        if (c >= 0) F->info.cond = c, F->crude = 0;
+        if (c >= 0) F->info.cond = c, crude = 0;
     }
     snprintf(F->info.method, sizeof F->info.method, "%s", s->method);
     snprintf(F->info.note, sizeof F->info.note, "%s%s",
              reused ? "symbolic analysis reused (same pattern); " : "",
-             F->crude ? "condition estimate is UMFPACK's crude 1/rcond (pivot ratio)"
-                      : "1-norm condition estimate (Hager/Higham)");
+             crude ? "condition estimate is UMFPACK's crude 1/rcond (pivot ratio)"
+                   : "1-norm condition estimate (Hager/Higham)");
     *out = F;
 done:
     if (local) um_symbolic_free(local);

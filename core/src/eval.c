@@ -611,38 +611,29 @@ static int opassign_token(int op)
 }
 
 /* Copy-on-write for `x += r`, `x -= r`, `x *= c`, `x /= c` (DESIGN 5): when
- * x's dense value is held by the store's binding alone (refs is the count
- * that means that here) and carries no attachments, nobody else can see it
+ * x's dense value is held by the store's binding alone (two references: the
+ * binding's and the caller's) and carries no attachments, nobody else can see it
  * change, so the result is written over it instead of into a new array.  r
  * is a dense array of x's shape or a scalar, c a scalar.  The arithmetic is
  * what SILC_OP_ADD / SCALE compute (1*x + (+-1)*r is x +- r exactly; x / c
  * is a scale by 1/c), so the numbers do not depend on which path ran.
  * Returns 1 when done. */
-static int update_in_place(lang_ev *V, int op, silc_value *x, int64_t refs, const silc_value *r)
+static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r)
 {
     int64_t i, n = x->m * x->n;
     int scalar = val_is_scalar(r) && !val_is_scalar(x);
     double c = scalar ? val_scalar(r) : 0;
-    if (V->explain || x->format != SILC_FMT_DENSE || x->refcount != refs || x->attach ||
+    if (V->explain || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;
     if ((op == TK_STAREQ || op == TK_SLASHEQ) && !scalar) return 0;
-    switch (op) {
-    case TK_PLUSEQ:
-        if (scalar) for (i = 0; i < n; i++) x->val[i] += c;
-        else for (i = 0; i < n; i++) x->val[i] += r->val[i];
-        break;
-    case TK_MINUSEQ:
-        if (scalar) for (i = 0; i < n; i++) x->val[i] -= c;
-        else for (i = 0; i < n; i++) x->val[i] -= r->val[i];
-        break;
-    case TK_STAREQ:
+    if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
+        double sign = op == TK_PLUSEQ ? 1 : -1; /* x + (-r) is x - r, bit for bit */
+        if (scalar) for (i = 0, c *= sign; i < n; i++) x->val[i] += c;
+        else for (i = 0; i < n; i++) x->val[i] += sign * r->val[i];
+    } else {
+        c = op == TK_STAREQ ? c : 1.0 / c; /* as apply_binary: x / c is a scale by 1/c */
         for (i = 0; i < n; i++) x->val[i] *= c;
-        break;
-    default: /* as apply_binary: a scale by 1/c */
-        c = 1.0 / c;
-        for (i = 0; i < n; i++) x->val[i] *= c;
-        break;
     }
     val_mutated(x);
     return 1;
@@ -671,8 +662,7 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     o.lname = ln;
     o.rname = rn;
     o.what = what;
-    if (s->kind == ST_OPASSIGN && update_in_place(V, s->op, cur, 2, r)) {
-        /* The store's reference and the one taken above: x is unshared. */
+    if (s->kind == ST_OPASSIGN && update_in_place(V, s->op, cur, r)) {
         val_release(r);
         return bind(V, s, s->name, cur, t0); /* hands over the reference taken above */
     } else if (s->kind == ST_OPASSIGN) {
