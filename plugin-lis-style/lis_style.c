@@ -340,7 +340,7 @@ static int solve_run(silc_call *call)
         A = M->A;
     }
     if (opt.solver == LIS_BICG) {
-        if (H->props(call->in[0])->symmetric) {
+        if (silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
             At = &A;
         } else {
             lis_matrix *T = H->attach_get(call->in[0], "lis-style.transpose");

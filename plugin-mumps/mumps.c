@@ -554,7 +554,7 @@ static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
     host->free(c.keep);
     if (inv < 0)
         return c.rc ? c.rc : host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
-    F->cond_est = host->props(call->in[0])->norm1 * inv;
+    F->cond_est = silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
     return SILC_OK;
 }
 
@@ -772,7 +772,7 @@ static int solve_accepts(const silc_call *call, const char **why)
         *why = "matrix too large for MUMPS's 32-bit indices";
         return 0;
     }
-    if (ends_with_spd(call->op_class) && !host->props(call->in[0])->symmetric) {
+    if (ends_with_spd(call->op_class) && !silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         *why = "SYM=1 needs a symmetric matrix";
         return 0;
     }

@@ -210,7 +210,7 @@ static int build_matrix(silc_call *call, const silc_view *a, int spd, Mat *out)
     TRY(MatSetType(M, MATSEQAIJ), "MatSetType");
     TRY(MatSeqAIJSetPreallocationCSR(M, ia, ja, a->val), "MatSeqAIJSetPreallocationCSR");
     /* What the host knows about A helps GAMG (CG eigenvalue estimates), MUMPS (SYM) and others. */
-    if (host->props(call->in[0])->symmetric) {
+    if (silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         TRY(MatSetOption(M, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
         TRY(MatSetOption(M, MAT_SYMMETRY_ETERNAL, PETSC_TRUE), "MatSetOption(MAT_SYMMETRY_ETERNAL)");
     }
@@ -395,7 +395,8 @@ static int solver_setup(silc_call *call, psc_solver *S, const silc_view *a)
     }
     if (fr != PC_NOERROR) return pc_failed(call, S, "KSPSetUp");
     S->direct = pc_is(pc, PCLU) || pc_is(pc, PCCHOLESKY);
-    if (S->direct && S->condest) S->cond_est = condition_estimate(S, a->n, host->props(call->in[0])->norm1);
+    if (S->direct && S->condest)
+        S->cond_est = condition_estimate(S, a->n, silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1);
     S->setup_seconds = host->now() - t0;
 done:
     return rc;
@@ -435,7 +436,7 @@ static int solve_accepts(const silc_call *call, const char **why)
         *why = "matrix too large for this PETSc's 32-bit PetscInt";
         return 0;
     }
-    if (ends_with_spd(call->op_class) && !host->props(call->in[0])->symmetric) {
+    if (ends_with_spd(call->op_class) && !silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         *why = "CG needs a symmetric matrix";
         return 0;
     }

@@ -57,7 +57,7 @@ int ss_cholmod_accepts(const silc_call *call, const char **why)
         *why = "Cholesky only: runs under the solve.*.spd classes";
         return 0;
     }
-    if (!ss_host->props(call->in[0])->symmetric) {
+    if (!silc_props_of(ss_host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         *why = "needs a symmetric matrix";
         return 0;
     }
@@ -144,7 +144,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
     cholmod_sparse A;
     cholmod_factor *L = NULL;
     ch_factor *F;
-    int sym_reused, status, rc, crude = 1;
+    int sym_reused, status, rc, crude;
     long long minor;
     *out = NULL;
     ch_sparse(a, &A);
@@ -205,11 +205,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
         ch_factor_free(F);
         return rc;
     }
-    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
-    if (ss_use_condest(condest, F->info.cond)) {
-        double inv = ss_inv_norm1(a->n, ch_apply_inv, F);
-        if (inv >= 0) F->info.cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
-    }
+    crude = ss_square_cond(call, condest, a->n, ch_apply_inv, F, &F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse Cholesky (CHOLMOD, %s, %s)",
              L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
     snprintf(F->info.note, sizeof F->info.note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",

@@ -143,7 +143,8 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
     klu_l_symbolic *S;
     kl_factor *F;
     kl_numeric *spare = NULL;
-    int sym_reused = 0, refactored = 0, crude = 1;
+    kl_apply u;
+    int sym_reused = 0, refactored = 0, crude;
     *out = NULL;
     kl_common(&c);
     F = ss_host->calloc(1, sizeof *F);
@@ -182,12 +183,8 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
         }
         F->info.rcond = F->num->rcond0 = c.rcond;
     }
-    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
-    if (ss_use_condest(condest, F->info.cond)) {
-        kl_apply u = {F, a->n};
-        double inv = ss_inv_norm1(a->n, kl_apply_inv, &u);
-        if (inv >= 0) F->info.cond = ss_host->props(call->in[0])->norm1 * inv, crude = 0;
-    }
+    u.F = F, u.n = a->n;
+    crude = ss_square_cond(call, condest, a->n, kl_apply_inv, &u, &F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse LU (KLU, BTF + AMD, %lld block%s)",
              (long long)S->nblocks, S->nblocks == 1 ? "" : "s");
     snprintf(F->info.note, sizeof F->info.note, "%s%s",

@@ -175,7 +175,7 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
     full = F->rank == (a->m < a->n ? a->m : a->n);
     F->info.cond = INFINITY;
     if (full && F->rank > 0) {
-        const silc_props *p = ss_host->props(call->in[0]);
+        const silc_props *p = silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS);
         double inv = ss_inv_norm1(F->rank, qr_apply_rinv, F);
         F->info.cond = inv >= 0 ? (F->transposed ? p->norminf : p->norm1) * inv : -1;
     }

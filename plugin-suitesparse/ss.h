@@ -85,7 +85,6 @@ silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld);
 enum { SS_CONDEST_AUTO = 0, SS_CONDEST_ALWAYS, SS_CONDEST_NEVER };
 #define SS_CONDEST_AUTO_ABOVE 1e6
 int ss_condest_mode(silc_call *call, int *mode);
-int ss_use_condest(int mode, double cheap_cond);
 
 /* Estimate of ||A^{-1}||_1 for an n x n A given by solves with A (trans = 0)
  * and A' (trans = 1) in place on x; about 5 pairs of solves.  -1 on failure. */
@@ -111,6 +110,13 @@ typedef struct ss_factor_info {
     char method[64];
     char note[160];
 } ss_factor_info;
+
+/* The condition estimate of a new square factorization, from fi->rcond (the
+ * library's cheap one, <= 0 when singular): fi->cond = 1/rcond, replaced by
+ * norm1(A) ||A^{-1}||_1 through solve when mode asks for it.  Returns 1 when
+ * fi->cond is the cheap estimate, 0 when it is Hager/Higham's. */
+int ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx, double *x, int trans),
+                   void *ctx, ss_factor_info *fi);
 
 /* The start every square solve shares: views of A and B, a decline unless A
  * is square CSR, and the condest option.  0, SILC_EDECLINE or an error. */

@@ -156,12 +156,6 @@ int ss_condest_mode(silc_call *call, int *mode)
     return SILC_OK;
 }
 
-int ss_use_condest(int mode, double cheap_cond)
-{
-    if (mode == SS_CONDEST_AUTO) return !(cheap_cond <= SS_CONDEST_AUTO_ABOVE); /* NaN, Inf too */
-    return mode == SS_CONDEST_ALWAYS;
-}
-
 /* ---- condition estimate ------------------------------------------------------ */
 
 /* The host lends the Hager-Higham estimator (ABI 1.1); this adapter lets the
@@ -182,6 +176,19 @@ double ss_inv_norm1(int64_t n, int (*solve)(void *ctx, double *x, int trans), vo
 {
     ss_est e = {solve, ctx};
     return ss_host->inv_norm1_est(n, ss_apply, &e, NULL);
+}
+
+int ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx, double *x, int trans),
+                   void *ctx, ss_factor_info *fi)
+{
+    double inv;
+    fi->cond = fi->rcond > 0 ? 1.0 / fi->rcond : INFINITY;
+    if (mode == SS_CONDEST_NEVER ||
+        (mode == SS_CONDEST_AUTO && fi->cond <= SS_CONDEST_AUTO_ABOVE)) /* NaN, Inf do estimate */
+        return 1;
+    if ((inv = ss_inv_norm1(n, solve, ctx)) < 0) return 1;
+    fi->cond = silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
+    return 0;
 }
 
 int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int condest,

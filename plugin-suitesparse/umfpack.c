@@ -82,7 +82,9 @@ int ss_umfpack_accepts(const silc_call *call, const char **why)
     return ss_accepts_csr(call, 1, why);
 }
 
-/* For the condition estimate: x := A^{-1} x or A^{-T} x, without refinement. */
+/* For the condition estimate: x := A^{-1} x or A^{-T} x, without refinement;
+ * the workspace is allocated by the first solve, so a factorization that
+ * makes no estimate allocates none. */
 typedef struct um_apply {
     const silc_view *a;
     void *numeric;
@@ -97,32 +99,20 @@ static int um_apply_inv(void *ctx, double *x, int trans)
     double info[UMFPACK_INFO];
     int64_t n = u->a->n;
     /* The factors are of A', so A^{-1} is the UMFPACK_At system. */
-    int sys = trans ? UMFPACK_A : UMFPACK_At;
-    int st = (int)umfpack_dl_wsolve(sys, u->a->rowptr, u->a->colind, u->a->val, u->y, x,
-                                    u->numeric, u->control, info, u->wi, u->w);
+    int sys = trans ? UMFPACK_A : UMFPACK_At, st;
+    if (!u->w) {
+        if (!u->y) u->y = ss_host->alloc((size_t)n * 2 * sizeof(double));
+        if (!u->wi) u->wi = ss_host->alloc((size_t)n * sizeof(SuiteSparse_long));
+        if (!u->y || !u->wi) return -1;
+        u->w = u->y + n;
+        umfpack_dl_defaults(u->control);
+        u->control[UMFPACK_IRSTEP] = 0;
+    }
+    st = (int)umfpack_dl_wsolve(sys, u->a->rowptr, u->a->colind, u->a->val, u->y, x, u->numeric,
+                                u->control, info, u->wi, u->w);
     if (st < 0) return -1;
     memcpy(x, u->y, (size_t)n * sizeof(double));
     return 0;
-}
-
-static double um_condest(const silc_view *a, void *numeric, double norm1)
-{
-    um_apply u;
-    double inv = -1;
-    int64_t n = a->n;
-    u.a = a;
-    u.numeric = numeric;
-    umfpack_dl_defaults(u.control);
-    u.control[UMFPACK_IRSTEP] = 0;
-    u.y = ss_host->alloc((size_t)n * 2 * sizeof(double));
-    u.wi = ss_host->alloc((size_t)n * sizeof(SuiteSparse_long));
-    if (u.y && u.wi) {
-        u.w = u.y + n;
-        inv = ss_inv_norm1(n, um_apply_inv, &u);
-    }
-    ss_host->free(u.y);
-    ss_host->free(u.wi);
-    return inv < 0 ? -1 : norm1 * inv;
 }
 
 static const char *um_ordering_name(double strategy, double ordering)
@@ -177,7 +167,8 @@ static int um_factor_new(silc_call *call, const silc_view *a, int tag, int conde
     ss_symbolic *entry;
     um_symbolic *local, *s;
     um_factor *F;
-    int reused, st, rc, crude = 1; /* info.cond is 1/rcond, not Hager/Higham's estimate */
+    um_apply u = {0};
+    int reused, st, rc, crude;
     *out = NULL;
     umfpack_dl_defaults(control);
     control[UMFPACK_STRATEGY] = tag;
@@ -199,11 +190,10 @@ static int um_factor_new(silc_call *call, const silc_view *a, int tag, int conde
         goto done;
     }
     F->info.rcond = info[UMFPACK_RCOND];
-    F->info.cond = F->info.rcond > 0 ? 1.0 / F->info.rcond : INFINITY;
-    if (ss_use_condest(condest, F->info.cond)) {
-        double c = um_condest(a, F->numeric, ss_host->props(call->in[0])->norm1);
-        if (c >= 0) F->info.cond = c, crude = 0;
-    }
+    u.a = a, u.numeric = F->numeric;
+    crude = ss_square_cond(call, condest, a->n, um_apply_inv, &u, &F->info);
+    ss_host->free(u.y);
+    ss_host->free(u.wi);
     snprintf(F->info.method, sizeof F->info.method, "%s", s->method);
     snprintf(F->info.note, sizeof F->info.note, "%s%s",
              reused ? "symbolic analysis reused (same pattern); " : "",

@@ -17,7 +17,10 @@
  *   - symmetry alone, then the norms, each agree with brute force, and so
  *     does val_props on a fresh copy that computes everything at once;
  *   - the backward error's ||A||_inf, taken from the residual's pass when
- *     the norms are not known, equals the one from the properties.
+ *     the norms are not known, equals the one from the properties;
+ *   - a plugin asking silc_props_of() for the symmetry gets the right answer
+ *     and (for CSR) no norms computed; on a host table of ABI 1.3, without
+ *     props_part, it gets every part.
  */
 #include "check.h"
 
@@ -28,6 +31,7 @@
 #include <string.h>
 
 #include "accuracy.h"
+#include "engine.h"
 #include "envelope.h"
 #include "value.h"
 #include "silc.h"
@@ -151,6 +155,28 @@ static silc_value *value_of(const silc_envelope_t *e)
 }
 
 /* All the checks on one matrix given as an envelope. */
+/* What a plugin sees through the host table (silc_plugin.h's silc_props_of). */
+static void check_plugin_view(const char *what, const silc_envelope_t *e, const truth *t)
+{
+    silc_host_api old = *host_api();
+    silc_value *u = value_of(e), *o = value_of(e);
+    const silc_props *p;
+    if (!u || !o) goto out;
+    p = silc_props_of(host_api(), u, SILC_PROPS_SYMMETRY);
+    CHECK(p->symmetric == t->symmetric, "%s: plugin's symmetric %d, truth %d", what, p->symmetric,
+          t->symmetric);
+    CHECK(u->format != SILC_FMT_CSR || u->props_have == SILC_PROPS_SYMMETRY,
+          "%s: a plugin asking for the symmetry got parts %d", what, u->props_have);
+    old.struct_size = SILC_HOST_NEEDS(dense_new_uninit); /* a 1.3 host */
+    p = silc_props_of(&old, o, SILC_PROPS_SYMMETRY);
+    CHECK(p->symmetric == t->symmetric && o->props_have == SILC_PROPS_ALL,
+          "%s: on a 1.3 host symmetric %d (truth %d), parts %d", what, p->symmetric, t->symmetric,
+          o->props_have);
+out:
+    val_release(u);
+    val_release(o);
+}
+
 static void check_matrix(const char *what, const silc_envelope_t *e)
 {
     silc_value *v = value_of(e), *w = value_of(e);
@@ -159,10 +185,11 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
     const silc_props *p;
     if (!v || !w) goto out;
     t = brute(v);
+    check_plugin_view(what, e, &t);
     k = (double)(v->format == SILC_FMT_CSR ? v->rowptr[v->m] : v->m * v->n);
-    p = val_props_part(v, PROPS_SHAPE);
+    p = val_props_part(v, SILC_PROPS_SHAPE);
     check_shape(what, p, &t);
-    CHECK(v->format != SILC_FMT_CSR || v->props_have == PROPS_SHAPE,
+    CHECK(v->format != SILC_FMT_CSR || v->props_have == SILC_PROPS_SHAPE,
           "%s: asking for the shape computed more (%d)", what, v->props_have);
     /* The shape's pass also filled the scan a right-hand side or the scaling
      * hook asks for. */
@@ -170,7 +197,7 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
               (t.has_nonfinite ? !(val_max_abs(v) < INFINITY) : val_max_abs(v) == t.maxabs),
           "%s: scan max %.17g nonfinite %d, truth %.17g %d", what, val_max_abs(v), val_has_nonfinite(v),
           t.maxabs, t.has_nonfinite);
-    p = val_props_part(v, PROPS_SYMMETRY);
+    p = val_props_part(v, SILC_PROPS_SYMMETRY);
     CHECK(p->symmetric == t.symmetric, "%s: symmetric %d, truth %d", what, p->symmetric, t.symmetric);
     /* The backward error before the norms are known (||A||_inf from the
      * residual's pass) and after (from the properties) must agree. */
@@ -181,7 +208,7 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
             int64_t i;
             for (i = 0; i < v->n; i++) x->val[i] = 1 + (double)(i % 7) / 8, b->val[i] = (double)(i % 3);
             be1 = acc_backward_error(v, b, x);
-            CHECK(!(v->props_have & PROPS_NORMS) || v->format != SILC_FMT_CSR,
+            CHECK(!(v->props_have & SILC_PROPS_NORMS) || v->format != SILC_FMT_CSR,
                   "%s: the backward error computed the norms", what);
             p = val_props(v);
             be2 = acc_backward_error(v, b, x);
@@ -194,7 +221,7 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
     p = val_props(v);
     check_shape(what, p, &t);
     check_norms(what, p, &t, k);
-    CHECK(v->props_have == PROPS_ALL, "%s: not all parts known (%d)", what, v->props_have);
+    CHECK(v->props_have == SILC_PROPS_ALL, "%s: not all parts known (%d)", what, v->props_have);
     p = val_props(w); /* everything at once, in the other order */
     check_shape(what, p, &t);
     check_norms(what, p, &t, k);

@@ -167,7 +167,7 @@ double acc_backward_error(const silc_value *A, const silc_value *B, const silc_v
      * solve already made of it (val_max_abs), not a properties pass.  A's
      * comes from its properties when they hold it, else from the residual's
      * pass over A. */
-    double nA = (A->props_have & PROPS_NORMS) ? A->props.norminf : -1;
+    double nA = (A->props_have & SILC_PROPS_NORMS) ? A->props.norminf : -1;
     double nB = B->n == 1 ? val_max_abs(B) : val_props(B)->norminf;
     double nX, nR, be = -1;
     const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;

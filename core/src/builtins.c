@@ -188,7 +188,7 @@ static int bi_count(lang_ev *V, const ast_node *call, silc_value **a, int n, sil
     (void)n;
     if (!strcmp(call->name, "rows")) x = (double)a[0]->m;
     else if (!strcmp(call->name, "cols")) x = (double)a[0]->n;
-    else x = (double)val_props_part(a[0], PROPS_SHAPE)->nnz;
+    else x = (double)val_props_part(a[0], SILC_PROPS_SHAPE)->nnz;
     *out = val_scalar_new(x);
     return *out ? 0 : oom(V);
 }
@@ -525,7 +525,7 @@ silc_value *bi_to_csr(const silc_value *a)
         val_csr_set_nnz(r, a->rowptr[a->m]);
         return r;
     }
-    cap = (int64_t)val_props_part(a, PROPS_SHAPE)->nnz;
+    cap = (int64_t)val_props_part(a, SILC_PROPS_SHAPE)->nnz;
     r = val_csr_new(a->m, a->n, cap);
     if (!r) return NULL;
     for (i = 0; i < a->m; i++) {

@@ -89,7 +89,7 @@ static int classify(const silc_call *call, const char *out[4], char *why, size_t
     B = call->nin > 1 ? call->in[1] : NULL;
     switch (call->op) {
     case SILC_OP_SOLVE:
-        p = val_props_part(A, PROPS_SHAPE); /* symmetry only if the shape leaves it open */
+        p = val_props_part(A, SILC_PROPS_SHAPE); /* symmetry only if the shape leaves it open */
         if (!p) return 0;
         sparse = A->format == SILC_FMT_CSR;
         if (A->m != A->n) {
@@ -108,13 +108,13 @@ static int classify(const silc_call *call, const char *out[4], char *why, size_t
             snprintf(band_reason, sizeof band_reason, "banded (kl=%lld, ku=%lld)",
                      (long long)p->kl, (long long)p->ku);
             reason = band_reason;
-        } else if (p->pos_diag && val_props_part(A, PROPS_SYMMETRY)->symmetric) {
+        } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric) {
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
             reason = "symmetric with positive diagonal";
         } else {
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
-            reason = why && val_props_part(A, PROPS_SYMMETRY)->symmetric
+            reason = why && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric
                          ? "symmetric, some diagonal entry <= 0"
                          : "general";
         }

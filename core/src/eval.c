@@ -700,7 +700,7 @@ static int exec_who(lang_ev *V)
         silc_value *v = store_get(&V->E->store, names[i]);
         ev_shape(v, shape, sizeof shape);
         sb_printf(&b, "%-*s  %-*s  %-6s  nnz %lld\n", (int)w, names[i], (int)sw, shape,
-                  val_format_name(v->format), (long long)val_props_part(v, PROPS_SHAPE)->nnz);
+                  val_format_name(v->format), (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
     }
     eng_print(V->E, sb_str(&b));
     sb_free(&b);
@@ -794,7 +794,7 @@ static int exec_info(lang_ev *V, const ast_node *s)
     sb_init(&b);
     ev_shape(v, shape, sizeof shape);
     sb_printf(&b, "%s: %s %s, nnz %lld\n", s->name, shape, val_format_name(v->format),
-              (long long)val_props_part(v, PROPS_SHAPE)->nnz);
+              (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
     if (!in) {
         sb_puts(&b, "  deposited by PUT (no statement of this session computed it)\n");
     } else {

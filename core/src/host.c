@@ -174,6 +174,11 @@ static const silc_props *h_props(const silc_value *v)
     return val_props(v);
 }
 
+static const silc_props *h_props_part(const silc_value *v, int parts)
+{
+    return val_props_part(v, parts & SILC_PROPS_ALL);
+}
+
 static uint64_t h_id(const silc_value *v)
 {
     return v ? v->id : 0;
@@ -229,6 +234,7 @@ static const silc_host_api host_table = {
     ref_inv_norm1_start,
     ref_inv_norm1_est_block,
     h_dense_new_uninit,
+    h_props_part,
 };
 
 const silc_host_api *host_api(void)

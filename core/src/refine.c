@@ -42,7 +42,7 @@ int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const c
 {
     silc_view w;
     int64_t i, j, p;
-    if (!v || !(matrix ? val_props_part(v, PROPS_SHAPE)->has_nonfinite : val_has_nonfinite(v))) return 0;
+    if (!v || !(matrix ? val_props_part(v, SILC_PROPS_SHAPE)->has_nonfinite : val_has_nonfinite(v))) return 0;
     val_view(v, &w);
     for (i = 0; i < w.m; i++)
         for (j = 0; j < w.n; j++) {

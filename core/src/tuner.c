@@ -454,8 +454,8 @@ static void signature(tuner *T)
     int i;
     for (i = 0; i < T->ncur; i++) {
         const t_class *c = &T->cur[i];
-        snprintf(buf, sizeof buf, "%s %lldx%lld nnz %lld rhs %lld", c->cls,
-                 (long long)c->a->m, (long long)c->a->n, (long long)val_props_part(c->a, PROPS_SHAPE)->nnz,
+        snprintf(buf, sizeof buf, "%s %lldx%lld nnz %lld rhs %lld", c->cls, (long long)c->a->m,
+                 (long long)c->a->n, (long long)val_props_part(c->a, SILC_PROPS_SHAPE)->nnz,
                  (long long)c->b->n);
         h = (h ^ tuner_hash(buf)) * 1099511628211ull;
     }

@@ -668,27 +668,27 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     silc_props *p;
     if (!v) return NULL;
     p = &v->props;
-    if ((parts & PROPS_SHAPE) && !(v->props_have & PROPS_SHAPE) && v->format == SILC_FMT_CSR) {
+    if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR) {
         shape_start(v, p);
         shape_csr(v, p);
-        v->props_have |= PROPS_SHAPE;
+        v->props_have |= SILC_PROPS_SHAPE;
     }
-    if ((parts & (PROPS_SHAPE | PROPS_NORMS)) & ~v->props_have) {
-        int shape = !(v->props_have & PROPS_SHAPE);
-        if (compute_norms(v, p, shape) == 0) v->props_have |= PROPS_NORMS;
-        v->props_have |= shape ? PROPS_SHAPE : 0;
+    if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
+        int shape = !(v->props_have & SILC_PROPS_SHAPE);
+        if (compute_norms(v, p, shape) == 0) v->props_have |= SILC_PROPS_NORMS;
+        v->props_have |= shape ? SILC_PROPS_SHAPE : 0;
     }
-    if ((parts & PROPS_SYMMETRY) && !(v->props_have & PROPS_SYMMETRY)) {
+    if ((parts & SILC_PROPS_SYMMETRY) && !(v->props_have & SILC_PROPS_SYMMETRY)) {
         int sym = value_symmetric(v);
         p->symmetric = sym > 0;
-        if (sym >= 0) v->props_have |= PROPS_SYMMETRY;
+        if (sym >= 0) v->props_have |= SILC_PROPS_SYMMETRY;
     }
     return p;
 }
 
 const silc_props *val_props(const silc_value *v)
 {
-    return val_props_part(v, PROPS_ALL);
+    return val_props_part(v, SILC_PROPS_ALL);
 }
 
 /* What val_scan has cached (value.h's scan_ready). */
@@ -720,7 +720,7 @@ static void val_scan(const silc_value *cv, int level)
 {
     silc_value *v = (silc_value *)cv; /* the cache is not part of the contents */
     if (v->scan_ready >= level) return;
-    if ((v->props_have & PROPS_NORMS) || v->format == SILC_FMT_BAND) {
+    if ((v->props_have & SILC_PROPS_NORMS) || v->format == SILC_FMT_BAND) {
         const silc_props *p = val_props(v);
         v->scan_maxabs = p->maxabs;
         v->scan_nonfinite = p->has_nonfinite;

@@ -40,7 +40,7 @@ struct silc_value {
     int64_t nnz;             /* csr: entries in use; dense m*n; band ld*n */
     int64_t cap;             /* csr: capacity of colind/val */
     int64_t kl, ku, ld;
-    int props_have;          /* PROPS_* bits: the parts of props that are valid */
+    int props_have;          /* SILC_PROPS_* bits: the parts of props that are valid */
     silc_props props;
     int scan_ready;          /* SCAN_FINITE: scan_nonfinite is known; SCAN_MAXABS: both */
     int scan_nonfinite;
@@ -72,10 +72,8 @@ void val_release(silc_value *v);          /* frees at zero, attachments first; N
 
 void val_view(const silc_value *v, silc_view *out);
 const silc_props *val_props(const silc_value *v); /* computes and caches on first call */
-/* Only some parts of the properties, each computed and cached when first
- * asked for (value.c says why): PROPS_SHAPE is every field but symmetric and
- * the norms (norm1, norminf, normfro, maxabs). */
-enum { PROPS_SHAPE = 1, PROPS_SYMMETRY = 2, PROPS_NORMS = 4, PROPS_ALL = 7 };
+/* Only some parts of the properties (SILC_PROPS_*, silc_plugin.h), each
+ * computed and cached when first asked for (value.c says why). */
 const silc_props *val_props_part(const silc_value *v, int parts);
 /* Any NaN or Inf among the stored entries, and the largest |entry| (NaN if
  * any is NaN), from one cached scan: what a solve needs of its right-hand
