@@ -246,12 +246,14 @@ static void check_csr(const char *what, int64_t m, int64_t n, const int64_t *rp,
 
 /* A 200 x 200 tridiagonal matrix, symmetric, then with one entry off in
  * rows (98, 99) that the symmetry probe's sample (every third row from 1)
- * does not visit, so the full walk must find it; then one it does visit. */
+ * does not visit, so the full walk must find it; then one it does visit;
+ * then with (99, 98) left out of the pattern, so that its mirror (98, 99)
+ * is the only entry no lower entry meets. */
 static void tridiagonal(void)
 {
     enum { N = 200 };
-    static int64_t rp[N + 1], ci[3 * N];
-    static double x[3 * N];
+    static int64_t rp[N + 1], ci[3 * N], rp2[N + 1], ci2[3 * N];
+    static double x[3 * N], x2[3 * N];
     int64_t i, k = 0, at = -1, probed = -1;
     for (i = 0; i < N; i++) {
         rp[i] = k;
@@ -267,6 +269,11 @@ static void tridiagonal(void)
     check_csr("tridiagonal 200, (99, 98) off (not in the probe's rows)", N, N, rp, ci, x);
     x[at] = -1 - 0.01 * 99, x[probed] = -5;
     check_csr("tridiagonal 200, (100, 99) off (in the probe's rows)", N, N, rp, ci, x);
+    x[probed] = -1 - 0.01 * 100;
+    for (i = 0; i <= N; i++) rp2[i] = rp[i] - (i > 99);
+    memcpy(ci2, ci, (size_t)at * sizeof *ci), memcpy(ci2 + at, ci + at + 1, (size_t)(k - at - 1) * sizeof *ci);
+    memcpy(x2, x, (size_t)at * sizeof *x), memcpy(x2 + at, x + at + 1, (size_t)(k - at - 1) * sizeof *x);
+    check_csr("tridiagonal 200 without (99, 98): (98, 99) unmet", N, N, rp2, ci2, x2);
 }
 
 static void edge_cases(void)

