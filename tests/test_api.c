@@ -232,6 +232,42 @@ static void test_csr_errors(void)
         h.nnz = 2;
         CHECK(SILC_PUT("h", &h) != 0, "unsorted hand-made CSR accepted");
         CHECK(contains(silc_errmsg(), "not sorted"), "message: %s", silc_errmsg());
+        /* PUT checks as it copies (val_csr_fill_checked); each failure, in
+         * any row, is named as env_check names it, and the name keeps its
+         * old value. */
+        {
+            int64_t rp3[4] = {0, 1, 2, 5}, ci3[5] = {0, 1, 0, 1, 2};
+            double x3[5] = {1, 2, 3, 4, 5};
+            silc_envelope_t g = h, out;
+            static const struct {
+                int at;
+                int64_t col;
+                const char *msg;
+            } bad[] = {{3, 0, "columns of row 2 are duplicated"},
+                       {4, 3, "column index 3 out of range [0, 3) in row 2"},
+                       {2, -1, "column index -1 out of range [0, 3) in row 2"},
+                       {0, 5, "column index 5 out of range [0, 3) in row 0"},
+                       {4, 0, "columns of row 2 are not sorted"}};
+            size_t b;
+            g.m = g.n = 3, g.rowptr = rp3, g.colind = ci3, g.values = x3, g.nnz = 5;
+            CHECK(SILC_PUT("g", &g) == 0, "good 3x3 CSR refused: %s", silc_errmsg());
+            for (b = 0; b < sizeof bad / sizeof bad[0]; b++) {
+                int64_t keep = ci3[bad[b].at];
+                ci3[bad[b].at] = bad[b].col;
+                CHECK(SILC_PUT("g", &g) != 0 && contains(silc_errmsg(), bad[b].msg), "%s: %s", bad[b].msg,
+                      silc_errmsg());
+                ci3[bad[b].at] = keep;
+            }
+            rp3[2] = 0;
+            CHECK(SILC_PUT("g", &g) != 0 && contains(silc_errmsg(), "rowptr decreases at row 1"),
+                  "decreasing rowptr: %s", silc_errmsg());
+            rp3[2] = 2;
+            CHECK(SILC_GET(&out, "g") == 0 && out.format == SILC_CSR && out.rowptr[3] == 5 &&
+                      out.colind[4] == 2 && out.values[4] == 5,
+                  "g changed by refused PUTs: %s", silc_errmsg());
+            silc_envelope_free(&out);
+            SILC_EXEC("clear g");
+        }
         h.format = (silc_format_t)7;
         CHECK(SILC_PUT("h", &h) != 0 && contains(silc_errmsg(), "unknown envelope format"),
               "unknown format: %s", silc_errmsg());

@@ -143,6 +143,7 @@ static void check_norms(const char *what, const silc_props *p, const truth *t, d
           t->norm1, p->norminf, t->norminf, p->normfro, t->normfro, p->maxabs, t->maxabs);
 }
 
+/* The value silc_put makes of e: a CSR one has its shape from the copy. */
 static silc_value *value_of(const silc_envelope_t *e)
 {
     silc_value *v = NULL;
@@ -154,12 +155,29 @@ static silc_value *value_of(const silc_envelope_t *e)
     return v;
 }
 
+/* The same matrix as a value an operation builds: nothing known of it. */
+static silc_value *value_built(const silc_envelope_t *e)
+{
+    silc_value *v;
+    if (e->format != SILC_CSR) return value_of(e);
+    v = val_csr_new(e->m, e->n, e->rowptr[e->m]);
+    CHECK(v != NULL, "val_csr_new");
+    if (!v) return NULL;
+    memcpy(v->rowptr, e->rowptr, (size_t)(e->m + 1) * sizeof *v->rowptr);
+    if (e->rowptr[e->m] > 0) {
+        memcpy(v->colind, e->colind, (size_t)e->rowptr[e->m] * sizeof *v->colind);
+        memcpy(v->val, e->values, (size_t)e->rowptr[e->m] * sizeof *v->val);
+    }
+    val_csr_set_nnz(v, e->rowptr[e->m]);
+    return v;
+}
+
 /* All the checks on one matrix given as an envelope. */
 /* What a plugin sees through the host table (silc_plugin.h's silc_props_of). */
 static void check_plugin_view(const char *what, const silc_envelope_t *e, const truth *t)
 {
     silc_host_api old = *host_api();
-    silc_value *u = value_of(e), *o = value_of(e);
+    silc_value *u = value_built(e), *o = value_built(e);
     const silc_props *p;
     if (!u || !o) goto out;
     p = silc_props_of(host_api(), u, SILC_PROPS_SYMMETRY);
@@ -179,13 +197,24 @@ out:
 
 static void check_matrix(const char *what, const silc_envelope_t *e)
 {
-    silc_value *v = value_of(e), *w = value_of(e);
+    silc_value *v = value_built(e), *w = value_built(e), *put = value_of(e);
     truth t;
     double k;
     const silc_props *p;
-    if (!v || !w) goto out;
+    if (!v || !w || !put) goto out;
     t = brute(v);
     check_plugin_view(what, e, &t);
+    if (put->format == SILC_FMT_CSR) {
+        /* silc_put's copy computed the shape (val_csr_fill_checked), and the
+         * scan with it. */
+        CHECK(put->props_have == SILC_PROPS_SHAPE, "%s: put's value knows parts %d, not the shape",
+              what, put->props_have);
+        check_shape(what, &put->props, &t);
+        CHECK(val_has_nonfinite(put) == t.has_nonfinite &&
+                  (t.has_nonfinite ? !(val_max_abs(put) < INFINITY) : val_max_abs(put) == t.maxabs),
+              "%s: put's scan max %.17g nonfinite %d, truth %.17g %d", what, val_max_abs(put),
+              val_has_nonfinite(put), t.maxabs, t.has_nonfinite);
+    }
     k = (double)(v->format == SILC_FMT_CSR ? v->rowptr[v->m] : v->m * v->n);
     p = val_props_part(v, SILC_PROPS_SHAPE);
     check_shape(what, p, &t);
@@ -230,6 +259,7 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
 out:
     val_release(v);
     val_release(w);
+    val_release(put);
 }
 
 static void check_csr(const char *what, int64_t m, int64_t n, const int64_t *rp, const int64_t *ci,

@@ -82,13 +82,11 @@ int silc_envelope_vector(silc_envelope_t *e, int64_t n, const double *x)
     return silc_envelope_dense(e, n, 1, x);
 }
 
-/* Checks rowptr and column range.  Sortedness is checked by the callers,
- * which differ: the constructor sorts, env_to_value insists. */
-static int csr_check_structure(int64_t m, int64_t n, const int64_t *rowptr,
-                               const int64_t *colind, const double *values,
-                               char *err, size_t errlen)
+/* Checks the size, rowptr, and that the arrays its last entry counts exist. */
+static int csr_check_rowptr(int64_t m, int64_t n, const int64_t *rowptr, const int64_t *colind,
+                            const double *values, char *err, size_t errlen)
 {
-    int64_t i, k, nnz;
+    int64_t i, nnz;
     if (m < 0 || n < 0) {
         snprintf(err, errlen, "invalid size %lldx%lld", (long long)m, (long long)n);
         return -1;
@@ -119,6 +117,17 @@ static int csr_check_structure(int64_t m, int64_t n, const int64_t *rowptr,
         snprintf(err, errlen, "too many entries (%lld)", (long long)nnz);
         return -1;
     }
+    return 0;
+}
+
+/* Checks rowptr and column range.  Sortedness is checked by the callers,
+ * which differ: the constructor sorts, env_to_value insists. */
+static int csr_check_structure(int64_t m, int64_t n, const int64_t *rowptr,
+                               const int64_t *colind, const double *values,
+                               char *err, size_t errlen)
+{
+    int64_t i, k;
+    if (csr_check_rowptr(m, n, rowptr, colind, values, err, errlen)) return -1;
     for (i = 0; i < m; i++)
         for (k = rowptr[i]; k < rowptr[i + 1]; k++)
             if (colind[k] < 0 || colind[k] >= n) {
@@ -417,40 +426,45 @@ int env_check(const silc_envelope_t *e, char *err, size_t errlen)
     }
 }
 
+int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
+{
+    if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
+    if (val_csr_fill_checked(v, e->rowptr, e->colind, e->values) == 0) return 0;
+    /* The fast pass only knows that a row failed; env_check finds it again
+     * and says how. */
+    if (env_check(e, err, errlen) == 0)
+        snprintf(err, errlen, "CSR arrays refused with no reason found (internal error)");
+    return -1;
+}
+
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
 {
-    silc_value *v = NULL;
+    silc_value *v;
     int64_t count;
     *out = NULL;
-    if (env_check(e, err, errlen)) return -1;
-    switch (e->format) {
-    case SILC_DENSE:
-        if (!(v = val_dense_new(e->m, e->n))) break;
-        count = e->m * e->n;
-        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
-        *out = v;
-        return 0;
-    case SILC_CSR:
-        count = e->rowptr[e->m];
-        if (!(v = val_csr_new(e->m, e->n, count))) break;
-        memcpy(v->rowptr, e->rowptr, (size_t)(e->m + 1) * sizeof(silc_index));
-        if (count > 0) {
-            memcpy(v->colind, e->colind, (size_t)count * sizeof(silc_index));
-            memcpy(v->val, e->values, (size_t)count * sizeof(double));
+    if (e && e->format == SILC_CSR) {
+        /* Checked while copied, not in a pass of its own (env_csr_fill). */
+        if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
+        v = val_new_unset(SILC_FMT_CSR, e->m, e->n, e->rowptr[e->m], 0, 0);
+        if (v && env_csr_fill(v, e, err, errlen)) {
+            val_release(v);
+            return -1;
         }
-        val_csr_set_nnz(v, count);
-        *out = v;
-        return 0;
-    default: /* SILC_BAND: env_check refused every other format */
-        if (!(v = val_band_new(e->m, e->n, e->kl, e->ku))) break;
-        count = band_count(e->n, e->kl, e->ku);
-        if (count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
-        *out = v;
-        return 0;
+    } else {
+        if (env_check(e, err, errlen)) return -1;
+        /* Dense or band (env_check refused every other format): one array,
+         * copied whole. */
+        count = e->format == SILC_DENSE ? e->m * e->n : band_count(e->n, e->kl, e->ku);
+        v = val_new_unset((int)e->format, e->m, e->n, 0, e->kl, e->ku);
+        if (v && count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
     }
-    snprintf(err, errlen, "out of memory copying a %lldx%lld %s matrix", (long long)e->m,
-             (long long)e->n, val_format_name((int)e->format));
-    return -1;
+    if (!v) {
+        snprintf(err, errlen, "out of memory copying a %lldx%lld %s matrix", (long long)e->m,
+                 (long long)e->n, val_format_name((int)e->format));
+        return -1;
+    }
+    *out = v;
+    return 0;
 }
 
 int env_from_value(const silc_value *v, silc_envelope_t *e)

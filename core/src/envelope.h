@@ -21,6 +21,11 @@ int env_check(const silc_envelope_t *e, char *err, size_t errlen);
  * shapes, array presence, CSR rowptr/colind consistency and sorted,
  * duplicate-free rows.  On failure writes the reason to err. */
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen);
+/* The CSR part of env_to_value for a value made for e's rowptr[m] entries:
+ * checks and fills it from e's arrays (which may be the value's own), with
+ * the value's shape computed on the way (val_csr_fill_checked).  0, or -1
+ * with the reason in err. */
+int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen);
 /* Copies a value into a freshly built envelope of the same format. */
 int env_from_value(const silc_value *v, silc_envelope_t *e);
 

@@ -656,9 +656,11 @@ static void view_envelope(const proto_desc *d, double *values, int64_t *rowptr, 
     e->ku = d->ku;
 }
 
-/* Checks received arrays as embedded silc_put does, after rowptr[m] == nnz. */
-static int check_arrays(const proto_desc *d, const char *name, double *values, int64_t *rowptr,
-                        int64_t *colind, char *err, size_t errlen)
+/* Checks received arrays as embedded silc_put does, after rowptr[m] == nnz.
+ * When they are a value's own (v), a CSR value gets its shape in the same
+ * pass, as there. */
+static int check_arrays(const proto_desc *d, const char *name, silc_value *v, double *values,
+                        int64_t *rowptr, int64_t *colind, char *err, size_t errlen)
 {
     silc_envelope_t view;
     char why[512];
@@ -669,7 +671,8 @@ static int check_arrays(const proto_desc *d, const char *name, double *values, i
         return perr(PROTO_REFUSED, err, errlen, "'%s': rowptr[m] = %lld but the descriptor "
                     "declares %lld entries", name, (long long)rowptr[d->m], (long long)d->nnz);
     view_envelope(d, values, rowptr, colind, &view);
-    if (env_check(&view, why, sizeof why))
+    if (v && d->format == SILC_CSR ? env_csr_fill(v, &view, why, sizeof why)
+                                   : env_check(&view, why, sizeof why))
         return perr(PROTO_REFUSED, err, errlen, "'%s': %s", name, why);
     return 0;
 }
@@ -690,12 +693,11 @@ int proto_read_value(proto_stream *s, const proto_request *r, silc_value **out, 
         return skip_refused(s, r->layout.total, err, errlen);
     }
     rc = recv_arrays(s, &r->layout, v->rowptr, v->colind, v->val, err, errlen);
-    if (!rc) rc = check_arrays(d, r->text, v->val, v->rowptr, v->colind, err, errlen);
+    if (!rc) rc = check_arrays(d, r->text, v, v->val, v->rowptr, v->colind, err, errlen);
     if (rc) {
         val_release(v);
         return rc;
     }
-    if (d->format == SILC_CSR) val_csr_set_nnz(v, d->nnz);
     *out = v;
     return 0;
 }
@@ -761,7 +763,7 @@ int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, c
         e->kl = desc.kl;
         e->ku = desc.ku;
         rc = recv_arrays(s, &L, e->rowptr, e->colind, e->values, err, errlen);
-        if (!rc && check_arrays(&desc, "VALUE", e->values, e->rowptr, e->colind, err, errlen))
+        if (!rc && check_arrays(&desc, "VALUE", NULL, e->values, e->rowptr, e->colind, err, errlen))
             rc = PROTO_FATAL;
         if (rc) silc_envelope_free(e);
         return rc;

@@ -418,47 +418,107 @@ static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros,
 
 static void scan_from_bits(silc_value *v, uint64_t maxbits);
 
-/* The shape of a CSR value without visiting its column indices: rows are
- * sorted, so a row's first and last nonzero give its band and triangle
- * flags, and its diagonal entry is found by bisection; the values get one
- * branch-free pass for the zero count, NaN/Inf and the largest entry.
- * 0.12 ms on memplus, where all the properties took 0.44. */
-static void shape_csr(const silc_value *v, silc_props *p)
+/* The shape's starting answers, before any entry disproves them. */
+static void shape_start(const silc_value *v, silc_props *p)
 {
-    /* Locals, not p's fields: p's int64_t fields could alias colind, and
-     * the compiler would reload them on every row. */
-    const silc_index *rp = v->rowptr, *ci = v->colind;
-    const double *x = v->val;
-    int64_t i, kl = 0, ku = 0, pos_diag = 0, zeros = 0;
-    uint64_t maxbits = max_abs_bits(x, v->nnz, 1, &zeros);
-    int diagonal = 1, lower = 1, upper = 1;
-    /* The same pass answers the scan (largest entry, NaN/Inf) the scaling
-     * hook asks of the matrix next. */
-    scan_from_bits((silc_value *)v, maxbits);
-    p->has_nonfinite = v->scan_nonfinite;
-    for (i = 0; i < v->m; i++) {
-        int64_t f, l;
-        for (f = rp[i]; f < rp[i + 1] && x[f] == 0; f++) {}
-        if (f == rp[i + 1]) continue;
-        for (l = rp[i + 1] - 1; x[l] == 0; l--) {}
-        diagonal &= ci[f] == i && ci[l] == i;
-        lower &= ci[l] <= i;
-        upper &= ci[f] >= i;
-        ku = ci[l] - i > ku ? ci[l] - i : ku;
-        kl = i - ci[f] > kl ? i - ci[f] : kl;
-        if (ci[f] <= i && ci[l] >= i) {
-            while (f < l) { /* first position in [f, l] with column >= i */
-                int64_t mid = f + (l - f) / 2;
-                if (ci[mid] < i) f = mid + 1;
-                else l = mid;
-            }
-            pos_diag += ci[f] == i && x[f] > 0;
+    p->square = v->m == v->n;
+    p->diagonal = p->lower = p->upper = 1;
+    p->kl = p->ku = p->nnz = 0;
+    p->has_nonfinite = 0;
+}
+
+/* What a pass over a CSR value's rows gathers for the shape.  A local of
+ * that pass: p's int64_t fields could alias colind, and the compiler would
+ * reload them on every row. */
+typedef struct shape_rows {
+    int64_t kl, ku, pos_diag;
+    int diagonal, lower, upper;
+} shape_rows;
+
+/* Row i (entries begin..end-1) of a CSR value with sorted rows: its first
+ * and last nonzero give the band and triangle flags, and its diagonal entry
+ * is found by bisection, so the row's other column indices are not read. */
+static inline void shape_row(shape_rows *s, int64_t i, const silc_index *ci, const double *x,
+                             int64_t begin, int64_t end)
+{
+    int64_t f, l;
+    for (f = begin; f < end && x[f] == 0; f++) {}
+    if (f == end) return;
+    for (l = end - 1; x[l] == 0; l--) {}
+    s->diagonal &= ci[f] == i && ci[l] == i;
+    s->lower &= ci[l] <= i;
+    s->upper &= ci[f] >= i;
+    s->ku = ci[l] - i > s->ku ? ci[l] - i : s->ku;
+    s->kl = i - ci[f] > s->kl ? i - ci[f] : s->kl;
+    if (ci[f] <= i && ci[l] >= i) {
+        while (f < l) { /* first position in [f, l] with column >= i */
+            int64_t mid = f + (l - f) / 2;
+            if (ci[mid] < i) f = mid + 1;
+            else l = mid;
         }
+        s->pos_diag += ci[f] == i && x[f] > 0;
     }
+}
+
+/* Stores the shape of a CSR value from its rows' pass and its values'
+ * largest magnitude (as bits, max_abs_bits) and zero count.  The same pass
+ * answers the scan (largest entry, NaN/Inf) the scaling hook asks of the
+ * matrix next. */
+static void shape_store(silc_value *v, const shape_rows *s, uint64_t maxbits, int64_t zeros)
+{
+    silc_props *p = &v->props;
+    shape_start(v, p);
+    scan_from_bits(v, maxbits);
+    p->has_nonfinite = v->scan_nonfinite;
     p->nnz = v->nnz - zeros;
-    p->diagonal = diagonal, p->lower = lower, p->upper = upper;
-    p->kl = kl, p->ku = ku;
-    p->pos_diag = p->square && v->n > 0 && pos_diag == v->n;
+    p->diagonal = s->diagonal, p->lower = s->lower, p->upper = s->upper;
+    p->kl = s->kl, p->ku = s->ku;
+    p->pos_diag = p->square && v->n > 0 && s->pos_diag == v->n;
+    v->props_have |= SILC_PROPS_SHAPE;
+}
+
+/* The shape of a CSR value: one branch-free pass over the values for the
+ * zero count, NaN/Inf and the largest entry, and shape_row on every row.
+ * 0.12 ms on memplus, where all the properties took 0.44. */
+static void shape_csr(silc_value *v)
+{
+    shape_rows s = {0, 0, 0, 1, 1, 1};
+    int64_t i, zeros = 0;
+    uint64_t maxbits = max_abs_bits(v->val, v->nnz, 1, &zeros);
+    for (i = 0; i < v->m; i++) shape_row(&s, i, v->colind, v->val, v->rowptr[i], v->rowptr[i + 1]);
+    shape_store(v, &s, maxbits, zeros);
+}
+
+int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_index *colind,
+                         const double *values)
+{
+    const uint64_t magnitude = 0x7fffffffffffffffULL;
+    shape_rows s = {0, 0, 0, 1, 1, 1};
+    silc_index *ci = v->colind;
+    double *x = v->val;
+    int64_t n = v->n, i, k, zeros = 0;
+    uint64_t maxbits = 0;
+    if (rowptr != v->rowptr) memcpy(v->rowptr, rowptr, (size_t)(v->m + 1) * sizeof *rowptr);
+    for (i = 0; i < v->m; i++) {
+        int64_t begin = rowptr[i], end = rowptr[i + 1], prev = -1, bad = 0;
+        for (k = begin; k < end; k++) {
+            int64_t c = colind[k];
+            uint64_t b;
+            bad |= (c <= prev) | (c >= n); /* out of [0, n), or not increasing */
+            prev = c;
+            ci[k] = c;
+            x[k] = values[k];
+            memcpy(&b, values + k, sizeof b);
+            b &= magnitude;
+            zeros += b == 0;
+            maxbits = b > maxbits ? b : maxbits;
+        }
+        if (bad) return -1;
+        shape_row(&s, i, ci, x, begin, end); /* while the row is in cache */
+    }
+    v->nnz = rowptr[v->m];
+    shape_store(v, &s, maxbits, zeros);
+    return 0;
 }
 
 /* The norms' sums over a CSR value without the shape's per-entry work: the
@@ -620,15 +680,6 @@ static int value_symmetric(const silc_value *v)
     }
 }
 
-/* The shape's starting answers, before any entry disproves them. */
-static void shape_start(const silc_value *v, silc_props *p)
-{
-    p->square = v->m == v->n;
-    p->diagonal = p->lower = p->upper = 1;
-    p->kl = p->ku = p->nnz = 0;
-    p->has_nonfinite = 0;
-}
-
 /* Readies acc for a pass: zero sums, and for a pass that also gathers the
  * shape, its starting answers. */
 static void props_start(const silc_value *v, props_acc *acc, int structure, double scale)
@@ -699,11 +750,8 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     silc_props *p;
     if (!v) return NULL;
     p = &v->props;
-    if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR) {
-        shape_start(v, p);
-        shape_csr(v, p);
-        v->props_have |= SILC_PROPS_SHAPE;
-    }
+    if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR)
+        shape_csr(v);
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
         int shape = !(v->props_have & SILC_PROPS_SHAPE);
         if (compute_norms(v, p, shape) == 0) v->props_have |= SILC_PROPS_NORMS;

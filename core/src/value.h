@@ -54,6 +54,15 @@ silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity);
 silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku);
 silc_value *val_scalar_new(double x);
 int val_csr_set_nnz(silc_value *v, int64_t nnz);
+/* Fills a CSR value made for rowptr[m] entries from rowptr/colind/values
+ * (which may be its own arrays: data received in place), checking that each
+ * row's columns lie in [0, n) and strictly increase, and computing the
+ * shape part of the properties in the same pass, while each row is in
+ * cache.  rowptr must be valid (0 first, never decreasing).  -1 at the first
+ * row that fails: the value is then partly filled, to be dropped, and
+ * env_check says what was wrong. */
+int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_index *colind,
+                         const double *values);
 /* As the constructors, elements left unset: for a caller that writes them all. */
 silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
 /* Recycling of value arrays, process-wide (silcd installs a pool): take(bytes)
