@@ -168,17 +168,15 @@ static void run_matrix(silc_context *c, tl_capture *cap, const char *file, const
 
 int main(void)
 {
-    char path[1024], line[1024];
+    char path[1024];
     silc_context *c = NULL;
     tl_capture cap = {0};
+    tl_index_row r;
     double t0 = tl_now();
     FILE *f;
     int k;
 
-    snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
-    f = fopen(path, "r");
-    CHECK(f != NULL, "cannot open %s", path);
-    if (!f) return check_done();
+    if (!(f = tl_index_open(NULL, path, sizeof path))) return check_done();
     if (silc_open(&c, NULL)) {
         CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
         fclose(f);
@@ -193,16 +191,12 @@ int main(void)
         printf(" %10s", dot ? dot + 1 : backends[k]);
     }
     printf("\n");
-    while (fgets(line, sizeof line, f)) {
-        char file[256], field[32], cls[32];
-        /* file rows cols nnz field symmetry class source */
-        if (sscanf(line, "%255s %*s %*s %*s %31s %*s %31s", file, field, cls) != 3) continue;
-        if (!strcmp(file, "file")) continue;
-        if (!strcmp(field, "complex")) {
-            printf("%-18s %-13s skipped: complex matrices are not supported yet\n", file, cls);
+    while (tl_index_next(f, &r)) {
+        if (!strcmp(r.field, "complex")) {
+            printf("%-18s %-13s skipped: complex matrices are not supported yet\n", r.file, r.cls);
             continue;
         }
-        run_matrix(c, &cap, file, cls);
+        run_matrix(c, &cap, r.file, r.cls);
     }
     fclose(f);
     silc_close(&c);

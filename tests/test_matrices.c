@@ -28,6 +28,7 @@
 
 #include "check.h"
 #include "silc.h"
+#include "testlib.h"
 
 #ifndef SILC_SHARED_MATRICES
 #define SILC_SHARED_MATRICES "../shared/matrices"
@@ -282,24 +283,14 @@ done:
 int main(int argc, char **argv)
 {
     const char *dir = argc > 1 ? argv[1] : SILC_SHARED_MATRICES;
-    char path[2048], line[1024];
-    snprintf(path, sizeof path, "%s/index.tsv", dir);
-    FILE *f = fopen(path, "r");
-    CHECK(f != NULL, "cannot open %s", path);
+    char path[2048];
+    FILE *f = tl_index_open(dir, path, sizeof path);
+    tl_index_row r;
     int count = 0;
-    while (f && fgets(line, sizeof line, f)) {
-        char file[256], field[64], symmetry[64], cls[64];
-        long long rows, cols, nnz;
-        if (strncmp(line, "file\t", 5) == 0 || line[0] == '#' || line[0] == '\n')
-            continue;
-        if (sscanf(line, "%255s %lld %lld %lld %63s %63s %63s", file, &rows, &cols, &nnz, field,
-                   symmetry, cls) != 7) {
-            CHECK(0, "index.tsv: cannot parse '%s'", line);
-            continue;
-        }
-        printf("%-20s %-14s %lldx%lld\n", file, cls, rows, cols);
+    while (f && tl_index_next(f, &r)) {
+        printf("%-20s %-14s %lldx%lld\n", r.file, r.cls, r.rows, r.cols);
         fflush(stdout);
-        run_matrix(dir, file, rows, cols, field, symmetry, cls);
+        run_matrix(dir, r.file, r.rows, r.cols, r.field, r.symmetry, r.cls);
         count++;
     }
     if (f)

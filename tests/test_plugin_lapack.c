@@ -474,23 +474,19 @@ static double timed(silc_context *c, const char *stmt, int *rc)
 
 static void test_shared(silc_context *L, silc_context *R)
 {
-    char path[1024], line[512];
-    FILE *idx;
-    snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
-    idx = fopen(path, "r");
-    CHECK(idx != NULL, "cannot open %s", path);
+    char path[1024];
+    tl_index_row r;
+    FILE *idx = tl_index_open(NULL, path, sizeof path);
     if (!idx) return;
     printf("%-18s %6s %6s  %-13s %9s %9s %9s %9s %9s\n", "matrix", "rows", "cols", "class", "lapack s",
            "ref s", "cond", "berr", "|xl-xr|");
-    while (fgets(line, sizeof line, idx)) {
-        char file[128], field[32], sym[32], cls[32];
-        long long m, n, nnz;
+    while (tl_index_next(idx, &r)) {
+        const char *file = r.file, *cls = r.cls;
+        long long m = r.rows, n = r.cols;
         silc_envelope_t e;
         double *b, *xt, *xl = NULL, *xr = NULL, tl, tr, cond, berr = -1, diff = -1;
         int rcl, rcr;
-        if (sscanf(line, "%127s %lld %lld %lld %31s %31s %31s", file, &m, &n, &nnz, field, sym, cls) != 7 ||
-            strcmp(file, "file") == 0 || m > 2000 || strcmp(field, "complex") == 0)
-            continue;
+        if (m > 2000 || strcmp(r.field, "complex") == 0) continue;
         if (tl_read_shared(file, &e)) continue;
         xt = malloc((size_t)n * sizeof(double));
         b = calloc((size_t)m, sizeof(double));

@@ -345,21 +345,17 @@ static void edge_cases(void)
 
 static void shared_matrices(void)
 {
-    char path[1024], line[512];
-    FILE *f;
+    char path[1024];
+    tl_index_row r;
+    FILE *f = tl_index_open(NULL, path, sizeof path);
     int count = 0;
-    snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
-    f = fopen(path, "r");
-    CHECK(f != NULL, "cannot open %s", path);
     if (!f) return;
-    while (fgets(line, sizeof line, f)) {
-        char name[256], field[32];
+    while (tl_index_next(f, &r)) {
+        const char *name = r.file;
         silc_envelope_t e;
-        /* file rows cols nnz field ...: complex files are refused elsewhere;
-         * any other file that does not read is a failure (tl_read_shared). */
-        if (sscanf(line, "%255s %*s %*s %*s %31s", name, field) != 2 || !strstr(name, ".mtx") ||
-            !strcmp(field, "complex") || tl_read_shared(name, &e))
-            continue;
+        /* Complex files are refused elsewhere; any other file that does not
+         * read is a failure (tl_read_shared). */
+        if (!strcmp(r.field, "complex") || tl_read_shared(name, &e)) continue;
         check_matrix(name, &e);
         if (e.m * e.n <= 250000) { /* and dense, where that is small */
             silc_envelope_t d;

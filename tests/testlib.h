@@ -400,6 +400,38 @@ static inline int tl_read_shared(const char *file, silc_envelope_t *A)
     return -1;
 }
 
+/* One matrix of index.tsv: file rows cols nnz field symmetry class source. */
+typedef struct tl_index_row {
+    char file[256], field[32], symmetry[32], cls[32];
+    long long rows, cols, nnz;
+} tl_index_row;
+
+/* dir/index.tsv (dir NULL: SILC_SHARED_MATRICES), or NULL with a failed check. */
+static inline FILE *tl_index_open(const char *dir, char *path, size_t pathlen)
+{
+    FILE *f;
+    snprintf(path, pathlen, "%s/index.tsv", dir ? dir : SILC_SHARED_MATRICES);
+    f = fopen(path, "r");
+    CHECK(f != NULL, "cannot open %s", path);
+    return f;
+}
+
+/* The next matrix of the index: 1, or 0 at its end.  The header, comments
+ * and blank lines are skipped; a row that does not parse is a failed check,
+ * and skipped too. */
+static inline int tl_index_next(FILE *f, tl_index_row *r)
+{
+    char line[1024];
+    while (fgets(line, sizeof line, f)) {
+        if (!strncmp(line, "file\t", 5) || line[0] == '#' || line[0] == '\n') continue;
+        if (sscanf(line, "%255s %lld %lld %lld %31s %31s %31s", r->file, &r->rows, &r->cols, &r->nnz,
+                   r->field, r->symmetry, r->cls) == 7)
+            return 1;
+        CHECK(0, "index.tsv: cannot parse '%s'", line);
+    }
+    return 0;
+}
+
 /* A context printing into tl_out() whose sparse solve classes (solve.sparse
  * and solve.sparse.spd) are forced to backend; NULL with a failed check. */
 static inline silc_context *tl_open_forced(const char *backend)
