@@ -37,12 +37,20 @@ extern const silc_host_api *lis_host;
  * bicgstab 4, bicgstabl 5, gpbicg 6, tfqmr 7, orthomin 8, gmres 9, jacobi 10,
  * gs 11, sor 12, bicgsafe 13, cr 14, bicr 15, crs 16, bicrstab 17, gpbicr 18,
  * bicrsafe 19, fgmres 20, idrs 21, idr1 22, minres 23, cocg 24, cocr 25.
- * The ones not implemented here are refused by name. */
+ * Not implemented here, and refused by name: bicgsafe, bicrsafe, and cocg
+ * and cocr, which are for complex symmetric matrices. */
 enum lis_solver_id {
     LIS_CG = 1, LIS_BICG = 2, LIS_CGS = 3, LIS_BICGSTAB = 4, LIS_BICGSTABL = 5,
-    LIS_GPBICG = 6, LIS_TFQMR = 7, LIS_GMRES = 9, LIS_JACOBI = 10, LIS_GS = 11,
-    LIS_SOR = 12, LIS_FGMRES = 20, LIS_IDRS = 21, LIS_MINRES = 23
+    LIS_GPBICG = 6, LIS_TFQMR = 7, LIS_ORTHOMIN = 8, LIS_GMRES = 9, LIS_JACOBI = 10,
+    LIS_GS = 11, LIS_SOR = 12, LIS_CR = 14, LIS_BICR = 15, LIS_CRS = 16, LIS_BICRSTAB = 17,
+    LIS_GPBICR = 18, LIS_FGMRES = 20, LIS_IDRS = 21, LIS_IDR1 = 22, LIS_MINRES = 23
 };
+
+/* The BiCR family (BiCR, CRS, BiCRSTAB, GPBiCR) runs the code of BiCG, CGS,
+ * BiCGSTAB and GPBiCG from another shadow residual (lis_krylov.c), for which
+ * it needs A' as BiCG does. */
+int lis_bicr_family(int solver);
+int lis_needs_transpose(int solver);
 
 /* Preconditioner numbers as in Lis (-p): none 0, jacobi 1, ilu 2, ssor 3,
  * hybrid 4, is 5, sainv 6, saamg 7, iluc 8, ilut 9.  IC(0) is not among
@@ -122,7 +130,7 @@ enum lis_outcome { LIS_CONVERGED = 0, LIS_MAXITER, LIS_BREAKDOWN, LIS_NAN, LIS_N
 
 typedef struct lis_ctx {
     const lk_csr *A;
-    const lk_csr *At;           /* A' (BiCG only), else NULL */
+    const lk_csr *At;           /* A' (lis_needs_transpose), else NULL */
     const lis_pc *pc;           /* NULL = none */
     const lis_options *o;
     int64_t n;
@@ -180,6 +188,7 @@ double lis_true_resid(lis_ctx *c, const lis_vec *x, lis_vec *work);
 
 typedef int (*lis_solver_fn)(lis_ctx *c, lis_vec *x);
 int lis_cg(lis_ctx *c, lis_vec *x);
+int lis_cr(lis_ctx *c, lis_vec *x);
 int lis_bicg(lis_ctx *c, lis_vec *x);
 int lis_cgs(lis_ctx *c, lis_vec *x);
 int lis_bicgstab(lis_ctx *c, lis_vec *x);
@@ -190,6 +199,7 @@ int lis_minres(lis_ctx *c, lis_vec *x);
 int lis_idrs(lis_ctx *c, lis_vec *x);
 int lis_gmres(lis_ctx *c, lis_vec *x);
 int lis_fgmres(lis_ctx *c, lis_vec *x);
+int lis_orthomin(lis_ctx *c, lis_vec *x);
 int lis_jacobi(lis_ctx *c, lis_vec *x);
 int lis_gs(lis_ctx *c, lis_vec *x);
 int lis_sor(lis_ctx *c, lis_vec *x);

@@ -1,6 +1,7 @@
 /*
- * lis_krylov.c -- the short-recurrence Krylov solvers: CG, BiCG, CGS,
- * BiCGSTAB, BiCGSTAB(l), GPBiCG, TFQMR, MINRES and IDR(s).
+ * lis_krylov.c -- the short-recurrence Krylov solvers: CG, CR, BiCG, CGS,
+ * BiCGSTAB, BiCGSTAB(l), GPBiCG, TFQMR, MINRES and IDR(s), and through the
+ * shadow residual (initial_shadow) BiCR, CRS, BiCRSTAB and GPBiCR.
  *
  * Each is written once in the arithmetic of lis_space.c, so it runs in double or
  * double-double (-f quad).  Preconditioning follows the usual formulations:
@@ -15,6 +16,18 @@
  *
  * Breakdowns are divisions by an exact zero (rho, a curvature, a norm); a NaN
  * anywhere ends the run as LIS_NAN.
+ *
+ * The BiCR family.  BiCR's residuals r_k are orthogonal to A' K_k(A', s0)
+ * where BiCG's are orthogonal to K_k(A', s0); since A' K_k(A', s0) =
+ * K_k(A', A' s0), BiCR is BiCG started from the shadow residual A' s0, and
+ * the product methods built on BiCR's residual polynomials (CRS, BiCRSTAB,
+ * GPBiCR) are CGS, BiCGSTAB and GPBiCG started from it (Sogabe, Sugihara &
+ * Zhang, JCAM 226, 2009, and the product-type papers that followed).  So
+ * they are the same code with s0 = A' r0 instead of r0 (initial_shadow); in
+ * exact arithmetic the iterates are those of the published recurrences,
+ * whose rounding differs.  With a preconditioner the shadow is the
+ * transpose of the operator the method runs on applied to r0: A' M^-T r0
+ * for BiCR (BiCG's (A, M) form), M^-T A' r0 for the others (A M^-1).
  *
  * References: Barrett et al., Templates for the Solution of Linear Systems
  * (1994); Sleijpen & Fokkema, BiCGstab(l) (ETNA 1, 1993); Zhang, GPBi-CG (SISC
@@ -64,6 +77,22 @@ static void finish_right(lis_ctx *c, lis_vec *x, const lis_vec *xi, lis_vec *t)
     lv_axpy(c, dd_d(1.0), t, x);
 }
 
+/* rt = the initial shadow residual: r, or for the BiCR family the transposed
+ * operator applied to r (see the top of this file).  t is scratch;
+ * left_form is 1 for BiCG's (A, M) form, 0 for the methods on A M^-1. */
+static void initial_shadow(lis_ctx *c, const lis_vec *r, lis_vec *rt, lis_vec *t, int left_form)
+{
+    if (!lis_bicr_family(c->o->solver)) {
+        lv_copy(c, r, rt);
+    } else if (left_form) {
+        lv_psolve_t(c, r, t);
+        lv_matvec_t(c, t, rt);
+    } else {
+        lv_matvec_t(c, r, t);
+        lv_psolve_t(c, t, rt);
+    }
+}
+
 /* ---- CG ---------------------------------------------------------------------- */
 
 int lis_cg(lis_ctx *c, lis_vec *x)
@@ -95,6 +124,44 @@ out:
     return st;
 }
 
+/* ---- CR ------------------------------------------------------------------------ */
+
+/* The conjugate residual method for symmetric A (and symmetric M): CG's
+ * recurrences in the A-inner product, so that each iterate minimises the
+ * residual's M^-1-norm over its Krylov space; A need not be definite. */
+int lis_cr(lis_ctx *c, lis_vec *x)
+{
+    lis_vec v[6], *r = &v[0], *z = &v[1], *p = &v[2], *az = &v[3], *ap = &v[4], *q = &v[5];
+    dd rho, rho1, apq, alpha;
+    int st = LIS_MAXITER;
+    if (lv_new_many(c, v, 6)) return LIS_NOMEM;
+    lv_residual(c, x, r);
+    lv_psolve(c, r, z);
+    lv_copy(c, z, p);
+    lv_matvec(c, z, az);
+    lv_copy(c, az, ap);
+    rho = lv_dot(c, z, az);
+    while (!lis_limit(c)) {
+        FAIL_IF_ZERO(rho, "(M^-1 r, A M^-1 r) = 0");
+        lv_psolve(c, ap, q);
+        apq = lv_dot(c, ap, q);
+        FAIL_IF_ZERO(apq, "(A p, M^-1 A p) = 0");
+        alpha = s_div(c, rho, apq);
+        lv_axpy(c, alpha, p, x);
+        lv_axpy(c, dd_neg(alpha), ap, r);
+        STEP(lv_nrm2(c, r));
+        lv_axpy(c, dd_neg(alpha), q, z);
+        lv_matvec(c, z, az);
+        rho1 = lv_dot(c, z, az);
+        lv_xpay(c, z, s_div(c, rho1, rho), p);
+        lv_xpay(c, az, s_div(c, rho1, rho), ap);
+        rho = rho1;
+    }
+out:
+    lv_free_many(v, 6);
+    return st;
+}
+
 /* ---- BiCG -------------------------------------------------------------------- */
 
 int lis_bicg(lis_ctx *c, lis_vec *x)
@@ -106,7 +173,7 @@ int lis_bicg(lis_ctx *c, lis_vec *x)
     int st = LIS_MAXITER, first = 1;
     if (lv_new_many(c, v, 8)) return LIS_NOMEM;
     lv_residual(c, x, r);
-    lv_copy(c, r, rt);
+    initial_shadow(c, r, rt, zt, 1);
     while (!lis_limit(c)) {
         lv_psolve(c, r, z);
         lv_psolve_t(c, rt, zt);
@@ -148,7 +215,7 @@ int lis_cgs(lis_ctx *c, lis_vec *x)
     int st = LIS_MAXITER, first = 1;
     if (lv_new_many(c, v, 8)) return LIS_NOMEM;
     lv_residual(c, x, r);
-    lv_copy(c, r, rt);
+    initial_shadow(c, r, rt, t, 0);
     while (!lis_limit(c)) {
         rho = lv_dot(c, rt, r);
         FAIL_IF_ZERO(rho, "rho = (r~, r) = 0");
@@ -192,7 +259,7 @@ int lis_bicgstab(lis_ctx *c, lis_vec *x)
     int st = LIS_MAXITER, first = 1;
     if (lv_new_many(c, v, 8)) return LIS_NOMEM;
     lv_residual(c, x, r);
-    lv_copy(c, r, rt);
+    initial_shadow(c, r, rt, t, 0);
     while (!lis_limit(c)) {
         rho = lv_dot(c, rt, r);
         FAIL_IF_ZERO(rho, "rho = (r~, r) = 0");
@@ -323,7 +390,7 @@ int lis_gpbicg(lis_ctx *c, lis_vec *x)
     int st = LIS_MAXITER, first = 1;
     if (lv_new_many(c, v, 13)) return LIS_NOMEM;
     lv_residual(c, x, r);
-    lv_copy(c, r, rt);
+    initial_shadow(c, r, rt, tmp, 0);
     rtr = lv_dot(c, rt, r);
     while (!lis_limit(c)) {
         lv_axpy(c, dd_d(-1), u, p);                     /* p = r + beta (p - u) */

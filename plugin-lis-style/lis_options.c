@@ -26,12 +26,12 @@ typedef struct named {
 static const named solvers[] = {
     {"cg", 1, LIS_CG},           {"bicg", 2, LIS_BICG},       {"cgs", 3, LIS_CGS},
     {"bicgstab", 4, LIS_BICGSTAB}, {"bicgstabl", 5, LIS_BICGSTABL}, {"gpbicg", 6, LIS_GPBICG},
-    {"tfqmr", 7, LIS_TFQMR},     {"orthomin", 8, 0},          {"gmres", 9, LIS_GMRES},
+    {"tfqmr", 7, LIS_TFQMR},     {"orthomin", 8, LIS_ORTHOMIN}, {"gmres", 9, LIS_GMRES},
     {"jacobi", 10, LIS_JACOBI},  {"gs", 11, LIS_GS},          {"sor", 12, LIS_SOR},
-    {"bicgsafe", 13, 0},         {"cr", 14, 0},               {"bicr", 15, 0},
-    {"crs", 16, 0},              {"bicrstab", 17, 0},         {"gpbicr", 18, 0},
+    {"bicgsafe", 13, 0},         {"cr", 14, LIS_CR},          {"bicr", 15, LIS_BICR},
+    {"crs", 16, LIS_CRS},        {"bicrstab", 17, LIS_BICRSTAB}, {"gpbicr", 18, LIS_GPBICR},
     {"bicrsafe", 19, 0},         {"fgmres", 20, LIS_FGMRES},  {"idrs", 21, LIS_IDRS},
-    {"idr1", 22, 0},             {"minres", 23, LIS_MINRES},  {"cocg", 24, 0},
+    {"idr1", 22, LIS_IDR1},      {"minres", 23, LIS_MINRES},  {"cocg", 24, 0},
     {"cocr", 25, 0},             {NULL, 0, 0}};
 
 static const named precons[] = {
@@ -332,6 +332,17 @@ void lis_options_finish(lis_options *o, int spd_class)
     }
     if (!o->solver) o->solver = LIS_BICG;
     if (o->precon < 0) o->precon = LIS_PC_NONE;
+    if (o->solver == LIS_IDR1) o->idrs_s = 1; /* IDR(s) with s = 1, whatever -idrs_s says */
+}
+
+int lis_bicr_family(int solver)
+{
+    return solver == LIS_BICR || solver == LIS_CRS || solver == LIS_BICRSTAB || solver == LIS_GPBICR;
+}
+
+int lis_needs_transpose(int solver)
+{
+    return solver == LIS_BICG || lis_bicr_family(solver);
 }
 
 const char *lis_solver_name(int solver)
@@ -350,7 +361,14 @@ const char *lis_solver_name(int solver)
     case LIS_SOR: return "SOR";
     case LIS_FGMRES: return "FGMRES";
     case LIS_IDRS: return "IDR(s)";
+    case LIS_IDR1: return "IDR(1)";
     case LIS_MINRES: return "MINRES";
+    case LIS_ORTHOMIN: return "Orthomin(m)";
+    case LIS_CR: return "CR";
+    case LIS_BICR: return "BiCR";
+    case LIS_CRS: return "CRS";
+    case LIS_BICRSTAB: return "BiCRSTAB";
+    case LIS_GPBICR: return "GPBiCR";
     default: return "?";
     }
 }
@@ -361,6 +379,7 @@ void lis_solver_label(const lis_options *o, char *buf, size_t len)
     case LIS_BICGSTABL: snprintf(buf, len, "BiCGSTAB(%d)", o->ell); break;
     case LIS_GMRES: snprintf(buf, len, "GMRES(%d)", o->restart); break;
     case LIS_FGMRES: snprintf(buf, len, "FGMRES(%d)", o->restart); break;
+    case LIS_ORTHOMIN: snprintf(buf, len, "Orthomin(%d)", o->restart); break;
     case LIS_IDRS: snprintf(buf, len, "IDR(%d)", o->idrs_s); break;
     case LIS_SOR: snprintf(buf, len, "SOR(%g)", o->omega); break;
     default: snprintf(buf, len, "%s", lis_solver_name(o->solver)); break;

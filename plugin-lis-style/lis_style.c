@@ -19,7 +19,8 @@
  *
  * The preconditioner is an attachment of the matrix value keyed by its full
  * description ("lis-style.pc.ILU(0)"), so it is built once per matrix value
- * and reused by every later solve with it; A' (for BiCG) likewise.
+ * and reused by every later solve with it; A' (for BiCG and the BiCR family)
+ * likewise.
  *
  * The driver runs the method, then recomputes b - A x: a method whose
  * recursive residual met the tolerance while the true one did not is
@@ -160,16 +161,18 @@ static lis_solver_fn solver_fn(int id)
 {
     switch (id) {
     case LIS_CG: return lis_cg;
-    case LIS_BICG: return lis_bicg;
-    case LIS_CGS: return lis_cgs;
-    case LIS_BICGSTAB: return lis_bicgstab;
+    case LIS_CR: return lis_cr;
+    case LIS_BICG: case LIS_BICR: return lis_bicg;
+    case LIS_CGS: case LIS_CRS: return lis_cgs;
+    case LIS_BICGSTAB: case LIS_BICRSTAB: return lis_bicgstab;
     case LIS_BICGSTABL: return lis_bicgstabl;
-    case LIS_GPBICG: return lis_gpbicg;
+    case LIS_GPBICG: case LIS_GPBICR: return lis_gpbicg;
     case LIS_TFQMR: return lis_tfqmr;
     case LIS_GMRES: return lis_gmres;
     case LIS_FGMRES: return lis_fgmres;
+    case LIS_ORTHOMIN: return lis_orthomin;
     case LIS_MINRES: return lis_minres;
-    case LIS_IDRS: return lis_idrs;
+    case LIS_IDRS: case LIS_IDR1: return lis_idrs;
     case LIS_JACOBI: return lis_jacobi;
     case LIS_GS: return lis_gs;
     case LIS_SOR: return lis_sor;
@@ -339,7 +342,7 @@ static int solve_run(silc_call *call)
         }
         A = M->A;
     }
-    if (opt.solver == LIS_BICG) {
+    if (lis_needs_transpose(opt.solver)) {
         if (silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
             At = &A;
         } else {

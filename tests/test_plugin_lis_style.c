@@ -12,9 +12,13 @@
  *     n = 200 Toeplitz matrix (2 on the diagonal, 1 above, 2 two below) with
  *     -i bicg -maxiter 1000 -f double is reported not converged, with the
  *     residual, leaving the store unchanged, and with -f quad converges;
- *   - every solver with every preconditioner on an SPD grid operator (CG and
- *     MINRES only there) and on an unsymmetric convection-diffusion operator,
- *     against the exact solution x_i = 1 + i/n; every solver in -f quad;
+ *   - every solver with every preconditioner on an SPD grid operator (CG, CR
+ *     and MINRES only there) and on an unsymmetric convection-diffusion
+ *     operator, against the exact solution x_i = 1 + i/n; every solver in
+ *     -f quad;
+ *   - the BiCR family's shadow residual: on a symmetric matrix BiCR's
+ *     residual after 8 iterations is CR's and BiCG's is CG's, and CRS,
+ *     BiCRSTAB, GPBiCR part from CGS, BiCGSTAB, GPBiCG;
  *   - the SPD shared matrices with CG+IC(0) and CG+ILU(0) (-tol 1e-10
  *     -maxiter 20000): converged => reported residual <= tol and the relative
  *     error against the reference direct solve <= 1e-10 * its condition
@@ -191,8 +195,9 @@ static void test_toeplitz(silc_context *c)
 
 /* ---- every solver, every preconditioner ------------------------------------------ */
 
-static const char *const krylov[] = {"cg", "minres", "bicg", "cgs", "bicgstab", "bicgstabl",
-                                     "gpbicg", "tfqmr", "gmres", "fgmres", "idrs", NULL};
+static const char *const krylov[] = {"cg", "cr", "minres", "bicg", "bicr", "cgs", "crs", "bicgstab",
+                                     "bicrstab", "bicgstabl", "gpbicg", "gpbicr", "tfqmr", "gmres",
+                                     "fgmres", "orthomin", "idrs", "idr1", NULL};
 static const char *const stationary[] = {"jacobi", "gs", "sor", NULL};
 static const char *const precons[] = {"none", "jacobi", "ilu", "ilu -ilu_fill 1", "ic", "ssor",
                                       "ilut", NULL};
@@ -238,11 +243,12 @@ static void test_all_methods(silc_context *c)
         put_system(c, &A, xt);
         /* cond_2 is below 100 for both: residual 1e-10 -> error below 1e-8. */
         for (int s = 0; krylov[s]; s++) {
-            if (!sym && (!strcmp(krylov[s], "cg") || !strcmp(krylov[s], "minres"))) continue;
-            int symmetric_method = !strcmp(krylov[s], "cg") || !strcmp(krylov[s], "minres");
+            int symmetric_method =
+                !strcmp(krylov[s], "cg") || !strcmp(krylov[s], "cr") || !strcmp(krylov[s], "minres");
+            if (!sym && symmetric_method) continue;
             for (int p = 0; precons[p]; p++) {
-                /* IC is for symmetric matrices; CG and MINRES need a symmetric
-                 * preconditioner, which ILUT's dropping is not. */
+                /* IC is for symmetric matrices; CG, CR and MINRES need a
+                 * symmetric preconditioner, which ILUT's dropping is not. */
                 if (!sym && !strcmp(precons[p], "ic")) continue;
                 if (symmetric_method && !strcmp(precons[p], "ilut")) continue;
                 snprintf(opts, sizeof opts, "-i %s -p %s -tol 1e-10 -maxiter 5000", krylov[s], precons[p]);
@@ -264,6 +270,57 @@ static void test_all_methods(silc_context *c)
     }
     printf("  every solver x preconditioner (double and quad): %d of %d runs agree with the exact solution\n",
            good, ran);
+    free(xt);
+}
+
+/* ---- the BiCR family's shadow residual ------------------------------------------------ */
+
+/* The relative residual after exactly k iterations: the message of a run
+ * stopped by -maxiter k. */
+static double residual_after(silc_context *c, const char *method, int k)
+{
+    char cmd[200];
+    const char *msg, *p;
+    snprintf(cmd, sizeof cmd, "x = solve(A, b, \"lis-style.options = -i %s -p none -tol 1e-30 -maxiter %d\")",
+             method, k);
+    CHECK(silc_exec(c, cmd) != 0, "%s: converged to 1e-30 in %d iterations", method, k);
+    msg = silc_context_errmsg(c);
+    p = strstr(msg, "relative residual ");
+    CHECK(p && tl_contains(msg, "not converged"), "%s: %s", method, msg);
+    return p ? strtod(p + 18, NULL) : -1;
+}
+
+/* BiCR is BiCG from the shadow residual A' r0, and on a symmetric matrix
+ * that makes it CR (both leave r_k orthogonal to A K_k(A, r0)), as BiCG
+ * from r0 is CG; CRS, BiCRSTAB and GPBiCR are CGS, BiCGSTAB and GPBiCG from
+ * that shadow, so they must part from them. */
+static void test_bicr_shadow(silc_context *c)
+{
+    static const char *const pairs[][2] = {{"cgs", "crs"}, {"bicgstab", "bicrstab"}, {"gpbicg", "gpbicr"}};
+    silc_envelope_t A;
+    int64_t k = 12, n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt), cg, cr, bicg, bicr;
+    size_t i;
+    for (int64_t j = 0; j < n; j++) xt[j] = 1 + (double)j / (double)n;
+    grid(&A, k, 0);
+    put_system(c, &A, xt);
+    cg = residual_after(c, "cg", 8), cr = residual_after(c, "cr", 8);
+    bicg = residual_after(c, "bicg", 8), bicr = residual_after(c, "bicr", 8);
+    printf("  after 8 iterations on the 12x12 Laplacian: CG %.2g BiCG %.2g, CR %.2g BiCR %.2g\n", cg, bicg,
+           cr, bicr);
+    CHECK(fabs(bicr - cr) <= 0.05 * cr, "BiCR %.3g is not CR %.3g on a symmetric matrix", bicr, cr);
+    CHECK(fabs(bicg - cg) <= 0.05 * cg, "BiCG %.3g is not CG %.3g on a symmetric matrix", bicg, cg);
+    CHECK(fabs(cr - cg) > 0.2 * cr, "CR %.3g and CG %.3g too close to tell the shadows apart", cr, cg);
+    silc_envelope_free(&A);
+    grid(&A, k, 1.0);
+    put_system(c, &A, xt);
+    for (i = 0; i < sizeof pairs / sizeof pairs[0]; i++) {
+        double g = residual_after(c, pairs[i][0], 8), r = residual_after(c, pairs[i][1], 8);
+        printf("  after 8 iterations on convection-diffusion (beta 1): %s %.2g, %s %.2g\n", pairs[i][0], g,
+               pairs[i][1], r);
+        CHECK(fabs(g - r) > 0.1 * g, "%s %.3g and %s %.3g: the same shadow?", pairs[i][0], g, pairs[i][1], r);
+    }
+    silc_envelope_free(&A);
     free(xt);
 }
 
@@ -311,6 +368,10 @@ static void test_options(silc_context *c)
     CHECK(tl_contains(tl_out_info(c, "x"), "BiCGSTAB(4) + ILUT(0.01,3)"), "bicgstabl/ilut:\n%s", tl_out());
     run_one(c, "-i 21 -idrs_s 4 -tol 1e-11", n, xt, 1e-8, "options");
     CHECK(tl_contains(tl_out_info(c, "x"), "IDR(4)"), "-i 21 -idrs_s 4:\n%s", tl_out());
+    run_one(c, "-i idr1 -idrs_s 4 -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(tl_contains(tl_out_info(c, "x"), "IDR(1)"), "-i idr1 is not IDR(1):\n%s", tl_out());
+    run_one(c, "-i 8 -restart 3 -p ilu -tol 1e-11", n, xt, 1e-8, "options");
+    CHECK(tl_contains(tl_out_info(c, "x"), "Orthomin(3) + ILU(0)"), "-i 8 -restart 3:\n%s", tl_out());
     run_one(c, "-i 20 -restart 5 -p 3 -ssor_omega 1.2 -tol 1e-11", n, xt, 1e-8, "options");
     CHECK(tl_contains(tl_out_info(c, "x"), "FGMRES(5) + SSOR(1.2)"), "-i 20 -restart 5:\n%s", tl_out());
     run_one(c, "-i 12 -omega 1.5 -tol 1e-11 -maxiter 5000", n, xt, 1e-8, "options");
@@ -325,7 +386,8 @@ static void test_options(silc_context *c)
     expect_error(c, "-p", "-p needs a value", "ilu");
     expect_error(c, "-foo 1", "unknown option '-foo'", "did you mean");
     expect_error(c, "-i bicg -maxiter", "-maxiter needs a value", "");
-    expect_error(c, "-i cr", "'cr'", "not implemented");
+    expect_error(c, "-i bicgsafe", "'bicgsafe'", "not implemented");
+    expect_error(c, "-i 25", "'cocr'", "not implemented");
     expect_error(c, "-i gs -p ilu", "takes no preconditioner", "");
     expect_error(c, "-omega 2.5", "-omega", "2.5");
     expect_error(c, "-f single", "-f", "single");
@@ -517,6 +579,7 @@ int main(void)
     test_toeplitz(c);
     printf("lis-style: solvers and preconditioners\n");
     test_all_methods(c);
+    test_bicr_shadow(c);
     printf("lis-style: options\n");
     test_options(c);
     test_defaults();
