@@ -18,6 +18,9 @@
  *     does val_props on a fresh copy that computes everything at once;
  *   - the backward error's ||A||_inf, taken from the residual's pass when
  *     the norms are not known, equals the one from the properties;
+ *   - silc_put's one-pass check refuses exactly what env_check refuses, with
+ *     its message, on 3000 random small envelopes, and gives the accepted
+ *     ones their brute-force shape;
  *   - a plugin asking silc_props_of() for the symmetry gets the right answer
  *     and (for CSR) no norms computed; on a host table of ABI 1.3, without
  *     props_part, it gets every part.
@@ -306,6 +309,60 @@ static void tridiagonal(void)
     check_csr("tridiagonal 200 without (99, 98): (98, 99) unmet", N, N, rp2, ci2, x2);
 }
 
+/* silc_put's one-pass check (val_csr_fill_checked) against env_check, which
+ * checks the same rules in passes of their own: on random small CSR arrays
+ * with columns out of range, repeated or out of order, both must refuse the
+ * same envelopes with the same message, and an accepted one must get the
+ * brute-force shape. */
+static void random_envelopes(void)
+{
+    uint64_t state = 12345;
+    int t, refused = 0, accepted = 0;
+    for (t = 0; t < 3000; t++) {
+        int64_t rp[7], ci[16], m, n, i, k;
+        double x[16];
+        silc_envelope_t e;
+        silc_value *v = NULL;
+        char e1[256] = "", e2[256] = "";
+        int r1, r2;
+#define RND(k) ((int64_t)((state = state * 6364136223846793005ULL + 1442695040888963407ULL) >> 33) % (k))
+        m = 1 + RND(6), n = 1 + RND(6);
+        rp[0] = 0;
+        for (i = 0; i < m; i++) rp[i + 1] = rp[i] + RND(16 / m + 1);
+        for (k = 0; k < rp[m]; k++) {
+            /* Mostly sorted and in range; a few of each kind of fault. */
+            int64_t f = RND(40);
+            ci[k] = f == 0 ? -1 : f == 1 ? n : f == 2 && k > 0 ? ci[k - 1] : RND(n);
+            x[k] = RND(5) == 0 ? 0 : (double)(RND(7) - 3);
+        }
+        for (i = 0; i < m && RND(3); i++) /* sort most rows */
+            for (k = rp[i] + 1; k < rp[i + 1]; k++)
+                for (int64_t q = k; q > rp[i] && ci[q - 1] > ci[q]; q--) {
+                    int64_t tc = ci[q];
+                    double tx = x[q];
+                    ci[q] = ci[q - 1], x[q] = x[q - 1];
+                    ci[q - 1] = tc, x[q - 1] = tx;
+                }
+#undef RND
+        memset(&e, 0, sizeof e);
+        e.m = m, e.n = n, e.format = SILC_CSR, e.rowptr = rp, e.colind = ci, e.values = x, e.nnz = rp[m];
+        r1 = env_check(&e, e1, sizeof e1);
+        r2 = env_to_value(&e, &v, e2, sizeof e2);
+        CHECK(r1 == r2 && !strcmp(e1, e2), "envelope %d: env_check %d '%s', put's check %d '%s'", t, r1, e1, r2,
+              e2);
+        if (v) {
+            truth tr = brute(v);
+            check_shape("random envelope", &v->props, &tr);
+            accepted++;
+        } else {
+            refused++;
+        }
+        val_release(v);
+    }
+    printf("random envelopes: %d refused, %d accepted, the same by both checks\n", refused, accepted);
+    CHECK(refused > 300 && accepted > 300, "random envelopes: %d refused, %d accepted", refused, accepted);
+}
+
 static void edge_cases(void)
 {
     /* 4x4, symmetric, with explicit zeros first and last in rows and a
@@ -378,6 +435,7 @@ static void shared_matrices(void)
 int main(void)
 {
     edge_cases();
+    random_envelopes();
     shared_matrices();
     return check_done();
 }
