@@ -627,13 +627,19 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;
     if ((op == TK_STAREQ || op == TK_SLASHEQ) && !scalar) return 0;
-    if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
-        double sign = op == TK_PLUSEQ ? 1 : -1; /* x + (-r) is x - r, bit for bit */
-        if (scalar) for (i = 0, c *= sign; i < n; i++) x->val[i] += c;
-        else for (i = 0; i < n; i++) x->val[i] += sign * r->val[i];
-    } else {
-        c = op == TK_STAREQ ? c : 1.0 / c; /* as apply_binary: x / c is a scale by 1/c */
-        for (i = 0; i < n; i++) x->val[i] *= c;
+    {
+        /* r is another value (x += x leaves x shared, so never comes here). */
+        double *restrict xv = x->val;
+        const double *restrict rv = scalar ? NULL : r->val;
+        if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
+            double sign = op == TK_PLUSEQ ? 1 : -1; /* x + (-r) is x - r, bit for bit */
+            if (scalar) for (i = 0, c *= sign; i < n; i++) xv[i] += c;
+            else if (sign > 0) for (i = 0; i < n; i++) xv[i] += rv[i];
+            else for (i = 0; i < n; i++) xv[i] -= rv[i];
+        } else {
+            c = op == TK_STAREQ ? c : 1.0 / c; /* as apply_binary: x / c is a scale by 1/c */
+            for (i = 0; i < n; i++) xv[i] *= c;
+        }
     }
     val_mutated(x);
     return 1;
