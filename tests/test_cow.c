@@ -7,6 +7,10 @@
  * same value object under the name:
  *   - x += 2*y, x -= 1, x *= 3, x /= 7 on an unshared x: the same object, a
  *     new id, entries equal to the plain expressions computed beside it;
+ *   - x += y*0.37, x -= 1.5*y (scaled into x with no temporary), x += M*y
+ *     (a matrix product: its result added in place): the same;
+ *   - x += 2*x: through the temporary 2*x; x += 2*q with q of another
+ *     length, x += 2*nope: refused, x untouched;
  *   - x shared with w (w = x): x gets a new object, w keeps the old entries;
  *   - x += x (the right-hand side holds x too): copied, doubled;
  *   - a matrix with a factorization attached (D \ b ran): copied, and the
@@ -84,6 +88,25 @@ int main(void)
     check_in_place("x /= 7", "e");
     run("e = x - y");
     check_in_place("x -= y", "e");
+    run("e = x + y * 0.37");
+    check_in_place("x += y * 0.37", "e");
+    run("e = x - 1.5 * y");
+    check_in_place("x -= 1.5 * y", "e");
+    run("M = 2 * eye(1000); e = x + M * y");
+    check_in_place("x += M * y", "e");
+    /* y is x: not scaled into x over itself, but 2 * x is a temporary that
+     * nothing else holds, added in place. */
+    run("e = x + 2 * x");
+    check_in_place("x += 2 * x", "e");
+    {
+        const silc_value *before = get("x");
+        run("f = x * 1; q = ones(999, 1)");
+        CHECK(api_exec(E, "x += 2 * q", err, sizeof err) != 0 && strstr(err, "same shape"),
+              "x += 2 * q (999 entries): %s", err);
+        CHECK(api_exec(E, "x += 2 * nope", err, sizeof err) != 0 && strstr(err, "nope"),
+              "x += 2 * nope: %s", err);
+        CHECK(get("x") == before && same_entries("x", "f"), "a refused x += 2 * ... changed x");
+    }
 
     /* Shared: w sees none of it. */
     run("w = x; e = x + 1; f = x * 1"); /* f: a copy of the entries */

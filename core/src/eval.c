@@ -462,12 +462,28 @@ static void node_text(const lang_ev *V, const ast_node *n, char *out, size_t out
     out[len] = 0;
 }
 
-static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
+/* Binary node n applied to its operands a and b, already evaluated (and
+ * released here). */
+static int binary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value *b, silc_value **out)
 {
-    silc_value *a, *b;
     char ln[64], rn[64], what[256];
     operands o;
     int rc;
+    ev_operand_name(V, n->kids[0], 0, ln, sizeof ln);
+    ev_operand_name(V, n->kids[1], 1, rn, sizeof rn);
+    node_text(V, n, what, sizeof what);
+    o.lname = ln;
+    o.rname = rn;
+    o.what = what;
+    rc = apply_binary(V, n->op, &o, a, b, out);
+    val_release(a);
+    val_release(b);
+    return rc;
+}
+
+static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a, *b;
     if (ev_expr(V, n->kids[0], &a)) return -1;
     /* && and || short-circuit on a scalar left side, so `k <= n && v[k] > 0` is safe */
     if ((n->op == TK_AND || n->op == TK_OR) && val_is_scalar(a)) {
@@ -482,16 +498,7 @@ static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
         val_release(a);
         return -1;
     }
-    ev_operand_name(V, n->kids[0], 0, ln, sizeof ln);
-    ev_operand_name(V, n->kids[1], 1, rn, sizeof rn);
-    node_text(V, n, what, sizeof what);
-    o.lname = ln;
-    o.rname = rn;
-    o.what = what;
-    rc = apply_binary(V, n->op, &o, a, b, out);
-    val_release(a);
-    val_release(b);
-    return rc;
+    return binary_of(V, n, a, b, out);
 }
 
 static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
@@ -617,21 +624,32 @@ static int opassign_token(int op)
  * is a dense array of x's shape or a scalar, c a scalar.  The arithmetic is
  * what SILC_OP_ADD / SCALE compute (1*x + (+-1)*r is x +- r exactly; x / c
  * is a scale by 1/c), so the numbers do not depend on which path ran.
- * Returns 1 when done. */
-static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r)
+ *
+ * With a scale s (a scalar value), `x += s * r` and `x -= s * r` for a
+ * dense r of x's shape: the time-stepping update (`u += dt * v`) without
+ * the temporary s * r.  Each s * r_i is rounded before it is added, as
+ * SILC_OP_SCALE then SILC_OP_ADD round it (no contraction to a fused
+ * multiply-add: the build targets x86-64 without FMA, and GCC does not
+ * contract across statements in ISO C mode).  Returns 1 when done. */
+static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r,
+                           const silc_value *s)
 {
     int64_t i, n = x->m * x->n;
-    int scalar = val_is_scalar(r) && !val_is_scalar(x);
+    int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
     double c = scalar ? val_scalar(r) : 0;
     if (V->explain || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;
-    if ((op == TK_STAREQ || op == TK_SLASHEQ) && !scalar) return 0;
+    if ((op == TK_STAREQ || op == TK_SLASHEQ) && (!scalar || s)) return 0;
     {
         /* r is another value (x += x leaves x shared, so never comes here). */
         double *restrict xv = x->val;
         const double *restrict rv = scalar ? NULL : r->val;
-        if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
+        if (s) {
+            double k = val_scalar(s);
+            if (op == TK_PLUSEQ) for (i = 0; i < n; i++) xv[i] += k * rv[i];
+            else for (i = 0; i < n; i++) xv[i] -= k * rv[i];
+        } else if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
             double sign = op == TK_PLUSEQ ? 1 : -1; /* x + (-r) is x - r, bit for bit */
             if (scalar) for (i = 0, c *= sign; i < n; i++) xv[i] += c;
             else if (sign > 0) for (i = 0; i < n; i++) xv[i] += rv[i];
@@ -658,7 +676,33 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     cur = store_get(&V->E->store, s->name);
     if (!cur) return undefined_name(V, s->name);
     val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
-    if (ev_expr(V, s->kids[0], &r)) {
+    if (s->kind == ST_OPASSIGN && (s->op == TK_PLUSEQ || s->op == TK_MINUSEQ) &&
+        s->kids[0]->kind == AST_BINARY && s->kids[0]->op == TK_STAR) {
+        /* x += s * y: both factors first, so that a scalar one can scale y
+         * into x directly (update_in_place); otherwise their product. */
+        const ast_node *t = s->kids[0];
+        const silc_value *k;
+        silc_value *a, *b;
+        if (ev_expr(V, t->kids[0], &a)) {
+            val_release(cur);
+            return -1;
+        }
+        if (ev_expr(V, t->kids[1], &b)) {
+            val_release(a);
+            val_release(cur);
+            return -1;
+        }
+        k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
+        if (k && update_in_place(V, s->op, cur, k == a ? b : a, k)) {
+            val_release(a);
+            val_release(b);
+            return bind(V, s, s->name, cur, t0);
+        }
+        if (binary_of(V, t, a, b, &r)) {
+            val_release(cur);
+            return -1;
+        }
+    } else if (ev_expr(V, s->kids[0], &r)) {
         val_release(cur);
         return -1;
     }
@@ -668,7 +712,7 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     o.lname = ln;
     o.rname = rn;
     o.what = what;
-    if (s->kind == ST_OPASSIGN && update_in_place(V, s->op, cur, r)) {
+    if (s->kind == ST_OPASSIGN && update_in_place(V, s->op, cur, r, NULL)) {
         val_release(r);
         return bind(V, s, s->name, cur, t0); /* hands over the reference taken above */
     } else if (s->kind == ST_OPASSIGN) {
