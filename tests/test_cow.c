@@ -11,6 +11,8 @@
  *     (a matrix product: its result added in place): the same;
  *   - x += 2*x: through the temporary 2*x; x += 2*q with q of another
  *     length, x += 2*nope: refused, x untouched;
+ *   - x = x + y, x = x - 0.5*y: the same updates, in place; x = y + x is not
+ *     one (copied); x = x + q refused in the words of the expression;
  *   - x shared with w (w = x): x gets a new object, w keeps the old entries;
  *   - x += x (the right-hand side holds x too): copied, doubled;
  *   - a matrix with a factorization attached (D \ b ran): copied, and the
@@ -108,11 +110,31 @@ int main(void)
         CHECK(get("x") == before && same_entries("x", "f"), "a refused x += 2 * ... changed x");
     }
 
+    /* x = x + e is x += e. */
+    run("e = x + y");
+    check_in_place("x = x + y", "e");
+    run("e = x - 0.5 * y");
+    check_in_place("x = x - 0.5 * y", "e");
+    run("e = y + x");
+    check_copied("x = y + x", "e");
+    {
+        const silc_value *before = get("x");
+        run("f = x * 1");
+        CHECK(api_exec(E, "x = x + q", err, sizeof err) != 0 &&
+                  strstr(err, "'+' needs operands of the same shape or a scalar: 'x' is 1000x1, 'q' is 999x1"),
+              "x = x + q: %s", err);
+        CHECK(get("x") == before && same_entries("x", "f"), "a refused x = x + q changed x");
+    }
+
     /* Shared: w sees none of it. */
     run("w = x; e = x + 1; f = x * 1"); /* f: a copy of the entries */
     w_before = get("w");
     check_copied("x += 1", "e");
     CHECK(get("w") == w_before && same_entries("w", "f"), "w changed with x");
+    run("w = x; e = x - 2 * y; f = x * 1");
+    w_before = get("w");
+    check_copied("x = x - 2 * y", "e");
+    CHECK(get("w") == w_before && same_entries("w", "f"), "w changed with x = x - 2 * y");
 
     /* The right-hand side is x itself. */
     run("e = x + x");

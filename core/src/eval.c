@@ -663,44 +663,72 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
     return 1;
 }
 
-static int exec_assign(lang_ev *V, const ast_node *s, double t0)
+/* The operand e of an update of x by op (+= -= *= /=): applied to x in
+ * place when update_in_place allows it (returns 1), else its value in *out
+ * (returns 0), or -1 on error.  e = s * y with a scalar s is scaled into x
+ * without the temporary s * y. */
+static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *e, silc_value **out)
 {
-    silc_value *v = NULL, *cur, *r;
-    char ln[64], rn[64], what[256];
-    operands o;
-    int rc;
-    if (s->kind == ST_ASSIGN) {
-        if (ev_expr(V, s->kids[0], &v)) return -1;
-        return bind(V, s, s->name, v, t0);
-    }
-    cur = store_get(&V->E->store, s->name);
-    if (!cur) return undefined_name(V, s->name);
-    val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
-    if (s->kind == ST_OPASSIGN && (s->op == TK_PLUSEQ || s->op == TK_MINUSEQ) &&
-        s->kids[0]->kind == AST_BINARY && s->kids[0]->op == TK_STAR) {
-        /* x += s * y: both factors first, so that a scalar one can scale y
-         * into x directly (update_in_place); otherwise their product. */
-        const ast_node *t = s->kids[0];
+    *out = NULL;
+    if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
         const silc_value *k;
         silc_value *a, *b;
-        if (ev_expr(V, t->kids[0], &a)) {
-            val_release(cur);
-            return -1;
-        }
-        if (ev_expr(V, t->kids[1], &b)) {
+        if (ev_expr(V, e->kids[0], &a)) return -1;
+        if (ev_expr(V, e->kids[1], &b)) {
             val_release(a);
-            val_release(cur);
             return -1;
         }
         k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
-        if (k && update_in_place(V, s->op, cur, k == a ? b : a, k)) {
+        if (k && update_in_place(V, op, x, k == a ? b : a, k)) {
             val_release(a);
             val_release(b);
-            return bind(V, s, s->name, cur, t0);
+            return 1;
         }
-        if (binary_of(V, t, a, b, &r)) {
+        if (binary_of(V, e, a, b, out)) return -1;
+    } else if (ev_expr(V, e, out)) {
+        return -1;
+    }
+    if (!update_in_place(V, op, x, *out, NULL)) return 0;
+    val_release(*out);
+    *out = NULL;
+    return 1;
+}
+
+/* `x = x + e` and `x = x - e` are the updates `x += e` and `x -= e`: the
+ * same arithmetic (so the same bits), in place under the same conditions.
+ * Returns TK_PLUSEQ / TK_MINUSEQ for such a statement, else 0. */
+static int self_update_op(const ast_node *s)
+{
+    const ast_node *e = s->kids[0];
+    if (s->kind != ST_ASSIGN || e->kind != AST_BINARY || (e->op != TK_PLUS && e->op != TK_MINUS) ||
+        e->kids[0]->kind != AST_NAME || strcmp(e->kids[0]->name, s->name) != 0)
+        return 0;
+    return e->op == TK_PLUS ? TK_PLUSEQ : TK_MINUSEQ;
+}
+
+static int exec_assign(lang_ev *V, const ast_node *s, double t0)
+{
+    silc_value *v = NULL, *cur = NULL, *r;
+    char ln[64], rn[64], what[256];
+    operands o;
+    int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
+    if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
+    if (s->kind == ST_ASSIGN && !cur) {
+        if (ev_expr(V, s->kids[0], &v)) return -1;
+        return bind(V, s, s->name, v, t0);
+    }
+    if (!cur) return undefined_name(V, s->name);
+    val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
+    if (op) {
+        rc = update_operand(V, op, cur, s->kind == ST_OPASSIGN ? s->kids[0] : s->kids[0]->kids[1], &r);
+        if (rc < 0) {
             val_release(cur);
             return -1;
+        }
+        if (rc > 0) return bind(V, s, s->name, cur, t0); /* hands over the reference taken above */
+        if (s->kind == ST_ASSIGN) { /* x = x + e, with that expression's wording */
+            if (binary_of(V, s->kids[0], cur, r, &v)) return -1;
+            return bind(V, s, s->name, v, t0);
         }
     } else if (ev_expr(V, s->kids[0], &r)) {
         val_release(cur);
@@ -712,15 +740,10 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     o.lname = ln;
     o.rname = rn;
     o.what = what;
-    if (s->kind == ST_OPASSIGN && update_in_place(V, s->op, cur, r, NULL)) {
-        val_release(r);
-        return bind(V, s, s->name, cur, t0); /* hands over the reference taken above */
-    } else if (s->kind == ST_OPASSIGN) {
+    if (s->kind == ST_OPASSIGN)
         rc = apply_binary(V, opassign_token(s->op), &o, cur, r, &v);
-    } else {
-        snprintf(ln, sizeof ln, "'%s'", s->name);
+    else
         rc = ix_assign(V, s->kids + 1, s->nkids - 1, ln, cur, r, &v);
-    }
     val_release(cur);
     val_release(r);
     if (rc) return -1;
