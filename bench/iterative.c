@@ -15,7 +15,8 @@
  * out-of-cache check.
  *
  * Part 2, through SILC: x = A \ b for the K x K Laplacian with b = A * ones,
- * by lis-style CG + IC(0) and BiCGSTAB + ILU(0) at -tol 1e-4, 1e-8, 1e-12,
+ * by lis-style CG + IC(0), CG + SA-AMG and BiCGSTAB + ILU(0) at -tol 1e-4,
+ * 1e-8, 1e-12,
  * next to the direct sparse Cholesky of the reference plugin and CHOLMOD, and
  * PETSc CG + hypre BoomerAMG and CG + GAMG when the "petsc" plugin is loaded
  * (rows that fail are skipped with the reason), with `set tune.threads` to
@@ -363,6 +364,7 @@ int main(int argc, char **argv)
             const char *series, *fmt;
         } it[] = {
             {"lis-style CG + IC(0)", "backend = lis-style; lis-style.options = -i cg -p ic -tol %g -maxiter 100000"},
+            {"lis-style CG + SA-AMG", "backend = lis-style; lis-style.options = -i cg -p saamg -tol %g -maxiter 100000"},
             {"lis-style BiCGSTAB + ILU(0)", "backend = lis-style; lis-style.options = -i bicgstab -p ilu -tol %g -maxiter 100000"},
             {"PETSc CG + hypre", "backend = petsc; petsc.options = -ksp_type cg -pc_type hypre -ksp_rtol %g -ksp_max_it 100000"},
             {"PETSc CG + GAMG", "backend = petsc; petsc.options = -ksp_type cg -pc_type gamg -ksp_rtol %g -ksp_max_it 100000"},

@@ -53,10 +53,11 @@ int lis_bicr_family(int solver);
 int lis_needs_transpose(int solver);
 
 /* Preconditioner numbers as in Lis (-p): none 0, jacobi 1, ilu 2, ssor 3,
- * hybrid 4, is 5, sainv 6, saamg 7, iluc 8, ilut 9.  IC(0) is not among
- * Lis's, so it has a name only (and an internal number outside Lis's range). */
+ * hybrid 4, is 5, sainv 6, saamg 7, iluc 8, ilut 9 (hybrid, is, sainv and
+ * iluc are refused by name).  IC(0) is not among Lis's, so it has a name
+ * only (and an internal number outside Lis's range). */
 enum lis_precon_id {
-    LIS_PC_NONE = 0, LIS_PC_JACOBI = 1, LIS_PC_ILU = 2, LIS_PC_SSOR = 3, LIS_PC_ILUT = 9,
+    LIS_PC_NONE = 0, LIS_PC_JACOBI = 1, LIS_PC_ILU = 2, LIS_PC_SSOR = 3, LIS_PC_SAAMG = 7, LIS_PC_ILUT = 9,
     LIS_PC_IC = 100
 };
 
@@ -71,6 +72,7 @@ typedef struct lis_options {
     double omega;               /* -omega: SOR */
     double ssor_omega;          /* -ssor_omega: SSOR preconditioner */
     double ilut_drop, ilut_rate;
+    double saamg_theta;         /* -saamg_theta: SA-AMG strength threshold */
     int conv_cond;              /* 0: ||r|| / ||r0||, 1: ||r|| / ||b|| (2-norms) */
     int initx_zeros;            /* 1: x0 = 0; 0: x0 = in[2] when given */
     int print;                  /* 1: residual history through host->log */
@@ -96,6 +98,17 @@ void lis_precon_label(const lis_options *o, char *buf, size_t len);
 
 /* ---- preconditioners ---------------------------------------------------------------- */
 
+/* The SA-AMG hierarchy (lis_amg.c), for symmetric matrices only. */
+typedef struct lis_amg lis_amg;
+/* Builds it for A (borrowed: it must outlive the hierarchy) with strength
+ * threshold theta; *nnz counts the entries of every level's matrix.
+ * SILC_OK, SILC_ENOMEM, or SILC_EBREAKDOWN with err (zero diagonal,
+ * coarsening that stalls, a singular coarsest level). */
+int lis_amg_build(const lk_csr *A, double theta, lis_amg **out, int64_t *nnz, char *err, size_t errlen);
+void lis_amg_apply(const lis_amg *G, const double *x, double *y); /* y = one V-cycle on x */
+int lis_amg_levels(const lis_amg *G);
+void lis_amg_free(lis_amg *G);
+
 typedef struct lis_pc {
     int kind;                   /* enum lis_precon_id */
     int64_t n;
@@ -106,10 +119,21 @@ typedef struct lis_pc {
     double *lx, *ux;
     lk_csr A;                   /* SSOR: the matrix itself (borrowed) */
     double omega;               /* SSOR */
+    lis_amg *amg;               /* SA-AMG */
     double shift;               /* diagonal shift that made the factorization work */
     int64_t nnz;                /* entries of L + U + D */
     double seconds;             /* setup time */
 } lis_pc;
+
+/* A CSR matrix the plugin owns (a converted A, A', the multigrid's levels). */
+typedef struct lis_matrix {
+    lk_csr A;                   /* views rp, ci, v */
+    int64_t *rp, *ci;
+    double *v;
+} lis_matrix;
+lis_matrix *lis_matrix_alloc(int64_t m, int64_t n, int64_t nnz); /* rp zeroed; NULL: no memory */
+void lis_matrix_free(void *M);
+lis_matrix *lis_matrix_transpose(const lk_csr *A);
 
 /* Builds the preconditioner of o for A.  Returns SILC_OK, SILC_ENOMEM, or
  * SILC_EBREAKDOWN with a message in err (zero diagonal; pivots that stay bad

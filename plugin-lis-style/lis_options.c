@@ -1,7 +1,7 @@
 /*
  * lis_options.c -- the Lis option string: `-i cg -p ilu -ilu_fill 1 -tol 1e-12
- * -maxiter 1000 -restart 40 -omega 1.9 -conv_cond nrm2_r -initx_zeros true
- * -print none -f double`.
+ * -maxiter 1000 -restart 40 -omega 1.9 -saamg_theta 0.05 -conv_cond nrm2_r
+ * -initx_zeros true -print none -f double`.
  *
  * Enumerations take Lis's names or Lis's numbers (see lis.h for the table).
  * Unlike Lis, which ignores what it does not know, every unknown option,
@@ -37,13 +37,13 @@ static const named solvers[] = {
 static const named precons[] = {
     {"none", 0, LIS_PC_NONE + 1000}, {"jacobi", 1, LIS_PC_JACOBI}, {"ilu", 2, LIS_PC_ILU},
     {"ssor", 3, LIS_PC_SSOR},        {"hybrid", 4, 0},             {"is", 5, 0},
-    {"sainv", 6, 0},                 {"saamg", 7, 0},              {"iluc", 8, 0},
+    {"sainv", 6, 0},                 {"saamg", 7, LIS_PC_SAAMG},   {"iluc", 8, 0},
     {"ilut", 9, LIS_PC_ILUT},        {"ic", -1, LIS_PC_IC},        {NULL, 0, 0}};
 /* (none's id is offset by 1000 only so that 0 can mean "not implemented".) */
 
 static const char *const option_names[] = {
     "-i", "-p", "-ilu_fill", "-ell", "-idrs_s", "-irestart", "-tol", "-maxiter", "-restart",
-    "-omega", "-ssor_omega", "-ilut_drop", "-ilut_rate", "-conv_cond", "-initx_zeros",
+    "-omega", "-ssor_omega", "-ilut_drop", "-ilut_rate", "-saamg_theta", "-conv_cond", "-initx_zeros",
     "-print", "-f", NULL};
 
 void lis_options_init(lis_options *o)
@@ -61,6 +61,7 @@ void lis_options_init(lis_options *o)
     o->ssor_omega = 1.0;
     o->ilut_drop = 0.05;
     o->ilut_rate = 5.0;
+    o->saamg_theta = 0.05;
     o->conv_cond = 0;
     o->initx_zeros = 1;
 }
@@ -250,6 +251,9 @@ static int set_option(lis_options *o, const char *opt, const char *val, char *er
     } else if (!strcmp(opt, "-ilut_rate")) {
         if (!real_in(opt, val, 0, 1e308, 1, &x, err, errlen)) return -1;
         o->ilut_rate = x;
+    } else if (!strcmp(opt, "-saamg_theta")) {
+        if (!real_in(opt, val, 0, 1, 0, &x, err, errlen)) return -1;
+        o->saamg_theta = x;
     } else if (!strcmp(opt, "-conv_cond")) {
         static const char *const n[] = {"nrm2_r", "0", "nrm2_b", "1", NULL};
         static const int v[] = {0, 0, 1, 1};
@@ -393,6 +397,7 @@ void lis_precon_label(const lis_options *o, char *buf, size_t len)
     case LIS_PC_ILU: snprintf(buf, len, "ILU(%d)", o->ilu_fill); break;
     case LIS_PC_SSOR: snprintf(buf, len, "SSOR(%g)", o->ssor_omega); break;
     case LIS_PC_ILUT: snprintf(buf, len, "ILUT(%g,%g)", o->ilut_drop, o->ilut_rate); break;
+    case LIS_PC_SAAMG: snprintf(buf, len, "SA-AMG(%g)", o->saamg_theta); break;
     case LIS_PC_IC: snprintf(buf, len, "IC(0)"); break;
     default: snprintf(buf, len, "none"); break;
     }

@@ -1,5 +1,6 @@
 /*
- * lis_precond.c -- the preconditioners: Jacobi, ILU(k), IC(0), SSOR, ILUT.
+ * lis_precond.c -- the preconditioners: Jacobi, ILU(k), IC(0), SSOR, ILUT,
+ * and SA-AMG through lis_amg.c.
  *
  * The incomplete factorizations share one form, M = (I + L)(D + U) with L
  * strictly lower (multipliers), U strictly upper and D diagonal, kept in CSR
@@ -48,6 +49,7 @@ void lis_pc_free(void *p)
     xfree(P->up);
     xfree(P->ui);
     xfree(P->ux);
+    lis_amg_free(P->amg);
     xfree(P);
 }
 
@@ -362,7 +364,13 @@ int lis_pc_build(const lk_csr *A, const lis_options *o, lis_pc **out, char *err,
     if (!P) return snprintf(err, errlen, "lis-style: out of memory for the preconditioner"), SILC_ENOMEM;
     P->kind = o->precon;
     P->n = A->m;
-    if (o->precon == LIS_PC_JACOBI || o->precon == LIS_PC_SSOR) {
+    if (o->precon == LIS_PC_SAAMG) {
+        int rc = lis_amg_build(A, o->saamg_theta, &P->amg, &P->nnz, err, errlen);
+        if (rc) {
+            lis_pc_free(P);
+            return rc;
+        }
+    } else if (o->precon == LIS_PC_JACOBI || o->precon == LIS_PC_SSOR) {
         P->dinv = xalloc((size_t)A->m, sizeof(double));
         if (!P->dinv) {
             lis_pc_free(P);
@@ -408,6 +416,8 @@ void lis_pc_apply(const lis_pc *P, const double *x, double *y)
     int64_t n = P->n, i, k;
     if (P->kind == LIS_PC_JACOBI) {
         for (i = 0; i < n; i++) y[i] = x[i] * P->dinv[i];
+    } else if (P->kind == LIS_PC_SAAMG) {
+        lis_amg_apply(P->amg, x, y);
     } else if (P->kind == LIS_PC_SSOR) {
         /* M = (D + wL) D^-1 (D + wU) / (w (2 - w)). */
         const lk_csr *A = &P->A;
@@ -441,7 +451,7 @@ void lis_pc_apply(const lis_pc *P, const double *x, double *y)
 void lis_pc_apply_t(const lis_pc *P, const double *x, double *y)
 {
     int64_t n = P->n, i, k;
-    if (P->kind == LIS_PC_JACOBI) {
+    if (P->kind == LIS_PC_JACOBI || P->kind == LIS_PC_SAAMG) { /* symmetric M */
         lis_pc_apply(P, x, y);
     } else if (P->kind == LIS_PC_SSOR) {
         /* M' = (D + wU') D^-1 (D + wL') / (w (2 - w)): column sweeps over the rows. */

@@ -46,13 +46,7 @@ const silc_host_api *lis_host;
 
 /* ---- converted matrices (attachments) ------------------------------------------ */
 
-typedef struct lis_matrix {
-    lk_csr A;
-    int64_t *rp, *ci;
-    double *v;
-} lis_matrix;
-
-static void matrix_free(void *p)
+void lis_matrix_free(void *p)
 {
     lis_matrix *M = p;
     if (!M) return;
@@ -62,7 +56,7 @@ static void matrix_free(void *p)
     lis_host->free(M);
 }
 
-static lis_matrix *matrix_alloc(int64_t m, int64_t n, int64_t nnz)
+lis_matrix *lis_matrix_alloc(int64_t m, int64_t n, int64_t nnz)
 {
     lis_matrix *M = lis_host->calloc(1, sizeof *M);
     if (!M) return NULL;
@@ -70,7 +64,7 @@ static lis_matrix *matrix_alloc(int64_t m, int64_t n, int64_t nnz)
     M->ci = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int64_t));
     M->v = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
     if (!M->rp || !M->ci || !M->v) {
-        matrix_free(M);
+        lis_matrix_free(M);
         return NULL;
     }
     M->A.m = m;
@@ -109,20 +103,20 @@ static lis_matrix *matrix_from_full(const silc_view *a)
             }
             if (pass) M->rp[i + 1] = nnz;
         }
-        if (!pass && !(M = matrix_alloc(a->m, a->n, nnz))) return NULL;
+        if (!pass && !(M = lis_matrix_alloc(a->m, a->n, nnz))) return NULL;
     }
     return M;
 }
 
-static lis_matrix *matrix_transpose(const lk_csr *A)
+lis_matrix *lis_matrix_transpose(const lk_csr *A)
 {
     int64_t nnz = A->rp[A->m], i, k;
-    lis_matrix *T = matrix_alloc(A->n, A->m, nnz);
+    lis_matrix *T = lis_matrix_alloc(A->n, A->m, nnz);
     int64_t *next;
     if (!T) return NULL;
     next = lis_host->calloc((size_t)A->n + 1, sizeof(int64_t));
     if (!next) {
-        matrix_free(T);
+        lis_matrix_free(T);
         return NULL;
     }
     for (k = 0; k < nnz; k++) T->rp[A->ci[k] + 1]++;
@@ -335,8 +329,8 @@ static int solve_run(silc_call *call)
         if (!M) {
             if (!(M = matrix_from_full(&a)))
                 return H->error(call, SILC_ENOMEM, "lis-style: out of memory converting A to CSR");
-            if (H->attach_set(call->in[0], "lis-style.csr", M, matrix_free)) {
-                matrix_free(M);
+            if (H->attach_set(call->in[0], "lis-style.csr", M, lis_matrix_free)) {
+                lis_matrix_free(M);
                 return H->error(call, SILC_ENOMEM, "lis-style: cannot attach the CSR copy of A");
             }
         }
@@ -348,10 +342,10 @@ static int solve_run(silc_call *call)
         } else {
             lis_matrix *T = H->attach_get(call->in[0], "lis-style.transpose");
             if (!T) {
-                if (!(T = matrix_transpose(&A)))
+                if (!(T = lis_matrix_transpose(&A)))
                     return H->error(call, SILC_ENOMEM, "lis-style: out of memory for A'");
-                if (H->attach_set(call->in[0], "lis-style.transpose", T, matrix_free)) {
-                    matrix_free(T);
+                if (H->attach_set(call->in[0], "lis-style.transpose", T, lis_matrix_free)) {
+                    lis_matrix_free(T);
                     return H->error(call, SILC_ENOMEM, "lis-style: cannot attach A'");
                 }
             }
@@ -360,6 +354,10 @@ static int solve_run(silc_call *call)
     }
 
     /* The preconditioner, built once per matrix value and description. */
+    if (opt.precon == LIS_PC_SAAMG && !silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric)
+        return H->error(call, SILC_EARG, "lis-style options: -p saamg needs a symmetric matrix (the "
+                                         "smoothed aggregation here is the symmetric one; Lis's "
+                                         "-saamg_unsym is not implemented)");
     if (opt.precon != LIS_PC_NONE) {
         snprintf(key, sizeof key, "lis-style.pc.%s", plabel);
         pc = H->attach_get(call->in[0], key);
@@ -444,6 +442,9 @@ static int solve_run(silc_call *call)
         if (pc && pc->shift > 0 && u < sizeof rep->note)
             u += (size_t)snprintf(rep->note + u, sizeof rep->note - u, " with diagonal shift %g",
                                   pc->shift);
+        if (pc && pc->amg && u < sizeof rep->note)
+            u += (size_t)snprintf(rep->note + u, sizeof rep->note - u, ", %d levels",
+                                  lis_amg_levels(pc->amg));
         if (restarts && u < sizeof rep->note)
             u += (size_t)snprintf(rep->note + u, sizeof rep->note - u,
                                   "; restarted %d time(s) on residual drift", restarts);

@@ -16,10 +16,15 @@
  *     and MINRES only there) and on an unsymmetric convection-diffusion
  *     operator, against the exact solution x_i = 1 + i/n; every solver in
  *     -f quad;
+ *   - SA-AMG: CG's iterations on the k x k Laplacian stay nearly flat for
+ *     k = 64, 128, 256 (at most 25, and at least 4x fewer than IC(0)'s at
+ *     k = 128), the 256 x 256 hierarchy has at least 3 levels, an
+ *     unsymmetric matrix and a bad -saamg_theta are refused, and every SPD
+ *     shared matrix is solved with CG + SA-AMG or honestly not;
  *   - the BiCR family's shadow residual: on a symmetric matrix BiCR's
  *     residual after 8 iterations is CR's and BiCG's is CG's, and CRS,
  *     BiCRSTAB, GPBiCR part from CGS, BiCGSTAB, GPBiCG;
- *   - the SPD shared matrices with CG+IC(0) and CG+ILU(0) (-tol 1e-10
+ *   - the SPD shared matrices with CG+IC(0), CG+ILU(0), CG+SA-AMG (-tol 1e-10
  *     -maxiter 20000): converged => reported residual <= tol and the relative
  *     error against the reference direct solve <= 1e-10 * its condition
  *     estimate (the 1-norm estimate bounds the 2-norm condition of a symmetric
@@ -200,7 +205,7 @@ static const char *const krylov[] = {"cg", "cr", "minres", "bicg", "bicr", "cgs"
                                      "fgmres", "orthomin", "idrs", "idr1", NULL};
 static const char *const stationary[] = {"jacobi", "gs", "sor", NULL};
 static const char *const precons[] = {"none", "jacobi", "ilu", "ilu -ilu_fill 1", "ic", "ssor",
-                                      "ilut", NULL};
+                                      "ilut", "saamg", NULL};
 
 static int run_one(silc_context *c, const char *opts, int64_t n, const double *xt, double tol_err,
                    const char *label)
@@ -247,9 +252,9 @@ static void test_all_methods(silc_context *c)
                 !strcmp(krylov[s], "cg") || !strcmp(krylov[s], "cr") || !strcmp(krylov[s], "minres");
             if (!sym && symmetric_method) continue;
             for (int p = 0; precons[p]; p++) {
-                /* IC is for symmetric matrices; CG, CR and MINRES need a
-                 * symmetric preconditioner, which ILUT's dropping is not. */
-                if (!sym && !strcmp(precons[p], "ic")) continue;
+                /* IC and SA-AMG are for symmetric matrices; CG, CR and MINRES
+                 * need a symmetric preconditioner, which ILUT's dropping is not. */
+                if (!sym && (!strcmp(precons[p], "ic") || !strcmp(precons[p], "saamg"))) continue;
                 if (symmetric_method && !strcmp(precons[p], "ilut")) continue;
                 snprintf(opts, sizeof opts, "-i %s -p %s -tol 1e-10 -maxiter 5000", krylov[s], precons[p]);
                 good += run_one(c, opts, n, xt, 1e-8, label);
@@ -324,6 +329,62 @@ static void test_bicr_shadow(silc_context *c)
     free(xt);
 }
 
+/* ---- SA-AMG ------------------------------------------------------------------------------ */
+
+static void expect_error(silc_context *c, const char *opts, const char *want1, const char *want2);
+
+/* Iterations of CG with preconditioner pc on the k x k Laplacian, b = A xt,
+ * after checking the solution against xt; the info's note in *note. */
+static double cg_iterations(silc_context *c, int64_t k, const char *pc, char *note, size_t notelen)
+{
+    silc_envelope_t A;
+    int64_t n = k * k;
+    double *xt = malloc((size_t)n * sizeof *xt), it = -1;
+    char opts[96], label[128];
+    for (int64_t i = 0; i < n; i++) xt[i] = 1 + (double)i / (double)n;
+    grid(&A, k, 0);
+    put_system(c, &A, xt);
+    snprintf(opts, sizeof opts, "-i cg -p %s -tol 1e-10 -maxiter 5000", pc);
+    snprintf(label, sizeof label, "%lldx%lld Laplacian", (long long)k, (long long)k);
+    /* cond_2 of the k x k Laplacian is about 0.4 k^2: residual 1e-10 leaves an error below 1e-5 */
+    if (run_one(c, opts, n, xt, 1e-5, label)) {
+        const char *in = tl_out_info(c, "x");
+        const char *p = strstr(in, "note: ");
+        it = tl_out_number(in, "iterations: ");
+        snprintf(note, notelen, "%.*s", p ? (int)strcspn(p, "\n") : 0, p ? p : "");
+    }
+    silc_envelope_free(&A);
+    free(xt);
+    return it;
+}
+
+/* Smoothed aggregation keeps CG's iteration count nearly flat as the grid is
+ * refined, where IC(0)'s grows like k; it builds several levels, reports
+ * them, and refuses an unsymmetric matrix. */
+static void test_saamg(silc_context *c)
+{
+    char note[256];
+    double ic = cg_iterations(c, 128, "ic", note, sizeof note);
+    double a64 = cg_iterations(c, 64, "saamg", note, sizeof note);
+    double a128 = cg_iterations(c, 128, "saamg", note, sizeof note);
+    double a256 = cg_iterations(c, 256, "saamg", note, sizeof note);
+    silc_envelope_t A;
+    double xt[144];
+    printf("  CG iterations on the k x k Laplacian: IC(0) %g at k = 128; SA-AMG %g, %g, %g at k = 64, 128, 256"
+           " (%s)\n", ic, a64, a128, a256, note);
+    CHECK(a64 > 0 && a128 > 0 && a256 > 0 && ic > 0, "a run failed");
+    CHECK(a256 <= 25 && a256 <= a64 + 6, "SA-AMG iterations grow with the grid: %g, %g, %g", a64, a128, a256);
+    CHECK(ic >= 4 * a128, "IC(0) %g against SA-AMG %g: not the multigrid gap", ic, a128);
+    CHECK(tl_contains(note, "levels") && !tl_contains(note, " 1 levels") && !tl_contains(note, " 2 levels"),
+          "256x256 SA-AMG: %s", note);
+    for (int i = 0; i < 144; i++) xt[i] = 1;
+    grid(&A, 12, 0.4);
+    put_system(c, &A, xt);
+    expect_error(c, "-i gmres -p saamg", "-p saamg needs a symmetric matrix", "");
+    expect_error(c, "-i gmres -p saamg -saamg_theta 1.5", "-saamg_theta", "1.5");
+    silc_envelope_free(&A);
+}
+
 /* ---- the SPD shared matrices against the reference direct solve -------------------- */
 
 static void test_shared_spd(silc_context *c, silc_context *ref)
@@ -332,6 +393,8 @@ static void test_shared_spd(silc_context *c, silc_context *ref)
                  "x = solve(A, b, \"lis-style.options = -i cg -p ic -tol 1e-10 -maxiter 20000\")", 1e-10);
     tl_spd_sweep(c, ref, "CG+ILU(0)",
                  "x = solve(A, b, \"lis-style.options = -i cg -p ilu -tol 1e-10 -maxiter 20000\")", 1e-10);
+    tl_spd_sweep(c, ref, "CG+SA-AMG",
+                 "x = solve(A, b, \"lis-style.options = -i cg -p saamg -tol 1e-10 -maxiter 20000\")", 1e-10);
 }
 
 /* ---- options -------------------------------------------------------------------------- */
@@ -580,6 +643,7 @@ int main(void)
     printf("lis-style: solvers and preconditioners\n");
     test_all_methods(c);
     test_bicr_shadow(c);
+    test_saamg(c);
     printf("lis-style: options\n");
     test_options(c);
     test_defaults();
