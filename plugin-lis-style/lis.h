@@ -73,6 +73,7 @@ typedef struct lis_options {
     double ssor_omega;          /* -ssor_omega: SSOR preconditioner */
     double ilut_drop, ilut_rate;
     double saamg_theta;         /* -saamg_theta: SA-AMG strength threshold */
+    int saamg_unsym;            /* -saamg_unsym true: SA-AMG accepts an unsymmetric A */
     int conv_cond;              /* 0: ||r|| / ||r0||, 1: ||r|| / ||b|| (2-norms) */
     int initx_zeros;            /* 1: x0 = 0; 0: x0 = in[2] when given */
     int print;                  /* 1: residual history through host->log */
@@ -105,7 +106,9 @@ typedef struct lis_amg lis_amg;
  * SILC_OK, SILC_ENOMEM, or SILC_EBREAKDOWN with err (zero diagonal,
  * coarsening that stalls, a singular coarsest level). */
 int lis_amg_build(const lk_csr *A, double theta, lis_amg **out, int64_t *nnz, char *err, size_t errlen);
-void lis_amg_apply(const lis_amg *G, const double *x, double *y); /* y = one V-cycle on x */
+/* y = one V-cycle on x.  For a symmetric A, M is symmetric, so this is also
+ * M'; for an unsymmetric one (-saamg_unsym) there is no M' here. */
+void lis_amg_apply(const lis_amg *G, const double *x, double *y);
 int lis_amg_levels(const lis_amg *G);
 void lis_amg_free(lis_amg *G);
 

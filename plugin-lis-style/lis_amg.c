@@ -1,6 +1,6 @@
 /*
  * lis_amg.c -- the smoothed-aggregation algebraic multigrid preconditioner
- * (-p saamg) for symmetric matrices: one V-cycle per application.
+ * (-p saamg): one V-cycle per application.
  *
  * Setup, level by level until at most AMG_COARSEST unknowns remain (Vanek,
  * Mandel & Brezina, Computing 56, 1996):
@@ -13,13 +13,20 @@
  *   prolongator P = (I - w D^-1 A) P0, P0 the aggregates' indicator columns
  *              scaled to unit norm (the constant near-null space), w = 4/(3 r)
  *              with r >= rho(D^-1 A) the Gershgorin bound;
- *   coarse     A_c = P' A P (two sparse products), and a dense LU with partial
- *              pivoting on the last level.
+ *   coarse     A_c = R A P with R = P' (two sparse products), and a dense LU
+ *              with partial pivoting on the last level.
  * The V-cycle smooths with one forward Gauss-Seidel sweep before the coarse
- * correction and one backward sweep after it, so the preconditioner is
- * symmetric (and positive definite for an SPD A): CG and MINRES may use it,
- * and its transpose is itself.  Unsymmetric matrices are refused (Lis's
- * -saamg_unsym variant is not implemented).
+ * correction and one backward sweep after it, so for a symmetric A the
+ * preconditioner is symmetric (and positive definite for an SPD A): CG and
+ * MINRES may use it, and its transpose is itself.
+ *
+ * -saamg_unsym true lets the driver use the same construction on an
+ * unsymmetric A (still Galerkin, R = P'); the V-cycle is then not symmetric
+ * and has no transposed application here, so the driver keeps it from the
+ * methods that need M^-T.  A Petrov-Galerkin restriction smoothed with A'
+ * (R = ((I - w D^-1 A') P0)') was tried and dropped: on the convection-
+ * diffusion grid of the tests (beta 0.4) GMRES then stalled from 64 x 64 on,
+ * where R = P' converges in 8-9 iterations at 32..128.
  */
 #include "lis.h"
 
@@ -220,8 +227,7 @@ static int coarse_lu(lis_amg *G, const lk_csr *A, char *err, size_t errlen)
     return SILC_OK;
 }
 
-int lis_amg_build(const lk_csr *A, double theta, lis_amg **out, int64_t *nnz_out, char *err,
-                  size_t errlen)
+int lis_amg_build(const lk_csr *A, double theta, lis_amg **out, int64_t *nnz_out, char *err, size_t errlen)
 {
     lis_amg *G = lis_host->calloc(1, sizeof *G);
     int64_t nnz = 0, i;

@@ -1,7 +1,7 @@
 /*
  * lis_options.c -- the Lis option string: `-i cg -p ilu -ilu_fill 1 -tol 1e-12
- * -maxiter 1000 -restart 40 -omega 1.9 -saamg_theta 0.05 -conv_cond nrm2_r
- * -initx_zeros true -print none -f double`.
+ * -maxiter 1000 -restart 40 -omega 1.9 -saamg_theta 0.05 -saamg_unsym false
+ * -conv_cond nrm2_r -initx_zeros true -print none -f double`.
  *
  * Enumerations take Lis's names or Lis's numbers (see lis.h for the table).
  * Unlike Lis, which ignores what it does not know, every unknown option,
@@ -43,7 +43,8 @@ static const named precons[] = {
 
 static const char *const option_names[] = {
     "-i", "-p", "-ilu_fill", "-ell", "-idrs_s", "-irestart", "-tol", "-maxiter", "-restart",
-    "-omega", "-ssor_omega", "-ilut_drop", "-ilut_rate", "-saamg_theta", "-conv_cond", "-initx_zeros",
+    "-omega", "-ssor_omega", "-ilut_drop", "-ilut_rate", "-saamg_theta", "-saamg_unsym", "-conv_cond",
+    "-initx_zeros",
     "-print", "-f", NULL};
 
 void lis_options_init(lis_options *o)
@@ -258,10 +259,11 @@ static int set_option(lis_options *o, const char *opt, const char *val, char *er
         static const char *const n[] = {"nrm2_r", "0", "nrm2_b", "1", NULL};
         static const int v[] = {0, 0, 1, 1};
         if (!choice(opt, val, n, v, &o->conv_cond, err, errlen)) return -1;
-    } else if (!strcmp(opt, "-initx_zeros")) {
+    } else if (!strcmp(opt, "-initx_zeros") || !strcmp(opt, "-saamg_unsym")) {
         static const char *const n[] = {"true", "1", "false", "0", NULL};
         static const int v[] = {1, 1, 0, 0};
-        if (!choice(opt, val, n, v, &o->initx_zeros, err, errlen)) return -1;
+        if (!choice(opt, val, n, v, opt[1] == 'i' ? &o->initx_zeros : &o->saamg_unsym, err, errlen))
+            return -1;
     } else if (!strcmp(opt, "-print")) {
         static const char *const n[] = {"none", "0", "out", "2", NULL};
         static const int v[] = {0, 0, 1, 1};

@@ -354,10 +354,15 @@ static int solve_run(silc_call *call)
     }
 
     /* The preconditioner, built once per matrix value and description. */
-    if (opt.precon == LIS_PC_SAAMG && !silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric)
-        return H->error(call, SILC_EARG, "lis-style options: -p saamg needs a symmetric matrix (the "
-                                         "smoothed aggregation here is the symmetric one; Lis's "
-                                         "-saamg_unsym is not implemented)");
+    if (opt.precon == LIS_PC_SAAMG && !silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
+        if (!opt.saamg_unsym)
+            return H->error(call, SILC_EARG, "lis-style options: -p saamg is for symmetric matrices; "
+                                             "-saamg_unsym true applies it to an unsymmetric one");
+        if (lis_needs_transpose(opt.solver))
+            return H->error(call, SILC_EARG, "lis-style options: -i %s needs M^-T, which SA-AMG on an "
+                                             "unsymmetric matrix does not provide (use -i bicgstab, gmres, ...)",
+                            lis_solver_name(opt.solver));
+    }
     if (opt.precon != LIS_PC_NONE) {
         snprintf(key, sizeof key, "lis-style.pc.%s", plabel);
         pc = H->attach_get(call->in[0], key);

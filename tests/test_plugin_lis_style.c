@@ -18,9 +18,10 @@
  *     -f quad;
  *   - SA-AMG: CG's iterations on the k x k Laplacian stay nearly flat for
  *     k = 64, 128, 256 (at most 25, and at least 4x fewer than IC(0)'s at
- *     k = 128), the 256 x 256 hierarchy has at least 3 levels, an
- *     unsymmetric matrix and a bad -saamg_theta are refused, and every SPD
- *     shared matrix is solved with CG + SA-AMG or honestly not;
+ *     k = 128), the 256 x 256 hierarchy has at least 3 levels; an
+ *     unsymmetric matrix is refused without -saamg_unsym true, and with it
+ *     by the methods that need M^-T; a bad -saamg_theta is refused; every
+ *     SPD shared matrix is solved with CG + SA-AMG or honestly not;
  *   - the BiCR family's shadow residual: on a symmetric matrix BiCR's
  *     residual after 8 iterations is CR's and BiCG's is CG's, and CRS,
  *     BiCRSTAB, GPBiCR part from CGS, BiCGSTAB, GPBiCG;
@@ -205,7 +206,7 @@ static const char *const krylov[] = {"cg", "cr", "minres", "bicg", "bicr", "cgs"
                                      "fgmres", "orthomin", "idrs", "idr1", NULL};
 static const char *const stationary[] = {"jacobi", "gs", "sor", NULL};
 static const char *const precons[] = {"none", "jacobi", "ilu", "ilu -ilu_fill 1", "ic", "ssor",
-                                      "ilut", "saamg", NULL};
+                                      "ilut", "saamg", "saamg -saamg_unsym true", NULL};
 
 static int run_one(silc_context *c, const char *opts, int64_t n, const double *xt, double tol_err,
                    const char *label)
@@ -255,6 +256,11 @@ static void test_all_methods(silc_context *c)
                 /* IC and SA-AMG are for symmetric matrices; CG, CR and MINRES
                  * need a symmetric preconditioner, which ILUT's dropping is not. */
                 if (!sym && (!strcmp(precons[p], "ic") || !strcmp(precons[p], "saamg"))) continue;
+                /* SA-AMG on an unsymmetric matrix has no M^-T. */
+                if (!sym && strstr(precons[p], "unsym") &&
+                    (!strcmp(krylov[s], "bicg") || !strcmp(krylov[s], "bicr") || !strcmp(krylov[s], "crs") ||
+                     !strcmp(krylov[s], "bicrstab") || !strcmp(krylov[s], "gpbicr")))
+                    continue;
                 if (symmetric_method && !strcmp(precons[p], "ilut")) continue;
                 snprintf(opts, sizeof opts, "-i %s -p %s -tol 1e-10 -maxiter 5000", krylov[s], precons[p]);
                 good += run_one(c, opts, n, xt, 1e-8, label);
@@ -380,8 +386,10 @@ static void test_saamg(silc_context *c)
     for (int i = 0; i < 144; i++) xt[i] = 1;
     grid(&A, 12, 0.4);
     put_system(c, &A, xt);
-    expect_error(c, "-i gmres -p saamg", "-p saamg needs a symmetric matrix", "");
+    expect_error(c, "-i gmres -p saamg", "-p saamg is for symmetric matrices", "-saamg_unsym true");
+    expect_error(c, "-i bicg -p saamg -saamg_unsym true", "-i BiCG needs M^-T", "unsymmetric");
     expect_error(c, "-i gmres -p saamg -saamg_theta 1.5", "-saamg_theta", "1.5");
+    run_one(c, "-i gmres -p saamg -saamg_unsym true -tol 1e-11", 144, xt, 1e-8, "unsymmetric SA-AMG");
     silc_envelope_free(&A);
 }
 
