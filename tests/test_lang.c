@@ -725,6 +725,18 @@ static void test_explain(void)
             free(x);
         }
     }
+    /* An update that runs in place says so; once the value is shared, the
+     * same statement goes to the add backend. */
+    captured[0] = 0;
+    CHECK(silc_exec(c, "u = v * 1; explain u += 2 * v") == 0, "explain in place: %s", silc_context_errmsg(c));
+    CHECK(strstr(captured, "  1. u += 2 * v: 3x1 dense, 3x1 dense, 1x1 scale\n     in place: nothing else "
+                           "holds the value") != NULL,
+          "explain in place: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "w = u; explain u = u - v") == 0, "explain shared: %s", silc_context_errmsg(c));
+    CHECK(strstr(captured, "  1. u - v: 3x1 dense, 3x1 dense\n     add -> add\n") != NULL &&
+              !strstr(captured, "in place"),
+          "explain shared: %s", captured);
     captured[0] = 0;
     CHECK(silc_exec(c, "explain y = zeros(2, 1)") == 0, "explain core: %s", silc_context_errmsg(c));
     CHECK(strstr(captured, "  1. zeros(2, 1): built by the core -> 2x1 dense\n") != NULL,

@@ -630,17 +630,28 @@ static int opassign_token(int op)
  * the temporary s * r.  Each s * r_i is rounded before it is added, as
  * SILC_OP_SCALE then SILC_OP_ADD round it (no contraction to a fused
  * multiply-add: the build targets x86-64 without FMA, and GCC does not
- * contract across statements in ISO C mode).  Returns 1 when done. */
+ * contract across statements in ISO C mode).  Returns 1 when done; under
+ * explain, 1 when it would be done, after saying so (what: the statement). */
 static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r,
-                           const silc_value *s)
+                           const silc_value *s, const char *what)
 {
     int64_t i, n = x->m * x->n;
     int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
     double c = scalar ? val_scalar(r) : 0;
-    if (V->explain || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
+    if (x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;
     if ((op == TK_STAREQ || op == TK_SLASHEQ) && (!scalar || s)) return 0;
+    if (V->explain) {
+        char xs[48], rs[48];
+        ev_shape(x, xs, sizeof xs);
+        ev_shape(r, rs, sizeof rs);
+        sb_printf(V->explain_out, "  %d. %s: %s dense, %s %s%s\n", ++V->explain_step, what, xs, rs,
+                  val_format_name(r->format), s ? ", 1x1 scale" : "");
+        indent_into(V->explain_out, "in place: nothing else holds the value, so the core writes the "
+                                    "result over its array (no backend, no new array)");
+        return 1;
+    }
     {
         /* r is another value (x += x leaves x shared, so never comes here). */
         double *restrict xv = x->val;
@@ -667,9 +678,12 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
  * place when update_in_place allows it (returns 1), else its value in *out
  * (returns 0), or -1 on error.  e = s * y with a scalar s is scaled into x
  * without the temporary s * y. */
-static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *e, silc_value **out)
+static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stmt, const ast_node *e,
+                          silc_value **out)
 {
+    char what[256];
     *out = NULL;
+    node_text(V, stmt, what, sizeof what);
     if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
         const silc_value *k;
         silc_value *a, *b;
@@ -679,7 +693,7 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *e, 
             return -1;
         }
         k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
-        if (k && update_in_place(V, op, x, k == a ? b : a, k)) {
+        if (k && update_in_place(V, op, x, k == a ? b : a, k, what)) {
             val_release(a);
             val_release(b);
             return 1;
@@ -688,7 +702,7 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *e, 
     } else if (ev_expr(V, e, out)) {
         return -1;
     }
-    if (!update_in_place(V, op, x, *out, NULL)) return 0;
+    if (!update_in_place(V, op, x, *out, NULL, what)) return 0;
     val_release(*out);
     *out = NULL;
     return 1;
@@ -720,7 +734,7 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     if (!cur) return undefined_name(V, s->name);
     val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
     if (op) {
-        rc = update_operand(V, op, cur, s->kind == ST_OPASSIGN ? s->kids[0] : s->kids[0]->kids[1], &r);
+        rc = update_operand(V, op, cur, s, s->kind == ST_OPASSIGN ? s->kids[0] : s->kids[0]->kids[1], &r);
         if (rc < 0) {
             val_release(cur);
             return -1;
