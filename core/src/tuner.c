@@ -667,13 +667,15 @@ static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b,
  * The iterative plugins' defaults alone would judge the method by one
  * preconditioner; the direct ones are also tried at mixed precision (a
  * single-precision factor refined to double: faster, and as accurate while
- * cond < 1 / eps_single, which the measured backward error checks).  opts ""
+ * cond < 1 / eps_single, which the measured backward error checks).  SA-AMG
+ * is tried on SPD classes only: it refuses unsymmetric matrices.  opts ""
  * is the backend's defaults; see variant_setting for the rest. */
 static const struct {
     const char *backend, *cls, *opts;
 } variants[] = {
     {"lis-style", NULL, "-i cg -p none"}, {"lis-style", NULL, "-i cg -p ilu"},
-    {"lis-style", NULL, "-i bicgstab -p ilu"}, {"petsc", NULL, "-ksp_type cg -pc_type icc"},
+    {"lis-style", NULL, "-i bicgstab -p ilu"}, {"lis-style", "solve.sparse.spd", "-i cg -p saamg"},
+    {"petsc", NULL, "-ksp_type cg -pc_type icc"},
     {"petsc", NULL, "-ksp_type gmres -pc_type ilu"},
     {"lapack", "solve.dense", ""}, {"lapack", "solve.dense", "precision = mixed"},
     {"mumps", "solve.sparse", ""}, {"mumps", "solve.sparse", "precision = single"},
