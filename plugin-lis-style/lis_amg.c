@@ -77,6 +77,12 @@ void lis_amg_free(lis_amg *G)
 
 /* ---- setup -------------------------------------------------------------------------- */
 
+static int by_index(const void *x, const void *y)
+{
+    int64_t a = *(const int64_t *)x, b = *(const int64_t *)y;
+    return (a > b) - (a < b);
+}
+
 /* C = A B (Gustavson: row i of C accumulates a_ik times row k of B, columns
  * collected through a marker array, then sorted).  NULL when out of memory. */
 static lis_matrix *spgemm(const lk_csr *A, const lk_csr *B)
@@ -107,8 +113,11 @@ static lis_matrix *spgemm(const lk_csr *A, const lk_csr *B)
                 if (mark[j] != i) mark[j] = i, acc[j] = 0, cols[len++] = j;
                 acc[j] += A->v[k] * B->v[q];
             }
-        for (t = 1; t < len; t++) /* insertion sort: rows are short */
-            for (q = t; q > 0 && cols[q - 1] > cols[q]; q--) j = cols[q], cols[q] = cols[q - 1], cols[q - 1] = j;
+        if (len > 32) /* insertion sort for the usual short rows */
+            qsort(cols, (size_t)len, sizeof *cols, by_index);
+        else
+            for (t = 1; t < len; t++)
+                for (q = t; q > 0 && cols[q - 1] > cols[q]; q--) j = cols[q], cols[q] = cols[q - 1], cols[q - 1] = j;
         for (t = 0; t < len; t++) C->ci[nnz] = cols[t], C->v[nnz++] = acc[cols[t]];
         C->rp[i + 1] = nnz;
     }
