@@ -307,6 +307,25 @@ static void put_laplacian(silc_engine *E, int n)
     val_release(A), val_release(b);
 }
 
+/* When backend is in the captured status table, its row for variant must be
+ * there too, and be admitted (neither refused as too inaccurate nor failed). */
+static void check_candidate(const char *backend, const char *variant)
+{
+    char head[64], want[160], line[256];
+    const char *row, *end;
+    snprintf(head, sizeof head, "\n  %s ", backend);
+    snprintf(want, sizeof want, "\n  %s %s ", backend, variant);
+    if (!strstr(sb_str(&captured), head)) return; /* not built here */
+    row = strstr(sb_str(&captured), want);
+    CHECK(row != NULL, "%s %s is a candidate: %s", backend, variant, sb_str(&captured));
+    if (!row) return;
+    end = strchr(row + 1, '\n');
+    snprintf(line, sizeof line, "%.*s", end ? (int)(end - row - 1) : 200, row + 1);
+    CHECK(!strstr(line, "too inaccurate") && !strstr(line, "failed") && !strstr(line, " - "),
+          "%s %s meets the target: %s", backend, variant, line);
+    printf("candidate: %s\n", line);
+}
+
 static void test_backends(const char *wisdom)
 {
     silc_engine *E = open_engine(wisdom);
@@ -316,19 +335,8 @@ static void test_backends(const char *wisdom)
     for (i = 0; i < 6; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "solve: %s", E->err);
     CHECK(status_has(E, "backends for solve.sparse.spd"), "table shown: %s", sb_str(&captured));
     CHECK(status_has(E, "fastest accurate"), "a winner: %s", sb_str(&captured));
-    /* lis-style's multigrid is a candidate for the SPD class, and meets the target. */
-    if (strstr(sb_str(&captured), "\n  lis-style ")) {
-        const char *row = strstr(sb_str(&captured), "\n  lis-style -i cg -p saamg ");
-        CHECK(row != NULL, "lis-style CG + SA-AMG is a candidate: %s", sb_str(&captured));
-        if (row) {
-            const char *end = strchr(row + 1, '\n');
-            char line[256];
-            snprintf(line, sizeof line, "%.*s", end ? (int)(end - row - 1) : 200, row + 1);
-            CHECK(!strstr(line, "too inaccurate") && !strstr(line, "failed"), "SA-AMG meets the target: %s",
-                  line);
-            printf("candidate: %s\n", line);
-        }
-    }
+    /* lis-style's multigrid is a candidate for the SPD class. */
+    check_candidate("lis-style", "-i cg -p saamg");
     captured.len = 0;
     CHECK(lang_exec(E, "explain x = A \\ b") == 0, "explain: %s", E->err);
     CHECK(strstr(sb_str(&captured), "tuner:") != NULL, "explain shows the tuner: %s",
@@ -338,18 +346,7 @@ static void test_backends(const char *wisdom)
      * with a single-precision factor for the sparse class, refined by the
      * core to the target (so admitted, not "too inaccurate"). */
     CHECK(status_has(E, "backends for solve.sparse"), "status: %s", sb_str(&captured));
-    if (strstr(sb_str(&captured), "\n  mumps ")) {
-        const char *row = strstr(sb_str(&captured), "\n  mumps precision = single ");
-        CHECK(row != NULL, "mumps single is a candidate: %s", sb_str(&captured));
-        if (row) {
-            const char *end = strchr(row + 1, '\n');
-            char line[256];
-            snprintf(line, sizeof line, "%.*s", end ? (int)(end - row - 1) : 200, row + 1);
-            CHECK(!strstr(line, "too inaccurate") && !strstr(line, " - "),
-                  "mumps single meets the target: %s", line);
-            printf("candidate: %s\n", line);
-        }
-    }
+    check_candidate("mumps", "precision = single");
     eng_destroy(&E);
 
     /* The dense class: lapack at mixed precision (dsgesv) next to its default. */
