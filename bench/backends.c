@@ -262,15 +262,15 @@ static double silc_time(silc_context *c, tl_capture *cap, const problem *P, cons
 {
     char stmt[160];
     double t0, t;
-    int k;
+    int k, put_failed;
     if (!strcmp(backend, "default")) snprintf(stmt, sizeof stmt, "x = A \\ b");
     else snprintf(stmt, sizeof stmt, "x = solve(%s, b, \"backend = %s\")",
                   strcmp(backend, "lapack") ? "A" : "Ad", backend);
     flush_pattern_caches(c);
     t0 = tl_now();
-    k = silc_put(c, "A", &P->A);
+    put_failed = silc_put(c, "A", &P->A);
     *tput = tl_now() - t0;
-    if (k || (!strcmp(backend, "lapack") && silc_exec(c, "Ad = dense(A)"))) {
+    if (put_failed || (!strcmp(backend, "lapack") && silc_exec(c, "Ad = dense(A)"))) {
         fprintf(stderr, "backends: %s: %s\n", P->name, silc_context_errmsg(c));
         return -1;
     }

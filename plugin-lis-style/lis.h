@@ -99,7 +99,14 @@ void lis_precon_label(const lis_options *o, char *buf, size_t len);
 
 /* ---- preconditioners ---------------------------------------------------------------- */
 
-/* The SA-AMG hierarchy (lis_amg.c), for symmetric matrices only. */
+/* An array of count elements of size bytes from the host (never a request
+ * for zero bytes, so NULL always means no memory), and A's diagonal into d,
+ * refusing a zero or non-finite entry with "lis-style <what>: zero diagonal
+ * entry in row r" in err (lis_precond.c). */
+void *lis_array(size_t count, size_t size);
+int lis_diagonal(const lk_csr *A, double *d, const char *what, char *err, size_t errlen);
+
+/* The SA-AMG hierarchy (lis_amg.c): symmetric A, or any with -saamg_unsym. */
 typedef struct lis_amg lis_amg;
 /* Builds it for A (borrowed: it must outlive the hierarchy) with strength
  * threshold theta; *nnz counts the entries of every level's matrix.

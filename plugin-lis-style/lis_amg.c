@@ -51,13 +51,6 @@ struct lis_amg {
     int64_t *piv;
 };
 
-static void *xalloc(size_t count, size_t size)
-{
-    if (count == 0) count = 1;
-    if (count > SIZE_MAX / size) return NULL;
-    return lis_host->alloc(count * size);
-}
-
 void lis_amg_free(lis_amg *G)
 {
     int l;
@@ -87,8 +80,8 @@ static int by_index(const void *x, const void *y)
  * collected through a marker array, then sorted).  NULL when out of memory. */
 static lis_matrix *spgemm(const lk_csr *A, const lk_csr *B)
 {
-    int64_t *mark = xalloc((size_t)B->n, sizeof(int64_t)), *cols = xalloc((size_t)B->n, sizeof(int64_t));
-    double *acc = xalloc((size_t)B->n, sizeof(double));
+    int64_t *mark = lis_array((size_t)B->n, sizeof(int64_t)), *cols = lis_array((size_t)B->n, sizeof(int64_t));
+    double *acc = lis_array((size_t)B->n, sizeof(double));
     int64_t i, j, k, q, nnz = 0, cap;
     lis_matrix *C = NULL;
     if (!mark || !cols || !acc) goto out;
@@ -128,19 +121,11 @@ out:
     return C;
 }
 
-static double diag_of(const lk_csr *A, int64_t i)
-{
-    int64_t k;
-    for (k = A->rp[i]; k < A->rp[i + 1]; k++)
-        if (A->ci[k] == i) return A->v[k];
-    return 0;
-}
-
 /* The aggregate of every node (agg[i] in 0..*nagg-1). */
 static int aggregate(const lk_csr *A, const double *diag, double theta, int64_t *agg, int64_t *nagg)
 {
     int64_t n = A->m, i, k, count = 0;
-    int64_t *first = xalloc((size_t)n, sizeof(int64_t));
+    int64_t *first = lis_array((size_t)n, sizeof(int64_t));
     if (!first) return -1;
 #define STRONG(i, k)                                                                             \
     (A->ci[k] != (i) && fabs(A->v[k]) >= theta * sqrt(fabs(diag[i] * diag[A->ci[k]])) && A->v[k] != 0)
@@ -181,7 +166,7 @@ static int aggregate(const lk_csr *A, const double *diag, double theta, int64_t 
 static lis_matrix *prolongator(const lk_csr *A, const double *diag, const int64_t *agg, int64_t nagg)
 {
     int64_t n = A->m, i, k;
-    double *scale = xalloc((size_t)nagg, sizeof(double)), rho = 0, w;
+    double *scale = lis_array((size_t)nagg, sizeof(double)), rho = 0, w;
     lis_matrix *P0 = lis_matrix_alloc(n, nagg, n), *AP0 = NULL, *P = NULL;
     if (!scale || !P0) goto out;
     for (i = 0; i < nagg; i++) scale[i] = 0;
@@ -210,8 +195,8 @@ out:
 static int coarse_lu(lis_amg *G, const lk_csr *A, char *err, size_t errlen)
 {
     int64_t n = A->m, i, j, k;
-    double *a = xalloc((size_t)(n * n), sizeof(double));
-    G->lu = a, G->piv = xalloc((size_t)n, sizeof(int64_t));
+    double *a = lis_array((size_t)(n * n), sizeof(double));
+    G->lu = a, G->piv = lis_array((size_t)n, sizeof(int64_t));
     if (!a || !G->piv) return snprintf(err, errlen, "lis-style SA-AMG: out of memory"), SILC_ENOMEM;
     memset(a, 0, (size_t)(n * n) * sizeof(double));
     for (i = 0; i < n; i++)
@@ -236,56 +221,65 @@ static int coarse_lu(lis_amg *G, const lk_csr *A, char *err, size_t errlen)
     return SILC_OK;
 }
 
+/* What coarsen() returns when aggregation would not reduce the level: it is
+ * then the coarsest. */
+enum { AMG_LAST = -1 };
+
+/* Level l's P and R = P', and the next level's A = R A P.  SILC_OK,
+ * AMG_LAST, or SILC_ENOMEM / SILC_EBREAKDOWN (zero diagonal) with err. */
+static int coarsen(amg_level *L, amg_level *next, double theta, int l, char *err, size_t errlen)
+{
+    int64_t n = L->A.m, nagg;
+    double *diag = lis_array((size_t)n, sizeof(double));
+    int64_t *agg = lis_array((size_t)n, sizeof(int64_t));
+    lis_matrix *AP = NULL;
+    char what[32];
+    int rc = SILC_ENOMEM;
+    snprintf(what, sizeof what, "SA-AMG level %d", l);
+    if (!diag || !agg) goto out;
+    if (lis_diagonal(&L->A, diag, what, err, errlen)) {
+        rc = SILC_EBREAKDOWN;
+        goto out;
+    }
+    if (aggregate(&L->A, diag, theta, agg, &nagg)) goto out;
+    if (nagg >= n) {
+        rc = AMG_LAST;
+        goto out;
+    }
+    if (!(L->P = prolongator(&L->A, diag, agg, nagg)) || !(L->R = lis_matrix_transpose(&L->P->A)) ||
+        !(AP = spgemm(&L->A, &L->P->A)) || !(next->own = spgemm(&L->R->A, &AP->A)))
+        goto out;
+    next->A = next->own->A;
+    rc = SILC_OK;
+out:
+    lis_host->free(diag);
+    lis_host->free(agg);
+    lis_matrix_free(AP);
+    return rc;
+}
+
 int lis_amg_build(const lk_csr *A, double theta, lis_amg **out, int64_t *nnz_out, char *err, size_t errlen)
 {
     lis_amg *G = lis_host->calloc(1, sizeof *G);
-    int64_t nnz = 0, i;
+    int64_t nnz = 0;
     int rc = SILC_ENOMEM, l;
     *out = NULL;
     if (!G) return snprintf(err, errlen, "lis-style SA-AMG: out of memory"), SILC_ENOMEM;
     G->L[0].A = *A;
     for (l = 0;; l++) {
         amg_level *L = &G->L[l];
-        int64_t n = L->A.m, nagg;
-        double *diag = NULL;
-        int64_t *agg = NULL;
-        lis_matrix *AP;
+        int64_t n = L->A.m;
         G->nlev = l + 1;
         nnz += L->A.rp[n];
-        L->x = xalloc((size_t)n, sizeof(double));
-        L->b = xalloc((size_t)n, sizeof(double));
-        L->r = xalloc((size_t)n, sizeof(double));
+        L->x = lis_array((size_t)n, sizeof(double));
+        L->b = lis_array((size_t)n, sizeof(double));
+        L->r = lis_array((size_t)n, sizeof(double));
         if (!L->x || !L->b || !L->r) goto fail;
         if (n <= AMG_COARSEST || l == AMG_MAXLEVELS - 1) break;
-        diag = xalloc((size_t)n, sizeof(double));
-        agg = xalloc((size_t)n, sizeof(int64_t));
-        if (!diag || !agg) {
-            lis_host->free(diag), lis_host->free(agg);
-            goto fail;
-        }
-        for (i = 0; i < n; i++)
-            if ((diag[i] = diag_of(&L->A, i)) == 0) {
-                lis_host->free(diag), lis_host->free(agg);
-                snprintf(err, errlen, "lis-style SA-AMG: zero diagonal in row %lld of level %d",
-                         (long long)i + 1, l);
-                rc = SILC_EBREAKDOWN;
-                goto fail;
-            }
-        if (aggregate(&L->A, diag, theta, agg, &nagg) || !(L->P = prolongator(&L->A, diag, agg, nagg))) {
-            lis_host->free(diag), lis_host->free(agg);
-            goto fail;
-        }
-        lis_host->free(diag), lis_host->free(agg);
-        if (nagg >= n) break; /* no coarsening left: this level is the coarsest */
-        if (!(L->R = lis_matrix_transpose(&L->P->A)) || !(AP = spgemm(&L->A, &L->P->A))) goto fail;
-        G->L[l + 1].own = spgemm(&L->R->A, &AP->A);
-        lis_matrix_free(AP);
-        if (!G->L[l + 1].own) goto fail;
-        G->L[l + 1].A = G->L[l + 1].own->A;
+        rc = coarsen(L, &G->L[l + 1], theta, l, err, errlen);
+        if (rc == AMG_LAST) break;
+        if (rc) goto fail;
     }
-    /* The last level has no P: a level that stopped coarsening drops it. */
-    lis_matrix_free(G->L[G->nlev - 1].P);
-    G->L[G->nlev - 1].P = NULL;
     if (G->L[G->nlev - 1].A.m > 2000) {
         snprintf(err, errlen, "lis-style SA-AMG: coarsening stalled at %lld unknowns on level %d "
                  "(try a smaller -saamg_theta)", (long long)G->L[G->nlev - 1].A.m, G->nlev - 1);

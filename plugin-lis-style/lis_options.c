@@ -211,6 +211,14 @@ static int choice(const char *opt, const char *val, const char *const *names, co
     return 0;
 }
 
+/* true / false, or Lis's 1 / 0. */
+static int boolean(const char *opt, const char *val, int *out, char *err, size_t errlen)
+{
+    static const char *const n[] = {"true", "1", "false", "0", NULL};
+    static const int v[] = {1, 1, 0, 0};
+    return choice(opt, val, n, v, out, err, errlen);
+}
+
 static int set_option(lis_options *o, const char *opt, const char *val, char *err, size_t errlen)
 {
     long long k;
@@ -259,11 +267,10 @@ static int set_option(lis_options *o, const char *opt, const char *val, char *er
         static const char *const n[] = {"nrm2_r", "0", "nrm2_b", "1", NULL};
         static const int v[] = {0, 0, 1, 1};
         if (!choice(opt, val, n, v, &o->conv_cond, err, errlen)) return -1;
-    } else if (!strcmp(opt, "-initx_zeros") || !strcmp(opt, "-saamg_unsym")) {
-        static const char *const n[] = {"true", "1", "false", "0", NULL};
-        static const int v[] = {1, 1, 0, 0};
-        if (!choice(opt, val, n, v, opt[1] == 'i' ? &o->initx_zeros : &o->saamg_unsym, err, errlen))
-            return -1;
+    } else if (!strcmp(opt, "-initx_zeros")) {
+        if (!boolean(opt, val, &o->initx_zeros, err, errlen)) return -1;
+    } else if (!strcmp(opt, "-saamg_unsym")) {
+        if (!boolean(opt, val, &o->saamg_unsym, err, errlen)) return -1;
     } else if (!strcmp(opt, "-print")) {
         static const char *const n[] = {"none", "0", "out", "2", NULL};
         static const int v[] = {0, 0, 1, 1};

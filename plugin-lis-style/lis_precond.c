@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *xalloc(size_t count, size_t size)
+void *lis_array(size_t count, size_t size)
 {
     if (count == 0) count = 1;
     if (count > SIZE_MAX / size) return NULL;
@@ -66,10 +66,10 @@ static int rows_init(rows *R, int64_t n, int64_t cap, int levels)
 {
     memset(R, 0, sizeof *R);
     R->cap = cap > 16 ? cap : 16;
-    R->p = xalloc((size_t)n + 1, sizeof(int64_t));
-    R->i = xalloc((size_t)R->cap, sizeof(int64_t));
-    R->x = xalloc((size_t)R->cap, sizeof(double));
-    R->lev = levels ? xalloc((size_t)R->cap, sizeof(int)) : NULL;
+    R->p = lis_array((size_t)n + 1, sizeof(int64_t));
+    R->i = lis_array((size_t)R->cap, sizeof(int64_t));
+    R->x = lis_array((size_t)R->cap, sizeof(double));
+    R->lev = levels ? lis_array((size_t)R->cap, sizeof(int)) : NULL;
     if (!R->p || !R->i || !R->x || (levels && !R->lev)) return -1;
     R->p[0] = 0;
     return 0;
@@ -185,13 +185,13 @@ static int factor(const lk_csr *A, int kind, int fill, double drop, double rate,
     work W;
     cand *cs = NULL;
     int rc = FACT_NOMEM, levels = kind == LIS_PC_ILU && fill > 0;
-    double *dinv = xalloc((size_t)n, sizeof(double));
+    double *dinv = lis_array((size_t)n, sizeof(double));
     memset(&W, 0, sizeof W);
-    W.w = xalloc((size_t)n, sizeof(double));
-    W.lev = xalloc((size_t)n, sizeof(int));
-    W.next = xalloc((size_t)n + 1, sizeof(int64_t));
-    W.mark = xalloc((size_t)n, sizeof(int64_t));
-    cs = xalloc((size_t)n, sizeof(cand));
+    W.w = lis_array((size_t)n, sizeof(double));
+    W.lev = lis_array((size_t)n, sizeof(int));
+    W.next = lis_array((size_t)n + 1, sizeof(int64_t));
+    W.mark = lis_array((size_t)n, sizeof(int64_t));
+    cs = lis_array((size_t)n, sizeof(cand));
     if (rows_init(&L, n, A->rp[n] / 2 + n, 0) || rows_init(&U, n, A->rp[n] / 2 + n, levels) ||
         !dinv || !W.w || !W.lev || !W.next || !W.mark || !cs)
         goto done;
@@ -288,7 +288,7 @@ static int factor(const lk_csr *A, int kind, int fill, double drop, double rate,
     }
     if (kind == LIS_PC_IC) {
         /* U = D L': the transpose of L by counting, scaled by the pivots. */
-        int64_t *cnt = xalloc((size_t)n + 1, sizeof(int64_t));
+        int64_t *cnt = lis_array((size_t)n + 1, sizeof(int64_t));
         if (!cnt) goto done;
         U.nnz = L.nnz;
         if (U.cap < L.nnz) {
@@ -337,18 +337,17 @@ done:
 
 /* ---- building ---------------------------------------------------------------------- */
 
-static int diag_inverse(const lk_csr *A, double *dinv, const char *what, char *err, size_t errlen)
+int lis_diagonal(const lk_csr *A, double *d, const char *what, char *err, size_t errlen)
 {
     for (int64_t i = 0; i < A->m; i++) {
-        double d = 0;
+        d[i] = 0;
         for (int64_t k = A->rp[i]; k < A->rp[i + 1]; k++)
-            if (A->ci[k] == i) d += A->v[k];
-        if (d == 0 || !isfinite(d)) {
+            if (A->ci[k] == i) d[i] += A->v[k];
+        if (d[i] == 0 || !isfinite(d[i])) {
             snprintf(err, errlen, "lis-style %s: zero diagonal entry in row %lld", what,
                      (long long)i + 1);
             return -1;
         }
-        dinv[i] = 1.0 / d;
     }
     return 0;
 }
@@ -371,15 +370,16 @@ int lis_pc_build(const lk_csr *A, const lis_options *o, lis_pc **out, char *err,
             return rc;
         }
     } else if (o->precon == LIS_PC_JACOBI || o->precon == LIS_PC_SSOR) {
-        P->dinv = xalloc((size_t)A->m, sizeof(double));
+        P->dinv = lis_array((size_t)A->m, sizeof(double));
         if (!P->dinv) {
             lis_pc_free(P);
             return snprintf(err, errlen, "lis-style: out of memory for the preconditioner"), SILC_ENOMEM;
         }
-        if (diag_inverse(A, P->dinv, label, err, errlen)) {
+        if (lis_diagonal(A, P->dinv, label, err, errlen)) {
             lis_pc_free(P);
             return SILC_EBREAKDOWN;
         }
+        for (int64_t i = 0; i < A->m; i++) P->dinv[i] = 1.0 / P->dinv[i];
         P->A = *A;
         P->omega = o->ssor_omega;
         P->nnz = o->precon == LIS_PC_SSOR ? A->rp[A->m] : A->m;

@@ -426,9 +426,9 @@ int env_check(const silc_envelope_t *e, char *err, size_t errlen)
     }
 }
 
-int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
+/* env_csr_fill after its rowptr check. */
+static int csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
 {
-    if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
     if (val_csr_fill_checked(v, e->rowptr, e->colind, e->values) == 0) return 0;
     /* The fast pass only knows that a row failed; env_check finds it again
      * and says how. */
@@ -437,16 +437,23 @@ int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errl
     return -1;
 }
 
+int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
+{
+    if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
+    return csr_fill(v, e, err, errlen);
+}
+
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
 {
     silc_value *v;
     int64_t count;
     *out = NULL;
     if (e && e->format == SILC_CSR) {
-        /* Checked while copied, not in a pass of its own (env_csr_fill). */
+        /* rowptr first, for the size; the entries are checked while copied,
+         * not in a pass of their own (csr_fill). */
         if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
         v = val_new_unset(SILC_FMT_CSR, e->m, e->n, e->rowptr[e->m], 0, 0);
-        if (v && env_csr_fill(v, e, err, errlen)) {
+        if (v && csr_fill(v, e, err, errlen)) {
             val_release(v);
             return -1;
         }

@@ -631,9 +631,9 @@ static int opassign_token(int op)
  * SILC_OP_SCALE then SILC_OP_ADD round it (no contraction to a fused
  * multiply-add: the build targets x86-64 without FMA, and GCC does not
  * contract across statements in ISO C mode).  Returns 1 when done; under
- * explain, 1 when it would be done, after saying so (what: the statement). */
+ * explain, 1 when it would be done, after saying so (stmt: the statement). */
 static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r,
-                           const silc_value *s, const char *what)
+                           const silc_value *s, const ast_node *stmt)
 {
     int64_t i, n = x->m * x->n;
     int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
@@ -643,7 +643,8 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
         return 0;
     if ((op == TK_STAREQ || op == TK_SLASHEQ) && (!scalar || s)) return 0;
     if (V->explain) {
-        char xs[48], rs[48];
+        char xs[48], rs[48], what[256];
+        node_text(V, stmt, what, sizeof what);
         ev_shape(x, xs, sizeof xs);
         ev_shape(r, rs, sizeof rs);
         sb_printf(V->explain_out, "  %d. %s: %s dense, %s %s%s\n", ++V->explain_step, what, xs, rs,
@@ -681,9 +682,7 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
 static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stmt, const ast_node *e,
                           silc_value **out)
 {
-    char what[256];
     *out = NULL;
-    node_text(V, stmt, what, sizeof what);
     if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
         const silc_value *k;
         silc_value *a, *b;
@@ -693,7 +692,7 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stm
             return -1;
         }
         k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
-        if (k && update_in_place(V, op, x, k == a ? b : a, k, what)) {
+        if (k && update_in_place(V, op, x, k == a ? b : a, k, stmt)) {
             val_release(a);
             val_release(b);
             return 1;
@@ -702,7 +701,7 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stm
     } else if (ev_expr(V, e, out)) {
         return -1;
     }
-    if (!update_in_place(V, op, x, *out, NULL, what)) return 0;
+    if (!update_in_place(V, op, x, *out, NULL, stmt)) return 0;
     val_release(*out);
     *out = NULL;
     return 1;

@@ -309,7 +309,8 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
  * leaves the question open, and of the norms only ||A||_inf, which the
  * backward error's residual pass sums as it goes; so a KLU solve of memplus
  * no longer pays for column sums it never reads (the properties took 4% of
- * it).  Plugins get all three (host->props).
+ * it).  Plugins ask for the parts they read (host->props_part); a CSR value
+ * made by silc_put has its shape from the copy (val_csr_fill_checked).
  *
  * The norms are first summed unscaled, which is exact enough and cannot
  * overflow or underflow harmfully while every |a| lies in
@@ -382,6 +383,14 @@ static void props_pass(const silc_value *v, props_acc *acc)
     }
 }
 
+/* |*x| as its bit pattern (the sign bit cleared). */
+static inline uint64_t magnitude_bits(const double *x)
+{
+    uint64_t b;
+    memcpy(&b, x, sizeof b);
+    return b & 0x7fffffffffffffffULL;
+}
+
 /* The largest |x_i| as its bit pattern, and with count_zeros also the
  * number of stored zeros, in one branch-free pass.  With the sign bit
  * cleared, the patterns of doubles order as their magnitudes do, with Inf
@@ -392,12 +401,11 @@ static void props_pass(const silc_value *v, props_acc *acc)
  * gets the loop it needs. */
 static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros, int64_t *zeros)
 {
-    const uint64_t magnitude = 0x7fffffffffffffffULL;
     uint64_t m0 = 0, m1 = 0, m2 = 0, m3 = 0, b[4];
     int64_t z0 = 0, z1 = 0, z2 = 0, z3 = 0, i = 0;
     for (; i + 4 <= n; i += 4) {
-        memcpy(b, x + i, sizeof b);
-        b[0] &= magnitude, b[1] &= magnitude, b[2] &= magnitude, b[3] &= magnitude;
+        b[0] = magnitude_bits(x + i), b[1] = magnitude_bits(x + i + 1);
+        b[2] = magnitude_bits(x + i + 2), b[3] = magnitude_bits(x + i + 3);
         if (count_zeros) z0 += b[0] == 0, z1 += b[1] == 0, z2 += b[2] == 0, z3 += b[3] == 0;
         m0 = b[0] > m0 ? b[0] : m0;
         m1 = b[1] > m1 ? b[1] : m1;
@@ -405,8 +413,7 @@ static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros,
         m3 = b[3] > m3 ? b[3] : m3;
     }
     for (; i < n; i++) {
-        memcpy(b, x + i, sizeof b[0]);
-        b[0] &= magnitude;
+        b[0] = magnitude_bits(x + i);
         if (count_zeros) z0 += b[0] == 0;
         m0 = b[0] > m0 ? b[0] : m0;
     }
@@ -492,7 +499,6 @@ static void shape_csr(silc_value *v)
 int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_index *colind,
                          const double *values)
 {
-    const uint64_t magnitude = 0x7fffffffffffffffULL;
     shape_rows s = {0, 0, 0, 1, 1, 1};
     silc_index *ci = v->colind;
     double *x = v->val;
@@ -503,13 +509,11 @@ int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_ind
         int64_t begin = rowptr[i], end = rowptr[i + 1], prev = -1, bad = 0;
         for (k = begin; k < end; k++) {
             int64_t c = colind[k];
-            uint64_t b;
+            uint64_t b = magnitude_bits(values + k); /* max_abs_bits' scan, entry by entry */
             bad |= (c <= prev) | (c >= n); /* out of [0, n), or not increasing */
             prev = c;
             ci[k] = c;
             x[k] = values[k];
-            memcpy(&b, values + k, sizeof b);
-            b &= magnitude;
             zeros += b == 0;
             maxbits = b > maxbits ? b : maxbits;
         }
