@@ -108,6 +108,23 @@ check "REPL goes on after an error" has out "z"
 check "REPL reports the error" has err "silc: "
 check "REPL on a pipe fails if a statement failed" status_is 1
 
+# Nesting beyond the language's limit (silc.h: SILC_MAX_NESTING) is refused
+# with a message, never a crash: 100000 '(' in a script, and on the REPL a line
+# that opens more brackets than any text may hold runs at once instead of
+# waiting for lines that could never make it valid.
+awk 'BEGIN { s = "y = "; for (i = 0; i < 100000; i++) s = s "("; s = s "1";
+             for (i = 0; i < 100000; i++) s = s ")"; print s }' >deep.silc
+run "$SILC" run deep.silc
+check "100000 nested parentheses: status 1" status_is 1
+check "100000 nested parentheses: message" has err "silc: 1:261: expression nested deeper than 256 levels"
+awk 'BEGIN { s = "y = 1"; for (i = 0; i < 100000; i++) s = s "+1"; print s }' >long.silc
+run "$SILC" run long.silc
+check "100000-term sum: message" has err "expression too long: more than 1024 operations in a chain"
+awk 'BEGIN { s = "y = "; for (i = 0; i < 300; i++) s = s "("; print s; print "z = 5"; print "who" }' >in
+run "$SILC" <in
+check "REPL runs a line nested past the limit at once" has err "expression nested deeper than 256 levels"
+check "REPL goes on after it" grep -q "^ *z " out
+
 # ---- errors --------------------------------------------------------------------------
 run "$SILC" -e 'x = (1 + 2'
 check "syntax error status" status_is 1

@@ -17,6 +17,7 @@
 #include "check.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <silc.h>
 #include <stdlib.h>
 #include <string.h>
@@ -883,6 +884,114 @@ static void test_formats(void)
     silc_close(&c);
 }
 
+/* ---- limits on nesting (silc.h: SILC_MAX_NESTING, SILC_MAX_EXPR_HEIGHT) ------- */
+
+/* prefix + k copies of rep + middle + k copies of close + suffix, malloc'd. */
+static char *repeat(const char *prefix, const char *rep, int k, const char *middle, const char *close,
+                    const char *suffix)
+{
+    size_t lr = strlen(rep), lc = strlen(close), len = strlen(prefix) + strlen(middle) + strlen(suffix);
+    char *s = malloc(len + (size_t)k * (lr + lc) + 1), *p;
+    int i;
+    if (!s) return NULL;
+    p = s + strlen(strcpy(s, prefix));
+    for (i = 0; i < k; i++, p += lr) memcpy(p, rep, lr);
+    p += strlen(strcpy(p, middle));
+    for (i = 0; i < k; i++, p += lc) memcpy(p, close, lc);
+    strcpy(p, suffix);
+    return s;
+}
+
+typedef struct nest_case {
+    const char *prefix, *rep, *middle, *close, *suffix;
+    int at_limit;            /* the most copies of rep that still parse */
+    double want;             /* y after the text at the limit */
+    const char *what;        /* the message past it, after "L:C: " */
+} nest_case;
+
+static const nest_case nest_cases[] = {
+    {"y = ", "(", "1", ")", "", SILC_MAX_NESTING - 1, 1, "expression nested deeper than 256 levels"},
+    {"y = ", "-", "1", "", "", SILC_MAX_NESTING - 1, -1, "expression nested deeper than 256 levels"},
+    {"y = ", "[", "1", "]", "", SILC_MAX_NESTING - 1, 1, "expression nested deeper than 256 levels"},
+    {"y = ", "abs(", "1", ")", "", SILC_MAX_NESTING - 1, 1, "expression nested deeper than 256 levels"},
+    {"y = ", "v[", "1", "]", "", SILC_MAX_NESTING - 1, 1, "expression nested deeper than 256 levels"},
+    {"y = ", "1^", "1", "", "", SILC_MAX_NESTING - 1, 1, "expression nested deeper than 256 levels"},
+    {"y = 1", "+1", "", "", "", SILC_MAX_EXPR_HEIGHT - 1, SILC_MAX_EXPR_HEIGHT,
+     "expression too long: more than 1024 operations in a chain (split it with intermediate names)"},
+    {"y = s", "'", "", "", "", SILC_MAX_EXPR_HEIGHT - 1, 5,
+     "expression too long: more than 1024 operations in a chain (split it with intermediate names)"},
+    {"", "if (1) { ", "y = 7", " }", "", SILC_MAX_NESTING - 1, 7, "blocks nested deeper than 256 levels"},
+    /* each else-if nests one level, and its block's statements one more */
+    {"y = 7; if (0) { y = 0 }", " else if (0) { y = 0 }", "", "", "", SILC_MAX_NESTING - 2, 7,
+     "blocks nested deeper than 256 levels"},
+    {"y = 2; ", "while (y < 3) { ", "y = y + 1", " }", "", SILC_MAX_NESTING - 1, 3,
+     "blocks nested deeper than 256 levels"},
+};
+
+/* Runs one case at its limit, one past it, and at 100000 (the crash reported
+ * in issue 14): the first computes the right y, the others are refused whole,
+ * leaving the store as it was, with a message at a line:column. */
+static void nest_check(const nest_case *t)
+{
+    static const int ks[3] = {0, 1, 100000};
+    silc_context *c = fixture();
+    int j;
+    if (!c) return;
+    for (j = 0; j < 3; j++) {
+        int k = j == 2 ? ks[2] : t->at_limit + ks[j];
+        char *src = repeat(t->prefix, t->rep, k, t->middle, t->close, t->suffix);
+        int64_t m, n;
+        double *x = NULL;
+        if (!src) continue;
+        silc_exec(c, "clear y");
+        if (j == 0) {
+            CHECK(silc_exec(c, src) == 0, "%d x '%s' at the limit: %s", k, t->rep, silc_context_errmsg(c));
+            if (fetch(c, "y", &m, &n, &x) == 1) {
+                CHECK(x[0] == t->want, "%d x '%s': y = %g, want %g", k, t->rep, x[0], t->want);
+                free(x);
+            }
+        } else {
+            const char *msg, *colon;
+            int line = 0, col = 0;
+            CHECK(silc_exec(c, src) != 0, "%d x '%s' past the limit must fail", k, t->rep);
+            msg = silc_context_errmsg(c);
+            colon = strchr(msg, ' ');
+            CHECK(sscanf(msg, "%d:%d:", &line, &col) == 2 && line == 1 && col > 0 && colon &&
+                      !strcmp(colon + 1, t->what),
+                  "%d x '%s': got \"%.200s\", want \"L:C: %s\"", k, t->rep, msg, t->what);
+            CHECK(!is_defined(c, "y"), "%d x '%s': y bound by a refused text", k, t->rep);
+            CHECK(silc_exec(c, "z = s + 1") == 0 && fetch(c, "z", &m, &n, &x) == 1,
+                  "context usable after a refused text");
+            if (x) CHECK(x[0] == 6, "z = %g", x[0]);
+            free(x);
+        }
+        free(src);
+    }
+    silc_close(&c);
+}
+
+static void *nest_thread(void *arg)
+{
+    size_t i;
+    (void)arg;
+    for (i = 0; i < sizeof nest_cases / sizeof nest_cases[0]; i++) nest_check(&nest_cases[i]);
+    return NULL;
+}
+
+/* The cases run on a thread with a small stack, so a limit too large for the
+ * recursion it admits fails here rather than in a user's thread. */
+static void test_nesting_limits(void)
+{
+    pthread_attr_t attr;
+    pthread_t th;
+    size_t stack = (size_t)2 << 20;
+    pthread_attr_init(&attr);
+    CHECK(pthread_attr_setstacksize(&attr, stack) == 0, "stack size");
+    if (pthread_create(&th, &attr, nest_thread, NULL) == 0) pthread_join(th, NULL);
+    else CHECK(0, "pthread_create");
+    pthread_attr_destroy(&attr);
+}
+
 int main(void)
 {
     size_t i;
@@ -898,5 +1007,6 @@ int main(void)
     test_clear();
     test_rand_reproducible();
     test_formats();
+    test_nesting_limits();
     return check_done();
 }

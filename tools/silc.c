@@ -249,10 +249,12 @@ static int print_gets(silc_context *ctx, const cli_options *o)
 /* ---- the interactive session ------------------------------------------------ */
 
 /* Net number of ( [ { left open in text, ignoring strings and comments: a line
- * that ends with brackets open continues on the next. */
-static int open_brackets(const char *s)
+ * that ends with brackets open continues on the next.  Strings and comments
+ * end at a newline, so the count of a buffer is the sum of its lines'. */
+static long open_brackets(const char *s)
 {
-    int depth = 0, in_string = 0;
+    long depth = 0;
+    int in_string = 0;
     for (; *s; s++) {
         if (in_string) {
             if (*s == '\\' && s[1] && s[1] != '\n') s++;
@@ -318,6 +320,7 @@ static int repl(silc_context *ctx)
 {
     int interactive = isatty(STDIN_FILENO), failed = 0;
     size_t len = 0, cap = 0;
+    long open = 0;     /* brackets the buffered lines leave open */
     char *buf = NULL;
 #ifdef SILC_HAVE_READLINE
     char *hist = interactive ? history_path() : NULL;
@@ -357,10 +360,15 @@ static int repl(silc_context *ctx)
         len += add;
         buf[len++] = '\n';
         buf[len] = '\0';
+        open += open_brackets(line);
         free(line);
-        if (open_brackets(buf) > 0) continue;
+        /* Past the language's nesting limit no closing line can make the text
+         * valid: run it now, so the parser names the limit, rather than
+         * buffering forever. */
+        if (open > 0 && open <= SILC_MAX_NESTING) continue;
         if (buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
         len = 0;
+        open = 0;
     }
     /* Input ended inside open brackets: run it anyway so the parser says what
      * is unclosed. */

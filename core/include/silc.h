@@ -42,6 +42,17 @@ extern "C" {
 
 #define SILC_VERSION "0.1.0"
 
+/* Limits of one EXEC text, so that no text can exhaust the stack of the
+ * recursive parser and evaluator (they hold in a server as embedded):
+ * brackets, unary operators, powers, `if`/`while` blocks and `else if`
+ * chains nest at most SILC_MAX_NESTING levels ("1:4000: expression nested
+ * deeper than 256 levels"), and an expression tree is at most
+ * SILC_MAX_EXPR_HEIGHT operations tall, which a chain such as a sum of that
+ * many terms reaches ("expression too long: ... operations in a chain").
+ * Deeper texts are refused whole, before anything runs. */
+#define SILC_MAX_NESTING 256
+#define SILC_MAX_EXPR_HEIGHT 1024
+
 /* What libsilc exports: the functions below and nothing else (the engine
  * is compiled with hidden visibility), so no name of its internals can clash
  * with one of the program's. */

@@ -464,7 +464,7 @@ static void node_text(const lang_ev *V, const ast_node *n, char *out, size_t out
 
 /* Binary node n applied to its operands a and b, already evaluated (and
  * released here). */
-static int binary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value *b, silc_value **out)
+UTIL_NOINLINE static int binary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value *b, silc_value **out)
 {
     char ln[64], rn[64], what[256];
     operands o;
@@ -501,16 +501,13 @@ static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
     return binary_of(V, n, a, b, out);
 }
 
-static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
+/* Unary node n applied to its operand a, already evaluated (and released
+ * here).  Apart from eval_unary so that the text buffer is not on the stack
+ * once per level of the recursion. */
+UTIL_NOINLINE static int unary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value **out)
 {
-    silc_value *a;
     char what[256];
     int rc;
-    if (ev_expr(V, n->kids[0], &a)) return -1;
-    if (n->op == TK_PLUS) {
-        *out = a;
-        return 0;
-    }
     node_text(V, n, what, sizeof what);
     if (n->kind == AST_TRANSPOSE)
         rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
@@ -518,6 +515,30 @@ static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
         rc = ev_run_op(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
                        what, out);
     val_release(a);
+    return rc;
+}
+
+static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a;
+    if (ev_expr(V, n->kids[0], &a)) return -1;
+    if (n->op == TK_PLUS) {
+        *out = a;
+        return 0;
+    }
+    return unary_of(V, n, a, out);
+}
+
+/* base[subscripts]: the subscripts are evaluated by ix_extract. */
+static UTIL_NOINLINE int eval_index(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *base;
+    char what[64];
+    int rc;
+    if (ev_expr(V, n->kids[0], &base)) return -1;
+    ev_operand_name(V, n->kids[0], 2, what, sizeof what);
+    rc = ix_extract(V, n->kids + 1, n->nkids - 1, what, base, out);
+    val_release(base);
     return rc;
 }
 
@@ -544,16 +565,8 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
     case AST_UNARY:
     case AST_TRANSPOSE:
         return eval_unary(V, n, out);
-    case AST_INDEX: {
-        silc_value *base;
-        char what[64];
-        int rc;
-        if (ev_expr(V, n->kids[0], &base)) return -1;
-        ev_operand_name(V, n->kids[0], 2, what, sizeof what);
-        rc = ix_extract(V, n->kids + 1, n->nkids - 1, what, base, out);
-        val_release(base);
-        return rc;
-    }
+    case AST_INDEX:
+        return eval_index(V, n, out);
     case AST_CALL:
         return bi_call(V, n, out);
     case AST_MATRIX:

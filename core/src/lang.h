@@ -51,7 +51,7 @@ enum ast_kind {
     AST_BINARY, AST_UNARY, AST_TRANSPOSE, AST_INDEX, AST_CALL,
     AST_MATRIX,            /* [a, b; c, d]: kids are AST_ROW nodes (none for []) */
     AST_ROW,               /* one row of a matrix literal: kids are its blocks */
-    /* statements */
+    /* statements (after every expression kind: parser.c tests kind < ST_EXPR) */
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
     ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
@@ -64,6 +64,7 @@ struct ast_node {
     int kind;              /* enum ast_kind */
     int op;                /* operator token kind (BINARY, UNARY, OPASSIGN) */
     int line, col;
+    int height;            /* 1 + the tallest kid's: bounds every walk of the tree */
     size_t start, end;     /* source span [start, end) */
     double num;            /* AST_NUM */
     char *name;            /* NAME, CALL, STRING (unquoted text), assignment target, SET raw text */

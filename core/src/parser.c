@@ -6,6 +6,12 @@
  * operand may carry a sign: 2^-1) ; postfix ' [subscripts] f(args).  So
  * -2^2 is -(2^2) and -A*B is (-A)*B, as in MATLAB.
  *
+ * No input can exhaust the C stack: every recursive descent passes enter(),
+ * which refuses a text nested deeper than SILC_MAX_NESTING levels, and
+ * add_kid() refuses a tree taller than SILC_MAX_EXPR_HEIGHT, which a long
+ * left-associative chain (`1+1+...+1`) reaches without recursing here but
+ * which the evaluator and node_free() would walk recursively.
+ *
  * Keywords (clear who set info explain tune if while else break continue) are
  * keywords only at the start of a statement and only when not followed by an
  * assignment, so `info = 3` still binds a variable.  The first syntax error
@@ -23,6 +29,8 @@ typedef struct ps_state {
     lx_token *t;
     size_t pos, n;
     int loop_depth;
+    int depth;             /* nested expressions: enter() bounds it */
+    int block_depth;       /* nested statements (blocks, else if, explain): the same */
     int bracket_depth;     /* inside [ ]: `end` and `:` are subscripts */
     char *err;
     size_t errlen;
@@ -70,6 +78,40 @@ static void *fail(ps_state *P, const lx_token *at, const char *fmt, ...)
     return NULL;
 }
 
+/* One more level of recursion on the input, or a failure past
+ * SILC_MAX_NESTING; every enter() that succeeds is matched by a leave().
+ * Expressions and statements count apart, so the message names what is too
+ * deep; the recursion is bounded by the sum of both limits. */
+static int enter_level(ps_state *P, int *depth, const char *what)
+{
+    if (*depth >= SILC_MAX_NESTING) {
+        fail(P, peek(P), "%s nested deeper than %d levels", what, SILC_MAX_NESTING);
+        return -1;
+    }
+    (*depth)++;
+    return 0;
+}
+
+static int enter(ps_state *P)
+{
+    return enter_level(P, &P->depth, "expression");
+}
+
+static void leave(ps_state *P)
+{
+    P->depth--;
+}
+
+static int enter_block(ps_state *P)
+{
+    return enter_level(P, &P->block_depth, "blocks");
+}
+
+static void leave_block(ps_state *P)
+{
+    P->block_depth--;
+}
+
 static void *unexpected(ps_state *P, const lx_token *at)
 {
     char d[64];
@@ -110,6 +152,7 @@ static ast_node *node_new(ps_state *P, int kind, const lx_token *at)
     ast_node *n = calloc(1, sizeof *n);
     if (!n) return fail(P, at, "out of memory while parsing");
     n->kind = kind;
+    n->height = 1;
     n->line = at->line;
     n->col = at->col;
     n->start = at->start;
@@ -117,6 +160,10 @@ static ast_node *node_new(ps_state *P, int kind, const lx_token *at)
     return n;
 }
 
+/* Makes kid the last kid of n.  On failure kid is either freed or already
+ * n's, so the caller frees only n.  An expression's height is checked here
+ * because a chain such as `1+1+...+1` grows it without any recursion in the
+ * parser; statements nest only through parse_statement(), bounded there. */
 static int add_kid(ps_state *P, ast_node *n, ast_node *kid)
 {
     ast_node **k;
@@ -131,6 +178,16 @@ static int add_kid(ps_state *P, ast_node *n, ast_node *kid)
     n->kids[n->nkids++] = kid;
     if (kid->end > n->end) n->end = kid->end;
     if (kid->start < n->start) n->start = kid->start;
+    if (kid->height >= n->height) n->height = kid->height + 1;
+    if (n->kind < ST_EXPR && n->height > SILC_MAX_EXPR_HEIGHT) {
+        lx_token at;
+        memset(&at, 0, sizeof at);
+        at.line = n->line;
+        at.col = n->col;
+        fail(P, &at, "expression too long: more than %d operations in a chain "
+                     "(split it with intermediate names)", SILC_MAX_EXPR_HEIGHT);
+        return -1;
+    }
     return 0;
 }
 
@@ -165,8 +222,12 @@ static ast_node *binary(ps_state *P, const lx_token *optk, ast_node *l, ast_node
         return NULL;
     }
     n->op = optk->kind;
-    if (add_kid(P, n, l) || add_kid(P, n, r)) {
-        if (n->nkids == 0) node_free(r);
+    if (add_kid(P, n, l)) {
+        node_free(r);
+        node_free(n);
+        return NULL;
+    }
+    if (add_kid(P, n, r)) {
         node_free(n);
         return NULL;
     }
@@ -346,10 +407,16 @@ static ast_node *parse_signed_power(ps_state *P);
 
 static ast_node *parse_power(ps_state *P)
 {
-    ast_node *l = parse_postfix(P);
+    ast_node *l = parse_postfix(P), *r;
     if (l && (is(P, TK_CARET) || is(P, TK_EPOW))) {
         const lx_token *op = next(P);
-        return binary(P, op, l, parse_signed_power(P));
+        if (enter(P)) {       /* 2^2^2^...: right-recursive */
+            node_free(l);
+            return NULL;
+        }
+        r = parse_signed_power(P);
+        leave(P);
+        return binary(P, op, l, r);
     }
     return l;
 }
@@ -360,7 +427,9 @@ static ast_node *unary(ps_state *P, ast_node *(*operand)(ps_state *))
     if (tk->kind == TK_MINUS || tk->kind == TK_PLUS || tk->kind == TK_NOT) {
         ast_node *n, *k;
         next(P);
+        if (enter(P)) return NULL;   /* ---...1: one level per sign */
         k = unary(P, operand);
+        leave(P);
         if (!k) return NULL;
         n = node_new(P, AST_UNARY, tk);
         if (!n || add_kid(P, n, k)) {
@@ -436,13 +505,24 @@ static ast_node *parse_and(ps_state *P)
     return l;
 }
 
-static ast_node *parse_expr(ps_state *P)
+static ast_node *parse_or(ps_state *P)
 {
     ast_node *l = parse_and(P);
     while (l && is(P, TK_OR)) {
         const lx_token *op = next(P);
         l = binary(P, op, l, parse_and(P));
     }
+    return l;
+}
+
+/* Every nested expression, (...), [...], f(...), subscript or condition,
+ * comes through here: the one place that bounds their nesting. */
+static ast_node *parse_expr(ps_state *P)
+{
+    ast_node *l;
+    if (enter(P)) return NULL;
+    l = parse_or(P);
+    leave(P);
     return l;
 }
 
@@ -535,7 +615,12 @@ static ast_node *parse_if(ps_state *P, const lx_token *kw)
         next(P);
         if (tok_is_text(P, peek(P), "if")) {
             const lx_token *kw2 = next(P);
+            if (enter_block(P)) {           /* an else-if chain recurses */
+                node_free(n);
+                return NULL;
+            }
             n->els = parse_if(P, kw2);
+            leave_block(P);
         } else {
             n->els = parse_block(P, n);
         }
@@ -727,7 +812,19 @@ static int is_assign_op(int k)
 static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
                                        "info", "set", "explain", "tune"};
 
+static ast_node *parse_statement_body(ps_state *P);
+
+/* Statements nest through if/while blocks and explain: bounded here. */
 static ast_node *parse_statement(ps_state *P)
+{
+    ast_node *s;
+    if (enter_block(P)) return NULL;
+    s = parse_statement_body(P);
+    leave_block(P);
+    return s;
+}
+
+static ast_node *parse_statement_body(ps_state *P)
 {
     const lx_token *tk = peek(P);
     ast_node *n, *e;
@@ -802,6 +899,7 @@ int ps_parse(const char *text, lang_program **out, char *err, size_t errlen)
     if (lx_tokenize(text, &toks, err, errlen)) return -1;
     memset(&P, 0, sizeof P);
     memset(&root, 0, sizeof root);
+    root.kind = ST_BLOCK;
     P.src = text;
     P.t = toks.t;
     P.n = toks.n;

@@ -30,6 +30,15 @@ const char *sb_str(const strbuf *b);   /* "" when empty */
  * at most max(1, strlen(name)/3)). */
 const char *util_closest(const char *name, const char *const *cands, size_t ncands);
 
+/* Marks a helper of a recursive function that holds large buffers, so the
+ * compiler does not inline them into each level of the recursion (the
+ * evaluator walks expression trees SILC_MAX_EXPR_HEIGHT deep). */
+#if defined(__GNUC__)
+#define UTIL_NOINLINE __attribute__((noinline))
+#else
+#define UTIL_NOINLINE
+#endif
+
 double util_now(void);                 /* monotonic seconds */
 char *util_strdup(const char *s);
 /* Formats a double the way the language prints values: %.17g, but shortest
