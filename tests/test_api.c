@@ -362,6 +362,27 @@ static void test_mm_read(void)
     check_mm_error("hello\n", ":1: not a Matrix Market file", "no banner");
     check_mm_error("%%MatrixMarket matrix coordinate real symmetric\n2 3 1\n1 1 1\n", "must be square",
                    "non-square symmetric");
+    /* no line may make the reader allocate without bound: 64 KiB at most,
+     * wherever the line is (an entry, the last line, a comment) */
+    {
+        static const char *const heads[3] = {
+            "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 ",
+            "%%MatrixMarket matrix coordinate real general\n2 2 1\n1 1 1\n",
+            "%%MatrixMarket matrix coordinate real general\n%"};
+        static const char *const where[3] = {":3: line longer than 65536 bytes",
+                                             ":4: line longer than 65536 bytes",
+                                             ":2: line longer than 65536 bytes"};
+        size_t h, len = 70000;
+        for (h = 0; h < 3; h++) {
+            char *text = malloc(strlen(heads[h]) + len + 2);
+            if (!text) continue;
+            strcpy(text, heads[h]);
+            memset(text + strlen(heads[h]), '1', len);
+            strcpy(text + strlen(heads[h]) + len, "\n");
+            check_mm_error(text, where[h], "long line");
+            free(text);
+        }
+    }
     CHECK(silc_mm_read(&e, "/nonexistent/x.mtx", err, sizeof err) != 0 &&
               contains(err, "/nonexistent/x.mtx: cannot open"),
           "missing file: %s", err);

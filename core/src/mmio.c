@@ -7,8 +7,9 @@
  * also one created by mirroring -- is an error naming both lines, because a
  * file that says the same entry twice is more likely broken than meant.
  * Explicit zeros are kept.  Every message names file:line.  Lines are read
- * whole with getline and parsed with strtoll/strtod, which reads a 150k-entry
- * file in a few tens of milliseconds.
+ * whole (at most MM_MAX_LINE bytes: a file is input, so no line of it may make
+ * the reader allocate without bound) and parsed with strtoll/strtod, which
+ * reads a 150k-entry file in a few tens of milliseconds.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "silc.h"
@@ -25,6 +26,10 @@
 enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN };
 enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW };
 
+/* A data line holds one entry ("row col value"); comments are free text.
+ * 64 KiB is far beyond either, and bounds what one line can allocate. */
+#define MM_MAX_LINE 65536
+
 typedef struct mm_reader {
     FILE *f;
     const char *path;
@@ -33,6 +38,7 @@ typedef struct mm_reader {
     int64_t lineno;
     char *err;
     size_t errlen;
+    int failed;            /* a message is set: later ones would only follow from it */
 } mm_reader;
 
 /* Formats "path:line: message" into the caller's buffer and the context-free
@@ -47,6 +53,8 @@ static int mm_fail(mm_reader *r, int64_t line, const char *fmt, ...)
 {
     char msg[768];
     va_list ap;
+    if (r->failed) return -1;
+    r->failed = 1;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
@@ -56,13 +64,42 @@ static int mm_fail(mm_reader *r, int64_t line, const char *fmt, ...)
     return -1;
 }
 
-/* Next line that is neither a comment nor blank; NULL at end of file. */
+/* Reads the next line into r->line (with its newline, if any); 1 when there
+ * is one, 0 at end of file, -1 when it is longer than MM_MAX_LINE or holds a
+ * NUL byte (reported).  The FILE is this reader's alone, hence getc_unlocked. */
+static int mm_read_line(mm_reader *r)
+{
+    size_t len = 0;
+    int ch;
+    while ((ch = getc_unlocked(r->f)) != EOF) {
+        if (len + 2 > r->cap) {
+            size_t cap = r->cap ? 2 * r->cap : 256;
+            char *grown;
+            if (cap > MM_MAX_LINE + 2) cap = MM_MAX_LINE + 2;
+            if (len + 2 > cap)
+                return mm_fail(r, r->lineno + 1, "line longer than %d bytes (not a Matrix Market file?)",
+                               MM_MAX_LINE);
+            if (!(grown = realloc(r->line, cap))) return mm_fail(r, r->lineno + 1, "out of memory");
+            r->line = grown;
+            r->cap = cap;
+        }
+        if (ch == 0) return mm_fail(r, r->lineno + 1, "a NUL byte: not a text file");
+        r->line[len++] = (char)ch;
+        if (ch == '\n') break;
+    }
+    if (len == 0) return 0;
+    r->line[len] = 0;
+    r->lineno++;
+    return 1;
+}
+
+/* Next line that is neither a comment nor blank; NULL at end of file or on a
+ * line mm_read_line refuses (r->failed tells them apart). */
 static char *mm_next_data_line(mm_reader *r)
 {
     for (;;) {
         char *p;
-        if (getline(&r->line, &r->cap, r->f) < 0) return NULL;
-        r->lineno++;
+        if (mm_read_line(r) <= 0) return NULL;
         p = r->line;
         while (isspace((unsigned char)*p)) p++;
         if (*p && *p != '%') return p;
@@ -100,8 +137,9 @@ static int only_space(const char *s)
 static int mm_banner(mm_reader *r, int *is_array, int *field, int *sym)
 {
     char w[5][64];
-    if (getline(&r->line, &r->cap, r->f) < 0) return mm_fail(r, 1, "empty file (expected a %%%%MatrixMarket banner)");
-    r->lineno = 1;
+    int got = mm_read_line(r);
+    if (got < 0) return -1;
+    if (got == 0) return mm_fail(r, 1, "empty file (expected a %%%%MatrixMarket banner)");
     if (sscanf(r->line, "%63s %63s %63s %63s %63s", w[0], w[1], w[2], w[3], w[4]) != 5 ||
         strcasecmp(w[0], "%%MatrixMarket") != 0)
         return mm_fail(r, 1, "not a Matrix Market file (expected '%%%%MatrixMarket matrix "
@@ -315,6 +353,10 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
             rc = mm_read_array(&r, e, m, n, sym);
         else
             rc = mm_read_coordinate(&r, e, m, n, nz, field, sym);
+    }
+    if (rc == 0 && r.failed) {          /* a refused line read as the end of the file */
+        silc_envelope_free(e);
+        rc = -1;
     }
     free(r.line);
     fclose(r.f);
