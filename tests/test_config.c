@@ -149,6 +149,19 @@ static void test_files(silc_engine *E)
     file_error(E, "[template]\nverbos = 1\n", 2,
                "plugin 'template' has no option 'verbos'; did you mean 'verbose'?");
     CHECK(cfg_load_file(E, "/nonexistent/silc.conf") != 0, "missing file accepted");
+    /* inih reads lines into a 200-byte buffer: a longer line is refused, not
+     * cut or split into a second line; 199 characters still fit */
+    {
+        char text[512];
+        snprintf(text, sizeof text, "[lis-style]\noptions = -i cg%*s\n", 199 - 15, "");
+        CHECK(load_text(E, text) == 0, "199-character line refused: %s", E->err);
+        snprintf(text, sizeof text, "[lis-style]\noptions = -i cg%*s\n", 200 - 15, "");
+        file_error(E, text, 2, "line longer than 199 characters (the INI reader's limit)");
+        snprintf(text, sizeof text, "[tune]\nthread = 4\n[lis-style]\noptions = -i cg%*s\n", 300, "");
+        file_error(E, text, 2, "unknown key 'tune.thread'; did you mean 'tune.threads'?");
+        snprintf(text, sizeof text, "[tune]\nthreads 4\n[lis-style]\noptions = -i cg%*s\n", 300, "");
+        file_error(E, text, 2, "syntax error (expected '[section]' or 'key = value')");
+    }
 
     /* Known but not installed backends and plugin sections are accepted, so a
      * config file serves machines with and without them. */

@@ -553,27 +553,46 @@ void cfg_list(const silc_engine *E, strbuf *b)
 /* ---- the INI file ---------------------------------------------------------- */
 
 /* inih (as packaged) does not pass line numbers to the handler, so the reader
- * counts them: a chunk that starts a line advances the count. */
+ * counts them. */
 typedef struct file_ctx {
     silc_engine *E;
     FILE *fp;
     const char *path;
     int line;
-    int at_line_start;
-    int err_line;          /* line of the first rejected key, 0 if none */
+    int err_line;          /* line of the first rejected key or line, 0 if none */
     char err[sizeof ((silc_engine *)0)->err];
 } file_ctx;
 
+/* Hands inih one whole line.  inih reads into a buffer of its build's
+ * INI_MAX_LINE bytes (num) and would silently cut a longer line, or take its
+ * rest as the next line; and a NUL byte would hide the rest of its line.
+ * Either ends the file here with an error naming the line. */
 static char *file_reader(char *str, int num, void *stream)
 {
     file_ctx *c = stream;
-    char *r = fgets(str, num, c->fp);
-    size_t len;
-    if (!r) return NULL;
-    if (c->at_line_start) c->line++;
-    len = strlen(r);
-    c->at_line_start = len > 0 && r[len - 1] == '\n';
-    return r;
+    int len = 0, ch = 0;
+    if (c->err_line) return NULL;          /* nothing after the first error */
+    while (len < num - 1 && (ch = getc(c->fp)) != EOF) {
+        if (ch == 0) {
+            c->err_line = c->line + 1;
+            snprintf(c->err, sizeof c->err, "a NUL byte: not a text file");
+            return NULL;
+        }
+        str[len++] = (char)ch;
+        if (ch == '\n') break;
+    }
+    if (len == 0) return NULL;
+    str[len] = 0;
+    c->line++;
+    if (ch != '\n' && len == num - 1) {
+        ch = getc(c->fp);                  /* a line of exactly num - 1 characters? */
+        if (ch != EOF && ch != '\n') {
+            c->err_line = c->line;
+            snprintf(c->err, sizeof c->err, "line longer than %d characters (the INI reader's limit)", num - 1);
+            return NULL;
+        }
+    }
+    return str;
 }
 
 static int file_handler(void *user, const char *section, const char *name, const char *value)
@@ -599,13 +618,14 @@ int cfg_load_file(silc_engine *E, const char *path)
     memset(&c, 0, sizeof c);
     c.E = E;
     c.path = path;
-    c.at_line_start = 1;
     c.fp = fopen(path, "r");
     if (!c.fp) return eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
     rc = ini_parse_stream(file_reader, &c, file_handler, &c);
     fclose(c.fp);
-    if (rc == 0) return 0;
     if (rc < 0) return eng_error(E, "%s: out of memory reading the config file", path);
-    if (c.err_line == rc) return eng_error(E, "%s:%d: %s", path, rc, c.err);
+    /* the first error wins: inih's syntax errors are numbered as ours */
+    if (c.err_line && (rc == 0 || rc == c.err_line))
+        return eng_error(E, "%s:%d: %s", path, c.err_line, c.err);
+    if (rc == 0) return 0;
     return eng_error(E, "%s:%d: syntax error (expected '[section]' or 'key = value')", path, rc);
 }
