@@ -56,6 +56,8 @@ int ref_spt_pair(const silc_view *a, const silc_view *b, ref_sp *At, ref_sp *Bt)
 int ref_sp_transpose(const ref_sp *A, ref_sp *T);
 /* Dense column-major copy of any format. */
 double *ref_dense_from_view(const silc_view *v);
+/* Writes v into the zeroed m x n column-major array D. */
+void ref_dense_fill(const silc_view *v, double *D);
 double ref_view_get(const silc_view *v, int64_t i, int64_t j);
 /* A CSR value from the compressed-column form of its transpose (rows of A). */
 silc_value *ref_value_from_rows(const ref_sp *R);

@@ -172,9 +172,14 @@ int ref_sp_from_view(const silc_view *v, ref_sp *A)
 
 double *ref_dense_from_view(const silc_view *v)
 {
+    double *D = ref_calloc((size_t)v->m * (size_t)v->n, sizeof(double));
+    if (D) ref_dense_fill(v, D);
+    return D;
+}
+
+void ref_dense_fill(const silc_view *v, double *D)
+{
     int64_t m = v->m, n = v->n;
-    double *D = ref_calloc((size_t)m * (size_t)n, sizeof(double));
-    if (!D) return NULL;
     if (v->format == SILC_FMT_DENSE) {
         if (m > 0 && n > 0) memcpy(D, v->val, (size_t)(m * n) * sizeof(double));
     } else if (v->format == SILC_FMT_CSR) {
@@ -188,7 +193,6 @@ double *ref_dense_from_view(const silc_view *v)
             for (int64_t i = lo; i < hi; i++) D[i + j * m] = v->val[(v->ku + i - j) + j * v->ld];
         }
     }
-    return D;
 }
 
 double ref_view_get(const silc_view *v, int64_t i, int64_t j)

@@ -431,6 +431,9 @@ int main(int argc, char **argv)
     sigaction(SIGPIPE, &sa, NULL);
     if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
     pool_install((size_t)srv_cfg.pool_bytes); /* core/src/pool.c */
+    /* A value a statement makes is held to the same limit as one a PUT
+     * carries, checked before it is allocated. */
+    val_set_max_bytes(srv_cfg.max_value_bytes, "silcd --max-value-bytes");
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,
             (unsigned long long)srv_cfg.max_value_bytes,
             (unsigned long long)srv_cfg.max_session_bytes, srv_cfg.token ? ", token required" : "");

@@ -221,7 +221,7 @@ static void test_malformed(void)
         proto_encode_header(big + b.len + pad, PROTO_LIST, 0);
         s = (proto_stream){-1, 0, big, b.len + pad + PROTO_HEADER_BYTES, 0};
         CHECK(proto_read_request(&s, &lim, &q, err, sizeof err) == PROTO_REFUSED &&
-                  contains(err, "exceeds the server's limit"), "value over limit: %s", err);
+                  contains(err, "per value (silcd --max-value-bytes)"), "value over limit: %s", err);
         proto_request_free(&q);
         CHECK(proto_read_request(&s, &lim, &q, err, sizeof err) == 0 && q.op == PROTO_LIST,
               "stream in step after a skipped value");

@@ -103,6 +103,19 @@ static const row rows[] = {
     LANG("x = nosuch(1)", "unknown function 'nosuch'"),
     LANG("x = abs(1, 2)", "abs takes 1 argument, got 2"),
     LANG("x = zeros(-1)", "zeros: argument 1 must be an integer >= 0, got -1"),
+    /* sizes are checked before anything is allocated ('#': this machine's memory) */
+    LANG("x = sparse(1, 1, 1, 1e10, 1e10)", "a 10000000000x10000000000 csr value needs 80000000024 "
+         "bytes (74.5 GiB), over the limit of # bytes (# GiB) by # GiB: the most one value may hold "
+         "(the machine's memory)"),
+    LANG("x = zeros(1e10)", "a 10000000000x10000000000 dense value needs 800000000000000000000 bytes "
+         "(693.9 EiB), over the limit of # bytes (# GiB) by # EiB: the most one value may hold "
+         "(the machine's memory)"),
+    LANG("x = rand(1e6, 1e6)", "a 1000000x1000000 dense value needs 8000000000000 bytes (7.3 TiB), "
+         "over the limit of # bytes (# GiB) by # TiB: the most one value may hold (the machine's "
+         "memory)"),
+    LANG("x = dense(eye(1e7))", "reference: a 10000000x10000000 dense value needs 800000000000000 bytes "
+         "(727.6 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "
+         "(the machine's memory)"),
     LANG("x = rand(-3)", "rand: argument 1 must be an integer >= 0, got -3"),
     LANG("x = norm(v, 3)", "norm: p must be 1, 2, inf or \"fro\""),
     LANG("x = band(M, -1, 0)", "band: argument 2 must be an integer >= 0, got -1"),
@@ -140,7 +153,7 @@ static const row rows[] = {
         "petsc: KSPSolve: diverged (KSP_DIVERGED_ITS) after 2 iterations, relative residual 0.333 "
         "(KSP cg + PC none)"),
     NUM("petsc", "x = solve(Zs, b, \"backend = petsc\")",
-        "petsc: KSPSolve: diverged (KSP_DIVERGED_BREAKDOWN) after 30 iterations, relative residual 11.7 "
+        "petsc: KSPSolve: diverged (KSP_DIVERGED_BREAKDOWN) after 30 iterations, relative residual # "
         "(KSP gmres + PC icc (petsc))"),
     NUM("lis-style", "x = solve(L, e1, \"backend = lis-style; lis-style.options = -i cg -maxiter 2\")",
         "lis-style CG: not converged after 2 iterations (relative residual 3.3e-01)"),
@@ -290,6 +303,25 @@ static int has_backend(silc_context *c, const char *backend)
            strstr(silc_context_errmsg(c), "not loaded") == NULL;
 }
 
+/* want == got, where a '#' in want stands for one number: a residual after a
+ * breakdown on a singular matrix is rounding noise that differs between
+ * BLAS builds (11.7 on one machine, 4.12 on another), while the rest of the
+ * message is what the row holds. */
+static int message_matches(const char *want, const char *got)
+{
+    for (; *want; want++, got++) {
+        if (*want == '#') {
+            const char *start = got;
+            while (*got && strchr("0123456789.e+-", *got)) got++;
+            if (got == start) return 0;
+            got--;
+        } else if (*want != *got) {
+            return 0;
+        }
+    }
+    return *got == '\0';
+}
+
 static int run_exec(const row *r)
 {
     silc_context *c = NULL;
@@ -316,7 +348,7 @@ static int run_exec(const row *r)
     } else {
         const char *msg = silc_context_errmsg(c);
         /* one statement: no "statement N: " prefix; its own prefix is part of want */
-        CHECK(rc != 0 && !strcmp(msg, r->want), "[%s]\n   got  \"%s\"\n   want \"%s\"", r->input,
+        CHECK(rc != 0 && message_matches(r->want, msg), "[%s]\n   got  \"%s\"\n   want \"%s\"", r->input,
               rc ? msg : "(success)", r->want);
         if (!strncmp(r->input, "x = 1; ", 7)) silc_exec(c, "clear x");   /* statement 1 stays done */
         snapshot_check(c, &before, r->input);

@@ -126,7 +126,7 @@ static void test_malformed(const char *url)
         d.n = 1;
         d.nnz = d.m;
         n = put_bytes(big, "h", d, PROTO_DESC_BYTES + 1 + payload);
-        malformed(url, big, n + payload, "exceeds the server's limit of 524288 bytes per value",
+        malformed(url, big, n + payload, "value of 600000 bytes (585.9 KiB), over the limit of 524288 bytes (512.0 KiB) by 73.9 KiB per value (silcd --max-value-bytes)",
                   1, "value over the limit");
         free(big);
     }

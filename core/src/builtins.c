@@ -38,7 +38,7 @@ typedef struct bi_entry {
 
 static int oom(lang_ev *V)
 {
-    return eng_error(V->E, "out of memory");
+    return eng_oom(V->E);
 }
 
 /* Argument i as an integer >= lo. */

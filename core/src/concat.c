@@ -148,7 +148,7 @@ int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out)
     *out = NULL;
     if (n->nkids == 0) {
         *out = val_dense_new(0, 0);
-        return *out ? 0 : eng_error(V->E, "out of memory");
+        return *out ? 0 : eng_oom(V->E);
     }
     for (r = 0; r < n->nkids; r++) nblocks += n->kids[r]->nkids;
     vals = calloc(nblocks, sizeof *vals);
@@ -156,7 +156,7 @@ int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out)
     if (!vals || !rows) {
         free(vals);
         free(rows);
-        return eng_error(V->E, "out of memory");
+        return eng_oom(V->E);
     }
     if (eval_blocks(V, n, vals) || check_shapes(V, n, vals, rows, &width)) goto done;
     for (r = 0; r < n->nkids; r++)
@@ -164,7 +164,7 @@ int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out)
     for (at = 0; at < nblocks; at++)
         if (vals[at]->format == SILC_FMT_CSR) any_csr = 1;
     *out = any_csr ? build_csr(n, vals, rows, m, width) : build_dense(n, vals, rows, m, width);
-    rc = *out ? 0 : eng_error(V->E, "out of memory");
+    rc = *out ? 0 : eng_oom(V->E);
 done:
     for (at = 0; at < nblocks; at++) val_release(vals[at]);
     free(vals);

@@ -328,7 +328,11 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* The message is prefixed with the backend, unless the
                  * plugin already named itself ("lis-style BiCG: ..."). */
                 size_t bl = strlen(b->full_name);
-                if (strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' '))
+                if (rc == SILC_ENOMEM && *val_refusal())
+                    /* A value constructor that refused a size said how
+                     * large: that beats the plugin's "out of memory". */
+                    eng_error(E, "%s: %s", b->full_name, val_refusal());
+                else if (strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' '))
                     eng_error(E, "%s", ctx.err);
                 else
                     eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));

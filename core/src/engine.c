@@ -132,6 +132,12 @@ int eng_error(silc_engine *E, const char *fmt, ...)
     return -1;
 }
 
+int eng_oom(silc_engine *E)
+{
+    const char *why = val_refusal();
+    return eng_error(E, "%s", *why ? why : "out of memory");
+}
+
 void eng_print(silc_engine *E, const char *text)
 {
     if (!text) return;

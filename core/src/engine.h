@@ -76,6 +76,9 @@ int eng_error(silc_engine *E, const char *fmt, ...)   /* sets E->err, returns -1
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+/* A constructor returned NULL: reports the size refusal it left
+ * (val_refusal) or "out of memory", and returns -1. */
+int eng_oom(silc_engine *E);
 void eng_print(silc_engine *E, const char *text);     /* to the output callback or stdout */
 /* Records a warning of the running exec ("matrix is singular to working
  * precision ..."); the API clears them at each exec start and the CLI prints them

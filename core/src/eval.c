@@ -76,7 +76,7 @@ static int program_for(silc_engine *E, const char *text, lang_program **out)
     char err[512];
     if (!c) {
         c = calloc(1, sizeof *c);
-        if (!c) return eng_error(E, "out of memory");
+        if (!c) return eng_oom(E);
         E->lang_cache = c;
         E->lang_cache_free = cache_free;
     }
@@ -92,7 +92,7 @@ static int program_for(silc_engine *E, const char *text, lang_program **out)
     if (!e) {
         ps_free(*out);
         *out = NULL;
-        return eng_error(E, "out of memory");
+        return eng_oom(E);
     }
     e->prog = *out;
     e->next = c->b[h];
@@ -174,7 +174,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         if (call->op == SILC_OP_SOLVE) {
             /* explain runs no solve: later steps see a placeholder of the right shape */
             *out = val_dense_new(call->in[0]->n, call->in[1]->n);
-            return *out ? 0 : eng_error(E, "out of memory");
+            return *out ? 0 : eng_oom(E);
         }
     }
     /* The evaluator records what a deferred backward error needs (bind). */
@@ -250,7 +250,7 @@ static int eval_name(lang_ev *V, const ast_node *n, silc_value **out)
     }
     if (bi_constant(n->name, &x)) {
         *out = val_scalar_new(x);
-        return *out ? 0 : eng_error(V->E, "out of memory");
+        return *out ? 0 : eng_oom(V->E);
     }
     return undefined_name(V, n->name);
 }
@@ -349,7 +349,7 @@ static int matrix_power(lang_ev *V, const silc_value *a, double k, const char *w
     if (e == 0) {
         val_release(base);
         *out = identity_like(a);
-        return *out ? 0 : eng_error(V->E, "out of memory");
+        return *out ? 0 : eng_oom(V->E);
     }
     while (e) {
         if (e & 1) {
@@ -491,7 +491,7 @@ static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
         if (truth == (n->op == TK_OR)) {
             val_release(a);
             *out = val_scalar_new(truth ? 1.0 : 0.0);
-            return *out ? 0 : eng_error(V->E, "out of memory");
+            return *out ? 0 : eng_oom(V->E);
         }
     }
     if (ev_expr(V, n->kids[1], &b)) {
@@ -549,12 +549,12 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
     switch (n->kind) {
     case AST_NUM:
         *out = val_scalar_new(n->num);
-        return *out ? 0 : eng_error(E, "out of memory");
+        return *out ? 0 : eng_oom(E);
     case AST_NAME:
         return eval_name(V, n, out);
     case AST_END:
         *out = val_scalar_new((double)V->end_value);
-        return *out ? 0 : eng_error(E, "out of memory");
+        return *out ? 0 : eng_oom(E);
     case AST_STRING:
         return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
     case AST_COLON_ALL:
@@ -857,7 +857,7 @@ static int exec_set(lang_ev *V, const ast_node *s)
     }
     eq = strchr(s->name, '=');
     key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
-    if (!key) return eng_error(E, "out of memory");
+    if (!key) return eng_oom(E);
     if (!eq) {
         const char *v = cfg_get(E, key);
         strbuf b;
@@ -872,7 +872,7 @@ static int exec_set(lang_ev *V, const ast_node *s)
     value = trimmed(eq + 1, strlen(eq + 1));
     if (!value) {
         free(key);
-        return eng_error(E, "out of memory");
+        return eng_oom(E);
     }
     if (!key[0]) rc = eng_error(E, "set needs a key before '=', as in 'set dispatch.solve.dense = lapack'");
     else rc = cfg_set(E, CFG_SCOPE_SESSION, key, value);

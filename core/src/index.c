@@ -25,7 +25,7 @@ typedef struct ix_list {
 
 static int oom(lang_ev *V)
 {
-    return eng_error(V->E, "out of memory");
+    return eng_oom(V->E);
 }
 
 static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, const char *what,

@@ -13,6 +13,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE 1   /* madvise */
 #include "protocol.h"
+#include "util.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -232,10 +233,12 @@ int proto_layout_of(const proto_desc *d, uint64_t max_bytes, proto_layout *L, ch
     L->values_bytes = va;
     L->total = rp + ci + va;
     if (L->total > max_bytes)
-        return perr(-1, err, errlen, "%lldx%lld %s value of %llu bytes exceeds the limit of "
-                    "%llu bytes", (long long)d->m, (long long)d->n,
-                    val_format_name((int)d->format), (unsigned long long)L->total,
-                    (unsigned long long)max_bytes);
+    {
+        char over[200];
+        util_fmt_over_limit(over, sizeof over, (double)L->total, (double)max_bytes);
+        return perr(-1, err, errlen, "%lldx%lld %s value of %s", (long long)d->m, (long long)d->n,
+                    val_format_name((int)d->format), over);
+    }
     return 0;
 }
 
@@ -579,10 +582,11 @@ int proto_read_request(proto_stream *s, const proto_limits *lim, proto_request *
         if (r->layout.total > lim->max_value_bytes) {
             /* Only the limit is exceeded and the length is consistent, so the
              * stream stays in step: skip the arrays and keep the session. */
-            perr(0, err, errlen, "'%s': %lldx%lld %s value of %llu bytes exceeds the server's "
-                 "limit of %llu bytes per value", r->text, (long long)r->desc.m,
-                 (long long)r->desc.n, val_format_name((int)r->desc.format),
-                 (unsigned long long)len, (unsigned long long)lim->max_value_bytes);
+            char over[200];
+            util_fmt_over_limit(over, sizeof over, (double)len, (double)lim->max_value_bytes);
+            perr(0, err, errlen, "'%s': %lldx%lld %s value of %s per value (silcd "
+                 "--max-value-bytes)", r->text, (long long)r->desc.m, (long long)r->desc.n,
+                 val_format_name((int)r->desc.format), over);
             return skip_refused(s, len, err, errlen);
         }
         return 0;

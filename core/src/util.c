@@ -158,3 +158,25 @@ void util_fmt_double(char *out, size_t outlen, double x)
         if (x != x || strtod(out, NULL) == x) return;
     }
 }
+
+/* 1536 -> "1.5 KiB": the unit a reader grasps at once, beside the exact count. */
+static void fmt_binary(char *out, size_t outlen, double bytes)
+{
+    static const char *const unit[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+    int u = 0;
+    while (bytes >= 1024 && u < 6) {
+        bytes /= 1024;
+        u++;
+    }
+    snprintf(out, outlen, u ? "%.1f %s" : "%.0f %s", bytes, unit[u]);
+}
+
+void util_fmt_over_limit(char *out, size_t outlen, double need, double limit)
+{
+    char a[32], b[32], c[32];
+    fmt_binary(a, sizeof a, need);
+    fmt_binary(b, sizeof b, limit);
+    fmt_binary(c, sizeof c, need - limit);
+    snprintf(out, outlen, "%.0f bytes (%s), over the limit of %.0f bytes (%s) by %s", need, a,
+             limit, b, c);
+}

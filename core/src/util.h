@@ -45,4 +45,10 @@ char *util_strdup(const char *s);
  * round-trip form (tries %.15g, %.16g first). */
 void util_fmt_double(char *out, size_t outlen, double x);
 
+/* "<need> bytes (74.5 GiB), over the limit of <limit> bytes (2.0 GiB) by
+ * 72.5 GiB": one wording for every size a client, a file or a statement can
+ * claim (value.c, protocol.c), so a refusal says how far over it is.  need
+ * is a double because a claimed size may not fit in 64 bits. */
+void util_fmt_over_limit(char *out, size_t outlen, double need, double limit);
+
 #endif

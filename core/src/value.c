@@ -8,13 +8,16 @@
  * with scaled norms so that entries near the overflow threshold give finite
  * answers), and the per-context store mapping names to values.
  */
+#define _DEFAULT_SOURCE   /* sysconf(_SC_PHYS_PAGES) */
 #include "value.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "util.h"
 
@@ -58,6 +61,54 @@ void val_array_free(void *p)
     if (p && !(pool_give && pool_give(p))) free(p);
 }
 
+/* The largest value this process makes (val_set_max_bytes).  Every size a
+ * statement, a file or a client claims passes here before anything is
+ * allocated, so `zeros(1e6)` is refused with its size instead of reaching
+ * malloc (which on Linux may say yes and let the OOM killer answer later).
+ * 0 = not set: the machine's physical memory. */
+static uint64_t max_value_bytes;
+static const char *max_value_source = "the machine's memory";
+/* Why the last constructor of this thread returned NULL when it was a size,
+ * not malloc: "" otherwise (val_refusal). */
+static _Thread_local char refusal[384];
+
+void val_set_max_bytes(uint64_t bytes, const char *source)
+{
+    max_value_bytes = bytes;
+    max_value_source = source ? source : "the machine's memory";
+}
+
+uint64_t val_max_bytes(void)
+{
+    if (!max_value_bytes) {
+        long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+        return pages > 0 && size > 0 ? (uint64_t)pages * (uint64_t)size : UINT64_MAX;
+    }
+    return max_value_bytes;
+}
+
+const char *val_refusal(void)
+{
+    return refusal;
+}
+
+/* 0 if a value of this format, shape and byte count may be made; else -1
+ * with the reason in refusal.  bytes is a double: a claimed size may not fit
+ * in 64 bits (sparse(1, 1, 1, 1e10, 1e10) asks for 80 GB of row pointers;
+ * zeros(1e10) for 8e20 bytes). */
+static int size_allowed(int format, int64_t m, int64_t n, double bytes)
+{
+    char over[200];
+    double limit = (double)val_max_bytes();
+    refusal[0] = '\0';
+    if (bytes <= limit) return 0;
+    util_fmt_over_limit(over, sizeof over, bytes, limit);
+    snprintf(refusal, sizeof refusal, "a %lldx%lld %s value needs %s: the most one value may "
+             "hold (%s)", (long long)m, (long long)n, val_format_name(format), over,
+             max_value_source);
+    return -1;
+}
+
 static silc_value *val_alloc(int64_t m, int64_t n, int format)
 {
     silc_value *v;
@@ -85,6 +136,7 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
 {
     int64_t count = count_mul(m, n);
     silc_value *v;
+    if (size_allowed(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double))) return NULL;
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
     v->val = val_array_alloc(count, sizeof(double), zero);
     if (!v->val) {
@@ -98,6 +150,9 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
 static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero)
 {
     silc_value *v;
+    if (size_allowed(SILC_FMT_CSR, m, n, ((double)m + 1) * sizeof(silc_index) +
+                     (double)nnz_capacity * (sizeof(silc_index) + sizeof(double))))
+        return NULL;
     if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
     if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
     v->rowptr = val_array_alloc(m + 1, sizeof(silc_index), zero);
@@ -115,6 +170,8 @@ static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int z
 {
     int64_t ld, count;
     silc_value *v;
+    if (size_allowed(SILC_FMT_BAND, m, n, ((double)kl + (double)ku + 1) * (double)n * sizeof(double)))
+        return NULL;
     if (kl < 0 || ku < 0 || kl > INT64_MAX / 4 || ku > INT64_MAX / 4) return NULL;
     ld = kl + ku + 1;
     count = count_mul(ld, n);

@@ -74,6 +74,16 @@ void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p));
  * from the pool when it has one; never asks for zero bytes, so NULL always
  * means failure.  Value and envelope arrays are made and freed with these. */
 void *val_array_alloc(int64_t count, size_t size, int zero);
+/* The largest value (its arrays' bytes) the constructors make in this
+ * process; source names the setting in refusals ("silcd --max-value-bytes").
+ * Unset: the machine's physical memory.  Set once, before values are made. */
+void val_set_max_bytes(uint64_t bytes, const char *source);
+uint64_t val_max_bytes(void);
+/* Why this thread's last constructor returned NULL if a size limit refused
+ * it ("a 10000000000x10000000000 csr value needs ... exceeds the limit ...
+ * by ..."), or "" if it was malloc: callers report it instead of "out of
+ * memory" (eng_oom). */
+const char *val_refusal(void);
 void val_array_free(void *p);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
