@@ -1,12 +1,12 @@
 /*
- * server.h -- what silcd.c (process: options, listening, signals) and
- * session.c (one connection: handshake, requests, the session's engine)
- * share.  docs/server.md explains the concurrency model.
+ * server.h -- what silcd.c (the parent process: options, listening, signals,
+ * one child process per connection) and session.c (one connection, in its
+ * child: handshake, requests, the session's engine) share.  docs/server.md
+ * explains the process model.
  */
 #ifndef SILCD_SERVER_H
 #define SILCD_SERVER_H
 
-#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -22,17 +22,28 @@ typedef struct srv_config {
     uint64_t max_session_bytes;  /* values bound in one session; 0 = unlimited */
     uint64_t max_text_bytes;     /* one statement */
     int io_timeout_ms;           /* a peer stalling inside a frame is dropped after this */
+    int handshake_timeout_ms;    /* a connection must complete its handshake within this */
+    int idle_timeout_ms;         /* a session idle this long is closed; 0 = never */
     int max_clients;
+    double peer_share;           /* of max_clients, the most one peer address may hold */
     int log_level;
     uint64_t pool_bytes;         /* freed value arrays kept for reuse; 0 = none */
 } srv_config;
 
 extern srv_config srv_cfg;
-/* Held around every call into an engine: plugins and their libraries keep
- * process-wide state (docs/server.md). */
-extern pthread_mutex_t srv_compute_lock;
-/* Readable once shutdown has begun: sessions poll it while idle. */
+/* Readable once this process should stop: a session polls it while idle. */
 extern int srv_shutdown_fd;
+
+/* Where a session's child stands, in memory shared with the parent, so that
+ * when a child dies the parent knows whether the client's stream is at a
+ * frame boundary (it can then send the client an ERROR saying what
+ * happened) or in the middle of a reply (it can only close). */
+enum {
+    SLOT_FREE = 0,
+    SLOT_HANDSHAKE,   /* accepted; no hello from the server yet */
+    SLOT_READY,       /* between replies: reading or computing a request */
+    SLOT_REPLYING     /* a reply is partly sent */
+};
 
 void srv_log(int level, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -40,9 +51,10 @@ void srv_log(int level, const char *fmt, ...)
 #endif
     ;
 
-/* Serves one accepted connection until BYE, disconnect or shutdown, then
- * closes fd.  id numbers the session in the log. */
-void srv_session(int fd, unsigned long id);
+/* Serves one accepted connection until BYE, disconnect, idle timeout or
+ * shutdown, then closes fd.  Runs in the session's own process; id numbers
+ * the session in the log; *state is its slot (above). */
+void srv_session(int fd, unsigned long id, volatile int *state);
 
 
 #endif

@@ -1,13 +1,13 @@
 /*
- * session.c -- one client connection of silcd: the handshake, then requests
- * until BYE, disconnect or shutdown, each answered on the session's own
- * engine (its own store: names never leak between sessions).
+ * session.c -- one client connection of silcd, in a process of its own
+ * (silcd.c forks one per connection): the handshake, then requests until
+ * BYE, disconnect, idle timeout or shutdown, each answered on the session's
+ * own engine (its own store: names never leak between sessions).
  *
- * I/O happens outside the compute lock and engine calls inside it, so a slow
- * or hostile client can stall only itself: a PUT's arrays are received into
- * the new value before the lock is taken, a GET's value is retained under the
- * lock and sent after it, and the text that `who`, `info` and `explain` print
- * is collected during the call and sent afterwards.
+ * The text that `who`, `info` and `explain` print is collected during the
+ * call and sent with the reply, whose start and end are marked in the
+ * session's slot (server.h): if this process dies, the parent then knows
+ * whether the client can still be told why.
  *
  * Session memory (the val_bytes of every bound value) is kept under
  * max_session_bytes.  A PUT is checked from its descriptor before its arrays
@@ -19,16 +19,19 @@
 #include "server.h"
 
 #include <poll.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include "api.h"
 #include "engine.h"
 #include "protocol.h"
 
-/* Frames produced while the lock is held, sent once it is released. */
+/* Frames an EXEC produces (who, info, explain), sent with its reply. */
 typedef struct outbuf {
     uint8_t *p;
     size_t len, cap;
@@ -38,6 +41,7 @@ typedef struct outbuf {
 typedef struct session {
     int fd;
     unsigned long id;
+    volatile int *state;   /* shared with the parent: SLOT_* */
     silc_engine *E;
     outbuf out;
     char err[4096];
@@ -160,19 +164,10 @@ static int snapshot_restore(silc_engine *E, snapshot *s)
     return rc;
 }
 
-static void lock(void)
-{
-    pthread_mutex_lock(&srv_compute_lock);
-}
-
-static void unlock(void)
-{
-    pthread_mutex_unlock(&srv_compute_lock);
-}
-
 static int reply_text(session *S, uint32_t op, const char *text)
 {
     char why[256];
+    *S->state = SLOT_REPLYING;
     if (proto_send_text(S->fd, op, text, srv_cfg.io_timeout_ms, why, sizeof why)) {
         srv_log(LOG_INFO, "session %lu: %s", S->id, why);
         return -1;
@@ -202,6 +197,7 @@ static int finish_exec(session *S, int rc, const char *warnings)
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
     S->out.len = 0;
+    *S->state = SLOT_REPLYING;
     if (iov.iov_len && proto_send(S->fd, &iov, 1, srv_cfg.io_timeout_ms, why, sizeof why)) {
         srv_log(LOG_INFO, "session %lu: %s", S->id, why);
         return -1;
@@ -217,9 +213,7 @@ static int do_exec(session *S, const char *text)
     char *warnings;
     uint64_t used;
     int rc, guarded = srv_cfg.max_session_bytes > 0, r;
-    lock();
     if (guarded && snapshot_take(E, &snap)) {
-        unlock();
         return reply_error(S, "out of memory preparing the statement");
     }
     rc = api_exec(E, text, S->err, sizeof S->err);
@@ -241,7 +235,6 @@ static int do_exec(session *S, const char *text)
         }
     }
     warnings = util_strdup(sb_str(&E->warnings));
-    unlock();
     r = finish_exec(S, rc, warnings);
     free(warnings);
     return r;
@@ -260,11 +253,9 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
         return reply_error(S, S->err);
     }
     if (srv_cfg.max_session_bytes > 0) {
-        lock();
         used = session_bytes(S->E);
         old = store_get(&S->E->store, q->text);
         old_bytes = old ? val_bytes(old) : 0;
-        unlock();
         if (used - old_bytes + q->layout.total > srv_cfg.max_session_bytes) {
             if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
@@ -282,10 +273,8 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
         srv_log(LOG_INFO, "session %lu: PUT '%s' abandoned: %s", S->id, q->text, S->err);
         return -1;
     }
-    lock();
     rc = api_bind(S->E, q->text, v, S->err, sizeof S->err);
     val_release(v);
-    unlock();
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
 }
 
@@ -297,37 +286,31 @@ static int do_get(session *S, const char *name)
     struct iovec body[4];
     char why[256];
     int k, rc;
-    lock();
     v = (silc_value *)api_lookup(S->E, name, S->err, sizeof S->err);
     val_retain(v);
-    unlock();
     if (!v) return reply_error(S, S->err);
-    /* The value is immutable and retained: its arrays are sent unlocked. */
     k = proto_value_iov(v, &d, body + 1);
     proto_encode_desc(desc, &d);
     body[0].iov_base = desc;
     body[0].iov_len = sizeof desc;
+    *S->state = SLOT_REPLYING;
     rc = k < 0 ? reply_error(S, "value too large to send")
                : proto_send_frame(S->fd, PROTO_VALUE, body, k + 1, srv_cfg.io_timeout_ms, why,
                                   sizeof why);
     if (k >= 0 && rc) srv_log(LOG_INFO, "session %lu: %s", S->id, why);
-    lock();
     val_release(v);
-    unlock();
     return rc;
 }
 
 static int do_delete(session *S, const char *name)
 {
     int rc = 0;
-    lock();
     if (!api_lookup(S->E, name, S->err, sizeof S->err)) {
         rc = -1;
     } else {
         store_remove(&S->E->store, name);
         eng_info_remove(S->E, name);
     }
-    unlock();
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
 }
 
@@ -338,10 +321,8 @@ static int do_list(session *S)
     size_t i, n;
     int rc;
     sb_init(&b);
-    lock();
     n = store_names(&S->E->store, &names);
     for (i = 0; i < n; i++) sb_printf(&b, "%s%s", i ? "\n" : "", names[i]);
-    unlock();
     free(names);
     rc = reply_text(S, PROTO_OK, sb_str(&b));
     sb_free(&b);
@@ -364,10 +345,8 @@ static int do_info(session *S, const char *name)
         sb_free(&b);
         return rc;
     }
-    lock();
     used = session_bytes(S->E);
     count = S->E->store.count;
-    unlock();
     snprintf(text, sizeof text,
              "server: silcd %s, protocol %u\nsession: %lu\nnames: %zu\nbytes: %llu\n"
              "max_session_bytes: %llu\nmax_value_bytes: %llu\n",
@@ -389,15 +368,28 @@ static int token_matches(const char *given)
     return diff == 0;
 }
 
+/* The hello exchange must end within --handshake-timeout however slowly
+ * the peer trickles its bytes: SIGALRM ends this process, and the parent
+ * logs why (silcd.c, reap_children). */
+static void handshake_deadline(int ms)
+{
+    struct itimerval t;
+    memset(&t, 0, sizeof t);
+    t.it_value.tv_sec = ms / 1000;
+    t.it_value.tv_usec = (ms % 1000) * 1000;
+    setitimer(ITIMER_REAL, &t, NULL);
+}
+
 /* Hello both ways, then OK, or ERROR and -1. */
 static int handshake(session *S)
 {
-    proto_stream st = {S->fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
+    proto_stream st = {S->fd, srv_cfg.handshake_timeout_ms, NULL, 0, 0};
     uint8_t hello[PROTO_HELLO_BYTES];
     struct iovec iov;
     uint32_t version;
     char *token = NULL, why[512];
     int rc;
+    handshake_deadline(srv_cfg.handshake_timeout_ms);
     rc = proto_read_hello(&st, &version, &token, why, sizeof why);
     if (rc) {
         srv_log(LOG_INFO, "session %lu: handshake failed: %s", S->id, why);
@@ -421,18 +413,17 @@ static int handshake(session *S)
         rc = -1;
     }
     free(token);
+    handshake_deadline(0);
     if (rc) {
         srv_log(LOG_WARN, "session %lu: refused: %s", S->id, why);
         reply_error(S, why);
         return -1;
     }
-    lock();
     rc = eng_create(&S->E, srv_cfg.engine_config, S->err, sizeof S->err);
     if (!rc && srv_cfg.threads > 0) {
         S->E->threads = srv_cfg.threads;
         ld_set_threads(S->E, srv_cfg.threads);
     }
-    unlock();
     if (rc) {
         srv_log(LOG_ERROR, "session %lu: engine: %s", S->id, S->err);
         reply_error(S, S->err);
@@ -443,22 +434,41 @@ static int handshake(session *S)
     return reply_text(S, PROTO_OK, "silcd " SILC_VERSION);
 }
 
-/* Waits for the next request; 0 when one is arriving, -1 on shutdown. */
-static int await_request(int fd)
+/* Waits for the next request; 0 when one is arriving, -1 on shutdown or
+ * after --idle-timeout, which the client is told with an ERROR that its
+ * next read finds. */
+static int await_request(session *S)
 {
     struct pollfd p[2];
-    p[0].fd = fd;
+    double deadline = util_now() + srv_cfg.idle_timeout_ms / 1000.0;
+    p[0].fd = S->fd;
     p[0].events = POLLIN;
     p[1].fd = srv_shutdown_fd;
     p[1].events = POLLIN;
     if (proto_spin(p, 2)) return p[1].revents ? -1 : 0;
     for (;;) {
+        int wait = -1, rc;
+        if (srv_cfg.idle_timeout_ms > 0) {
+            double left = deadline - util_now();
+            wait = left > 0 ? (int)(left * 1000) + 1 : 0;
+        }
         p[0].revents = p[1].revents = 0;
-        if (poll(p, 2, -1) < 0) continue;
+        rc = poll(p, 2, wait);
+        if (rc < 0) continue;
         if (p[1].revents) return -1;
         if (p[0].revents) return 0;
+        if (rc == 0 && srv_cfg.idle_timeout_ms > 0 && util_now() >= deadline) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "session closed: idle for %g s (silcd --idle-timeout); "
+                     "its values are gone", srv_cfg.idle_timeout_ms / 1000.0);
+            srv_log(LOG_INFO, "session %lu: %s", S->id, msg);
+            reply_text(S, PROTO_ERROR, msg);
+            shutdown(S->fd, SHUT_WR);
+            return -1;
+        }
     }
 }
+
 
 static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
 {
@@ -500,7 +510,7 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
     return rc;
 }
 
-void srv_session(int fd, unsigned long id)
+void srv_session(int fd, unsigned long id, volatile int *state)
 {
     session S;
     proto_stream st;
@@ -508,18 +518,16 @@ void srv_session(int fd, unsigned long id)
     memset(&S, 0, sizeof S);
     S.fd = fd;
     S.id = id;
+    S.state = state;
     lim.max_value_bytes = srv_cfg.max_value_bytes;
     lim.max_text_bytes = srv_cfg.max_text_bytes;
     st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
     if (handshake(&S) == 0) {
+        *S.state = SLOT_READY;
         srv_log(LOG_INFO, "session %lu: open", id);
-        while (await_request(fd) == 0 && serve_one(&S, &st, &lim) == 0) {}
+        while (await_request(&S) == 0 && serve_one(&S, &st, &lim) == 0) *S.state = SLOT_READY;
     }
-    if (S.E) {
-        lock();
-        eng_destroy(&S.E);
-        unlock();
-    }
+    eng_destroy(&S.E);
     free(S.out.p);
     close(fd);
     srv_log(LOG_INFO, "session %lu: closed", id);

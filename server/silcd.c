@@ -1,10 +1,21 @@
 /*
- * silcd.c -- the SILC server: options, the listening socket, signals, and one
- * thread per connection (session.c).  Runs in the foreground; SIGTERM or
- * SIGINT stops accepting, lets requests in flight finish, closes idle
- * sessions, and exits 0.  docs/server.md is the user's guide.
+ * silcd.c -- the SILC server's parent process: options, the listening
+ * socket, signals, and one child process per connection (fork after accept,
+ * as PostgreSQL does), which runs the session (session.c).
+ *
+ * A session owns a whole process so that nothing it does can hurt another:
+ * a plugin that crashes or a library that aborts takes down only its own
+ * session, whose client gets an ERROR saying so from this parent, and two
+ * sessions compute at once on two cores with no lock between them.  The
+ * parent never runs an engine.  It loads the plugins once before it
+ * listens (the children inherit them, as PostgreSQL's preloaded libraries),
+ * limits connections (--max-clients, --peer-share), gives each a deadline
+ * for its handshake, and on SIGTERM or SIGINT stops accepting, lets the
+ * children finish the requests in flight, and exits 0.  docs/server.md is
+ * the user's guide.
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE   /* MAP_ANONYMOUS */
 #include "server.h"
 #include "pool.h"
 
@@ -16,6 +27,8 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +39,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "engine.h"
 #include "protocol.h"
 #include "silc.h"
 
@@ -34,15 +48,33 @@ srv_config srv_cfg = {
     (uint64_t)2 << 30,   /* max_value_bytes: 2 GiB */
     (uint64_t)4 << 30,   /* max_session_bytes: 4 GiB */
     (uint64_t)64 << 20,  /* max_text_bytes: 64 MiB */
-    30000, 256, LOG_INFO,
+    30000,               /* io_timeout_ms */
+    5000,                /* handshake_timeout_ms */
+    0,                   /* idle_timeout_ms: never */
+    256,                 /* max_clients */
+    0.5,                 /* peer_share */
+    LOG_INFO,
     (uint64_t)1 << 30};  /* pool_bytes: 1 GiB */
-pthread_mutex_t srv_compute_lock = PTHREAD_MUTEX_INITIALIZER;
 int srv_shutdown_fd = -1;
 
+/* Written by the signal handlers, read by the poll loops.  In a child,
+ * shutdown_pipe is its own: a signal to one session stops only that one. */
 static int shutdown_pipe[2] = {-1, -1};
-static pthread_mutex_t count_lock = PTHREAD_MUTEX_INITIALIZER;
-static pthread_cond_t count_zero = PTHREAD_COND_INITIALIZER;
-static int active_sessions;
+static int child_pipe[2] = {-1, -1};   /* SIGCHLD: a session process ended */
+
+/* One connection: what the parent knows of it.  state lives in memory
+ * shared with the child (server.h); the rest is the parent's. */
+typedef struct conn {
+    pid_t pid;                 /* 0: free */
+    int fd;                    /* the parent's copy, to tell the client of a crash */
+    unsigned long id;
+    char peer[64];             /* "127.0.0.1", or "" on a Unix socket */
+    double accepted;           /* util_now() */
+} conn;
+
+static conn *conns;
+static volatile int *conn_state;   /* max_clients ints, MAP_SHARED */
+static int n_conns;
 
 static const char *const level_names[] = {"error", "warn", "info", "debug"};
 
@@ -71,7 +103,12 @@ static void usage(FILE *f)
           "  --token-file FILE       shared secret clients must present (required off loopback)\n"
           "  --max-value-bytes N     largest value one PUT may carry (default 2G)\n"
           "  --max-session-bytes N   memory of the values bound in one session, 0 = no limit (default 4G)\n"
-          "  --max-clients N         concurrent sessions (default 256)\n"
+          "  --max-clients N         concurrent connections, handshakes included (default 256)\n"
+          "  --peer-share F          the share of --max-clients one TCP peer address may hold\n"
+          "                          (default 0.5)\n"
+          "  --handshake-timeout S   close a connection that has not completed its handshake\n"
+          "                          after S seconds (default 5)\n"
+          "  --idle-timeout S        close a session idle for S seconds, 0 = never (default 0)\n"
           "  --array-pool N          freed value arrays kept for the next PUT, 0 = none (default 1G)\n"
           "  --io-timeout SECONDS    drop a peer that stalls inside a frame (default 30)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
@@ -108,6 +145,18 @@ static int parse_int(const char *s, int lo, int hi, int *out)
     x = strtol(s, &end, 10);
     if (end == s || *end || x < lo || x > hi) return -1;
     *out = (int)x;
+    return 0;
+}
+
+/* Seconds (fractions allowed, at most a day) as milliseconds, at least 1;
+ * zero_ok admits 0 (= off). */
+static int parse_seconds(const char *s, int zero_ok, int *ms)
+{
+    char *end;
+    double x = strtod(s, &end);
+    if (end == s || *end || !(x >= 0 && x <= 86400) || (x == 0 && !zero_ok)) return -1;
+    *ms = x == 0 ? 0 : (int)(x * 1000);
+    if (x > 0 && *ms < 1) *ms = 1;
     return 0;
 }
 
@@ -175,11 +224,15 @@ static int parse_args(int argc, char **argv, const char **ready_file)
         else if (strcmp(name, "--max-session-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_session_bytes);
         else if (strcmp(name, "--array-pool") == 0) ok = !parse_size(val, &srv_cfg.pool_bytes);
         else if (strcmp(name, "--max-clients") == 0) ok = !parse_int(val, 1, 65536, &srv_cfg.max_clients);
-        else if (strcmp(name, "--io-timeout") == 0) {
-            double s = strtod(val, NULL);
-            ok = s > 0 && s <= 86400;
-            srv_cfg.io_timeout_ms = (int)(s * 1000);
-            if (srv_cfg.io_timeout_ms < 1) srv_cfg.io_timeout_ms = 1;
+        else if (strcmp(name, "--io-timeout") == 0) ok = !parse_seconds(val, 0, &srv_cfg.io_timeout_ms);
+        else if (strcmp(name, "--handshake-timeout") == 0)
+            ok = !parse_seconds(val, 0, &srv_cfg.handshake_timeout_ms);
+        else if (strcmp(name, "--idle-timeout") == 0)
+            ok = !parse_seconds(val, 1, &srv_cfg.idle_timeout_ms);
+        else if (strcmp(name, "--peer-share") == 0) {
+            char *end;
+            srv_cfg.peer_share = strtod(val, &end);
+            ok = end != val && !*end && srv_cfg.peer_share > 0 && srv_cfg.peer_share <= 1;
         } else if (strcmp(name, "--log-level") == 0) {
             int k;
             ok = 0;
@@ -312,83 +365,265 @@ static void on_signal(int sig)
     (void)rc;
 }
 
-typedef struct session_arg {
-    int fd;
-    unsigned long id;
-} session_arg;
-
-static void *session_thread(void *p)
+static void on_child(int sig)
 {
-    session_arg a = *(session_arg *)p;
-    free(p);
-    srv_session(a.fd, a.id);
-    pthread_mutex_lock(&count_lock);
-    if (--active_sessions == 0) pthread_cond_broadcast(&count_zero);
-    pthread_mutex_unlock(&count_lock);
-    return NULL;
+    ssize_t rc;
+    (void)sig;
+    rc = write(child_pipe[1], "c", 1);   /* non-blocking: a full pipe already wakes */
+    (void)rc;
 }
 
-/* Refuses a connection over --max-clients with a proper hello and ERROR. */
-static void refuse_busy(int fd)
+/* Refuses a connection with a proper hello and an ERROR saying why. */
+static void refuse(int fd, const char *why)
 {
     uint8_t hello[PROTO_HELLO_BYTES];
     struct iovec iov;
-    char why[128];
+    char err[128];
     proto_encode_hello(hello, PROTO_VERSION, 0);
     iov.iov_base = hello;
     iov.iov_len = sizeof hello;
-    if (proto_send(fd, &iov, 1, 1000, why, sizeof why) == 0)
-        proto_send_text(fd, PROTO_ERROR, "server busy: too many sessions (silcd --max-clients)",
-                        1000, why, sizeof why);
+    if (proto_send(fd, &iov, 1, 1000, err, sizeof err) == 0)
+        proto_send_text(fd, PROTO_ERROR, why, 1000, err, sizeof err);
     close(fd);
+}
+
+/* The peer's address for --peer-share; "" on a Unix socket, whose mode
+ * (0600) already admits only the server's owner. */
+static void peer_of(int fd, char *out, size_t outlen)
+{
+    struct sockaddr_storage ss;
+    socklen_t sl = sizeof ss;
+    out[0] = '\0';
+    if (getpeername(fd, (struct sockaddr *)&ss, &sl) != 0) return;
+    if (ss.ss_family == AF_INET)
+        inet_ntop(AF_INET, &((struct sockaddr_in *)&ss)->sin_addr, out, (socklen_t)outlen);
+    else if (ss.ss_family == AF_INET6)
+        inet_ntop(AF_INET6, &((struct sockaddr_in6 *)&ss)->sin6_addr, out, (socklen_t)outlen);
+}
+
+/* A free slot for a new connection from peer, or -1 with why set.  When
+ * every slot is taken, the oldest connection still in its handshake gives
+ * way: a client that completes its handshake takes a millisecond, so
+ * connections that never send a byte cannot lock real clients out. */
+static int take_slot(const char *peer, char *why, size_t whylen)
+{
+    int i, free_slot = -1, oldest = -1, from_peer = 0;
+    int peer_cap = (int)(srv_cfg.peer_share * srv_cfg.max_clients);
+    if (peer_cap < 1) peer_cap = 1;
+    for (i = 0; i < n_conns; i++) {
+        if (!conns[i].pid) {
+            if (free_slot < 0) free_slot = i;
+            continue;
+        }
+        if (*peer && strcmp(conns[i].peer, peer) == 0) from_peer++;
+        if (conn_state[i] == SLOT_HANDSHAKE &&
+            (oldest < 0 || conns[i].accepted < conns[oldest].accepted))
+            oldest = i;
+    }
+    if (*peer && from_peer >= peer_cap) {
+        snprintf(why, whylen, "server busy: %s holds %d connections, its share of %d (silcd "
+                 "--peer-share %g of --max-clients)", peer, from_peer, peer_cap,
+                 srv_cfg.peer_share);
+        return -1;
+    }
+    if (free_slot >= 0) return free_slot;
+    if (oldest < 0) {
+        snprintf(why, whylen, "server busy: too many sessions (silcd --max-clients %d)",
+                 srv_cfg.max_clients);
+        return -1;
+    }
+    srv_log(LOG_WARN, "session %lu: closed unauthenticated to make room (--max-clients %d)",
+            conns[oldest].id, srv_cfg.max_clients);
+    /* Waited for here, so that it cannot touch the slot's state once reused. */
+    kill(conns[oldest].pid, SIGKILL);
+    waitpid(conns[oldest].pid, NULL, 0);
+    close(conns[oldest].fd);
+    conns[oldest].pid = 0;
+    conns[oldest].fd = -1;
+    return oldest;
+}
+
+static void sigmask_session_signals(int how)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGCHLD);
+    sigprocmask(how, &set, NULL);
+}
+
+/* In the new child: its own shutdown pipe and signals, none of the parent's
+ * descriptors but its connection, then the session. */
+static void run_child(int lfd, int slot)
+{
+    struct sigaction sa;
+    int i, fd = conns[slot].fd;
+    close(lfd);
+    for (i = 0; i < n_conns; i++)
+        if (conns[i].pid && i != slot) close(conns[i].fd);
+    close(shutdown_pipe[0]);
+    close(shutdown_pipe[1]);
+    close(child_pipe[0]);
+    close(child_pipe[1]);
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = SIG_DFL;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGCHLD, &sa, NULL);
+    if (pipe(shutdown_pipe) != 0) _exit(1);
+    fcntl(shutdown_pipe[1], F_SETFL, O_NONBLOCK);
+    srv_shutdown_fd = shutdown_pipe[0];
+    sigmask_session_signals(SIG_UNBLOCK);
+    srv_session(fd, conns[slot].id, &conn_state[slot]);
+    /* exit, not _exit: the plugins' shutdown and (in sanitizer builds) the
+     * leak check run as in any process. */
+    exit(0);
+}
+
+static void start_session(int lfd, int fd, unsigned long id, const char *peer)
+{
+    char why[256];
+    pid_t pid;
+    int slot = take_slot(peer, why, sizeof why);
+    if (slot < 0) {
+        srv_log(LOG_WARN, "refusing a connection%s%s: %s", *peer ? " from " : "", peer, why);
+        refuse(fd, why);
+        return;
+    }
+    conns[slot].fd = fd;
+    conns[slot].id = id;
+    conns[slot].accepted = util_now();
+    snprintf(conns[slot].peer, sizeof conns[slot].peer, "%s", peer);
+    conn_state[slot] = SLOT_HANDSHAKE;
+    sigmask_session_signals(SIG_BLOCK);   /* until the child has its own pipes */
+    pid = fork();
+    if (pid == 0) run_child(lfd, slot);
+    sigmask_session_signals(SIG_UNBLOCK);
+    if (pid < 0) {
+        srv_log(LOG_ERROR, "cannot start a session process: %s", strerror(errno));
+        refuse(fd, "server cannot start a session: fork failed");
+        conn_state[slot] = SLOT_FREE;
+        return;
+    }
+    conns[slot].pid = pid;
+}
+
+/* Collects every ended session process.  One that died of a signal while
+ * its client waited at a frame boundary gets an ERROR naming the signal;
+ * no other session is touched. */
+static void reap_children(void)
+{
+    int status, i;
+    pid_t pid;
+    while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+        for (i = 0; i < n_conns && conns[i].pid != pid; i++) {}
+        if (i == n_conns) continue;
+        if (WIFSIGNALED(status)) {
+            int sig = WTERMSIG(status), st = conn_state[i];
+            if (st == SLOT_HANDSHAKE && sig == SIGALRM) {
+                srv_log(LOG_INFO, "session %lu: no handshake within %g s, closed "
+                        "(--handshake-timeout)", conns[i].id, srv_cfg.handshake_timeout_ms / 1000.0);
+            } else {
+                char msg[512], err[128];
+                snprintf(msg, sizeof msg, "session %lu lost: the server process running it died "
+                         "of signal %d (%s); its values are gone, other sessions are unaffected",
+                         conns[i].id, sig, strsignal(sig));
+                srv_log(LOG_ERROR, "%s", msg);
+                if (st == SLOT_READY)
+                    proto_send_text(conns[i].fd, PROTO_ERROR, msg, 1000, err, sizeof err);
+            }
+        } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
+            srv_log(LOG_ERROR, "session %lu: its process exited with status %d", conns[i].id,
+                    WEXITSTATUS(status));
+        }
+        close(conns[i].fd);
+        conns[i].pid = 0;
+        conns[i].fd = -1;
+        conn_state[i] = SLOT_FREE;
+    }
+}
+
+static int live_sessions(void)
+{
+    int i, n = 0;
+    for (i = 0; i < n_conns; i++) n += conns[i].pid != 0;
+    return n;
+}
+
+static void drain_pipe(int fd)
+{
+    char buf[64];
+    while (read(fd, buf, sizeof buf) > 0) {}
 }
 
 static void accept_loop(int lfd, int is_tcp)
 {
     unsigned long next_id = 1;
-    struct pollfd p[2];
+    struct pollfd p[3];
     p[0].fd = lfd;
     p[0].events = POLLIN;
     p[1].fd = shutdown_pipe[0];
     p[1].events = POLLIN;
+    p[2].fd = child_pipe[0];
+    p[2].events = POLLIN;
     for (;;) {
-        session_arg *a;
-        pthread_t th;
-        pthread_attr_t attr;
-        int fd, one = 1, busy;
-        p[0].revents = p[1].revents = 0;
-        if (poll(p, 2, -1) < 0) continue;
+        char peer[64];
+        int fd, one = 1;
+        p[0].revents = p[1].revents = p[2].revents = 0;
+        if (poll(p, 3, -1) < 0) continue;
+        if (p[2].revents) {
+            drain_pipe(child_pipe[0]);
+            reap_children();
+        }
         if (p[1].revents) return;
         if (!(p[0].revents & POLLIN)) continue;
         fd = accept(lfd, NULL, NULL);
         if (fd < 0) continue;
         if (is_tcp) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-        pthread_mutex_lock(&count_lock);
-        busy = active_sessions >= srv_cfg.max_clients;
-        if (!busy) active_sessions++;
-        pthread_mutex_unlock(&count_lock);
-        if (busy) {
-            srv_log(LOG_WARN, "refusing a connection: %d sessions open", srv_cfg.max_clients);
-            refuse_busy(fd);
-            continue;
-        }
-        a = malloc(sizeof *a);
-        pthread_attr_init(&attr);
-        pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
-        if (a) {
-            a->fd = fd;
-            a->id = next_id++;
-        }
-        if (!a || pthread_create(&th, &attr, session_thread, a) != 0) {
-            srv_log(LOG_ERROR, "cannot start a session thread");
-            free(a);
-            close(fd);
-            pthread_mutex_lock(&count_lock);
-            active_sessions--;
-            pthread_mutex_unlock(&count_lock);
-        }
-        pthread_attr_destroy(&attr);
+        peer_of(fd, peer, sizeof peer);
+        start_session(lfd, fd, next_id++, peer);
     }
+}
+
+/* After SIGTERM: every session finishes the request it is in, the idle ones
+ * close at once; a second signal kills what is left. */
+static void drain_sessions(void)
+{
+    struct pollfd p[2];
+    int i, forced = 0;
+    for (i = 0; i < n_conns; i++)
+        if (conns[i].pid) kill(conns[i].pid, SIGTERM);
+    drain_pipe(shutdown_pipe[0]);
+    p[0].fd = child_pipe[0];
+    p[0].events = POLLIN;
+    p[1].fd = shutdown_pipe[0];
+    p[1].events = POLLIN;
+    while (reap_children(), live_sessions() > 0) {
+        p[0].revents = p[1].revents = 0;
+        if (poll(p, 2, 1000) < 0) continue;
+        if (p[0].revents) drain_pipe(child_pipe[0]);
+        if (p[1].revents && !forced) {
+            srv_log(LOG_WARN, "second signal: killing %d session(s)", live_sessions());
+            for (i = 0; i < n_conns; i++)
+                if (conns[i].pid) kill(conns[i].pid, SIGKILL);
+            forced = 1;
+        }
+    }
+}
+
+/* Loads the plugins once (an engine made and dropped), so every session
+ * process inherits them instead of loading each for itself, and a bad
+ * --config stops the server at start instead of failing every session. */
+static int preload_plugins(void)
+{
+    silc_engine *E = NULL;
+    char err[1024];
+    if (eng_create(&E, srv_cfg.engine_config, err, sizeof err)) {
+        fprintf(stderr, "silcd: %s\n", err);
+        return -1;
+    }
+    eng_destroy(&E);
+    return 0;
 }
 
 static int write_ready_file(const char *path, const char *url)
@@ -409,7 +644,7 @@ int main(int argc, char **argv)
     struct sigaction sa;
     proto_addr addr;
     char url[600], err[512];
-    int lfd;
+    int lfd, i;
     if (parse_args(argc, argv, &ready_file)) return 2;
     if (*(const uint8_t *)&probe != 1) {
         fprintf(stderr, "silcd: the wire protocol needs a little-endian host\n");
@@ -419,21 +654,37 @@ int main(int argc, char **argv)
         fprintf(stderr, "silcd: --listen: %s\n", err);
         return 2;
     }
-    if (pipe(shutdown_pipe) != 0) return 1;
+    n_conns = srv_cfg.max_clients;
+    conns = calloc((size_t)n_conns, sizeof *conns);
+    conn_state = mmap(NULL, (size_t)n_conns * sizeof *conn_state, PROT_READ | PROT_WRITE,
+                      MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (!conns || conn_state == MAP_FAILED || pipe(shutdown_pipe) != 0 || pipe(child_pipe) != 0) {
+        fprintf(stderr, "silcd: cannot set up: %s\n", strerror(errno));
+        return 1;
+    }
+    for (i = 0; i < n_conns; i++) conns[i].fd = -1;
+    fcntl(shutdown_pipe[0], F_SETFL, O_NONBLOCK);   /* drained once, at shutdown */
     fcntl(shutdown_pipe[1], F_SETFL, O_NONBLOCK);
+    fcntl(child_pipe[0], F_SETFL, O_NONBLOCK);
+    fcntl(child_pipe[1], F_SETFL, O_NONBLOCK);
     srv_shutdown_fd = shutdown_pipe[0];
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGINT, &sa, NULL);
+    sa.sa_handler = on_child;
+    sa.sa_flags = SA_NOCLDSTOP;
+    sigaction(SIGCHLD, &sa, NULL);
+    sa.sa_flags = 0;
     sa.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &sa, NULL);
-    if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
-    pool_install((size_t)srv_cfg.pool_bytes); /* core/src/pool.c */
-    /* A value a statement makes is held to the same limit as one a PUT
-     * carries, checked before it is allocated. */
+    /* A statement's value is held to the same limit as one a PUT carries,
+     * checked before it is allocated. */
     val_set_max_bytes(srv_cfg.max_value_bytes, "silcd --max-value-bytes");
+    if (preload_plugins()) return 1;
+    if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
+    pool_install((size_t)srv_cfg.pool_bytes); /* core/src/pool.c: each session's own */
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,
             (unsigned long long)srv_cfg.max_value_bytes,
             (unsigned long long)srv_cfg.max_session_bytes, srv_cfg.token ? ", token required" : "");
@@ -442,13 +693,12 @@ int main(int argc, char **argv)
         return 1;
     }
     accept_loop(lfd, !addr.is_unix);
-    srv_log(LOG_INFO, "shutting down: waiting for %d session(s)", active_sessions);
+    srv_log(LOG_INFO, "shutting down: waiting for %d session(s)", live_sessions());
     close(lfd);
     if (addr.is_unix) unlink(addr.path);
-    pthread_mutex_lock(&count_lock);
-    while (active_sessions > 0) pthread_cond_wait(&count_zero, &count_lock);
-    pthread_mutex_unlock(&count_lock);
+    drain_sessions();
     srv_log(LOG_INFO, "stopped");
     free(srv_cfg.token);
+    free(conns);
     return 0;
 }

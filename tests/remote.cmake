@@ -15,6 +15,21 @@ foreach(t test_remote test_remote_stress)
   set_tests_properties(${t} PROPERTIES TIMEOUT 120)
 endforeach()
 
+# The process model under faults: a plugin that dies on purpose (built in a
+# directory of its own, which a server config names as core.plugin_path),
+# and the test that crashes sessions, floods idle connections and kills
+# clients and servers (tests/test_server.c).
+add_library(silc_test_crash MODULE ${CMAKE_CURRENT_LIST_DIR}/server/crash_plugin.c)
+target_include_directories(silc_test_crash PRIVATE ${PROJECT_SOURCE_DIR}/plugins)
+set_target_properties(silc_test_crash PROPERTIES PREFIX "lib" OUTPUT_NAME silc_plugin_crash C_VISIBILITY_PRESET hidden
+  LIBRARY_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/crash-plugin)
+silc_add_test(test_server INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_server.c)
+target_compile_definitions(test_server PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>"
+  CRASH_PLUGIN_DIR="${CMAKE_CURRENT_BINARY_DIR}/crash-plugin")
+target_link_libraries(test_server PRIVATE Threads::Threads)
+add_dependencies(test_server silc_test_crash silcd)
+set_tests_properties(test_server PROPERTIES TIMEOUT 300)
+
 # The frame decoder under a deterministic mutation fuzzer (always), and under
 # libFuzzer when clang can build it (a short run; longer runs by hand).
 add_executable(fuzz_frame ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c)

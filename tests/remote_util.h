@@ -108,9 +108,10 @@ static inline int raw_connect(const char *url)
     struct sockaddr_un sa;
     int fd;
     if (strncmp(url, "unix:", 5) != 0) return -1;
+    if (strlen(url + 5) >= sizeof sa.sun_path) return -1;
     memset(&sa, 0, sizeof sa);
     sa.sun_family = AF_UNIX;
-    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", url + 5);
+    memcpy(sa.sun_path, url + 5, strlen(url + 5) + 1);
     fd = socket(AF_UNIX, SOCK_STREAM, 0);
     if (fd >= 0 && connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
         close(fd);

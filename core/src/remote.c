@@ -7,9 +7,11 @@
  * VALUE reply is received straight into freshly allocated envelope arrays.
  * The client waits for the server without a timeout, since a statement may
  * compute for as long as it needs; a server that dies shows as a closed
- * connection.
+ * connection, and one whose machine vanishes (no FIN ever comes) is found by
+ * TCP keepalive probes within about 25 s (keep_alive below).
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE   /* TCP_KEEPIDLE and friends */
 #include "remote.h"
 
 #include <errno.h>
@@ -25,6 +27,24 @@
 
 #include "envelope.h"
 #include "protocol.h"
+
+/* A reply may take hours, so waiting for it has no timeout; a server whose
+ * host dies or drops off the network is detected by the kernel instead:
+ * probes after 10 s of silence, every 5 s, 3 unanswered end the connection
+ * (25 s, under silcd's default --io-timeout of 30 s). */
+static void keep_alive(int fd)
+{
+    int one = 1;
+    setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &one, sizeof one);
+#if defined(TCP_KEEPIDLE) && defined(TCP_KEEPINTVL) && defined(TCP_KEEPCNT)
+    {
+        int idle = 10, interval = 5, count = 3;
+        setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle, sizeof idle);
+        setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval, sizeof interval);
+        setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &count, sizeof count);
+    }
+#endif
+}
 
 struct rem_conn {
     int fd;
@@ -67,6 +87,7 @@ static int connect_addr(const proto_addr *a, char *err, size_t errlen)
         freeaddrinfo(res);
         /* Small requests must not wait for Nagle's coalescing. */
         if (fd >= 0) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+        if (fd >= 0) keep_alive(fd);
         if (fd >= 0) return fd;
     }
     if (fd >= 0) close(fd);

@@ -1,0 +1,511 @@
+/*
+ * test_server.c -- silcd's process model under faults (issue 14): a session
+ * that crashes loses only itself, sessions compute at once, connections
+ * that never speak cannot lock real clients out, and killed clients, a
+ * killed server and SIGTERM lose nothing that was promised.
+ *
+ * Every server here is private (remote_util.h), on loopback or a Unix
+ * socket in a private directory; every wait is bounded and every loop
+ * counted, so the test ends by itself whatever the server does.  No timing
+ * is asserted beyond "before a generous bound" (a hang, not a speed):
+ * bench/remote measures how fast.
+ */
+#define _DEFAULT_SOURCE
+#include "check.h"
+#include "remote_util.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <silc.h>
+#include <stdint.h>
+
+#include "util.h"
+
+static int contains(const char *s, const char *sub)
+{
+    return s && strstr(s, sub) != NULL;
+}
+
+/* The session processes of silcd `parent`, from /proc (Linux). */
+static int children_of(pid_t parent, pid_t *out, int max)
+{
+    char path[64];
+    FILE *f;
+    int n = 0;
+    long pid;
+    snprintf(path, sizeof path, "/proc/%d/task/%d/children", (int)parent, (int)parent);
+    if (!(f = fopen(path, "r"))) return -1;
+    while (n < max && fscanf(f, "%ld", &pid) == 1) out[n++] = (pid_t)pid;
+    fclose(f);
+    return n;
+}
+
+/* Waits (bounded) until silcd has `want` session processes; their count. */
+static int await_children(pid_t parent, int want, int ms)
+{
+    pid_t kids[512];
+    int n = -1, i;
+    for (i = 0; i <= ms / 20; i++) {
+        if ((n = children_of(parent, kids, 512)) == want) return n;
+        sleep_ms(20);
+    }
+    return n;
+}
+
+static long rss_kib(pid_t pid)
+{
+    char path[64], line[256];
+    long kib = -1;
+    FILE *f;
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    if (!(f = fopen(path, "r"))) return -1;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "VmRSS: %ld", &kib) == 1) break;
+    fclose(f);
+    return kib;
+}
+
+/* silcd's resident memory: the parent and every session process. */
+static long server_rss_kib(pid_t parent)
+{
+    pid_t kids[512];
+    int n = children_of(parent, kids, 512), i;
+    long total = rss_kib(parent);
+    for (i = 0; i < n; i++) total += rss_kib(kids[i]);
+    return total;
+}
+
+static silc_context *open_client(const char *url)
+{
+    silc_context *c = NULL;
+    if (silc_open_remote(&c, url)) {
+        CHECK(0, "cannot open a session on %s: %s", url, silc_errmsg());
+        return NULL;
+    }
+    return c;
+}
+
+/* name = 7 * ones(n, 1) in session c, and a check that it is still there. */
+static void put_marker(silc_context *c, const char *name, int n)
+{
+    char text[96];
+    snprintf(text, sizeof text, "%s = 7 * ones(%d, 1)", name, n);
+    CHECK(silc_exec(c, text) == 0, "marker %s: %s", name, silc_context_errmsg(c));
+}
+
+static void check_marker(silc_context *c, const char *name, int n, const char *after)
+{
+    char text[160];
+    silc_envelope_t e;
+    snprintf(text, sizeof text, "ok_ = rows(%s) == %d && norm(%s - 7, inf) == 0", name, n, name);
+    CHECK(silc_exec(c, text) == 0 && silc_get(c, &e, "ok_") == 0 && e.values[0] == 1,
+          "after %s: %s lost or changed (%s)", after, name, silc_context_errmsg(c));
+    if (e.values) silc_envelope_free(&e);
+}
+
+/* ---- 1. a crash ends only its own session ------------------------------ */
+
+static void test_crash(const char *plugin_dir)
+{
+    test_server srv;
+    char conf[512], opt[600];
+    FILE *f;
+    silc_context *a, *b;
+    snprintf(conf, sizeof conf, "%s/crash.conf", plugin_dir);
+    f = fopen(conf, "w");
+    if (!f) {
+        CHECK(0, "cannot write %s", conf);
+        return;
+    }
+    fprintf(f, "[core]\nplugin_path = %s\n[dispatch]\nadd = crash, reference\n", plugin_dir);
+    fclose(f);
+    snprintf(opt, sizeof opt, "%s", conf);
+    {
+        const char *opts[] = {"--config", opt, "--log-level", "error", NULL};
+        if (server_start(&srv, NULL, opts)) {
+            CHECK(0, "silcd with the crash plugin did not start");
+            return;
+        }
+    }
+    a = open_client(srv.url);
+    b = open_client(srv.url);
+    if (!a || !b) goto out;
+    put_marker(a, "keep", 1000);
+    CHECK(silc_exec(b, "y = 2 * [1; 2]") == 0, "the crash plugin's scale: %s", silc_context_errmsg(b));
+    /* abort() in a plugin, as a library's failed assertion */
+    CHECK(silc_exec(b, "y = 13 * [1; 2]") != 0 &&
+              contains(silc_context_errmsg(b), "lost: the server process running it died of signal 6"),
+          "abort in a session: want a message naming signal 6, got '%s'", silc_context_errmsg(b));
+    CHECK(contains(silc_context_errmsg(b), "other sessions are unaffected"),
+          "crash message: '%s'", silc_context_errmsg(b));
+    CHECK(silc_exec(b, "z = 1") != 0, "a crashed session answered again");
+    check_marker(a, "keep", 1000, "another session's abort");
+    silc_close(&b);
+    /* SIGSEGV, as a plugin bug */
+    b = open_client(srv.url);
+    if (!b) goto out;
+    /* (signal 11; 6 in sanitizer builds, whose SEGV handler aborts) */
+    CHECK(silc_exec(b, "y = 11 * [1; 2]") != 0 &&
+              (contains(silc_context_errmsg(b), "died of signal 11") ||
+               contains(silc_context_errmsg(b), "died of signal 6")),
+          "segfault in a session: '%s'", silc_context_errmsg(b));
+    check_marker(a, "keep", 1000, "another session's segfault");
+    silc_close(&b);
+    b = open_client(srv.url);
+    CHECK(b && silc_exec(b, "w = 3 * [1; 2]") == 0, "a new session after two crashes");
+    CHECK(await_children(srv.pid, 2, 3000) == 2, "silcd keeps one process per live session");
+out:
+    silc_close(&a);
+    silc_close(&b);
+    CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly after crashes");
+}
+
+/* ---- 2. sessions do not queue behind each other ------------------------- */
+
+typedef struct long_exec {
+    const char *url;
+    const char *text;
+    int rc;
+    char err[512];
+    volatile int done;
+} long_exec;
+
+static void *run_long(void *p)
+{
+    long_exec *L = p;
+    silc_context *c = NULL;
+    L->rc = -1;
+    if (silc_open_remote(&c, L->url) == 0) {
+        L->rc = silc_exec(c, L->text);
+        snprintf(L->err, sizeof L->err, "%s", L->rc ? silc_context_errmsg(c) : "");
+        silc_close(&c);
+    } else {
+        snprintf(L->err, sizeof L->err, "%s", silc_errmsg());
+    }
+    L->done = 1;
+    return NULL;
+}
+
+/* A loop of about 10^6 statements: a second or more, on any build. */
+static const char *const long_text = "i = 0; while (i < 1000000) { i = i + 1 }";
+
+static void test_no_queue(void)
+{
+    test_server srv;
+    const char *opts[] = {"--log-level", "error", NULL};
+    long_exec L;
+    pthread_t th;
+    silc_context *c;
+    int k, answered = 0;
+    if (server_start(&srv, NULL, opts)) {
+        CHECK(0, "silcd did not start");
+        return;
+    }
+    memset(&L, 0, sizeof L);
+    L.url = srv.url;
+    L.text = long_text;
+    pthread_create(&th, NULL, run_long, &L);
+    c = open_client(srv.url);
+    sleep_ms(100);
+    /* While the long statement runs, another session's tiny ones answer. */
+    for (k = 0; c && k < 20 && !L.done; k++)
+        if (silc_exec(c, "t = 1 + 1") == 0 && !L.done) answered++;
+    CHECK(answered >= 5, "only %d tiny EXECs answered while another session computed (they queue)",
+          answered);
+    pthread_join(th, NULL);
+    CHECK(L.rc == 0, "the long EXEC: %s", L.err);
+    silc_close(&c);
+    CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+}
+
+/* ---- 3. connections that never speak ----------------------------------- */
+
+/* Connects to 127.0.0.1:port from the loopback address src (127.0.0.0/8). */
+static int tcp_from(const char *src, int port)
+{
+    struct sockaddr_in a, b;
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) return -1;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    inet_pton(AF_INET, src, &a.sin_addr);
+    memset(&b, 0, sizeof b);
+    b.sin_family = AF_INET;
+    b.sin_port = htons((uint16_t)port);
+    inet_pton(AF_INET, "127.0.0.1", &b.sin_addr);
+    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 ||
+        connect(fd, (struct sockaddr *)&b, sizeof b) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* 1 if the server closed fd within ms (EOF, after an optional reply). */
+static int closed_within(int fd, int ms)
+{
+    struct pollfd p;
+    char buf[512];
+    double end = util_now() + ms / 1000.0;
+    p.fd = fd;
+    p.events = POLLIN;
+    while (util_now() < end) {
+        ssize_t n;
+        p.revents = 0;
+        if (poll(&p, 1, 50) <= 0) continue;
+        n = read(fd, buf, sizeof buf);
+        if (n <= 0) return 1;
+    }
+    return 0;
+}
+
+static void test_idle_connections(void)
+{
+    test_server srv;
+    int fds[300], i, n = 0, port;
+    silc_context *c;
+    /* Same peer (a Unix socket): 300 silent connections against 256 slots.
+     * The oldest silent ones give way to new connections, so a real
+     * client, which completes its handshake at once, gets in. */
+    {
+        const char *opts[] = {"--log-level", "error", "--handshake-timeout", "30", NULL};
+        if (server_start(&srv, NULL, opts)) {
+            CHECK(0, "silcd did not start");
+            return;
+        }
+        for (i = 0; i < 300; i++)
+            if ((fds[n] = raw_connect(srv.url)) >= 0) n++;
+        CHECK(n == 300, "only %d of 300 idle connections made", n);
+        c = open_client(srv.url);
+        CHECK(c && silc_exec(c, "x = 2 * 3") == 0, "a real client behind 300 idle connections: %s",
+              c ? silc_context_errmsg(c) : silc_errmsg());
+        silc_close(&c);
+        for (i = 0; i < n; i++) close(fds[i]);
+        CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+    }
+    /* TCP, 300 silent connections from 127.0.0.2: that peer holds at most
+     * its share (--peer-share 0.5 of 64), the rest are refused at once, and
+     * a client from 127.0.0.1 is served. */
+    {
+        const char *opts[] = {"--log-level", "error", "--max-clients", "64", "--peer-share", "0.5",
+                              "--handshake-timeout", "30", NULL};
+        char *msg = NULL;
+        int refused = 0;
+        if (server_start(&srv, "tcp://127.0.0.1:0", opts)) {
+            CHECK(0, "silcd on tcp did not start");
+            return;
+        }
+        port = atoi(strrchr(srv.url, ':') + 1);
+        for (i = n = 0; i < 300; i++) {
+            int fd = tcp_from("127.0.0.2", port);
+            if (fd >= 0) fds[n++] = fd;
+        }
+        CHECK(n == 300, "only %d of 300 idle tcp connections made", n);
+        for (i = n - 10; i < n; i++) {
+            uint8_t hello[PROTO_HELLO_BYTES];
+            struct iovec iov = {hello, sizeof hello};
+            proto_stream s = {fds[i], 3000, NULL, 0, 0};
+            char err[128];
+            if (proto_recv(&s, &iov, 1, err, sizeof err) == 0 && raw_reply(fds[i], &msg, 3000) == PROTO_ERROR &&
+                contains(msg, "127.0.0.2 holds 32 connections, its share of 32"))
+                refused++;
+            free(msg);
+            msg = NULL;
+        }
+        CHECK(refused == 10, "connections past the peer's share: %d of the last 10 told why", refused);
+        c = open_client(srv.url);
+        CHECK(c && silc_exec(c, "x = 2 * 3") == 0, "a client from another address: %s",
+              c ? silc_context_errmsg(c) : silc_errmsg());
+        silc_close(&c);
+        for (i = 0; i < n; i++) close(fds[i]);
+        CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+    }
+    /* --handshake-timeout closes a silent connection; --idle-timeout a
+     * session that stopped asking, and its client is told why. */
+    {
+        const char *opts[] = {"--log-level", "error", "--handshake-timeout", "0.3",
+                              "--idle-timeout", "0.5", NULL};
+        int fd;
+        if (server_start(&srv, NULL, opts)) {
+            CHECK(0, "silcd did not start");
+            return;
+        }
+        fd = raw_connect(srv.url);
+        CHECK(fd >= 0 && closed_within(fd, 5000), "a silent connection outlived --handshake-timeout 0.3");
+        if (fd >= 0) close(fd);
+        c = open_client(srv.url);
+        CHECK(c && silc_exec(c, "x = 1") == 0, "a session under --idle-timeout");
+        sleep_ms(1500);
+        CHECK(c && silc_exec(c, "x = 2") != 0 &&
+                  (contains(silc_context_errmsg(c), "idle for 0.5 s (silcd --idle-timeout)") ||
+                   contains(silc_context_errmsg(c), "lost")),
+              "an idle session: '%s'", c ? silc_context_errmsg(c) : "");
+        silc_close(&c);
+        CHECK(await_children(srv.pid, 0, 3000) == 0, "session processes left after the timeouts");
+        CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+    }
+}
+
+/* ---- 4. faults lose nothing that was promised -------------------------- */
+
+static size_t put_header(uint8_t *out, const char *name, int64_t m)
+{
+    proto_desc d;
+    memset(&d, 0, sizeof d);
+    d.format = SILC_DENSE;
+    d.m = m;
+    d.n = 1;
+    d.nnz = m;
+    d.namelen = (uint32_t)strlen(name);
+    proto_encode_header(out, PROTO_PUT, PROTO_DESC_BYTES + d.namelen + (uint64_t)m * 8);
+    proto_encode_desc(out + PROTO_HEADER_BYTES, &d);
+    memcpy(out + PROTO_HEADER_BYTES + PROTO_DESC_BYTES, name, d.namelen);
+    return PROTO_HEADER_BYTES + PROTO_DESC_BYTES + d.namelen;
+}
+
+/* A client SIGKILLed 100 MB into a 200 MB PUT: its session process ends,
+ * the memory it held goes back, the other session keeps its values. */
+static void test_killed_client(void)
+{
+    test_server srv;
+    const char *opts[] = {"--log-level", "error", "--max-value-bytes", "512M", NULL};
+    silc_context *a;
+    long before, during = 0, after = 0;
+    pid_t pid;
+    int status, pfd[2], i;
+    char c;
+    if (server_start(&srv, NULL, opts)) {
+        CHECK(0, "silcd did not start");
+        return;
+    }
+    a = open_client(srv.url);
+    if (!a) goto out;
+    put_marker(a, "keep", 1000);
+    before = server_rss_kib(srv.pid);
+    if (pipe(pfd)) goto out;
+    pid = fork();
+    if (pid == 0) {
+        const size_t chunk = 1u << 20;
+        uint8_t b[256], *junk = malloc(chunk);
+        char *text;
+        int fd = raw_open(srv.url, PROTO_VERSION, NULL, &text);
+        memset(junk, 0x3f, chunk);   /* 0.49: a valid double, nothing for the server to refuse */
+        raw_send(fd, b, put_header(b, "big", 25 * 1000 * 1000));
+        for (i = 0; i < 100; i++) raw_send(fd, junk, chunk);
+        if (write(pfd[1], "k", 1) != 1) {}
+        pause();
+        _exit(0);
+    }
+    close(pfd[1]);
+    CHECK(read(pfd[0], &c, 1) == 1, "the client did not send its 100 MB");
+    close(pfd[0]);
+    sleep_ms(200);
+    during = server_rss_kib(srv.pid);
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    CHECK(await_children(srv.pid, 1, 5000) == 1, "the killed client's session process is still there");
+    after = server_rss_kib(srv.pid);
+    printf("silcd RSS: %ld MiB before, %ld MiB 100 MB into the PUT, %ld MiB after the kill\n",
+           before / 1024, during / 1024, after / 1024);
+    CHECK(during - before > 90 * 1024, "the partial PUT was not received (%ld KiB)", during - before);
+    CHECK(after - before < 16 * 1024, "memory not given back: %ld KiB more than before", after - before);
+    check_marker(a, "keep", 1000, "a client killed mid-PUT");
+out:
+    silc_close(&a);
+    CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+}
+
+/* silcd killed (every process of it) during a long EXEC: the client gets
+ * "connection ... lost" at once instead of waiting for ever. */
+static void test_killed_server(void)
+{
+    test_server srv;
+    const char *opts[] = {"--log-level", "error", "--io-timeout", "2", NULL};
+    long_exec L;
+    pthread_t th;
+    pid_t kids[64];
+    double t0;
+    int n, i, status;
+    if (server_start(&srv, NULL, opts)) {
+        CHECK(0, "silcd did not start");
+        return;
+    }
+    memset(&L, 0, sizeof L);
+    L.url = srv.url;
+    L.text = long_text;
+    pthread_create(&th, NULL, run_long, &L);
+    await_children(srv.pid, 1, 3000);
+    sleep_ms(200);
+    n = children_of(srv.pid, kids, 64);
+    kill(srv.pid, SIGKILL);
+    for (i = 0; i < n; i++) kill(kids[i], SIGKILL);
+    waitpid(srv.pid, &status, 0);
+    t0 = util_now();
+    for (i = 0; i < 250 && !L.done; i++) sleep_ms(20);
+    CHECK(L.done, "the client still waits 5 s after the server was killed");
+    pthread_join(th, NULL);
+    CHECK(L.rc != 0 && contains(L.err, "connection to silc server") && contains(L.err, "lost"),
+          "client of a killed server: '%s'", L.err);
+    printf("client told of the killed server after %.3f s: %s\n", util_now() - t0, L.err);
+    {
+        char cmd[400];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", srv.dir);
+        if (system(cmd)) {}
+    }
+}
+
+/* SIGTERM during a long EXEC: it finishes and is answered, new connections
+ * are refused, and silcd exits 0. */
+static void test_sigterm_drains(void)
+{
+    test_server srv;
+    const char *opts[] = {"--log-level", "error", NULL};
+    long_exec L;
+    pthread_t th;
+    silc_context *idle;
+    int status, i;
+    if (server_start(&srv, NULL, opts)) {
+        CHECK(0, "silcd did not start");
+        return;
+    }
+    idle = open_client(srv.url);
+    memset(&L, 0, sizeof L);
+    L.url = srv.url;
+    L.text = long_text;
+    pthread_create(&th, NULL, run_long, &L);
+    await_children(srv.pid, 2, 3000);
+    sleep_ms(200);
+    kill(srv.pid, SIGTERM);
+    sleep_ms(100);
+    CHECK(raw_connect(srv.url) < 0, "a new connection accepted after SIGTERM");
+    CHECK(!L.done, "the long EXEC ended before it could have finished");
+    for (i = 0; i < 3000 && waitpid(srv.pid, &status, WNOHANG) != srv.pid; i++) sleep_ms(20);
+    CHECK(i < 3000, "silcd still running 60 s after SIGTERM");
+    pthread_join(th, NULL);
+    CHECK(L.rc == 0, "the EXEC in flight at SIGTERM was not answered: %s", L.err);
+    CHECK(i < 3000 && WIFEXITED(status) && WEXITSTATUS(status) == 0, "silcd's exit after SIGTERM: %d",
+          status);
+    CHECK(silc_exec(idle, "x = 1") != 0, "an idle session survived SIGTERM");
+    silc_close(&idle);
+    {
+        char cmd[400];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", srv.dir);
+        if (system(cmd)) {}
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *plugin_dir = argc > 1 ? argv[1] : CRASH_PLUGIN_DIR;
+    signal(SIGPIPE, SIG_IGN);
+    test_crash(plugin_dir);
+    test_no_queue();
+    test_idle_connections();
+    test_killed_client();
+    test_killed_server();
+    test_sigterm_drains();
+    return check_done();
+}
