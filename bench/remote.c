@@ -14,11 +14,17 @@
  * REPS_SMALL (REPS from 128 MiB) runs, raw, PUT and GET taking turns.  PUT time runs from the call to the server's OK (the server
  * allocates the value and receives into it); GET time from the call to the
  * filled envelope (the client allocates it).  Latency is "a = 1" through
- * silc_exec, 20000 times after 1000 warm-up calls.  Not run by the test suite.
+ * silc_exec, 20000 times after 1000 warm-up calls.  Concurrency: one session
+ * alone solves a dense system sized to take about a second, then two sessions
+ * solve it at once (each silcd session is a process of its own; before issue
+ * 14 they queued behind one lock, which would make the pair take twice as
+ * long); and a tiny EXEC's round trip is timed while another session runs a
+ * solve of about five seconds.  Not run by the test suite.
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE 1 /* madvise */
 #include <arpa/inet.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <pthread.h>
@@ -175,6 +181,96 @@ static void latency(const char *label, silc_context *c)
     printf("| %-28s | %8.1f | %8.1f |\n", label, 1e6 * t[N / 2], 1e6 * t[N * 99 / 100]);
 }
 
+/* ---- concurrency ----------------------------------------------------------- */
+typedef struct solve_job {
+    const char *url;
+    int n;
+    double seconds;   /* the solve alone, measured in the session; < 0 on failure */
+} solve_job;
+
+/* One session: A = rand(n) + n I (well conditioned), then x = A \ b timed. */
+static void *solve_session(void *p)
+{
+    solve_job *j = p;
+    silc_context *c = NULL;
+    char text[160];
+    double t0;
+    j->seconds = -1;
+    if (silc_open_remote(&c, j->url)) return NULL;
+    snprintf(text, sizeof text, "A = rand(%d) + %d * dense(eye(%d)); b = ones(%d, 1); w = A[1:50, 1:50] \\ b[1:50]",
+             j->n, j->n, j->n, j->n);
+    if (silc_exec(c, text) == 0) {
+        t0 = now();
+        if (silc_exec(c, "x = A \\ b") == 0) j->seconds = now() - t0;
+    }
+    if (j->seconds < 0) fprintf(stderr, "solve session: %s\n", silc_context_errmsg(c));
+    silc_close(&c);
+    return NULL;
+}
+
+static double solve_alone(const char *url, int n)
+{
+    solve_job j = {url, n, 0};
+    solve_session(&j);
+    return j.seconds;
+}
+
+static void concurrency(const char *url)
+{
+    enum { N = 2000 };
+    static double t[N];
+    solve_job jobs[2];
+    pthread_t th[2];
+    silc_context *c = NULL;
+    double t1, t0, wall;
+    int n = 1200, i, k, count;
+    /* n for a solve of about a second (LU: time ~ n^3). */
+    t1 = solve_alone(url, n);
+    if (t1 <= 0) return;
+    n = (int)(n * cbrt(1.0 / t1));
+    t1 = solve_alone(url, n);
+    printf("\nConcurrency: dense LU of n = %d (about 1 s) per session, OPENBLAS_NUM_THREADS=1\n\n", n);
+    printf("| sessions at once | wall (s) | one alone (s) | wall / alone | queued behind one lock would be |\n");
+    printf("|-----------------:|---------:|--------------:|-------------:|--------------------------------:|\n");
+    for (k = 0; k < 2; k++) {
+        jobs[k].url = url;
+        jobs[k].n = n;
+    }
+    t0 = now();
+    for (k = 0; k < 2; k++) pthread_create(&th[k], NULL, solve_session, &jobs[k]);
+    for (k = 0; k < 2; k++) pthread_join(th[k], NULL);
+    wall = now() - t0;
+    printf("| %16d | %8.3f | %13.3f | %12.2f | %30.2fx |\n", 1, t1, t1, 1.0, 1.0);
+    /* wall includes each session's set-up (rand, a small solve); the pair's
+     * own solves are in jobs[].seconds. */
+    printf("| %16d | %8.3f | %13.3f | %12.2f | %30.2fx |\n", 2,
+           jobs[0].seconds > jobs[1].seconds ? jobs[0].seconds : jobs[1].seconds, t1,
+           (jobs[0].seconds > jobs[1].seconds ? jobs[0].seconds : jobs[1].seconds) / t1, 2.0);
+    printf("(two sessions from connect to close: %.3f s)\n", wall);
+
+    /* A tiny EXEC of one session while another solves for about 5 s. */
+    jobs[0].n = (int)(n * cbrt(5.0));
+    if (silc_open_remote(&c, url)) return;
+    for (i = 0; i < 200; i++) silc_exec(c, "a = 1");
+    pthread_create(&th[0], NULL, solve_session, &jobs[0]);
+    sleep(1);   /* past the session's set-up: into the solve */
+    for (count = 0; count < N; count++) {
+        t0 = now();
+        if (silc_exec(c, "a = 1")) break;
+        t[count] = now() - t0;
+        usleep(1000);
+    }
+    pthread_join(th[0], NULL);
+    silc_close(&c);
+    qsort(t, (size_t)count, sizeof *t, cmp_double);
+    printf("\nTiny EXEC (\"a = 1\") of one session while another runs x = A \\ b, n = %d (%.2f s)\n\n",
+           jobs[0].n, jobs[0].seconds);
+    printf("| calls | median (us) | p99 (us) | max (us) |\n|------:|------------:|---------:|---------:|\n");
+    if (count > 0)
+        printf("| %5d | %11.1f | %8.1f | %8.1f |\n", count, 1e6 * t[count / 2], 1e6 * t[count * 99 / 100],
+               1e6 * t[count - 1]);
+}
+
 static double diffusion(const char *server, int64_t n, int steps)
 {
     double *u = malloc((size_t)(n * n) * sizeof *u), t0, t;
@@ -293,6 +389,7 @@ int main(int argc, char **argv)
     latency("unix socket", cu);
     silc_close(&c);
     silc_close(&cu);
+    concurrency(unix_url);
 
     printf("\n2-D diffusion, Crank-Nicolson on an n x n grid (A \\ (B * u) per step)\n\n");
     printf("| grid | steps | embedded (s) | remote tcp (s) | remote/embedded |\n");
