@@ -22,6 +22,7 @@
 #include <strings.h>
 
 #include "envelope.h"
+#include "value.h"
 
 enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN };
 enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW };
@@ -160,6 +161,26 @@ static int mm_banner(mm_reader *r, int *is_array, int *field, int *sym)
     else return mm_fail(r, 1, "unknown symmetry '%s' (expected general, symmetric or skew-symmetric)", w[4]);
     if (*is_array && *field == MM_PATTERN) return mm_fail(r, 1, "an array file cannot have field 'pattern'");
     return 0;
+}
+
+/* What the size line claims, checked before anything is allocated: the
+ * value and, for coordinate files, the triplets read before assembly (four
+ * 8-byte arrays of up to 2 nz entries for symmetric files, and the
+ * assembly's own copies). */
+static int mm_claim(int is_array, int64_t m, int64_t n, int64_t nz, int sym)
+{
+    char what[160];
+    double cap = sym == MM_GENERAL ? (double)nz : 2.0 * (double)nz, bytes;
+    if (is_array) {
+        bytes = (double)m * (double)n * 8;
+        snprintf(what, sizeof what, "the %lldx%lld array the size line announces", (long long)m,
+                 (long long)n);
+    } else {
+        bytes = ((double)m + 1) * 24 + ((double)n + 1) * 8 + cap * (32 + 32);
+        snprintf(what, sizeof what, "the %lldx%lld matrix of %lld entries the size line announces",
+                 (long long)m, (long long)n, (long long)nz);
+    }
+    return val_claim(bytes, what);
 }
 
 /* Reads the array body (column-major; symmetric files hold the lower
@@ -346,9 +367,8 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
         else if (parse_index(&p, &m) || parse_index(&p, &n) || (!is_array && parse_index(&p, &nz)) ||
                  !only_space(p) || m < 0 || n < 0 || nz < 0)
             rc = mm_fail(&r, r.lineno, "expected the size line '%s'", is_array ? "rows cols" : "rows cols entries");
-        else if (m > INT32_MAX * 64LL || n > INT32_MAX * 64LL || nz > INT32_MAX * 64LL ||
-                 (is_array && m > 0 && n > (INT64_MAX / 16) / m))
-            rc = mm_fail(&r, r.lineno, "sizes too large");
+        else if (mm_claim(is_array, m, n, nz, sym))
+            rc = mm_fail(&r, r.lineno, "%s", val_refusal());
         else if (is_array)
             rc = mm_read_array(&r, e, m, n, sym);
         else

@@ -92,21 +92,31 @@ const char *val_refusal(void)
     return refusal;
 }
 
-/* 0 if a value of this format, shape and byte count may be made; else -1
- * with the reason in refusal.  bytes is a double: a claimed size may not fit
- * in 64 bits (sparse(1, 1, 1, 1e10, 1e10) asks for 80 GB of row pointers;
- * zeros(1e10) for 8e20 bytes). */
-static int size_allowed(int format, int64_t m, int64_t n, double bytes)
+int val_claim(double bytes, const char *what)
 {
     char over[200];
     double limit = (double)val_max_bytes();
     refusal[0] = '\0';
     if (bytes <= limit) return 0;
     util_fmt_over_limit(over, sizeof over, bytes, limit);
-    snprintf(refusal, sizeof refusal, "a %lldx%lld %s value needs %s: the most one value may "
-             "hold (%s)", (long long)m, (long long)n, val_format_name(format), over,
+    snprintf(refusal, sizeof refusal, "%s needs %s: the most one value may hold (%s)", what, over,
              max_value_source);
     return -1;
+}
+
+/* val_claim for a value of this format and shape.  bytes is a double: a
+ * claimed size may not fit in 64 bits (sparse(1, 1, 1, 1e10, 1e10) asks
+ * for 80 GB of row pointers; zeros(1e10) for 8e20 bytes). */
+static int size_allowed(int format, int64_t m, int64_t n, double bytes)
+{
+    char what[96];
+    if (bytes <= (double)val_max_bytes()) {
+        refusal[0] = '\0';
+        return 0;
+    }
+    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
+             val_format_name(format));
+    return val_claim(bytes, what);
 }
 
 static silc_value *val_alloc(int64_t m, int64_t n, int format)

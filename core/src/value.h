@@ -84,6 +84,10 @@ uint64_t val_max_bytes(void);
  * by ..."), or "" if it was malloc: callers report it instead of "out of
  * memory" (eng_oom). */
 const char *val_refusal(void);
+/* 0 if bytes fit the limit; else -1 and val_refusal() says "<what> needs N
+ * bytes (..), over the limit of .. by ..: the most one value may hold (..)".
+ * For sizes claimed before any value exists (a Matrix Market size line). */
+int val_claim(double bytes, const char *what);
 void val_array_free(void *p);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
