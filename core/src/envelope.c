@@ -62,6 +62,9 @@ int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *
     count = dense_count(m, n);
     if (count < 0)
         return env_error("silc_envelope_dense: invalid size %lldx%lld", (long long)m, (long long)n);
+    if (val_claim((double)count * sizeof(double), "the envelope"))
+        return env_error("silc_envelope_dense: %lldx%lld: %s", (long long)m, (long long)n,
+                         val_refusal());
     e->values = copy_array(colmajor, count, sizeof(double));
     if (!e->values) return env_error("silc_envelope_dense: out of memory for %lldx%lld",
                                      (long long)m, (long long)n);
@@ -308,6 +311,9 @@ int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int
     if (m < 0 || count < 0)
         return env_error("silc_envelope_band: invalid size %lldx%lld with kl = %lld, ku = %lld",
                          (long long)m, (long long)n, (long long)kl, (long long)ku);
+    if (val_claim((double)count * sizeof(double), "the envelope"))
+        return env_error("silc_envelope_band: %lldx%lld with kl = %lld, ku = %lld: %s",
+                         (long long)m, (long long)n, (long long)kl, (long long)ku, val_refusal());
     e->values = copy_array(band, count, sizeof(double));
     if (!e->values) return env_error("silc_envelope_band: out of memory");
     e->m = m;
