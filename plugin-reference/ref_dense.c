@@ -391,7 +391,13 @@ int ref_dense_qr(int64_t m, int64_t n, const double *A, ref_factor *F, char *msg
         for (int64_t i = 0; i <= j; i++) s += fabs(a[i + j * rows]);
         rn = fmax(rn, s);
     }
-    F->cond = f->rank ? ref_cond_from(rn, ref_inv_norm1_est(f->rank, r11_apply, f, NULL)) : INFINITY;
+    double est = f->rank ? ref_inv_norm1_est(f->rank, r11_apply, f, NULL) : 0.0;
+    if (est < 0) { /* out of memory: without the estimate no warning of a singular matrix */
+        dense_qr_free(f);
+        F->data = NULL;
+        return SILC_ENOMEM;
+    }
+    F->cond = f->rank ? ref_cond_from(rn, est) : INFINITY;
     if (f->rank < cols && F->cond >= 0) F->cond = INFINITY;
     (void)msg;
     (void)msglen;

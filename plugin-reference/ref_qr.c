@@ -291,16 +291,22 @@ int ref_sparse_qr(const ref_sp *A, ref_factor *F, char *msg, size_t msglen)
              f->under ? ", minimum norm" : "");
     if (f->nk < N)
         snprintf(F->note, sizeof F->note, "rank deficient: rank %lld of %lld", (long long)f->nk, (long long)N);
-    double rn = 0.0, *rs = ref_calloc((size_t)f->nk + 1, sizeof(double));
-    if (rs) { /* ||R||_1 = largest column sum of R = largest row sum of L */
-        for (int64_t j = 0; j < f->nk; j++)
-            for (int64_t p = f->L.p[j]; p < f->L.p[j + 1]; p++) rs[f->L.i[p]] += fabs(f->L.x[p]);
-        for (int64_t j = 0; j < f->nk; j++) rn = fmax(rn, rs[j]);
-        ref_free(rs);
-    }
-    F->cond = ref_cond_from(rn, ref_inv_norm1_est(f->nk, r_apply, f, NULL));
+    /* Out of memory here fails the factorization: without ||R||_1 the
+     * estimate would say "singular", without the estimate no warning. */
+    double rn = 0.0, est, *rs = ref_calloc((size_t)f->nk + 1, sizeof(double));
+    if (!rs) goto fail_factored;
+    /* ||R||_1 = largest column sum of R = largest row sum of L */
+    for (int64_t j = 0; j < f->nk; j++)
+        for (int64_t p = f->L.p[j]; p < f->L.p[j + 1]; p++) rs[f->L.i[p]] += fabs(f->L.x[p]);
+    for (int64_t j = 0; j < f->nk; j++) rn = fmax(rn, rs[j]);
+    ref_free(rs);
+    if ((est = ref_inv_norm1_est(f->nk, r_apply, f, NULL)) < 0) goto fail_factored;
+    F->cond = ref_cond_from(rn, est);
     if (f->nk < N && F->cond >= 0) F->cond = INFINITY;
     return 0;
+fail_factored:
+    F->data = NULL;
+    st = SILC_ENOMEM;
 fail:
     ref_sp_free(&At);
     ref_free(keep);

@@ -208,12 +208,19 @@ int ref_op_solve(silc_call *call)
         }
         if (F->cond == 0.0) { /* square factor: ||A||_1 * est ||A^{-1}||_1 */
             double *w = ref_alloc((size_t)(F->work_len + a.n + 1), sizeof(double));
-            if (w) {
-                F->cond = ref_cond_from(P->norm1, ref_inv_norm1_est(a.n, F->solve, F->data, w));
-                ref_free(w);
-            } else {
-                F->cond = -1.0;
+            if (!w) { /* no estimate would mean no warning of an ill-conditioned matrix */
+                ref_factor_free(F);
+                return ref_nomem(call);
             }
+            /* The estimator fails only when it runs out of memory (it applies
+             * the solve of this factor, which does not fail). */
+            double est = ref_inv_norm1_est(a.n, F->solve, F->data, w);
+            ref_free(w);
+            if (est < 0) {
+                ref_factor_free(F);
+                return ref_nomem(call);
+            }
+            F->cond = ref_cond_from(P->norm1, est);
         }
         F->rcond = F->cond > 0 ? 1.0 / F->cond : (F->cond == 0.0 ? INFINITY : -1.0);
         if (isinf(F->cond)) F->rcond = 0.0;

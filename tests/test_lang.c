@@ -15,6 +15,7 @@
  *   D = diag(2, 4, 8) (dense)         L = [2 0 0; 1 1 0; 0 1 4] (dense)
  */
 #include "check.h"
+#include "lang_fixture.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -400,6 +401,9 @@ static const lang_case cases[] = {
     ERR("x = A[13]", "index 13 is out of range for 'A' (3x4)"),
     ERR("x = v[1:5]", "index 4 is out of range for 'v' (3x1)"),
     ERR("x = v[1:1000000000000]", "index 4 is out of range for 'v' (3x1)"),
+    /* fuzz_lang: a range whose count does not fit 64 bits (was undefined behaviour) */
+    ERR("x = v[1:1e84]", "index 4 is out of range for 'v' (3x1)"),
+    ERR("x = v[-1e300:1e300]", "index -1e+300 is out of range for 'v' (3x1)"),
     ERR("x = v[end + 1]", "index 4 is out of range for 'v' (3x1)"),
     ERR("x = band(S, 0, 0)", "band(S, 0, 0): entry (1,2) lies outside the band"),
     ERR("x = band(A, 1, 1)", "band(A, 1, 1): entry (1,3) lies outside the band"),
@@ -445,46 +449,14 @@ static const lang_case cases[] = {
 
 /* ---- fixtures --------------------------------------------------------------- */
 
-static void put_dense(silc_context *c, const char *name, int64_t m, int64_t n, const double *x)
-{
-    silc_envelope_t e;
-    silc_envelope_dense(&e, m, n, x);
-    CHECK(silc_put(c, name, &e) == 0, "put %s: %s", name, silc_context_errmsg(c));
-    silc_envelope_free(&e);
-}
-
 static silc_context *fixture(void)
 {
-    static const double v[] = {1, 2, 3}, w[] = {4, 5, 6}, idx[] = {1, 3}, s = 5;
-    static const double M[] = {1, 3, 2, 4};
-    static const double A[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
-    static const double D[] = {2, 0, 0, 0, 4, 0, 0, 0, 8};
-    static const double L[] = {2, 1, 0, 0, 1, 1, 0, 0, 4};
-    static const int64_t Sp[] = {0, 2, 5, 7}, Si[] = {0, 1, 0, 1, 2, 1, 2};
-    static const double Sv[] = {4, 1, 1, 4, 1, 1, 4};
-    /* band storage, ld = 3: rows are superdiagonal, diagonal, subdiagonal */
-    static const double Bb[] = {0, 2, -1, -1, 2, -1, -1, 2, 0};
     silc_context *c = NULL;
-    silc_envelope_t e;
     if (silc_open(&c, NULL)) {
         CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
         return NULL;
     }
-    put_dense(c, "v", 3, 1, v);
-    put_dense(c, "w", 3, 1, w);
-    put_dense(c, "r", 1, 3, v);
-    put_dense(c, "idx", 2, 1, idx);
-    put_dense(c, "s", 1, 1, &s);
-    put_dense(c, "M", 2, 2, M);
-    put_dense(c, "A", 3, 4, A);
-    put_dense(c, "D", 3, 3, D);
-    put_dense(c, "L", 3, 3, L);
-    silc_envelope_csr(&e, 3, 3, Sp, Si, Sv);
-    CHECK(silc_put(c, "S", &e) == 0, "put S: %s", silc_context_errmsg(c));
-    silc_envelope_free(&e);
-    silc_envelope_band(&e, 3, 3, 1, 1, Bb);
-    CHECK(silc_put(c, "B", &e) == 0, "put B: %s", silc_context_errmsg(c));
-    silc_envelope_free(&e);
+    CHECK(lang_fixture_put(c) == 0, "fixture: %s", silc_context_errmsg(c));
     return c;
 }
 
@@ -687,7 +659,7 @@ static void test_symmetry_detection(void)
     size_t k;
     if (!c) return;
     silc_set_output(c, capture, NULL);
-    put_dense(c, "b3", 3, 1, b);
+    CHECK(lang_fixture_dense(c, "b3", 3, 1, b) == 0, "put b3: %s", silc_context_errmsg(c));
     for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         silc_envelope_t e;
         int64_t nnz = cases[k].rp[3];

@@ -116,6 +116,14 @@ static const row rows[] = {
     LANG("x = dense(eye(1e7))", "reference: a 10000000x10000000 dense value needs 800000000000000 bytes "
          "(727.6 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "
          "(the machine's memory)"),
+    /* a work array is held to the same limit (fuzz_lang: calloc'd 4.4 TiB before) */
+    LANG("x = max(eye(2, 61e10))", "reference: a plugin's work array needs 4880000000008 bytes "
+         "(4.4 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "
+         "(the machine's memory)"),
+    /* and so are subscripts' index lists (fuzz_lang: malloc'd 4.4 TiB before) */
+    LANG("x = (eye(2, 61e10))[1, :]", "the subscript's index list needs 4880000000000 bytes "
+         "(4.4 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "
+         "(the machine's memory)"),
     LANG("x = rand(-3)", "rand: argument 1 must be an integer >= 0, got -3"),
     LANG("x = norm(v, 3)", "norm: p must be 1, 2, inf or \"fro\""),
     LANG("x = band(M, -1, 0)", "band: argument 2 must be an integer >= 0, got -1"),

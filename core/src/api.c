@@ -98,6 +98,7 @@ const silc_value *api_lookup(silc_engine *E, const char *name, char *err, size_t
 int api_exec(silc_engine *E, const char *statements, char *err, size_t errlen)
 {
     E->warnings.len = 0;
+    E->warnings.failed = 0;
     if (E->warnings.s) E->warnings.s[0] = '\0';
     if (lang_exec(E, statements) == 0) return 0;
     snprintf(err, errlen, "%s", E->err[0] ? E->err : "statement failed");

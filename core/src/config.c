@@ -238,8 +238,8 @@ static int check_backend_list(silc_engine *E, const char *key, const char *value
         if (!backend_known(E, name)) return unknown_backend(E, name, key);
         if (++count > CFG_MAX_LIST)
             return eng_error(E, "%s: more than %d backends listed", key, CFG_MAX_LIST);
-        if (count > 1) sb_puts(norm, ", ");
-        sb_puts(norm, name);
+        if ((count > 1 && sb_puts(norm, ", ")) || sb_puts(norm, name))
+            return eng_error(E, "out of memory setting '%s'", key);
         if (!comma) break;
         p = comma + 1;
     }
@@ -302,6 +302,15 @@ static int check_option(silc_engine *E, const silc_plugin *pl, const char *name,
     return 0;
 }
 
+/* value as the one to store (norm), or "out of memory" (a short value
+ * stored silently would be another setting). */
+static int keep_value(silc_engine *E, strbuf *norm, const char *section, const char *name,
+                      const char *value)
+{
+    if (sb_puts(norm, value) == 0) return 0;
+    return eng_error(E, "out of memory setting '%s%s%s'", section, section[0] ? "." : "", name);
+}
+
 /* Validates section.name = value; on success norm holds the value to store. */
 static int check_key(silc_engine *E, int scope, const char *section, const char *name,
                      const char *value, strbuf *norm)
@@ -314,7 +323,7 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
                 return eng_error(E, "'backend' forces a backend for one call only; use "
                                     "dispatch.<class> to change the default");
             if (!backend_known(E, value)) return unknown_backend(E, value, "option 'backend'");
-            return sb_puts(norm, value);
+            return keep_value(E, norm, section, name, value);
         }
         return eng_error(E, "key '%s' has no section (write section.key, e.g. tune.threads)",
                          name);
@@ -349,7 +358,7 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         } else if (strcmp(name, "wisdom") != 0) {
             return unknown_key(E, section, name, tune_keys, 4);
         }
-        return sb_puts(norm, value);
+        return keep_value(E, norm, section, name, value);
     }
     if (strcmp(section, "core") == 0) {
         if (strcmp(name, "threads") == 0) {
@@ -357,7 +366,7 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         } else if (strcmp(name, "plugin_path") != 0) {
             return unknown_key(E, section, name, core_keys, 2);
         }
-        return sb_puts(norm, value);
+        return keep_value(E, norm, section, name, value);
     }
     if (strcmp(section, "solve") == 0) {
         int64_t steps;
@@ -377,14 +386,14 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         } else {
             return unknown_key(E, section, name, solve_keys, 3);
         }
-        return sb_puts(norm, value);
+        return keep_value(E, norm, section, name, value);
     }
     pl = ld_find_plugin(E, section);
     if (pl) {
         if (check_option(E, pl->table, name, value)) return -1;
-        return sb_puts(norm, value);
+        return keep_value(E, norm, section, name, value);
     }
-    if (plugin_known(section)) return sb_puts(norm, value);
+    if (plugin_known(section)) return keep_value(E, norm, section, name, value);
     return unknown_section(E, section);
 }
 
@@ -459,11 +468,10 @@ static int set_parts(silc_engine *E, int scope, const char *section, const char 
     sb_init(&norm);
     sb_init(&key);
     rc = check_key(E, scope, section, name, value, &norm);
-    if (rc == 0) {
-        if (section[0]) sb_printf(&key, "%s.%s", section, name);
-        else sb_puts(&key, name);
+    if (rc == 0 && (section[0] ? sb_printf(&key, "%s.%s", section, name) : sb_puts(&key, name)))
+        rc = eng_error(E, "out of memory setting '%s%s%s'", section, section[0] ? "." : "", name);
+    else if (rc == 0)
         rc = store_value(E, scope, sb_str(&key), sb_str(&norm));
-    }
     if (rc == 0 && strcmp(section, "core") == 0 && strcmp(name, "plugin_path") == 0)
         rc = ld_load_path(E, value);
     sb_free(&norm);

@@ -224,8 +224,9 @@ static const char *status_text(int status)
 /* ---- the accuracy report --------------------------------------------------- */
 
 /* Completes the report of a solve that succeeded and warns about a result that
- * deserves distrust. */
-static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
+ * deserves distrust.  -1 when the backward error could not be computed (out
+ * of memory): a result returned without it could hide an unsolved system. */
+static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
 {
     silc_report *r = call->report;
     double eps_cond;
@@ -243,8 +244,11 @@ static void finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, i
         eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
                  r->cond_est);
     acc_report(E, call, may_defer);
+    if (r->backward_error < 0 && r->backward_error != ACC_DEFERRED)
+        return eng_error(E, "out of memory computing the backward error of '\\'");
     if (val_has_nonfinite(call->out))
         eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
+    return 0;
 }
 
 /* ---- running --------------------------------------------------------------- */
@@ -313,9 +317,14 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report. */
                 if (call->op == SILC_OP_SOLVE) refine_solve(E, call, b);
-                if (call->op == SILC_OP_SOLVE) finish_solve(E, call, cholesky_failed, may_defer);
+                rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, may_defer);
                 call->host_private = NULL;
                 sb_free(&skipped);
+                if (rc) {
+                    val_release(call->out);
+                    call->out = NULL;
+                    return SILC_ENOMEM;
+                }
                 return 0;
             }
             if (rc == SILC_ENOTSPD && ci + 1 < nchain) {
@@ -351,6 +360,19 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
     return SILC_EUNSUP;
 }
 
+/* 1 when classify asked whether a solve's A is symmetric and could not tell
+ * (out of memory), so chose a general class: going on with a general method
+ * instead of Cholesky would give other bits, or another explanation, than
+ * with memory to spare.  (With a `why`, classify asks twice, and the second
+ * time may have found A symmetric after all.) */
+static int symmetry_unknown(const silc_call *call, const char *const chain[4])
+{
+    const silc_value *A = call->in[0];
+    return call->op == SILC_OP_SOLVE && A->props.pos_diag &&
+           (!(A->props_have & SILC_PROPS_SYMMETRY) || A->props.symmetric) &&
+           !strcmp(chain[0], A->format == SILC_FMT_CSR ? "solve.sparse" : "solve.dense");
+}
+
 int disp_run(silc_engine *E, silc_call *call)
 {
     const char *chain[4];
@@ -368,6 +390,9 @@ int disp_run(silc_engine *E, silc_call *call)
     } else if (call->op == SILC_OP_SOLVE && (call->nin < 2 || !call->in[1])) {
         eng_error(E, "solve needs a right-hand side");
         rc = SILC_EARG;
+    } else if (symmetry_unknown(call, chain)) {
+        eng_error(E, "out of memory classifying the matrix of '\\'");
+        rc = SILC_ENOMEM;
     } else if (call->op == SILC_OP_SOLVE &&
                (refine_check_finite(E, call->in[0], 1, "the matrix") ||
                 refine_check_finite(E, call->in[1], 0, "the right-hand side"))) {
@@ -412,6 +437,10 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     if (n == 0) {
         if (call->options) cfg_clear_call_options(E);
         return eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
+    }
+    if (symmetry_unknown(call, chain)) {
+        if (call->options) cfg_clear_call_options(E);
+        return eng_error(E, "out of memory classifying the matrix of '\\'");
     }
     resolve_list(E, chain, n, &L);
     sb_printf(b, "%s\n", why);

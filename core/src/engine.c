@@ -154,34 +154,54 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     sb_puts(&E->warnings, "\n");
 }
 
-int eng_info_set(silc_engine *E, const char *name, eng_info *info)
+/* The record of name, made (empty) when absent; NULL when out of memory. */
+static eng_info_entry *info_entry(silc_engine *E, const char *name)
 {
     eng_info_entry *e;
-    char *stmt = NULL;
+    for (e = E->infos; e; e = e->next)
+        if (strcmp(e->name, name) == 0) return e;
+    e = calloc(1, sizeof *e);
+    if (!e || !(e->name = util_strdup(name))) {
+        free(e);
+        return NULL;
+    }
+    e->next = E->infos;
+    E->infos = e;
+    return e;
+}
+
+int eng_info_reserve(silc_engine *E, const char *name)
+{
+    if (!E || !name) return -1;
+    if (!info_entry(E, name)) return eng_error(E, "out of memory recording info for '%s'", name);
+    return 0;
+}
+
+int eng_info_take(silc_engine *E, const char *name, eng_info *info)
+{
+    eng_info_entry *e;
     if (!E || !name || !info) return -1;
-    if (info->statement && !(stmt = util_strdup(info->statement))) {
+    if (!(e = info_entry(E, name))) {
+        free(info->statement);
         acc_pending_release(&info->pending);
         return eng_error(E, "out of memory recording info for '%s'", name);
     }
-    for (e = E->infos; e; e = e->next)
-        if (strcmp(e->name, name) == 0) break;
-    if (!e) {
-        e = calloc(1, sizeof *e);
-        if (!e || !(e->name = util_strdup(name))) {
-            free(e);
-            free(stmt);
-            acc_pending_release(&info->pending);
-            return eng_error(E, "out of memory recording info for '%s'", name);
-        }
-        e->next = E->infos;
-        E->infos = e;
-    } else {
-        free(e->info.statement);
-        acc_pending_release(&e->info.pending);
-    }
+    free(e->info.statement);
+    acc_pending_release(&e->info.pending);
     e->info = *info;
-    e->info.statement = stmt;
     return 0;
+}
+
+int eng_info_set(silc_engine *E, const char *name, eng_info *info)
+{
+    eng_info copy;
+    if (!E || !name || !info) return -1;
+    copy = *info;
+    if (info->statement && !(copy.statement = util_strdup(info->statement))) {
+        acc_pending_release(&info->pending);
+        return eng_error(E, "out of memory recording info for '%s'", name);
+    }
+    return eng_info_take(E, name, &copy);
 }
 
 eng_info *eng_info_get(const silc_engine *E, const char *name)

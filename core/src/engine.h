@@ -62,6 +62,9 @@ struct silc_engine {
     int accuracy_defer;                 /* solves may defer their backward error
                                            (accuracy.h); set by the evaluator */
     uint64_t rand_state;                /* rand() seed state */
+    uint64_t loop_budget;               /* most `while` iterations one exec may run, 0 =
+                                           unlimited (the default): an internal guard that
+                                           the fuzzers set so `while 1 {}` ends; no option */
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
@@ -90,6 +93,12 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     ;
 /* Copies info; takes over its pending references (also on failure). */
 int eng_info_set(silc_engine *E, const char *name, eng_info *info);
+/* As eng_info_set, but takes over info->statement (malloc'd) too; allocates
+ * nothing when name already has a record (see eng_info_reserve). */
+int eng_info_take(silc_engine *E, const char *name, eng_info *info);
+/* Makes sure name has a record, so that the next eng_info_take of name
+ * cannot fail: for a change that cannot be undone (an update in place). */
+int eng_info_reserve(silc_engine *E, const char *name);
 eng_info *eng_info_get(const silc_engine *E, const char *name);
 void eng_info_remove(silc_engine *E, const char *name);
 

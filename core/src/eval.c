@@ -168,8 +168,13 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         sb_puts(V->explain_out, "\n");
         sb_init(&d);
         rc = disp_explain(E, call, &d);
+        if (rc && strstr(E->err, "out of memory")) { /* not a reason to show, a failure */
+            sb_free(&d);
+            return -1;
+        }
         if (!rc) tuner_explain(E, call, &d);
         indent_into(V->explain_out, rc ? E->err : sb_str(&d));
+        if (d.failed) V->explain_out->failed = 1;   /* explain says out of memory */
         sb_free(&d);
         if (call->op == SILC_OP_SOLVE) {
             /* explain runs no solve: later steps see a placeholder of the right shape */
@@ -223,10 +228,11 @@ static int undefined_name(lang_ev *V, const char *name)
     size_t n = store_names(&V->E->store, &names), nb = 0, i;
     const char *best;
     while (bi_names[nb]) nb++;
-    cands = malloc((n + nb + 1) * sizeof *cands);
+    cands = (n || !V->E->store.count) ? malloc((n + nb + 1) * sizeof *cands) : NULL;
     if (!cands) {
+        /* no suggestion: say why there is none */
         free(names);
-        return eng_error(V->E, "undefined name '%s'", name);
+        return eng_error(V->E, "undefined name '%s' (out of memory looking for a similar name)", name);
     }
     for (i = 0; i < n; i++) cands[i] = names[i];
     for (i = 0; i < nb; i++) cands[n + i] = bi_names[i];
@@ -604,20 +610,50 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
         val_release(v);
         return 0;
     }
-    rc = store_set(&V->E->store, name, v);
-    val_release(v);
-    if (rc) return eng_error(V->E, "out of memory binding '%s'", name);
+    /* The record `info` shows is made first, so that running out of memory
+     * leaves neither a binding without its record nor a record without
+     * its binding: rebinding a name never allocates, and a new name has no
+     * record to restore.  (An update in place made both beforehand,
+     * bind_reserve, since it cannot be undone.) */
+    if (V->E->warnings.failed) {   /* a result without its warning would be trusted */
+        val_release(v);
+        return eng_error(V->E, "out of memory recording a warning of '%s'", name);
+    }
     memset(&info, 0, sizeof info);
-    info.statement = stmt_text(V, stmt);
+    info.statement = V->bind_text ? V->bind_text : stmt_text(V, stmt);
+    V->bind_text = NULL;
+    if (!info.statement) {
+        val_release(v);
+        return eng_error(V->E, "out of memory binding '%s'", name);
+    }
     info.has_solve = V->has_solve;
     if (V->has_solve) info.report = V->report;
     info.pending = V->pending; /* handed over */
     memset(&V->pending, 0, sizeof V->pending);
     info.seconds = util_now() - t0;
     snprintf(info.backends, sizeof info.backends, "%s", V->backends);
-    eng_info_set(V->E, name, &info);
-    free(info.statement);
+    rc = eng_info_take(V->E, name, &info);
+    if (rc) {
+        val_release(v);
+        return -1;   /* "out of memory recording info for 'x'" */
+    }
+    rc = store_set(&V->E->store, name, v);
+    val_release(v);
+    if (rc) {
+        eng_info_remove(V->E, name);
+        return eng_error(V->E, "out of memory binding '%s'", name);
+    }
     return 0;
+}
+
+/* Makes what bind() allocates for stmt before x changes in place, which
+ * cannot be undone: then running out of memory stops the statement while x
+ * is still as it was. */
+static int bind_reserve(lang_ev *V, const ast_node *stmt)
+{
+    if (!V->bind_text && !(V->bind_text = stmt_text(V, stmt)))
+        return eng_error(V->E, "out of memory binding '%s'", stmt->name);
+    return eng_info_reserve(V->E, stmt->name);
 }
 
 static int opassign_token(int op)
@@ -644,7 +680,8 @@ static int opassign_token(int op)
  * SILC_OP_SCALE then SILC_OP_ADD round it (no contraction to a fused
  * multiply-add: the build targets x86-64 without FMA, and GCC does not
  * contract across statements in ISO C mode).  Returns 1 when done; under
- * explain, 1 when it would be done, after saying so (stmt: the statement). */
+ * explain, 1 when it would be done, after saying so (stmt: the statement);
+ * -1 when out of memory before anything changed. */
 static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r,
                            const silc_value *s, const ast_node *stmt)
 {
@@ -666,6 +703,7 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
                                     "result over its array (no backend, no new array)");
         return 1;
     }
+    if (bind_reserve(V, stmt)) return -1;
     {
         /* r is another value (x += x leaves x shared, so never comes here). */
         double *restrict xv = x->val;
@@ -695,6 +733,7 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
 static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stmt, const ast_node *e,
                           silc_value **out)
 {
+    int rc;
     *out = NULL;
     if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
         const silc_value *k;
@@ -705,19 +744,19 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stm
             return -1;
         }
         k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
-        if (k && update_in_place(V, op, x, k == a ? b : a, k, stmt)) {
+        if (k && (rc = update_in_place(V, op, x, k == a ? b : a, k, stmt)) != 0) {
             val_release(a);
             val_release(b);
-            return 1;
+            return rc;
         }
         if (binary_of(V, e, a, b, out)) return -1;
     } else if (ev_expr(V, e, out)) {
         return -1;
     }
-    if (!update_in_place(V, op, x, *out, NULL, stmt)) return 0;
+    if (!(rc = update_in_place(V, op, x, *out, NULL, stmt))) return 0;
     val_release(*out);
     *out = NULL;
-    return 1;
+    return rc;
 }
 
 /* `x = x + e` and `x = x - e` are the updates `x += e` and `x -= e`: the
@@ -776,6 +815,16 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     return bind(V, s, s->name, v, t0);
 }
 
+/* Prints b and frees it, or, when an append to it ran out of memory, prints
+ * nothing: a listing cut short would pass for a complete one. */
+static int print_whole(silc_engine *E, strbuf *b, const char *what)
+{
+    int failed = b->failed;
+    if (!failed) eng_print(E, sb_str(b));
+    sb_free(b);
+    return failed ? eng_error(E, "out of memory printing the output of %s", what) : 0;
+}
+
 static int exec_who(lang_ev *V)
 {
     const char **names = NULL;
@@ -783,6 +832,7 @@ static int exec_who(lang_ev *V)
     strbuf b;
     char shape[48];
     sb_init(&b);
+    if (n == 0 && V->E->store.count) return eng_error(V->E, "out of memory listing the names");
     if (n == 0) {
         eng_print(V->E, "no variables\n");
         free(names);
@@ -801,10 +851,8 @@ static int exec_who(lang_ev *V)
         sb_printf(&b, "%-*s  %-*s  %-6s  nnz %lld\n", (int)w, names[i], (int)sw, shape,
                   val_format_name(v->format), (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
     }
-    eng_print(V->E, sb_str(&b));
-    sb_free(&b);
     free(names);
-    return 0;
+    return print_whole(V->E, &b, "who");
 }
 
 static void clear_name(silc_engine *E, const char *name)
@@ -851,9 +899,8 @@ static int exec_set(lang_ev *V, const ast_node *s)
         strbuf b;
         sb_init(&b);
         cfg_list(E, &b);
-        eng_print(E, b.len ? sb_str(&b) : "no settings\n");
-        sb_free(&b);
-        return 0;
+        if (!b.len && !b.failed) sb_puts(&b, "no settings\n");
+        return print_whole(E, &b, "set");
     }
     eq = strchr(s->name, '=');
     key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
@@ -864,10 +911,8 @@ static int exec_set(lang_ev *V, const ast_node *s)
         sb_init(&b);
         if (v) sb_printf(&b, "%s = %s\n", key, v);
         else sb_printf(&b, "%s is not set\n", key);
-        eng_print(E, sb_str(&b));
-        sb_free(&b);
         free(key);
-        return 0;
+        return print_whole(E, &b, "set");
     }
     value = trimmed(eq + 1, strlen(eq + 1));
     if (!value) {
@@ -934,9 +979,7 @@ static int exec_info(lang_ev *V, const ast_node *s)
             if (r->note[0]) sb_printf(&b, "  note: %s\n", r->note);
         }
     }
-    eng_print(E, sb_str(&b));
-    sb_free(&b);
-    return 0;
+    return print_whole(E, &b, "info");
 }
 
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
@@ -960,8 +1003,9 @@ static int exec_explain(lang_ev *V, const ast_node *s)
     strbuf b;
     int flow = FLOW_NEXT, rc;
     char *text = stmt_text(V, s->kids[0]);
+    if (!text) return eng_error(V->E, "out of memory printing the output of explain");
     sb_init(&b);
-    sb_printf(&b, "explain: %s\n", text ? text : "");
+    sb_printf(&b, "explain: %s\n", text);
     free(text);
     V->explain = 1;
     V->explain_out = &b;
@@ -969,12 +1013,12 @@ static int exec_explain(lang_ev *V, const ast_node *s)
     rc = exec_stmt(V, s->kids[0], &flow);
     V->explain = 0;
     V->explain_out = NULL;
-    if (!rc) {
-        if (V->explain_step == 0) sb_puts(&b, "  no operation runs: values are built by the core\n");
-        eng_print(V->E, sb_str(&b));
+    if (rc) {
+        sb_free(&b);
+        return rc;
     }
-    sb_free(&b);
-    return rc;
+    if (V->explain_step == 0) sb_puts(&b, "  no operation runs: values are built by the core\n");
+    return print_whole(V->E, &b, "explain");
 }
 
 static int condition(lang_ev *V, const ast_node *c, int *truth)
@@ -1021,6 +1065,7 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
                       val_format_name(v->format));
         }
         val_release(v);
+        if (V->E->warnings.failed) return eng_error(V->E, "out of memory recording a warning");
         return 0;
     }
     case ST_ASSIGN:
@@ -1055,6 +1100,9 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
         for (;;) {
             if (condition(V, s->cond, &truth)) return -1;
             if (!truth) return 0;
+            if (V->E->loop_budget && ++V->loops > V->E->loop_budget)
+                return eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
+                                 (unsigned long long)V->E->loop_budget);
             if (exec_block(V, s->kids[0], flow)) return -1;
             if (*flow == FLOW_BREAK) break;
         }
@@ -1082,6 +1130,7 @@ int lang_exec(silc_engine *E, const char *text)
         E->err[0] = 0;
         if (exec_stmt(&V, prog->stmts[i], &flow)) {
             acc_pending_release(&V.pending);
+            free(V.bind_text);
             if (prog->nstmts > 1) {
                 char msg[sizeof E->err];
                 memcpy(msg, E->err, sizeof msg);
@@ -1091,6 +1140,7 @@ int lang_exec(silc_engine *E, const char *text)
         }
     }
     acc_pending_release(&V.pending);
+    free(V.bind_text);
     tuner_observe(E, text, util_now() - t0);
     return 0;
 }

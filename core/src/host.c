@@ -30,18 +30,32 @@ static int h_threads(void)
     return host_threads_budget;
 }
 
+/* One array a plugin asks for is held to the limit of one value
+ * (val_max_bytes): work arrays grow with their operands' shapes, and a small
+ * but wide operand (eye(2, 1e12): 48 bytes as CSR, 8 TB of column pointers
+ * as CSC) must be refused with its size, which the dispatcher reports (found
+ * by fuzz_lang), not handed to calloc.  Arrays under 64 MiB are not checked:
+ * when the limit is the machine's memory, asking it costs a system call. */
+static int h_too_big(double bytes)
+{
+    return bytes >= (double)(64u << 20) && val_claim(bytes, "a plugin's work array");
+}
+
 static void *h_alloc(size_t bytes)
 {
+    if (h_too_big((double)bytes)) return NULL;
     return malloc(bytes ? bytes : 1);
 }
 
 static void *h_calloc(size_t count, size_t size)
 {
+    if (h_too_big((double)count * (double)size)) return NULL;
     return calloc(count ? count : 1, size ? size : 1);
 }
 
 static void *h_realloc(void *p, size_t bytes)
 {
+    if (h_too_big((double)bytes)) return NULL;
     return realloc(p, bytes ? bytes : 1);
 }
 

@@ -61,6 +61,20 @@ static int range_end(lang_ev *V, const ast_node *n, double *x)
     return 0;
 }
 
+/* The list of count indices of one subscript, held to the limit of one
+ * value: `:` over a wide sparse value (eye(2, 1e12)[1, :]) or a sparse
+ * subscript (S[S]) would otherwise ask malloc for terabytes (found by
+ * fuzz_lang).  NULL with E->err set. */
+static int64_t *ix_alloc(lang_ev *V, int64_t count)
+{
+    int64_t *ix = NULL;
+    if (count < 1) count = 1;
+    if (val_claim((double)count * sizeof *ix, "the subscript's index list") ||
+        !(ix = malloc((size_t)count * sizeof *ix)))
+        oom(V);
+    return ix;
+}
+
 /* Resolves one subscript against a dimension of the given extent. */
 static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *what,
                    const silc_value *base, ix_list *out)
@@ -71,15 +85,16 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *
     out->n = 0;
     V->end_value = extent;
     if (sub->kind == AST_COLON_ALL) {
-        out->ix = malloc((size_t)(extent ? extent : 1) * sizeof *out->ix);
-        if (!out->ix) rc = oom(V);
+        if (!(out->ix = ix_alloc(V, extent))) rc = -1;
         for (k = 0; !rc && k < extent; k++) out->ix[out->n++] = k;
     } else if (sub->kind == AST_RANGE) {
         double a, b, x;
         if (range_end(V, sub->kids[0], &a) || range_end(V, sub->kids[1], &b)) {
             rc = -1;
         } else {
-            int64_t cnt = b >= a ? (int64_t)floor(b - a) + 1 : 0;
+            /* counted as a double: the count of 1:1e84 does not fit int64_t */
+            double span = b >= a ? floor(b - a) + 1 : 0;
+            int64_t cnt = span > (double)extent ? extent + 1 : (int64_t)span;
             if (cnt > extent) {
                 /* some index must be out of range: report the first without
                  * allocating for a range that may be huge */
@@ -89,8 +104,7 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *
                 rc = push_index(V, out, bad, extent, what, base);
                 out->ix = NULL;
             } else {
-                out->ix = malloc((size_t)(cnt ? cnt : 1) * sizeof *out->ix);
-                if (!out->ix) rc = oom(V);
+                if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
                 for (x = a, k = 0; !rc && k < cnt; k++, x += 1.0)
                     rc = push_index(V, out, x, extent, what, base);
             }
@@ -101,8 +115,7 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *
             rc = -1;
         } else {
             int64_t cnt = v->m * v->n;
-            out->ix = malloc((size_t)(cnt ? cnt : 1) * sizeof *out->ix);
-            if (!out->ix) rc = oom(V);
+            if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
             for (k = 0; !rc && k < cnt; k++)
                 rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, what, base);
             val_release(v);
@@ -301,6 +314,8 @@ int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
             return eng_error(V->E, "cannot assign a %s value to %s of %s", s0, s1, what);
         }
     }
+    /* I.n * J.n entries: each list fits (ix_alloc), their product may not */
+    if (val_claim((double)(ne ? ne : 1) * sizeof *e, "the assigned block")) goto nomem;
     e = malloc((size_t)(ne ? ne : 1) * sizeof *e);
     if (!e) goto nomem;
     for (k = 0; k < ne; k++) {

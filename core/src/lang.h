@@ -102,6 +102,8 @@ typedef struct lang_ev {
     silc_report report;    /* its last solve report */
     acc_pending pending;   /* its operands when its backward error is deferred */
     char backends[128];    /* solve backends of the current statement */
+    char *bind_text;       /* the statement's text, made before an update in place */
+    uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

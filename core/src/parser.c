@@ -269,12 +269,13 @@ static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetex
         } else if (is(P, TK_STRING)) {
             const lx_token *tk = next(P);
             item = node_new(P, AST_STRING, tk);
+            if (item && !(item->name = malloc(tk->len - 1))) {
+                node_free(item);   /* a string node without its text would be cached */
+                item = fail(P, tk, "out of memory while parsing");
+            }
             if (item) {
-                item->name = malloc(tk->len - 1);
-                if (item->name) {
-                    memcpy(item->name, P->src + tk->start + 1, tk->len - 2);
-                    item->name[tk->len - 2] = 0;
-                }
+                memcpy(item->name, P->src + tk->start + 1, tk->len - 2);
+                item->name[tk->len - 2] = 0;
             }
         } else {
             item = parse_expr(P);

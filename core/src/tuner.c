@@ -777,7 +777,7 @@ static int trial_backends(silc_engine *E, tuner *T)
 {
     char err[sizeof E->err];
     size_t wlen = E->warnings.len;
-    int i, changed = 0;
+    int i, changed = 0, wfailed = E->warnings.failed;
     memcpy(err, E->err, sizeof err);
     for (i = 0; i < T->ncur; i++) {
         t_class *c = &T->cur[i];
@@ -797,6 +797,7 @@ static int trial_backends(silc_engine *E, tuner *T)
         E->warnings.len = wlen;
         E->warnings.s[wlen] = 0;
     }
+    E->warnings.failed = wfailed;   /* the trials' warnings are dropped, their failures too */
     return changed;
 }
 

@@ -16,6 +16,7 @@ void sb_init(strbuf *b)
 {
     b->s = NULL;
     b->len = b->cap = 0;
+    b->failed = 0;
 }
 
 void sb_free(strbuf *b)
@@ -33,7 +34,10 @@ static int sb_reserve(strbuf *b, size_t extra)
     cap = b->cap ? b->cap : 64;
     while (cap < need) cap *= 2;
     s = realloc(b->s, cap);
-    if (!s) return -1;
+    if (!s) {
+        b->failed = 1;
+        return -1;
+    }
     b->s = s;
     b->cap = cap;
     return 0;

@@ -13,6 +13,7 @@
 typedef struct strbuf {
     char *s;
     size_t len, cap;
+    int failed;   /* an append ran out of memory: the text is incomplete */
 } strbuf;
 
 void sb_init(strbuf *b);

@@ -220,15 +220,8 @@ static void seed_replies(buf *b)
     frame(b, PROTO_ERROR, "undefined name 'u'", 18);
 }
 
-static uint64_t rng = 0x9E3779B97F4A7C15ull;
-
-static uint64_t next(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
-}
+#include "fuzz_rng.h"
+#define next fuzz_next
 
 /* One to eight mutations of the kinds that find length bugs: bit flips,
  * interesting integers over length fields, truncation, chunk copies. */
