@@ -53,8 +53,9 @@ void srv_log(int level, const char *fmt, ...)
 
 /* Serves one accepted connection until BYE, disconnect, idle timeout or
  * shutdown, then closes fd.  Runs in the session's own process; id numbers
- * the session in the log; *state is its slot (above). */
-void srv_session(int fd, unsigned long id, volatile int *state);
+ * the session in the log; *state is its slot (above).  1 if a session was
+ * opened (the handshake completed), else 0. */
+int srv_session(int fd, unsigned long id, volatile int *state);
 
 
 #endif

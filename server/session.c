@@ -510,11 +510,12 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
     return rc;
 }
 
-void srv_session(int fd, unsigned long id, volatile int *state)
+int srv_session(int fd, unsigned long id, volatile int *state)
 {
     session S;
     proto_stream st;
     proto_limits lim;
+    int opened;
     memset(&S, 0, sizeof S);
     S.fd = fd;
     S.id = id;
@@ -522,7 +523,8 @@ void srv_session(int fd, unsigned long id, volatile int *state)
     lim.max_value_bytes = srv_cfg.max_value_bytes;
     lim.max_text_bytes = srv_cfg.max_text_bytes;
     st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
-    if (handshake(&S) == 0) {
+    opened = handshake(&S) == 0;
+    if (opened) {
         *S.state = SLOT_READY;
         srv_log(LOG_INFO, "session %lu: open", id);
         while (await_request(&S) == 0 && serve_one(&S, &st, &lim) == 0) *S.state = SLOT_READY;
@@ -531,4 +533,5 @@ void srv_session(int fd, unsigned long id, volatile int *state)
     free(S.out.p);
     close(fd);
     srv_log(LOG_INFO, "session %lu: closed", id);
+    return opened;
 }

@@ -474,10 +474,12 @@ static void run_child(int lfd, int slot)
     fcntl(shutdown_pipe[1], F_SETFL, O_NONBLOCK);
     srv_shutdown_fd = shutdown_pipe[0];
     sigmask_session_signals(SIG_UNBLOCK);
-    srv_session(fd, conns[slot].id, &conn_state[slot]);
-    /* exit, not _exit: the plugins' shutdown and (in sanitizer builds) the
-     * leak check run as in any process. */
-    exit(0);
+    /* A session that ran ends with exit: the plugins' shutdown and (in
+     * sanitizer builds) the leak check run as in any process.  A connection
+     * that never completed its handshake made no engine, and a flood of them
+     * must not cost a leak scan each: _exit. */
+    if (srv_session(fd, conns[slot].id, &conn_state[slot])) exit(0);
+    _exit(0);
 }
 
 static void start_session(int lfd, int fd, unsigned long id, const char *peer)
@@ -523,6 +525,8 @@ static void reap_children(void)
             if (st == SLOT_HANDSHAKE && sig == SIGALRM) {
                 srv_log(LOG_INFO, "session %lu: no handshake within %g s, closed "
                         "(--handshake-timeout)", conns[i].id, srv_cfg.handshake_timeout_ms / 1000.0);
+            } else if (st == SLOT_HANDSHAKE) {
+                srv_log(LOG_INFO, "session %lu: closed in its handshake (signal %d)", conns[i].id, sig);
             } else {
                 char msg[512], err[128];
                 snprintf(msg, sizeof msg, "session %lu lost: the server process running it died "
@@ -591,8 +595,10 @@ static void drain_sessions(void)
 {
     struct pollfd p[2];
     int i, forced = 0;
+    /* A connection still in its handshake was promised nothing: it goes
+     * now, instead of waiting out --handshake-timeout. */
     for (i = 0; i < n_conns; i++)
-        if (conns[i].pid) kill(conns[i].pid, SIGTERM);
+        if (conns[i].pid) kill(conns[i].pid, conn_state[i] == SLOT_HANDSHAKE ? SIGKILL : SIGTERM);
     drain_pipe(shutdown_pipe[0]);
     p[0].fd = child_pipe[0];
     p[0].events = POLLIN;

@@ -189,8 +189,30 @@ static void *run_long(void *p)
     return NULL;
 }
 
-/* A loop of about 10^6 statements: a second or more, on any build. */
-static const char *const long_text = "i = 0; while (i < 1000000) { i = i + 1 }";
+/* A loop that takes one to two seconds on this build (a sanitizer build
+ * evaluates it 20 to 100 times slower): calibrated against the server. */
+static char long_text[96];
+
+static void calibrate_long_text(void)
+{
+    test_server srv;
+    const char *opts[] = {"--log-level", "error", NULL};
+    silc_context *c;
+    double t = 0, n = 20000;
+    snprintf(long_text, sizeof long_text, "i = 0; while (i < 1000000) { i = i + 1 }");
+    if (server_start(&srv, NULL, opts)) return;
+    if ((c = open_client(srv.url))) {
+        double t0 = util_now();
+        if (silc_exec(c, "i = 0; while (i < 20000) { i = i + 1 }") == 0) t = util_now() - t0;
+        silc_close(&c);
+    }
+    server_stop(&srv);
+    if (t > 0) n = n * 1.5 / t;
+    if (n < 20000) n = 20000;
+    if (n > 1e7) n = 1e7;
+    snprintf(long_text, sizeof long_text, "i = 0; while (i < %.0f) { i = i + 1 }", n);
+    printf("long EXEC: %s\n", long_text);
+}
 
 static void test_no_queue(void)
 {
@@ -501,6 +523,7 @@ int main(int argc, char **argv)
 {
     const char *plugin_dir = argc > 1 ? argv[1] : CRASH_PLUGIN_DIR;
     signal(SIGPIPE, SIG_IGN);
+    calibrate_long_text();
     test_crash(plugin_dir);
     test_no_queue();
     test_idle_connections();
