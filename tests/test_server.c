@@ -189,10 +189,19 @@ static void *run_long(void *p)
     return NULL;
 }
 
+static char long_text[96];   /* calibrate_long_text */
+
+/* Runs long_text in a new session of url on a thread of its own. */
+static void start_long(long_exec *L, pthread_t *th, const char *url)
+{
+    memset(L, 0, sizeof *L);
+    L->url = url;
+    L->text = long_text;
+    pthread_create(th, NULL, run_long, L);
+}
+
 /* A loop that takes one to two seconds on this build (a sanitizer build
  * evaluates it 20 to 100 times slower): calibrated against the server. */
-static char long_text[96];
-
 static void calibrate_long_text(void)
 {
     test_server srv;
@@ -226,10 +235,7 @@ static void test_no_queue(void)
         CHECK(0, "silcd did not start");
         return;
     }
-    memset(&L, 0, sizeof L);
-    L.url = srv.url;
-    L.text = long_text;
-    pthread_create(&th, NULL, run_long, &L);
+    start_long(&L, &th, srv.url);
     c = open_client(srv.url);
     sleep_ms(100);
     /* While the long statement runs, another session's tiny ones answer. */
@@ -455,10 +461,7 @@ static void test_killed_server(void)
         CHECK(0, "silcd did not start");
         return;
     }
-    memset(&L, 0, sizeof L);
-    L.url = srv.url;
-    L.text = long_text;
-    pthread_create(&th, NULL, run_long, &L);
+    start_long(&L, &th, srv.url);
     await_children(srv.pid, 1, 3000);
     sleep_ms(200);
     n = children_of(srv.pid, kids, 64);
@@ -494,10 +497,7 @@ static void test_sigterm_drains(void)
         return;
     }
     idle = open_client(srv.url);
-    memset(&L, 0, sizeof L);
-    L.url = srv.url;
-    L.text = long_text;
-    pthread_create(&th, NULL, run_long, &L);
+    start_long(&L, &th, srv.url);
     await_children(srv.pid, 2, 3000);
     sleep_ms(200);
     kill(srv.pid, SIGTERM);
