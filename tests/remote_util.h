@@ -179,4 +179,55 @@ static inline int raw_open(const char *url, uint32_t version, const char *token,
     return fd;
 }
 
+/* The header, descriptor and name of a PUT frame whose body (descriptor,
+ * name, arrays) claims body_len bytes. */
+static inline size_t raw_put_header(uint8_t *out, const char *name, proto_desc d, uint64_t body_len)
+{
+    d.namelen = (uint32_t)strlen(name);
+    proto_encode_header(out, PROTO_PUT, body_len);
+    proto_encode_desc(out + PROTO_HEADER_BYTES, &d);
+    memcpy(out + PROTO_HEADER_BYTES + PROTO_DESC_BYTES, name, d.namelen);
+    return PROTO_HEADER_BYTES + PROTO_DESC_BYTES + d.namelen;
+}
+
+/* Forks a client that opens a session on url, starts the PUT of a dense
+ * m x 1 value named name, sends the first `sent` bytes of its arrays (whole
+ * MiB chunks, each a valid double pattern) and waits to be killed.  Returns
+ * its pid once those bytes are sent, or -1. */
+static inline pid_t raw_partial_put(const char *url, const char *name, int64_t m, size_t sent)
+{
+    int pfd[2];
+    char c;
+    pid_t pid;
+    if (pipe(pfd)) return -1;
+    pid = fork();
+    if (pid == 0) {
+        const size_t chunk = 1u << 20;
+        uint8_t b[256], *junk = malloc(chunk);
+        proto_desc d;
+        size_t done;
+        char *text;
+        int fd = raw_open(url, PROTO_VERSION, NULL, &text);
+        memset(junk, 0x3f, chunk);   /* 0.49: nothing for the server to refuse */
+        memset(&d, 0, sizeof d);
+        d.format = SILC_DENSE;
+        d.m = m;
+        d.n = 1;
+        d.nnz = m;
+        raw_send(fd, b, raw_put_header(b, name, d, PROTO_DESC_BYTES + strlen(name) + (uint64_t)m * 8));
+        for (done = 0; done < sent; done += chunk) raw_send(fd, junk, chunk);
+        if (write(pfd[1], "k", 1) != 1) {}
+        pause();
+        _exit(0);
+    }
+    close(pfd[1]);
+    if (pid > 0 && read(pfd[0], &c, 1) != 1) {
+        kill(pid, SIGKILL);
+        waitpid(pid, NULL, 0);
+        pid = -1;
+    }
+    close(pfd[0]);
+    return pid;
+}
+
 #endif

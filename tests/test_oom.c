@@ -74,8 +74,18 @@ static int api_open(silc_context *c, char *msg, size_t len)
     return rc;
 }
 
-static int put_result(silc_context *c, int rc, char *msg, size_t len)
+/* Puts e under name, where made is what e's constructor returned (a failed
+ * constructor's message is the library's, a failed put's the context's). */
+static int put_made(silc_context *c, const char *name, int made, silc_envelope_t *e, char *msg,
+                    size_t len)
 {
+    int rc;
+    if (made) {
+        snprintf(msg, len, "%s", silc_errmsg());
+        return made;
+    }
+    rc = silc_put(c, name, e);
+    silc_envelope_free(e);
     if (rc) snprintf(msg, len, "%s", silc_context_errmsg(c));
     return rc;
 }
@@ -84,28 +94,15 @@ static int api_put_dense_new(silc_context *c, char *msg, size_t len)
 {
     static const double x[] = {1, 2, 3, 4, 5, 6};
     silc_envelope_t e;
-    int rc = silc_envelope_dense(&e, 3, 2, x);
-    if (rc) {
-        snprintf(msg, len, "%s", silc_errmsg());
-        return rc;
-    }
-    rc = silc_put(c, "x", &e);
-    silc_envelope_free(&e);
-    return put_result(c, rc, msg, len);
+    return put_made(c, "x", silc_envelope_dense(&e, 3, 2, x), &e, msg, len);
 }
 
 static int api_put_dense_over(silc_context *c, char *msg, size_t len)
 {
     static const double x[] = {7, 8, 9};
     silc_envelope_t e;
-    int rc = silc_envelope_dense(&e, 3, 1, x);
-    if (rc) {
-        snprintf(msg, len, "%s", silc_errmsg());
-        return rc;
-    }
-    rc = silc_put(c, "v", &e);   /* rebinding: on failure v keeps its value */
-    silc_envelope_free(&e);
-    return put_result(c, rc, msg, len);
+    /* rebinding: on failure v keeps its value */
+    return put_made(c, "v", silc_envelope_dense(&e, 3, 1, x), &e, msg, len);
 }
 
 static int api_put_csr(silc_context *c, char *msg, size_t len)
@@ -114,28 +111,14 @@ static int api_put_csr(silc_context *c, char *msg, size_t len)
     static const int64_t rp[] = {0, 2, 3, 5}, ci[] = {2, 0, 1, 2, 0};
     static const double vals[] = {1, 2, 3, 4, 5};
     silc_envelope_t e;
-    int rc = silc_envelope_csr(&e, 3, 3, rp, ci, vals);
-    if (rc) {
-        snprintf(msg, len, "%s", silc_errmsg());
-        return rc;
-    }
-    rc = silc_put(c, "S", &e);
-    silc_envelope_free(&e);
-    return put_result(c, rc, msg, len);
+    return put_made(c, "S", silc_envelope_csr(&e, 3, 3, rp, ci, vals), &e, msg, len);
 }
 
 static int api_put_band(silc_context *c, char *msg, size_t len)
 {
     static const double bb[] = {0, 4, 1, 1, 4, 1, 1, 4, 0};
     silc_envelope_t e;
-    int rc = silc_envelope_band(&e, 3, 3, 1, 1, bb);
-    if (rc) {
-        snprintf(msg, len, "%s", silc_errmsg());
-        return rc;
-    }
-    rc = silc_put(c, "y", &e);
-    silc_envelope_free(&e);
-    return put_result(c, rc, msg, len);
+    return put_made(c, "y", silc_envelope_band(&e, 3, 3, 1, 1, bb), &e, msg, len);
 }
 
 static int api_get(silc_context *c, const char *name, char *msg, size_t len)

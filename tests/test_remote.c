@@ -68,15 +68,6 @@ static void malformed(const char *url, const void *bytes, size_t n, const char *
     good_still_served(what);
 }
 
-static size_t put_bytes(uint8_t *out, const char *name, proto_desc d, uint64_t body_len)
-{
-    d.namelen = (uint32_t)strlen(name);
-    proto_encode_header(out, PROTO_PUT, body_len);
-    proto_encode_desc(out + PROTO_HEADER_BYTES, &d);
-    memcpy(out + PROTO_HEADER_BYTES + PROTO_DESC_BYTES, name, d.namelen);
-    return PROTO_HEADER_BYTES + PROTO_DESC_BYTES + d.namelen;
-}
-
 static void test_malformed(const char *url)
 {
     uint8_t b[512];
@@ -102,19 +93,19 @@ static void test_malformed(const char *url)
     d.m = (int64_t)1 << 45;
     d.n = (int64_t)1 << 45;
     d.nnz = 1;
-    n = put_bytes(b, "h", d, PROTO_DESC_BYTES + 1);
+    n = raw_put_header(b, "h", d, PROTO_DESC_BYTES + 1);
     malformed(url, b, n, "exceed the protocol's limit", 1, "huge dimensions");
 
     d.m = -1;
     d.n = 4;
     d.nnz = -4;
-    n = put_bytes(b, "h", d, PROTO_DESC_BYTES + 1);
+    n = raw_put_header(b, "h", d, PROTO_DESC_BYTES + 1);
     malformed(url, b, n, "negative size", 1, "negative sizes");
 
     d.m = 2;
     d.n = 2;
     d.nnz = 4;
-    n = put_bytes(b, "h", d, (uint64_t)-1);
+    n = raw_put_header(b, "h", d, (uint64_t)-1);
     malformed(url, b, n, "descriptor needs 32", 0, "length inconsistent with descriptor");
 
     /* 600 KB over the 512 KB limit, sent whole: refused, the arrays skipped,
@@ -125,7 +116,7 @@ static void test_malformed(const char *url)
         d.m = 75000;
         d.n = 1;
         d.nnz = d.m;
-        n = put_bytes(big, "h", d, PROTO_DESC_BYTES + 1 + payload);
+        n = raw_put_header(big, "h", d, PROTO_DESC_BYTES + 1 + payload);
         malformed(url, big, n + payload, "value of 600000 bytes (585.9 KiB), over the limit of 524288 bytes (512.0 KiB) by 73.9 KiB per value (silcd --max-value-bytes)",
                   1, "value over the limit");
         free(big);
@@ -136,7 +127,7 @@ static void test_malformed(const char *url)
     d.n = 3;
     d.nnz = 2;
     csr[0] = 0; csr[1] = 1; csr[2] = 1; csr[3] = 0; csr[4] = 2;
-    n = put_bytes(b, "S", d, PROTO_DESC_BYTES + 1 + sizeof csr + 16);
+    n = raw_put_header(b, "S", d, PROTO_DESC_BYTES + 1 + sizeof csr + 16);
     memcpy(b + n, csr, sizeof csr);
     memset(b + n + sizeof csr, 0, 16);
     malformed(url, b, n + sizeof csr + 16, "rowptr[m] = 1 but the descriptor declares 2", 1,
@@ -181,35 +172,13 @@ static void test_malformed(const char *url)
 /* A child process connects, sends half of a 4 MiB PUT of 'x', and is killed. */
 static void test_killed_mid_put(const char *url)
 {
-    pid_t pid;
-    int status, pfd[2];
-    char c;
-    if (pipe(pfd)) return;
-    pid = fork();
-    if (pid == 0) {
-        uint8_t b[256];
-        proto_desc d;
-        size_t n, half = 2u << 20;
-        char *text;
-        uint8_t *junk = calloc(1, half);
-        int fd = raw_open(url, PROTO_VERSION, NULL, &text);
-        memset(&d, 0, sizeof d);
-        d.format = SILC_DENSE;
-        d.m = 512 * 1024;
-        d.n = 1;
-        d.nnz = d.m;
-        n = put_bytes(b, "x", d, PROTO_DESC_BYTES + 1 + 4u * 1024 * 1024);
-        raw_send(fd, b, n);
-        raw_send(fd, junk, half);
-        if (write(pfd[1], "k", 1) != 1) {}
-        pause();
-        _exit(0);
+    /* 2 MiB of a 4 MiB PUT, then SIGKILL */
+    pid_t pid = raw_partial_put(url, "x", 512 * 1024, 2u << 20);
+    CHECK(pid > 0, "child did not start its PUT");
+    if (pid > 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, NULL, 0);
     }
-    close(pfd[1]);
-    CHECK(read(pfd[0], &c, 1) == 1, "child did not start its PUT");
-    close(pfd[0]);
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
     good_still_served("a client killed mid-PUT");
 }
 

@@ -290,6 +290,18 @@ static int closed_within(int fd, int ms)
     return 0;
 }
 
+/* A client that completes its handshake computes in spite of the n silent
+ * connections fds; then they close and the server stops cleanly. */
+static void served_then_stop(test_server *srv, const int *fds, int n, const char *who)
+{
+    silc_context *c = open_client(srv->url);
+    int i;
+    CHECK(c && silc_exec(c, "x = 2 * 3") == 0, "%s: %s", who, c ? silc_context_errmsg(c) : silc_errmsg());
+    silc_close(&c);
+    for (i = 0; i < n; i++) close(fds[i]);
+    CHECK(server_stop(srv) == 0, "silcd did not shut down cleanly");
+}
+
 static void test_idle_connections(void)
 {
     test_server srv;
@@ -307,12 +319,7 @@ static void test_idle_connections(void)
         for (i = 0; i < 300; i++)
             if ((fds[n] = raw_connect(srv.url)) >= 0) n++;
         CHECK(n == 300, "only %d of 300 idle connections made", n);
-        c = open_client(srv.url);
-        CHECK(c && silc_exec(c, "x = 2 * 3") == 0, "a real client behind 300 idle connections: %s",
-              c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        for (i = 0; i < n; i++) close(fds[i]);
-        CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+        served_then_stop(&srv, fds, n, "a real client behind 300 idle connections");
     }
     /* TCP, 300 silent connections from 127.0.0.2: that peer holds at most
      * its share (--peer-share 0.5 of 64), the rest are refused at once, and
@@ -344,12 +351,7 @@ static void test_idle_connections(void)
             msg = NULL;
         }
         CHECK(refused == 10, "connections past the peer's share: %d of the last 10 told why", refused);
-        c = open_client(srv.url);
-        CHECK(c && silc_exec(c, "x = 2 * 3") == 0, "a client from another address: %s",
-              c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        for (i = 0; i < n; i++) close(fds[i]);
-        CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
+        served_then_stop(&srv, fds, n, "a client from another address");
     }
     /* --handshake-timeout closes a silent connection; --idle-timeout a
      * session that stopped asking, and its client is told why. */
@@ -379,21 +381,6 @@ static void test_idle_connections(void)
 
 /* ---- 4. faults lose nothing that was promised -------------------------- */
 
-static size_t put_header(uint8_t *out, const char *name, int64_t m)
-{
-    proto_desc d;
-    memset(&d, 0, sizeof d);
-    d.format = SILC_DENSE;
-    d.m = m;
-    d.n = 1;
-    d.nnz = m;
-    d.namelen = (uint32_t)strlen(name);
-    proto_encode_header(out, PROTO_PUT, PROTO_DESC_BYTES + d.namelen + (uint64_t)m * 8);
-    proto_encode_desc(out + PROTO_HEADER_BYTES, &d);
-    memcpy(out + PROTO_HEADER_BYTES + PROTO_DESC_BYTES, name, d.namelen);
-    return PROTO_HEADER_BYTES + PROTO_DESC_BYTES + d.namelen;
-}
-
 /* A client SIGKILLed 100 MB into a 200 MB PUT: its session process ends,
  * the memory it held goes back, the other session keeps its values. */
 static void test_killed_client(void)
@@ -403,8 +390,7 @@ static void test_killed_client(void)
     silc_context *a;
     long before, during = 0, after = 0;
     pid_t pid;
-    int status, pfd[2], i;
-    char c;
+    int status;
     if (server_start(&srv, NULL, opts)) {
         CHECK(0, "silcd did not start");
         return;
@@ -413,23 +399,9 @@ static void test_killed_client(void)
     if (!a) goto out;
     put_marker(a, "keep", 1000);
     before = server_rss_kib(srv.pid);
-    if (pipe(pfd)) goto out;
-    pid = fork();
-    if (pid == 0) {
-        const size_t chunk = 1u << 20;
-        uint8_t b[256], *junk = malloc(chunk);
-        char *text;
-        int fd = raw_open(srv.url, PROTO_VERSION, NULL, &text);
-        memset(junk, 0x3f, chunk);   /* 0.49: a valid double, nothing for the server to refuse */
-        raw_send(fd, b, put_header(b, "big", 25 * 1000 * 1000));
-        for (i = 0; i < 100; i++) raw_send(fd, junk, chunk);
-        if (write(pfd[1], "k", 1) != 1) {}
-        pause();
-        _exit(0);
-    }
-    close(pfd[1]);
-    CHECK(read(pfd[0], &c, 1) == 1, "the client did not send its 100 MB");
-    close(pfd[0]);
+    pid = raw_partial_put(srv.url, "big", 25 * 1000 * 1000, 100u << 20);
+    CHECK(pid > 0, "the client did not send its 100 MB");
+    if (pid < 0) goto out;
     sleep_ms(200);
     during = server_rss_kib(srv.pid);
     kill(pid, SIGKILL);

@@ -35,7 +35,8 @@ static int h_threads(void)
  * but wide operand (eye(2, 1e12): 48 bytes as CSR, 8 TB of column pointers
  * as CSC) must be refused with its size, which the dispatcher reports (found
  * by fuzz_lang), not handed to calloc.  Arrays under 64 MiB are not checked:
- * when the limit is the machine's memory, asking it costs a system call. */
+ * the small work arrays of every operation skip the check and its double
+ * arithmetic. */
 static int h_too_big(double bytes)
 {
     return bytes >= (double)(64u << 20) && val_claim(bytes, "a plugin's work array");

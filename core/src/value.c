@@ -80,11 +80,17 @@ void val_set_max_bytes(uint64_t bytes, const char *source)
 
 uint64_t val_max_bytes(void)
 {
-    if (!max_value_bytes) {
+    /* Read once: every constructor asks, and sysconf(_SC_PHYS_PAGES) is a
+     * system call.  Threads that race here store the same number. */
+    static _Atomic uint64_t phys_bytes;
+    uint64_t phys;
+    if (max_value_bytes) return max_value_bytes;
+    if (!(phys = phys_bytes)) {
         long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
-        return pages > 0 && size > 0 ? (uint64_t)pages * (uint64_t)size : UINT64_MAX;
+        phys = pages > 0 && size > 0 ? (uint64_t)pages * (uint64_t)size : UINT64_MAX;
+        phys_bytes = phys;
     }
-    return max_value_bytes;
+    return phys;
 }
 
 const char *val_refusal(void)
