@@ -494,6 +494,7 @@ static const silc_plugin lis_plugin = {
     1, lis_option_specs,
     lis_set_threads,
     NULL,
+    NULL,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,

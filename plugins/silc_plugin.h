@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 4
+#define SILC_ABI_MINOR 5
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -197,6 +197,18 @@ typedef struct silc_option_spec {
     const char *help;
 } silc_option_spec;
 
+/* ---- distribution (ABI 1.5) ------------------------------------------------ */
+/* Where the rows of a distributed value live: rank r holds the contiguous
+ * rows [starts[r], starts[r+1]) of the m_global rows; this rank holds
+ * m_local = starts[rank+1] - starts[rank] rows from first_row on.  Every
+ * column is on every rank (PETSc's MPIAIJ and MPI vector layout). */
+typedef struct silc_layout {
+    int64_t m_global;
+    int64_t first_row, m_local;
+    int rank, size;
+    const int64_t *starts;      /* size + 1 entries, owned by the host */
+} silc_layout;
+
 /* ---- the host's services --------------------------------------------------- */
 typedef struct silc_host_api {
     int abi_major, abi_minor;
@@ -279,6 +291,24 @@ typedef struct silc_host_api {
      * was 0.3 ms, 1.5% of a MUMPS factorization.  Call it through
      * silc_props_of(), which falls back to props() on an older host. */
     const silc_props *(*props_part)(const silc_value *v, int parts);
+
+    /* ABI 1.5: distributed values (the MPI server and SPMD programs; see
+     * docs/distributed.md).  A backend that lists an op in its
+     * silc_plugin.collective_ops may be handed operands distributed by
+     * contiguous row blocks (PETSc's layout); the same call then runs on
+     * every rank of the communicator at once, each rank seeing its own block.
+     * comm: the communicator of this call (a pointer to an MPI_Comm), with
+     * this rank and the size; NULL (rank 0, size 1) when the call runs on one
+     * process, and then every operand is whole.  A plugin built without MPI
+     * never calls these and lists no collective op. */
+    const void *(*comm)(const silc_call *call, int *rank, int *size);
+    /* 1 and *out if v is distributed; view() then shows this rank's block:
+     * m = out->m_local rows, CSR column indices global.  0 if v is whole. */
+    int (*layout)(const silc_value *v, silc_layout *out);
+    /* A distributed dense value with like's row blocks (like is
+     * distributed) and n columns, this rank's block zero-filled: the
+     * result of a collective call (x = A \ b: like = b).  NULL on failure. */
+    silc_value *(*dist_dense_new)(const silc_value *like, int64_t n);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */
@@ -304,7 +334,13 @@ typedef struct silc_plugin {
 
     void (*set_threads)(int nthreads); /* NULL if the plugin is single-threaded */
     void (*shutdown)(void);            /* NULL if nothing to release; called once at unload */
+
+    /* ABI 1.5: per backend (n_backends entries, in the order of backends),
+     * the ops it runs collectively on distributed operands, as bits
+     * SILC_COLLECTIVE(op); NULL = none.  Only such calls see host->comm. */
+    const uint32_t *collective_ops;
 } silc_plugin;
+#define SILC_COLLECTIVE(op) (1u << (op))
 
 /* The check every silc_plugin_init starts with: the host table exists, speaks
  * this major version and index width, and is long enough to hold every host

@@ -10,6 +10,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "dist.h"
 
 #include <errno.h>
 #include <math.h>
@@ -209,6 +210,38 @@ static int h_attach_set(const silc_value *v, const char *key, void *data, void (
     return val_attach_set(v, key, data, destroy);
 }
 
+/* ---- ABI 1.5: distributed calls (dist.h) ---- */
+
+static const void *h_comm(const silc_call *call, int *rank, int *size)
+{
+    const host_call_ctx *ctx = call ? call->host_private : NULL;
+    int collective = ctx && ctx->collective && ctx->E->dist;
+    if (rank) *rank = collective ? ctx->E->dist->rank : 0;
+    if (size) *size = collective ? ctx->E->dist->size : 1;
+    return collective ? ctx->E->dist->ops->handle : NULL;
+}
+
+static int h_layout(const silc_value *v, silc_layout *out)
+{
+    const val_dist *d = v ? v->dist : NULL;
+    if (!d) return 0;
+    out->m_global = v->m;
+    out->rank = d->ctx->rank;
+    out->size = d->ctx->size;
+    out->first_row = d->part->starts[out->rank];
+    out->m_local = d->part->starts[out->rank + 1] - out->first_row;
+    out->starts = d->part->starts;
+    return 1;
+}
+
+static silc_value *h_dist_dense_new(const silc_value *like, int64_t n)
+{
+    silc_value *blk;
+    if (!like || !like->dist) return NULL;
+    if (!(blk = val_dense_new(like->dist->block->m, n))) return NULL;
+    return val_dist_new(like->m, n, SILC_FMT_DENSE, like->dist->ctx, like->dist->part, blk);
+}
+
 /* The estimator lives in the built-in reference plugin (plugin-reference/
  * ref_cond.c); lending it through the host keeps one implementation for every
  * backend that needs it. */
@@ -250,6 +283,9 @@ static const silc_host_api host_table = {
     ref_inv_norm1_est_block,
     h_dense_new_uninit,
     h_props_part,
+    h_comm,
+    h_layout,
+    h_dist_dense_new,
 };
 
 const silc_host_api *host_api(void)

@@ -21,6 +21,7 @@
 #include "engine.h"
 
 #include <dirent.h>
+#include <sys/stat.h>
 #include <dlfcn.h>
 #include <errno.h>
 #include <limits.h>
@@ -96,7 +97,8 @@ static int check_table(silc_engine *E, const silc_plugin *pl, const char *path)
     if (pl->index_bytes != (int)sizeof(silc_index))
         return eng_error(E, "plugin '%s' (%s) uses %d-byte indices, host uses %d", name, path,
                          pl->index_bytes, (int)sizeof(silc_index));
-    if (pl->struct_size < sizeof(silc_plugin) || pl->struct_size > LD_MAX_STRUCT_SIZE)
+    /* A 1.0 table ends at shutdown; later fields are read only when present. */
+    if (pl->struct_size < offsetof(silc_plugin, collective_ops) || pl->struct_size > LD_MAX_STRUCT_SIZE)
         return eng_error(E, "plugin '%s' (%s) has a table of %zu bytes, ABI %d.0 needs at least %zu",
                          name, path, pl->struct_size, SILC_ABI_MAJOR, sizeof(silc_plugin));
     if (!pl->name || !pl->name[0] || strchr(pl->name, '.'))
@@ -357,6 +359,15 @@ static int cmp_str(const void *a, const void *b)
 
 /* Loads the plugins of one directory in name order (so which of two
  * same-named plugins wins does not depend on readdir order). */
+/* 1 if dir/sub/name exists. */
+static int exists_in(const char *dir, const char *sub, const char *name)
+{
+    char path[PATH_MAX];
+    struct stat st;
+    int len = snprintf(path, sizeof path, "%s/%s/%s", dir, sub, name);
+    return len > 0 && (size_t)len < sizeof path && stat(path, &st) == 0;
+}
+
 static int load_dir(silc_engine *E, const char *dir)
 {
     DIR *d = opendir(dir);
@@ -364,8 +375,17 @@ static int load_dir(silc_engine *E, const char *dir)
     char **names = NULL;
     size_t n = 0, cap = 0, i;
     if (!d) return eng_error(E, "cannot read plugin directory %s: %s", dir, strerror(errno));
+    /* An engine on a communicator (dist.h) takes the MPI builds of plugins
+     * from dir/mpi first, and then not the sequential build of the same
+     * file: Debian's sequential MUMPS and the MPI one must never share a
+     * process (docs/distributed.md). */
+    if (E->dist && exists_in(dir, "mpi", ".")) {
+        char sub[PATH_MAX];
+        if ((size_t)snprintf(sub, sizeof sub, "%s/mpi", dir) < sizeof sub) load_dir(E, sub);
+    }
     while ((ent = readdir(d)) != NULL) {
         if (!plugin_file_name(ent->d_name)) continue;
+        if (E->dist && exists_in(dir, "mpi", ent->d_name)) continue;
         if (n == cap) {
             char **nn = realloc(names, (cap = cap ? 2 * cap : 16) * sizeof *nn);
             if (!nn) break;

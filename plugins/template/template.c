@@ -71,6 +71,7 @@ static const silc_plugin template_plugin = {
     1, template_options,
     NULL, /* set_threads: single-threaded */
     NULL, /* shutdown: nothing to release */
+    NULL, /* collective_ops: runs on one process only (ABI 1.5) */
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

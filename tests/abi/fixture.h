@@ -50,7 +50,7 @@ static const silc_backend fix_backends[] = {
 
 static const silc_plugin fix_plugin = {
     FIX_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), FIX_INDEX_BYTES,
-    FIX_NAME, "1.0", 1, fix_backends, 0, 0, 0, 0,
+    FIX_NAME, "1.0", 1, fix_backends, 0, 0, 0, 0, 0,
 };
 
 #ifndef FIX_NO_SYMBOL
