@@ -151,6 +151,33 @@ SILC_API const char *silc_context_warnings(const silc_context *ctx);
 typedef void (*silc_output_fn)(void *user, const char *text);
 SILC_API void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
 
+/* ---- MPI programs (SPMD) --------------------------------------------------- */
+/* An MPI program opens one context per rank over its communicator
+ * (silc_open_mpi in silc_mpi.h, or SILC_INIT with SILC_MODE=spmd when the
+ * program links libsilc_mpi).  Every call on such a context is collective:
+ * all ranks make the same calls in the same order (a mismatch -- ranks
+ * EXECing different texts, one rank PUTting while another GETs -- is an error
+ * on every rank, naming the ranks and the calls).  silc_put binds the same
+ * whole value on every rank (each passes it), silc_get returns the whole
+ * value on every rank; the row-block calls below move nothing between ranks.
+ * docs/distributed.md says which operations run distributed.
+ *
+ * silc_put_rows: this rank's rows [first_row, first_row + block->m) of the
+ * value `name`; the blocks of the ranks, in rank order, must tile the rows
+ * with no gap or overlap and have the same columns and format (CSR or dense;
+ * CSR column indices are global).  On one process (any other context) the
+ * block must be the whole value, first_row 0.
+ * silc_get_rows: this rank's rows of `name` and, in *first_row (may be NULL),
+ * the first of them: a value computed from distributed operands keeps their
+ * rows; a whole value is split evenly, as PETSc's PETSC_DECIDE splits it. */
+SILC_API int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row,
+                           const silc_envelope_t *block);
+SILC_API int silc_get_rows(silc_context *ctx, silc_envelope_t *block, int64_t *first_row,
+                           const char *name);
+/* This process's rank and the number of ranks of ctx (0 and 1 unless the
+ * context is an SPMD one). */
+SILC_API int silc_context_rank(const silc_context *ctx, int *rank, int *size);
+
 /* ---- the default context (the seeds' calls) -------------------------------- */
 SILC_API int SILC_INIT(void);
 SILC_API int SILC_FINALIZE(void);

@@ -6,6 +6,7 @@
  * same kernel.
  */
 #include "accuracy.h"
+#include "dist.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -161,7 +162,7 @@ static void transpose_times(const silc_value *A, const double *R, int64_t k, dou
  * of A, so the second measures the normal equations' residual A'R, scaled so
  * that it is invariant under scaling A and B, as the first is.
  */
-double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
+static double backward_error_whole(const silc_value *A, const silc_value *B, const silc_value *X)
 {
     /* A one-column B's infinity norm is its largest entry: the scan the
      * solve already made of it (val_max_abs), not a properties pass.  A's
@@ -205,6 +206,12 @@ out:
     free(R);
     free(G);
     return be;
+}
+
+double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
+{
+    if (A->dist || B->dist || X->dist) return dist_backward_error(A, B, X);
+    return backward_error_whole(A, B, X);
 }
 
 /* ---- when -------------------------------------------------------------------- */

@@ -22,6 +22,8 @@
 #include <string.h>
 
 #include "api.h"
+#include "dist.h"
+#include "silc_comm.h"
 #include "engine.h"
 #include "envelope.h"
 #include "pool.h"
@@ -173,6 +175,82 @@ int silc_open(silc_context **out, const char *config_path)
     return 0;
 }
 
+/* Ranks other than 0 print nothing by default: one copy of `who`, `info`
+ * and `explain` per job, as an MPI program prints on rank 0. */
+static void quiet(void *user, const char *text)
+{
+    (void)user;
+    (void)text;
+}
+
+int silc_open_comm(silc_context **out, const char *config_path, silc_comm_ops *ops)
+{
+    silc_context *ctx;
+    char err[4096];
+    int rc, failed;
+    if (!out) {
+        if (ops && ops->destroy) ops->destroy(ops->impl);
+        return env_error("silc_open_comm: NULL context pointer");
+    }
+    *out = NULL;
+    if (!ops) return env_error("silc_open_comm: no communicator");
+    pool_install_default();
+    ctx = calloc(1, sizeof *ctx);
+    rc = ctx ? eng_create_comm(&ctx->E, config_path, ops, err, sizeof err) : -1;
+    if (!ctx) {
+        snprintf(err, sizeof err, "silc_open_comm: out of memory");
+        if (ops->destroy) ops->destroy(ops->impl);
+    }
+    /* Every rank opens or none does: a rank left without an engine would
+     * leave the others waiting in their first collective.  The engines
+     * that opened agree through their communicator; a rank whose engine
+     * failed cannot reach it any more, so it ends the job instead. */
+    if (rc) {
+        free(ctx);
+        return env_error("%s", err);
+    }
+    failed = dist_agree(ctx->E, 0);
+    (void)failed;
+    if (ctx->E->dist->rank != 0) ctx->E->output = quiet;
+    *out = ctx;
+    return 0;
+}
+
+static silc_spmd_opener spmd_opener;
+
+void silc_set_spmd_opener(silc_spmd_opener open)
+{
+    spmd_opener = open;
+}
+
+int silc_context_rank(const silc_context *ctx, int *rank, int *size)
+{
+    if (!ctx) return env_error("silc_context_rank: NULL context");
+    if (rank) *rank = ctx->E ? dist_rank(ctx->E) : 0;
+    if (size) *size = ctx->E ? dist_size(ctx->E) : 1;
+    return 0;
+}
+
+/* SPMD contexts: every call is collective.  Checks that all ranks make the
+ * same call (what, text), then agrees on this rank's local verdict rc (with
+ * its message in ctx->err), so that all ranks go on or all fail. */
+static int spmd_enter(silc_context *ctx, const char *what, const char *text, int rc)
+{
+    silc_engine *E = ctx->E;
+    if (!E || !E->dist) return rc;
+    if (rc) snprintf(E->err, sizeof E->err, "%s", ctx->err);
+    if (dist_check_call(E, what, rc ? "" : text)) {
+        /* The mismatch outranks a local error: it is what went wrong first. */
+        snprintf(ctx->err, sizeof ctx->err, "%s", E->err);
+        return -1;
+    }
+    if (dist_agree(E, rc)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", E->err);
+        return -1;
+    }
+    return 0;
+}
+
 void silc_close(silc_context **pctx)
 {
     if (!pctx || !*pctx) return;
@@ -203,10 +281,80 @@ int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e)
         if (env_check(e, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
         return ctx_result(ctx, rem_put(ctx->R, name, e, ctx->err, sizeof ctx->err));
     }
-    if (env_to_value(e, &v, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
+    rc = env_to_value(e, &v, err, sizeof err);
+    if (rc) ctx_error(ctx, "'%s': %s", name, err);
+    if (spmd_enter(ctx, "PUT", name, rc)) {
+        if (!rc) val_release(v);
+        return ctx_result(ctx, -1);
+    }
     rc = api_bind(ctx->E, name, v, ctx->err, sizeof ctx->err);
     val_release(v);
     return ctx_result(ctx, rc);
+}
+
+int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const silc_envelope_t *e)
+{
+    silc_value *v = NULL;
+    char err[1024];
+    int rc = 0;
+    if (!ctx) return env_error("silc_put_rows: NULL context");
+    if (!name) rc = ctx_error(ctx, "silc_put_rows: NULL name");
+    else if (!e) rc = ctx_error(ctx, "silc_put_rows: NULL envelope for '%s'", name);
+    else if (api_check_name(name, ctx->err, sizeof ctx->err)) rc = -1;
+    else if (first_row < 0) rc = ctx_error(ctx, "silc_put_rows '%s': first row %lld is negative", name, (long long)first_row);
+    else if (env_to_value(e, &v, err, sizeof err)) rc = ctx_error(ctx, "'%s': %s", name, err);
+    if (!ctx->E || !ctx->E->dist) {
+        /* One process: the block is the whole value. */
+        if (!rc && (first_row != 0))
+            rc = ctx_error(ctx, "silc_put_rows '%s': rows start at %lld, but on one process the block "
+                                "is the whole value (first row 0)", name, (long long)first_row);
+        if (!rc && ctx->R) {
+            val_release(v);
+            return silc_put(ctx, name, e);
+        }
+        if (!rc) rc = api_bind(ctx->E, name, v, ctx->err, sizeof ctx->err);
+        val_release(v);
+        return ctx_result(ctx, rc);
+    }
+    if (spmd_enter(ctx, "PUT_ROWS", name ? name : "", rc)) {
+        val_release(v);
+        return ctx_result(ctx, -1);
+    }
+    if (dist_put_rows(ctx->E, name, first_row, v)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        return ctx_result(ctx, -1);
+    }
+    return 0;
+}
+
+int silc_get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, const char *name)
+{
+    const silc_value *v = NULL;
+    silc_value *blk = NULL;
+    int64_t first = 0;
+    int rc = 0;
+    if (e) memset(e, 0, sizeof *e);
+    if (first_row) *first_row = 0;
+    if (!ctx) return env_error("silc_get_rows: NULL context");
+    if (!e) rc = ctx_error(ctx, "silc_get_rows: NULL envelope");
+    else if (!name) rc = ctx_error(ctx, "silc_get_rows: NULL name");
+    if (ctx->R) return rc ? ctx_result(ctx, rc) : silc_get(ctx, e, name);
+    if (!rc && !(v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err))) rc = -1;
+    if (spmd_enter(ctx, "GET_ROWS", name ? name : "", rc)) return ctx_result(ctx, -1);
+    if (dist_rows_of(ctx->E, v, &blk, &first)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        return ctx_result(ctx, -1);
+    }
+    rc = env_from_value(blk, e);
+    val_release(blk);
+    if (ctx->E->dist && dist_agree(ctx->E, rc ? (snprintf(ctx->E->err, sizeof ctx->E->err, "out of memory copying '%s'", name), -1) : 0)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        silc_envelope_free(e);
+        return ctx_result(ctx, -1);
+    }
+    if (rc) return ctx_error(ctx, "out of memory copying '%s'", name);
+    if (first_row) *first_row = first;
+    return 0;
 }
 
 int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
@@ -218,7 +366,11 @@ int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
     if (!name) return ctx_error(ctx, "silc_get: NULL name");
     if (ctx->R) return ctx_result(ctx, rem_get(ctx->R, e, name, ctx->err, sizeof ctx->err));
     v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err);
-    if (!v) return ctx_result(ctx, -1);
+    if (spmd_enter(ctx, "GET", name, v ? 0 : -1)) return ctx_result(ctx, -1);
+    if (dist_is(v) && !(v = dist_whole(ctx->E, v, 1))) { /* every rank gets the whole value */
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        return ctx_result(ctx, -1);
+    }
     if (env_from_value(v, e))
         return ctx_error(ctx, "out of memory copying '%s' (%lldx%lld %s)", name, (long long)v->m,
                          (long long)v->n, val_format_name(v->format));
@@ -239,6 +391,7 @@ int silc_exec(silc_context *ctx, const char *statements)
     if (ctx->R)
         return ctx_result(ctx, rem_exec(ctx->R, statements, ctx->output, ctx->output_user,
                                         &ctx->warnings, ctx->err, sizeof ctx->err));
+    if (spmd_enter(ctx, "EXEC", statements, 0)) return ctx_result(ctx, -1);
     return ctx_result(ctx, api_exec(ctx->E, statements, ctx->err, sizeof ctx->err));
 }
 
@@ -275,7 +428,17 @@ static const char not_initialised[] = "SILC_INIT has not been called";
 
 int SILC_INIT(void)
 {
+    const char *mode = getenv("SILC_MODE");
     if (default_ctx) return ctx_error(default_ctx, "SILC_INIT: already initialised");
+    if (mode && !strcmp(mode, "spmd")) {
+        if (!spmd_opener)
+            return env_error("SILC_MODE=spmd needs the program linked with libsilc_mpi "
+                             "(-lsilc_mpi): this one is not");
+        return spmd_opener(&default_ctx, NULL);
+    }
+    if (mode && *mode && strcmp(mode, "embedded") && strcmp(mode, "remote"))
+        return env_error("SILC_MODE='%s' is not a mode: embedded (default), remote (with SILC_SERVER) "
+                         "or spmd (an MPI program)", mode);
     return silc_open(&default_ctx, NULL);
 }
 

@@ -478,6 +478,20 @@ static int unknown_function(lang_ev *V, const char *name)
     return eng_error(V->E, "unknown function '%s'", name);
 }
 
+/* Builtins that only read their arguments' shapes and properties or hand
+ * them to ev_run: they take distributed values as they are (dist.h); the
+ * others read entries, and get whole copies. */
+static int takes_distributed(const char *name)
+{
+    static const char *const names[] = {"size", "rows", "cols", "nnz", "sum", "max", "min", "dot",
+                                        "norm", "abs", "sqrt", "exp", "log", "sin", "cos", "trans",
+                                        "solve", NULL};
+    int i;
+    for (i = 0; names[i]; i++)
+        if (!strcmp(names[i], name)) return 1;
+    return 0;
+}
+
 int bi_call(lang_ev *V, const ast_node *call, silc_value **out)
 {
     const bi_entry *f = lookup(call->name);
@@ -503,7 +517,7 @@ int bi_call(lang_ev *V, const ast_node *call, silc_value **out)
             }
             continue;
         }
-        if (ev_expr(V, k, &args[i])) goto done;
+        if ((takes_distributed(f->name) ? ev_expr_dist : ev_expr)(V, k, &args[i])) goto done;
     }
     /* option strings stay NULL in args: their handlers read them from the node */
     rc = f->fn(V, call, args, n, out);

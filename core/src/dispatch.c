@@ -20,6 +20,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
 #include "accuracy.h"
+#include "dist.h"
 #include "refine.h"
 #include "scale.h"
 
@@ -282,6 +283,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 const blist *L, int may_defer)
 {
     strbuf skipped;
+    dist_swap swap;
     int ci, i, rc, cholesky_failed = 0;
     sb_init(&skipped);
     for (ci = 0; ci < nchain; ci++) {
@@ -304,8 +306,17 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             ctx.backend = b;
             call->host_private = &ctx;
             call->op_class = chain[ci];
+            /* Distributed operands (dist.h): a collective backend runs on the
+             * row blocks on every rank; any other gets whole copies. */
+            if (dist_walk_begin(E, call, b, &swap) < 0) {
+                call->host_private = NULL;
+                sb_free(&skipped);
+                return SILC_ENOMEM;
+            }
+            ctx.collective = swap.mode == DIST_COLLECTIVE;
             if (b->backend->ops[call->op].accepts && !b->backend->ops[call->op].accepts(call, &why)) {
                 sb_printf(&skipped, "%s declines: %s; ", b->full_name, why ? why : "no reason given");
+                dist_walk_end(call, &swap);
                 continue;
             }
             rc = run_one(call, b);
@@ -313,11 +324,31 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 rc = SILC_EINTERNAL;
                 snprintf(ctx.err, sizeof ctx.err, "reported success but returned no result");
             }
+            if (ctx.collective) { /* every rank learns how every rank did */
+                if (rc != SILC_OK) eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
+                else E->err[0] = 0;
+                rc = dist_agree(E, rc);
+                if (rc != SILC_OK) {
+                    val_release(call->out);
+                    call->out = NULL;
+                    snprintf(ctx.err, sizeof ctx.err, "%.1000s", E->err);
+                }
+            }
             if (rc == SILC_OK) {
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
-                 * by the backend that just solved, before the report. */
-                if (call->op == SILC_OP_SOLVE) refine_solve(E, call, b);
+                 * by the backend that just solved, before the report (not
+                 * of a distributed solve: refine.c reads whole arrays). */
+                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine_solve(E, call, b);
+                if (call->op == SILC_OP_SOLVE && ctx.collective) {
+                    int rk = dist_size(E);
+                    call->report->backward_error_unrefined = -1; /* no refinement ran */
+                    size_t l = strlen(call->report->note);
+                    if (!strstr(call->report->note, "ranks"))
+                        snprintf(call->report->note + l, sizeof call->report->note - l, "%son %d ranks",
+                                 l ? "; " : "", rk);
+                }
                 rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, may_defer);
+                dist_walk_end(call, &swap);
                 call->host_private = NULL;
                 sb_free(&skipped);
                 if (rc) {
@@ -327,6 +358,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 }
                 return 0;
             }
+            dist_walk_end(call, &swap);
             if (rc == SILC_ENOTSPD && ci + 1 < nchain) {
                 cholesky_failed = 1;
                 next_class = 1;
@@ -341,7 +373,8 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                     /* A value constructor that refused a size said how
                      * large: that beats the plugin's "out of memory". */
                     eng_error(E, "%s: %s", b->full_name, val_refusal());
-                else if (strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' '))
+                else if ((strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' ')) ||
+                         (ctx.collective && strncmp(ctx.err, "rank ", 5) == 0))
                     eng_error(E, "%s", ctx.err);
                 else
                     eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
@@ -401,7 +434,8 @@ int disp_run(silc_engine *E, silc_call *call)
     } else {
         silc_report *saved = call->report;
         scale_state S;
-        int scaling = call->op == SILC_OP_SOLVE;
+        /* A distributed system is not rescaled (scale.c copies whole arrays). */
+        int scaling = call->op == SILC_OP_SOLVE && !dist_call_has(call);
         if (scaling && !call->report) call->report = &local;
         /* Hook (scale.c): systems near 1e+-300 are solved scaled by 2^k. */
         if (scaling && scale_solve_begin(E, call, &S)) {
@@ -429,6 +463,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     const char *chain[4];
     char why[256];
     silc_call c;
+    dist_swap swap;
     blist L;
     int n, i, chosen = 0;
     if (!E || !call || !b) return -1;
@@ -466,11 +501,24 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         ctx.E = E;
         ctx.backend = be;
         c.host_private = &ctx;
+        /* As walk: a backend judges the operands it would get (gathered
+         * copies, kept with the values, when it is not collective). */
+        if (dist_walk_begin(E, &c, be, &swap) < 0) {
+            if (call->options) cfg_clear_call_options(E);
+            return -1;
+        }
+        ctx.collective = swap.mode == DIST_COLLECTIVE;
         if (be->backend->ops[call->op].accepts && !be->backend->ops[call->op].accepts(&c, &reason)) {
+            dist_walk_end(&c, &swap);
             sb_printf(b, "  %s: declines: %s\n", be->full_name, reason ? reason : "no reason given");
             continue;
         }
-        sb_printf(b, "  %s -> would run\n", be->full_name);
+        dist_walk_end(&c, &swap);
+        sb_printf(b, "  %s -> would run%s\n", be->full_name,
+                  !E->dist || !dist_call_has(call) ? ""
+                  : dist_backend_collective(be, call->op) && call->op == SILC_OP_SOLVE
+                      ? " (collective, on the row blocks of every rank)"
+                      : " (sequential, on operands gathered to every rank)");
         chosen = 1;
     }
     if (!chosen) sb_printf(b, "  no backend can run this\n");

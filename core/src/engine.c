@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "dist.h"
 #include "accuracy.h"
 #include "tuner.h"
 
@@ -72,6 +73,12 @@ static int eng_setup(silc_engine *E, const char *config_path)
 
 int eng_create(silc_engine **out, const char *config_path, char *err, size_t errlen)
 {
+    return eng_create_comm(out, config_path, NULL, err, errlen);
+}
+
+int eng_create_comm(silc_engine **out, const char *config_path, silc_comm_ops *comm, char *err,
+                    size_t errlen)
+{
     silc_engine *E;
     if (!out) return -1;
     *out = NULL;
@@ -83,7 +90,9 @@ int eng_create(silc_engine **out, const char *config_path, char *err, size_t err
     sb_init(&E->warnings);
     E->threads = 1;
     E->rand_state = ENG_RAND_SEED;
-    if (eng_setup(E, config_path)) {
+    /* The communicator first: the loader picks MPI builds of plugins for it. */
+    if ((comm && dist_attach(E, comm)) || eng_setup(E, config_path)) {
+        if (comm && !E->dist && comm->destroy) comm->destroy(comm->impl);
         if (err && errlen)
             snprintf(err, errlen, "%s", E->err[0] ? E->err : "engine initialisation failed");
         eng_destroy(&E);
@@ -118,6 +127,7 @@ void eng_destroy(silc_engine **pE)
     }
     cfg_destroy(E);
     ld_destroy(E);
+    dist_detach(E);
     sb_free(&E->warnings);
     free(E);
     *pE = NULL;

@@ -40,6 +40,8 @@ typedef struct eng_info {
     silc_report report;     /* of the last solve in the statement */
     double seconds;         /* wall time of the whole statement */
     char backends[128];     /* backends that ran, comma separated, deduplicated */
+    int ranks;              /* of an SPMD engine (dist.h), else 0 */
+    uint64_t moved_matrix, moved_vector; /* bytes moved between ranks by the statement */
     acc_pending pending;    /* report.backward_error == ACC_DEFERRED: owned refs */
 } eng_info;
 
@@ -66,6 +68,7 @@ struct silc_engine {
                                            unlimited (the default): an internal guard that
                                            the fuzzers set so `while 1 {}` ends; no option */
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
+    struct dist_ctx *dist;              /* the communicator of an SPMD engine (dist.h), NULL = one process */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
 };
@@ -73,6 +76,11 @@ struct silc_engine {
 /* ---- engine.c -------------------------------------------------------------- */
 /* config_path NULL: SILC_CONFIG, else ./silc.conf if present, else defaults. */
 int eng_create(silc_engine **out, const char *config_path, char *err, size_t errlen);
+/* As eng_create, on every rank of comm (taken over, also on failure): an
+ * SPMD engine (dist.h).  Collective. */
+struct silc_comm_ops;
+int eng_create_comm(silc_engine **out, const char *config_path, struct silc_comm_ops *comm, char *err,
+                    size_t errlen);
 void eng_destroy(silc_engine **E);
 int eng_error(silc_engine *E, const char *fmt, ...)   /* sets E->err, returns -1 */
 #if defined(__GNUC__)
@@ -164,6 +172,7 @@ typedef struct host_call_ctx {
     const ld_backend *backend;      /* backend running the call (options prefix) */
     char err[1024];
     int status;
+    int collective;                 /* runs on the row blocks of every rank (dist.h) */
 } host_call_ctx;
 
 /* ---- dispatch.c ------------------------------------------------------------ */

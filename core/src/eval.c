@@ -17,6 +17,7 @@
 #include "tuner.h"
 #include "refine.h"
 #include "accuracy.h"
+#include "dist.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -167,6 +168,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         }
         sb_puts(V->explain_out, "\n");
         sb_init(&d);
+        dist_explain(E, call, &d);
         rc = disp_explain(E, call, &d);
         if (rc && strstr(E->err, "out of memory")) { /* not a reason to show, a failure */
             sb_free(&d);
@@ -178,13 +180,13 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         sb_free(&d);
         if (call->op == SILC_OP_SOLVE) {
             /* explain runs no solve: later steps see a placeholder of the right shape */
-            *out = val_dense_new(call->in[0]->n, call->in[1]->n);
+            *out = val_dense_new(call->in[0]->n, call->in[1]->n); /* whole: explain moves nothing */
             return *out ? 0 : eng_oom(E);
         }
     }
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
-    rc = disp_run(E, call);
+    rc = dist_run(E, call);
     E->accuracy_defer = 0;
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
@@ -198,7 +200,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         if (rep.backward_error == ACC_DEFERRED) acc_pending_hold(&V->pending, call);
         else acc_pending_release(&V->pending);
         add_backend(V, rep.backend);
-        tuner_note_solve(E, call);
+        if (!E->dist) tuner_note_solve(E, call); /* the tuner times one process (issue 18) */
     }
     call->report = NULL;
     *out = call->out;
@@ -490,7 +492,7 @@ UTIL_NOINLINE static int binary_of(lang_ev *V, const ast_node *n, silc_value *a,
 static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
 {
     silc_value *a, *b;
-    if (ev_expr(V, n->kids[0], &a)) return -1;
+    if (ev_expr_dist(V, n->kids[0], &a)) return -1;
     /* && and || short-circuit on a scalar left side, so `k <= n && v[k] > 0` is safe */
     if ((n->op == TK_AND || n->op == TK_OR) && val_is_scalar(a)) {
         int truth = val_scalar(a) != 0;
@@ -500,7 +502,7 @@ static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
             return *out ? 0 : eng_oom(V->E);
         }
     }
-    if (ev_expr(V, n->kids[1], &b)) {
+    if (ev_expr_dist(V, n->kids[1], &b)) {
         val_release(a);
         return -1;
     }
@@ -527,7 +529,7 @@ UTIL_NOINLINE static int unary_of(lang_ev *V, const ast_node *n, silc_value *a, 
 static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
 {
     silc_value *a;
-    if (ev_expr(V, n->kids[0], &a)) return -1;
+    if (ev_expr_dist(V, n->kids[0], &a)) return -1;
     if (n->op == TK_PLUS) {
         *out = a;
         return 0;
@@ -549,6 +551,36 @@ static UTIL_NOINLINE int eval_index(lang_ev *V, const ast_node *n, silc_value **
 }
 
 int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    if (ev_expr_dist(V, n, out)) return -1;
+    if (dist_make_whole(V->E, out)) {
+        val_release(*out);
+        *out = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+/* A distributed 1x1 (a row block of one row, np = 1) is made whole: every
+ * consumer of a scalar reads its entry. */
+static int scalar_whole(lang_ev *V, int rc, silc_value **out)
+{
+    if (rc == 0 && dist_is(*out) && val_is_scalar(*out) && dist_make_whole(V->E, out)) {
+        val_release(*out);
+        *out = NULL;
+        return -1;
+    }
+    return rc;
+}
+
+static int expr_any(lang_ev *V, const ast_node *n, silc_value **out);
+
+int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    return scalar_whole(V, expr_any(V, n, out), out);
+}
+
+static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
 {
     silc_engine *E = V->E;
     *out = NULL;
@@ -632,6 +664,11 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
     memset(&V->pending, 0, sizeof V->pending);
     info.seconds = util_now() - t0;
     snprintf(info.backends, sizeof info.backends, "%s", V->backends);
+    if (V->E->dist) {
+        info.ranks = V->E->dist->size;
+        info.moved_matrix = V->E->dist->moved_matrix - V->moved0[0];
+        info.moved_vector = V->E->dist->moved_vector - V->moved0[1];
+    }
     rc = eng_info_take(V->E, name, &info);
     if (rc) {
         val_release(v);
@@ -688,7 +725,8 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
     int64_t i, n = x->m * x->n;
     int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
     double c = scalar ? val_scalar(r) : 0;
-    if (x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
+    /* Distributed values are never updated in place: their arrays are blocks (dist.h). */
+    if (x->dist || r->dist || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;
     if ((op == TK_STAREQ || op == TK_SLASHEQ) && (!scalar || s)) return 0;
@@ -738,8 +776,8 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stm
     if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
         const silc_value *k;
         silc_value *a, *b;
-        if (ev_expr(V, e->kids[0], &a)) return -1;
-        if (ev_expr(V, e->kids[1], &b)) {
+        if (ev_expr_dist(V, e->kids[0], &a)) return -1;
+        if (ev_expr_dist(V, e->kids[1], &b)) {
             val_release(a);
             return -1;
         }
@@ -750,7 +788,7 @@ static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stm
             return rc;
         }
         if (binary_of(V, e, a, b, out)) return -1;
-    } else if (ev_expr(V, e, out)) {
+    } else if (ev_expr_dist(V, e, out)) {
         return -1;
     }
     if (!(rc = update_in_place(V, op, x, *out, NULL, stmt))) return 0;
@@ -779,7 +817,7 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
     if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
     if (s->kind == ST_ASSIGN && !cur) {
-        if (ev_expr(V, s->kids[0], &v)) return -1;
+        if (ev_expr_dist(V, s->kids[0], &v)) return -1;
         return bind(V, s, s->name, v, t0);
     }
     if (!cur) return undefined_name(V, s->name);
@@ -795,8 +833,14 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
             if (binary_of(V, s->kids[0], cur, r, &v)) return -1;
             return bind(V, s, s->name, v, t0);
         }
-    } else if (ev_expr(V, s->kids[0], &r)) {
+    } else if ((s->kind == ST_INDEX_ASSIGN ? ev_expr : ev_expr_dist)(V, s->kids[0], &r)) {
         val_release(cur);
+        return -1;
+    }
+    /* x[i] = r reads and writes x's entries: a whole copy of a distributed x. */
+    if (s->kind == ST_INDEX_ASSIGN && dist_make_whole(V->E, &cur)) {
+        val_release(cur);
+        val_release(r);
         return -1;
     }
     snprintf(ln, sizeof ln, "'%s'", s->name);
@@ -939,6 +983,17 @@ static int exec_info(lang_ev *V, const ast_node *s)
     ev_shape(v, shape, sizeof shape);
     sb_printf(&b, "%s: %s %s, nnz %lld\n", s->name, shape, val_format_name(v->format),
               (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
+    if (dist_is(v)) {
+        const dist_part *P = v->dist->part;
+        sb_printf(&b, "  distributed: rows in %d blocks (rank 0: %lld rows", P->size,
+                  (long long)(P->starts[1] - P->starts[0]));
+        if (P->size > 1)
+            sb_printf(&b, ", rank %d: %lld rows", P->size - 1,
+                      (long long)(P->starts[P->size] - P->starts[P->size - 1]));
+        sb_puts(&b, ")\n");
+    } else if (E->dist) {
+        sb_printf(&b, "  whole on each of the %d ranks\n", E->dist->size);
+    }
     if (!in) {
         sb_puts(&b, "  deposited by PUT (no statement of this session computed it)\n");
     } else {
@@ -948,6 +1003,10 @@ static int exec_info(lang_ev *V, const ast_node *s)
             in->report.backward_error = acc_pending_resolve(E, &in->pending, r->backend);
         sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
         sb_printf(&b, "  wall time: %.3g s\n", in->seconds);
+        if (in->ranks)
+            sb_printf(&b, "  ranks: %d; moved between ranks by the statement: %llu bytes of matrices, "
+                          "%llu bytes of vectors\n", in->ranks, (unsigned long long)in->moved_matrix,
+                      (unsigned long long)in->moved_vector);
         if (!in->has_solve) {
             sb_puts(&b, "  no solve in this statement\n");
         } else {
@@ -1046,13 +1105,29 @@ static int exec_block(lang_ev *V, const ast_node *b, int *flow)
     return 0;
 }
 
+static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
+
+/* One statement; on a communicator every rank learns whether every rank
+ * ran it (dist.h): a statement that failed on one rank alone (out of
+ * memory) stops all, instead of leaving that rank out of the next
+ * collective. */
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
+{
+    int rc = exec_stmt_here(V, s, flow);
+    return V->E->dist && !V->explain ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+}
+
+static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
 {
     double t0 = util_now();
     int truth;
     *flow = FLOW_NEXT;
     V->has_solve = 0;
     V->backends[0] = 0;
+    if (V->E->dist) {
+        V->moved0[0] = V->E->dist->moved_matrix;
+        V->moved0[1] = V->E->dist->moved_vector;
+    }
     acc_pending_release(&V->pending);
     switch (s->kind) {
     case ST_EXPR: {

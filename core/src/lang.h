@@ -99,6 +99,7 @@ typedef struct lang_ev {
     int64_t end_value;     /* what `end` means in the subscript being evaluated */
     int in_subscript;
     int has_solve;         /* the current statement ran a solve */
+    uint64_t moved0[2];    /* dist.h's byte counters (matrices, vectors) when the statement began */
     silc_report report;    /* its last solve report */
     acc_pending pending;   /* its operands when its backward error is deferred */
     char backends[128];    /* solve backends of the current statement */
@@ -147,5 +148,9 @@ int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
 
 /* eval.c entry used by index.c and builtins.c */
 int ev_expr(lang_ev *V, const ast_node *n, silc_value **out);
+/* As ev_expr, but the value may be distributed by rows (dist.h): for the
+ * consumers that hand it to ev_run or bind it, never read its arrays.
+ * ev_expr gathers such a value to every rank first. */
+int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out);
 
 #endif

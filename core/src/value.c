@@ -261,11 +261,54 @@ void val_release(silc_value *v)
         free(a);
     }
     v->attach = NULL;
+    if (v->dist) {
+        val_release(v->dist->block);
+        val_release(v->dist->whole);
+        dist_part_unref(v->dist->part);
+        free(v->dist);
+    }
     val_free_arrays(v);
+}
+
+static val_dist_hooks dist_hooks;
+
+void val_set_dist_hooks(const val_dist_hooks *h)
+{
+    dist_hooks = *h;
+}
+
+dist_part *dist_part_ref(dist_part *p)
+{
+    if (p) p->refcount++;
+    return p;
+}
+
+void dist_part_unref(dist_part *p)
+{
+    if (p && --p->refcount == 0) free(p);
+}
+
+silc_value *val_dist_new(int64_t m, int64_t n, int format, struct dist_ctx *ctx, dist_part *part,
+                         silc_value *block)
+{
+    silc_value *v = val_alloc(m, n, format);
+    if (!v || !(v->dist = calloc(1, sizeof *v->dist))) {
+        free(v);
+        val_release(block);
+        return NULL;
+    }
+    v->dist->ctx = ctx;
+    v->dist->part = dist_part_ref(part);
+    v->dist->block = block;
+    return v;
 }
 
 void val_view(const silc_value *v, silc_view *out)
 {
+    if (v->dist) { /* a distributed value shows this rank's rows (silc_plugin.h, ABI 1.5) */
+        val_view(v->dist->block, out);
+        return;
+    }
     out->m = v->m;
     out->n = v->n;
     out->format = v->format;
@@ -290,6 +333,8 @@ double val_scalar(const silc_value *v)
 
 double val_get(const silc_value *v, int64_t i, int64_t j)
 {
+    if (v && v->dist) /* the evaluator gathers before reading entries (dist.h) */
+        return v->dist->whole ? val_get(v->dist->whole, i, j) : NAN;
     if (!v || i < 0 || j < 0 || i >= v->m || j >= v->n) return 0.0;
     switch (v->format) {
     case SILC_FMT_DENSE:
@@ -316,6 +361,7 @@ size_t val_bytes(const silc_value *v)
 {
     size_t b;
     if (!v) return 0;
+    if (v->dist) return val_bytes(v->dist->block) + val_bytes(v->dist->whole);
     b = (size_t)v->cap * sizeof(double);
     if (v->format == SILC_FMT_CSR)
         b += (size_t)(v->m + 1) * sizeof(silc_index) + (size_t)v->cap * sizeof(silc_index);
@@ -827,6 +873,10 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     silc_props *p;
     if (!v) return NULL;
     p = &v->props;
+    if (v->dist) {
+        if ((parts & ~v->props_have) && dist_hooks.props) dist_hooks.props(v, parts & ~v->props_have);
+        return p;
+    }
     if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR)
         shape_csr(v);
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
@@ -876,6 +926,10 @@ static void val_scan(const silc_value *cv, int level)
 {
     silc_value *v = (silc_value *)cv; /* the cache is not part of the contents */
     if (v->scan_ready >= level) return;
+    if (v->dist) {
+        if (dist_hooks.scan) dist_hooks.scan(v);
+        return;
+    }
     if ((v->props_have & SILC_PROPS_NORMS) || v->format == SILC_FMT_BAND) {
         const silc_props *p = val_props(v);
         v->scan_maxabs = p->maxabs;

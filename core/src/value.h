@@ -30,6 +30,31 @@ typedef struct val_attachment {
     struct val_attachment *next;
 } val_attachment;
 
+/* A row partition: rank r holds rows [starts[r], starts[r+1]).  Shared,
+ * reference counted, by the values distributed the same way, so "same
+ * layout" is one comparison (dist.h). */
+typedef struct dist_part {
+    int64_t refcount;
+    int size;
+    int64_t starts[];           /* size + 1 */
+} dist_part;
+
+/* Where a distributed value's whole copy is: the same on every rank. */
+enum { DIST_WHOLE_NONE = 0, DIST_WHOLE_ROOT = 1, DIST_WHOLE_ALL = 2 };
+
+/* What makes a value distributed (dist.c builds and reads it; value.c only
+ * frees it).  The value itself then has no arrays: its m, n and format are
+ * the whole value's, block holds this rank's rows (an ordinary value,
+ * global column indices), and whole the gathered copy once one was needed,
+ * on rank 0 (DIST_WHOLE_ROOT) or on every rank (DIST_WHOLE_ALL). */
+typedef struct val_dist {
+    struct dist_ctx *ctx;       /* the engine's communicator and counters */
+    dist_part *part;
+    struct silc_value *block;
+    struct silc_value *whole;
+    int where;
+} val_dist;
+
 struct silc_value {
     int64_t refcount;
     uint64_t id;
@@ -46,6 +71,7 @@ struct silc_value {
     int scan_nonfinite;
     double scan_maxabs;
     val_attachment *attach;
+    val_dist *dist;          /* NULL: the value is whole here (value.h: val_dist) */
 };
 
 /* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
@@ -115,6 +141,21 @@ double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
 double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
 size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
 const char *val_format_name(int format);  /* "dense", "csr", "band" */
+
+/* Distributed values (dist.c).  val_dist_new makes an array-less value of
+ * the whole shape that takes over block and retains part.  The hooks let
+ * the properties and scans of such a value be computed collectively by
+ * dist.c (which installs them) when someone asks: value.c sits below the
+ * communicator. */
+silc_value *val_dist_new(int64_t m, int64_t n, int format, struct dist_ctx *ctx, dist_part *part,
+                         silc_value *block);
+dist_part *dist_part_ref(dist_part *p);
+void dist_part_unref(dist_part *p);
+typedef struct val_dist_hooks {
+    void (*props)(silc_value *v, int parts);     /* fill v->props for parts, set props_have */
+    void (*scan)(silc_value *v);                 /* fill scan_nonfinite, scan_maxabs, SCAN_MAXABS */
+} val_dist_hooks;
+void val_set_dist_hooks(const val_dist_hooks *h);
 
 void *val_attach_get(const silc_value *v, const char *key);
 int val_attach_set(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
