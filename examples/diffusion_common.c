@@ -14,35 +14,51 @@ static const double pi = 3.14159265358979323846;
 
 int diff_shifted_laplacian(int dim, int64_t n, double h, double c, silc_envelope_t *out)
 {
+    int64_t rows = (dim == 1 || dim == 2) && n >= 1 ? (dim == 1 ? n : n * n) : 0;
+    return diff_shifted_laplacian_rows(dim, n, h, c, 0, rows, out);
+}
+
+int diff_shifted_laplacian_rows(int dim, int64_t n, double h, double c, int64_t r0, int64_t r1,
+                                silc_envelope_t *out)
+{
     if ((dim != 1 && dim != 2) || n < 1 || !(h > 0)) {
         fprintf(stderr, "diff_shifted_laplacian: need dim 1 or 2, n >= 1, h > 0\n");
         return 1;
     }
     int64_t rows = dim == 1 ? n : n * n;
-    int64_t cap = rows * (2 * dim + 1);
-    int64_t *rowptr = malloc((size_t)(rows + 1) * sizeof *rowptr);
+    if (r0 < 0 || r1 < r0 || r1 > rows) {
+        fprintf(stderr, "diff_shifted_laplacian: rows [%lld, %lld) are not within [0, %lld)\n",
+                (long long)r0, (long long)r1, (long long)rows);
+        return 1;
+    }
+    int64_t m = r1 - r0;
+    /* At least one entry each, so that an empty block (a rank with no rows)
+     * is not mistaken for a failed allocation. */
+    int64_t cap = m * (2 * dim + 1) + 1;
+    int64_t *rowptr = malloc((size_t)(m + 1) * sizeof *rowptr);
     int64_t *colind = malloc((size_t)cap * sizeof *colind);
     double *val = malloc((size_t)cap * sizeof *val);
     if (!rowptr || !colind || !val) {
         free(rowptr), free(colind), free(val);
-        fprintf(stderr, "diff_shifted_laplacian: out of memory for %lld rows\n", (long long)rows);
+        fprintf(stderr, "diff_shifted_laplacian: out of memory for %lld rows\n", (long long)m);
         return 1;
     }
     /* Neighbours in increasing column order, so every CSR row comes out sorted:
-     * (i, j-1), (i-1, j), (i, j), (i+1, j), (i, j+1). */
+     * (i, j-1), (i-1, j), (i, j), (i+1, j), (i, j+1).  Column indices are
+     * global (a block of rows of the whole matrix). */
     double off = c / (h * h), diag = 1.0 - 2.0 * dim * off;
     int64_t nz = 0;
-    for (int64_t k = 0; k < rows; k++) {
+    for (int64_t k = r0; k < r1; k++) {
         int64_t i = k % n, j = k / n;
-        rowptr[k] = nz;
+        rowptr[k - r0] = nz;
         if (dim == 2 && j > 0) colind[nz] = k - n, val[nz++] = off;
         if (i > 0) colind[nz] = k - 1, val[nz++] = off;
         colind[nz] = k, val[nz++] = diag;
         if (i < n - 1) colind[nz] = k + 1, val[nz++] = off;
         if (dim == 2 && j < n - 1) colind[nz] = k + n, val[nz++] = off;
     }
-    rowptr[rows] = nz;
-    int rc = silc_envelope_csr(out, rows, rows, rowptr, colind, val);
+    rowptr[m] = nz;
+    int rc = silc_envelope_csr(out, m, rows, rowptr, colind, val);
     free(rowptr), free(colind), free(val);
     return rc;
 }
@@ -106,12 +122,17 @@ double diff2d_h(int64_t n)
 
 void diff2d_initial(int64_t n, double *u)
 {
+    diff2d_initial_rows(n, 0, n * n, u);
+}
+
+void diff2d_initial_rows(int64_t n, int64_t r0, int64_t r1, double *u)
+{
     double h = diff2d_h(n);
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t i = 0; i < n; i++) {
-            double x = (double)(i + 1) * h, y = (double)(j + 1) * h;
-            u[i + j * n] = (x > 0.4 && x < 0.6 && y > 0.4 && y < 0.6) ? 1.0 : 0.0;
-        }
+    for (int64_t k = r0; k < r1; k++) {
+        int64_t i = k % n, j = k / n;
+        double x = (double)(i + 1) * h, y = (double)(j + 1) * h;
+        u[k - r0] = (x > 0.4 && x < 0.6 && y > 0.4 && y < 0.6) ? 1.0 : 0.0;
+    }
 }
 
 double diff2d_heat(int64_t n, const double *u)
@@ -119,4 +140,42 @@ double diff2d_heat(int64_t n, const double *u)
     double h = diff2d_h(n), s = 0;
     for (int64_t k = 0; k < n * n; k++) s += u[k];
     return s * h * h;
+}
+
+int diff_parse_num(const char *prog, const char *opt, const char *s, double lo, double hi,
+                   int integer, double *out)
+{
+    char *end;
+    double v = s ? strtod(s, &end) : 0;
+    if (!s || end == s || *end || !(v >= lo && v <= hi) || (integer && v != floor(v))) {
+        fprintf(stderr, "%s: %s needs %s in [%g, %g], got '%s'\n", prog, opt,
+                integer ? "an integer" : "a number", lo, hi, s ? s : "");
+        return 1;
+    }
+    *out = v;
+    return 0;
+}
+
+int diff2d_write_pgm(const char *prog, const char *path, int64_t n, const double *u, double umax)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        fprintf(stderr, "%s: cannot write '%s'\n", prog, path);
+        return 1;
+    }
+    unsigned char *row = malloc((size_t)n);
+    int rc = !row || fprintf(f, "P5\n%lld %lld\n255\n", (long long)n, (long long)n) < 0;
+    for (int64_t j = n - 1; j >= 0 && !rc; j--) {
+        for (int64_t i = 0; i < n; i++) {
+            double v = umax > 0 ? u[i + j * n] / umax : 0;
+            row[i] = (unsigned char)lround(255.0 * (v < 0 ? 0 : v > 1 ? 1 : v));
+        }
+        rc = fwrite(row, 1, (size_t)n, f) != (size_t)n;
+    }
+    free(row);
+    if (fclose(f) || rc) {
+        fprintf(stderr, "%s: error writing '%s'\n", prog, path);
+        return 1;
+    }
+    return 0;
 }

@@ -24,6 +24,11 @@
  * dimensions on n points per side with spacing h; the unknown (i, j) is
  * i + j*n.  With c = -dt/2 this is Crank-Nicolson's A, with c = +dt/2 its B. */
 int diff_shifted_laplacian(int dim, int64_t n, double h, double c, silc_envelope_t *out);
+/* Rows [r0, r1) of that matrix, as an (r1 - r0) x n^dim CSR block with global
+ * column indices: what one rank of an MPI program puts with silc_put_rows.
+ * diff_shifted_laplacian is this for all the rows. */
+int diff_shifted_laplacian_rows(int dim, int64_t n, double h, double c, int64_t r0, int64_t r1,
+                                silc_envelope_t *out);
 
 /* Advances u (n^dim entries, in/out) by `steps` Crank-Nicolson steps of size dt
  * inside SILC: the matrices are PUT once, u stays in SILC between steps, and is
@@ -38,7 +43,18 @@ double diff1d_max_error(int64_t n, double t, const double *u);
 /* 2-D problem on the unit square: 1 on the block (0.4, 0.6)^2, 0 elsewhere. */
 double diff2d_h(int64_t n);
 void diff2d_initial(int64_t n, double *u);
+/* Entries [r0, r1) of that field (unknown k = i + j*n) into u[0 .. r1-r0). */
+void diff2d_initial_rows(int64_t n, int64_t r0, int64_t r1, double *u);
 /* Total heat sum(u) * h^2 (the midpoint rule for the integral of u). */
 double diff2d_heat(int64_t n, const double *u);
+
+/* Command-line and output helpers of the 2-D programs; their messages start
+ * with prog.  diff_parse_num: *out = the number s given for option opt, which
+ * must lie in [lo, hi] (and be an integer if `integer`); 1 with a message on
+ * stderr otherwise.  diff2d_write_pgm: the field as a binary 8-bit PGM scaled
+ * by umax, rows from the top (largest y) down so that y points up. */
+int diff_parse_num(const char *prog, const char *opt, const char *s, double lo, double hi,
+                   int integer, double *out);
+int diff2d_write_pgm(const char *prog, const char *path, int64_t n, const double *u, double umax);
 
 #endif
