@@ -39,10 +39,26 @@
  * single precision's range, or the single LU is numerically singular, the
  * matrix is factored in double and the note says why.
  *
- * The module links MUMPS's static archives with -Wl,--exclude-libs,ALL and
- * -Bsymbolic (see CMakeLists.txt): Debian's sequential MUMPS carries a stub
- * MPI and the same dmumps_c symbol as the MPI MUMPS inside PETSc, and neither
- * may leak out of this plugin or bind to the other's.
+ * The file is built twice (CMakeLists.txt).  The sequential module links
+ * MUMPS's static archives with -Wl,--exclude-libs,ALL and -Bsymbolic:
+ * Debian's sequential MUMPS carries a stub MPI and the same dmumps_c symbol
+ * as the MPI MUMPS inside PETSc, and neither may leak out of this plugin or
+ * bind to the other's.  The MPI module (-DSILC_MUMPS_MPI=1, Debian's MPI
+ * MUMPS on Open MPI, shared) has the same file and backend name in
+ * plugins/mpi/, which the core loads instead in MPI mode only.  There a
+ * whole-operand call runs as above on MPI_COMM_SELF, and SOLVE is also a
+ * collective op: with A and B distributed by row blocks, every rank calls
+ * MUMPS on the call's communicator (PAR=1) with its own rows as distributed
+ * assembled triplets (ICNTL(18)=3, global indices), B is gathered onto rank
+ * 0 (MUMPS's centralized right-hand side and solution) and X scattered back
+ * into the ranks' blocks.  The instance is cached on A per rank as above; its
+ * JOB=-2 is collective (an allreduce and MPI_Comm_free), so a distributed A
+ * must die on all ranks together.  MUMPS's INFOG is the same on every rank,
+ * so its failures give every rank the same status; local failures
+ * (allocations) are agreed over the communicator before the next collective
+ * step (agree below).  Distributed operands get neither the condition
+ * estimate (the estimator's control flow would run on rank 0 alone) nor
+ * mumps.precision = single (EUNSUP: the core's refinement is whole-operand).
  */
 #include "common/blas_threads.h"
 #include "silc_plugin.h"
@@ -58,6 +74,9 @@
 
 #include <dmumps_c.h>
 #include <smumps_c.h>
+#if SILC_MUMPS_MPI
+#include <mpi.h>
+#endif
 
 #define MUMPS_JOB_INIT (-1)
 #define MUMPS_JOB_END (-2)
@@ -65,6 +84,7 @@
 #define MUMPS_JOB_SOLVE 3
 #define MUMPS_JOB_ANALYSE_FACTOR 4
 #define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's only communicator */
+#define MUMPS_DISTRIBUTED_INPUT 3      /* ICNTL(18): each rank passes its own triplets */
 #define MUMPS_RETRIES 4                /* ICNTL(14) doublings on workspace errors */
 #define N_ICNTL 40
 #define N_CNTL 15
@@ -101,7 +121,7 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
     IC(15, "", "dense-row detection / compression in analysis"),
     IC(16, "", "number of OpenMP threads (0: as the environment says)"),
     IC(17, "", "reserved"),
-    IC(18, "0", "matrix distribution (the plugin centralizes: 0)"),
+    IC(18, "0", "matrix distribution (the plugin chooses: 0 centralized, 3 for distributed operands)"),
     IC(19, "0", "Schur complement (not supported: 0)"),
     IC(20, "0", "right-hand side format (dense: 0)"),
     IC(21, "0", "solution distribution (centralized: 0)"),
@@ -155,7 +175,7 @@ static const struct {
 } fixed_icntl[] = {
     {5, 0, "the plugin passes the matrix assembled"},
     {9, 1, "'\\' solves A x = b"},
-    {18, 0, "the matrix is centralized on the host"},
+    {18, 0, "the plugin chooses (centralized, or distributed for distributed operands)"},
     {19, 0, "no Schur complement is returned"},
     {20, 0, "the right-hand side is dense"},
     {21, 0, "the solution is returned centralized"},
@@ -276,6 +296,145 @@ static int workspace_error(int code)
     return code == -8 || code == -9 || code == -14 || code == -15 || code == -17 || code == -20;
 }
 
+/* ---- the ranks of a call ----------------------------------------------------------- */
+
+/* Who takes part in a call.  dist: A and B are distributed by rows over comm
+ * (a collective call; MPI build only), and layout is A's.  Otherwise the
+ * operands are whole and MUMPS runs on this process alone: on the sequential
+ * library's one communicator, or on MPI_COMM_SELF in the MPI build. */
+typedef struct solve_ctx {
+    int dist;
+    int rank, size;
+    MUMPS_INT comm_f;           /* MUMPS's comm_fortran */
+#if SILC_MUMPS_MPI
+    MPI_Comm comm;
+#endif
+    silc_layout layout;
+    int status;                 /* local_error's status and message, for agree */
+    char msg[256];
+} solve_ctx;
+
+/* A failure found on this rank alone: kept for agree(), which every rank
+ * reaches, instead of being returned straight away while the other ranks go
+ * on into a collective step. */
+static int local_error(solve_ctx *c, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static int local_error(solve_ctx *c, int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->msg, sizeof c->msg, fmt, ap);
+    va_end(ap);
+    return c->status = status;
+}
+
+#if SILC_MUMPS_MPI
+/* The communicator of the call: the host's for distributed operands, else
+ * MPI_COMM_SELF.  This build is only loaded in MPI mode, so MPI must be up. */
+static int ctx_open(silc_call *call, solve_ctx *c)
+{
+    int up = 0, down = 0;
+    const void *comm;
+    memset(c, 0, sizeof *c);
+    comm = host->comm(call, &c->rank, &c->size);
+    MPI_Initialized(&up);
+    MPI_Finalized(&down);
+    if (!up || down)
+        return host->error(call, SILC_ELIB,
+                           "mumps (MPI build): MPI is %s; this build runs only in MPI mode "
+                           "(the sequential libsilc_plugin_mumps.so serves the others)",
+                           down ? "already finalized" : "not initialized");
+    if (comm) {
+        c->dist = 1;
+        c->comm = *(const MPI_Comm *)comm;
+        if (!host->layout(call->in[0], &c->layout))
+            return host->error(call, SILC_EARG, "mumps: a collective solve needs A distributed by rows");
+    } else {
+        c->comm = MPI_COMM_SELF;
+        c->rank = 0;
+        c->size = 1;
+    }
+    c->comm_f = (MUMPS_INT)MPI_Comm_c2f(c->comm);
+    return SILC_OK;
+}
+
+/* Every rank passes its local status (0, or local_error's); all return the
+ * same: the lowest failing rank's status and message, naming that rank. */
+static int agree(silc_call *call, solve_ctx *c, int rc)
+{
+    struct {
+        int rank, status;
+    } in, out;
+    if (!c->dist) return rc ? host->error(call, c->status, "%s", c->msg) : SILC_OK;
+    in.rank = rc ? c->rank : INT_MAX;
+    in.status = rc ? c->status : SILC_OK;
+    /* MINLOC on MPI_2INT keeps the status that goes with the lowest rank. */
+    if (MPI_Allreduce(&in, &out, 1, MPI_2INT, MPI_MINLOC, c->comm) != MPI_SUCCESS)
+        return host->error(call, SILC_ELIB, "mumps: MPI_Allreduce failed agreeing on a status");
+    if (out.rank == INT_MAX) return SILC_OK;
+    if (MPI_Bcast(c->msg, (int)sizeof c->msg, MPI_CHAR, out.rank, c->comm) != MPI_SUCCESS)
+        return host->error(call, out.status, "mumps: failed on rank %d of %d", out.rank, c->size);
+    c->msg[sizeof c->msg - 1] = '\0';
+    return host->error(call, out.status, "%s (on rank %d of %d)", c->msg, out.rank, c->size);
+}
+
+/* 1 if flag is non-zero on every rank. */
+static int all_ranks(const solve_ctx *c, int flag)
+{
+    int all = flag != 0;
+    if (c->dist) MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_LAND, c->comm);
+    return all;
+}
+
+static int64_t sum_ranks(const solve_ctx *c, int64_t x)
+{
+    if (c->dist) MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_INT64_T, MPI_SUM, c->comm);
+    return x;
+}
+
+/* A value destroyed after MPI_Finalize cannot run JOB=-2 (MPI calls). */
+static int mpi_alive(void)
+{
+    int down = 0;
+    MPI_Finalized(&down);
+    return !down;
+}
+#else
+static int ctx_open(silc_call *call, solve_ctx *c)
+{
+    (void)call;
+    memset(c, 0, sizeof *c);
+    c->size = 1;
+    c->comm_f = MUMPS_USE_COMM_WORLD;
+    return SILC_OK;
+}
+
+static int agree(silc_call *call, solve_ctx *c, int rc)
+{
+    return rc ? host->error(call, c->status, "%s", c->msg) : SILC_OK;
+}
+
+static int all_ranks(const solve_ctx *c, int flag)
+{
+    (void)c;
+    return flag != 0;
+}
+
+static int64_t sum_ranks(const solve_ctx *c, int64_t x)
+{
+    (void)c;
+    return x;
+}
+
+static int mpi_alive(void)
+{
+    return 1;
+}
+#endif
+
 /* ---- the factorization attachment ------------------------------------------------ */
 
 typedef struct mumps_factor {
@@ -284,6 +443,8 @@ typedef struct mumps_factor {
         SMUMPS_STRUC_C s;
     } id;                       /* id.s when single, else id.d */
     int single;                 /* factored by smumps_c from af */
+    int dist;                   /* irn/jcn/a are this rank's rows (ICNTL(18)=3), rhs is on rank 0 */
+    MUMPS_INT comm_f;           /* the communicator it runs on */
     MUMPS_INT *icntl, *infog;   /* the arrays of the instance in use */
     int live;                   /* JOB=-1 succeeded: JOB=-2 must run */
     MUMPS_INT *irn, *jcn;       /* 1-based triplets; MUMPS reads them again for */
@@ -316,15 +477,26 @@ static void mumps_job(mumps_factor *F, int job)
     ((F)->single ? (void)((F)->id.s.member = (value)) : (void)((F)->id.d.member = (value)))
 #define ID_N(F) ((F)->single ? (F)->id.s.n : (F)->id.d.n)
 
-static void factor_free(void *p)
+/* Ends the MUMPS instance (collective over its communicator) and frees the
+ * triplets; F stays, no longer live, so it is never reused. */
+static void factor_end(mumps_factor *F)
 {
-    mumps_factor *F = p;
-    if (!F) return;
-    if (F->live) mumps_job(F, MUMPS_JOB_END);
+    if (F->live && mpi_alive()) mumps_job(F, MUMPS_JOB_END);
+    F->live = 0;
     host->free(F->irn);
     host->free(F->jcn);
     host->free(F->a);
     host->free(F->af);
+    F->irn = F->jcn = NULL;
+    F->a = NULL;
+    F->af = NULL;
+}
+
+static void factor_free(void *p)
+{
+    mumps_factor *F = p;
+    if (!F) return;
+    factor_end(F);
     host->free(F);
 }
 
@@ -337,8 +509,11 @@ static double full_get(const silc_view *v, int64_t i, int64_t j)
 }
 
 /* 1-based triplets of A (SYM=1: the lower triangle only).  CSR keeps explicit
- * zeros (they are part of the pattern); dense and band skip zeros. */
-static int build_triplets(const silc_view *v, int lower, mumps_factor *F, int64_t *nnz_out)
+ * zeros (they are part of the pattern); dense and band skip zeros.  A
+ * distributed A is CSR, v its rows from global row row0 on (else row0 = 0):
+ * the triplets carry global row numbers. */
+static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_factor *F,
+                          int64_t *nnz_out)
 {
     int64_t n = v->n, cap, nz = 0, i, j, k;
     cap = v->format == SILC_FMT_CSR ? v->nnz : v->format == SILC_FMT_BAND ? v->ld * n : n * n;
@@ -348,10 +523,10 @@ static int build_triplets(const silc_view *v, int lower, mumps_factor *F, int64_
     F->a = host->alloc((size_t)cap * sizeof(double));
     if (!F->irn || !F->jcn || !F->a) return SILC_ENOMEM;
     if (v->format == SILC_FMT_CSR) {
-        for (i = 0; i < n; i++)
+        for (i = 0; i < v->m; i++)
             for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) {
-                if (lower && v->colind[k] > i) break; /* columns are sorted */
-                F->irn[nz] = (MUMPS_INT)(i + 1);
+                if (lower && v->colind[k] > row0 + i) break; /* columns are sorted */
+                F->irn[nz] = (MUMPS_INT)(row0 + i + 1);
                 F->jcn[nz] = (MUMPS_INT)(v->colind[k] + 1);
                 F->a[nz++] = v->val[k];
             }
@@ -575,15 +750,16 @@ static const char *to_single(mumps_factor *F, int64_t nnz)
 }
 
 /* JOB=-1, then JOB=4, then JOB=2 again with twice the workspace while it runs
- * short, in F's arithmetic.  Returns INFOG(1) and the last JOB in *job. */
+ * short, in F's arithmetic.  nnz: the triplets of this rank when F->dist.
+ * Returns INFOG(1) and the last JOB in *job. */
 static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const settings *s, int *job)
 {
     int k;
     F->icntl = F->single ? F->id.s.icntl : F->id.d.icntl;
     F->infog = F->single ? F->id.s.infog : F->id.d.infog;
-    ID_SET(F, par, 1);
+    ID_SET(F, par, 1); /* rank 0 (the host) works too */
     ID_SET(F, sym, sym);
-    ID_SET(F, comm_fortran, MUMPS_USE_COMM_WORLD);
+    ID_SET(F, comm_fortran, F->comm_f);
     mumps_job(F, *job = MUMPS_JOB_INIT);
     if (INFOG(F, 1) < 0) return (int)INFOG(F, 1);
     F->live = 1;
@@ -597,14 +773,23 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
                 F->id.d.cntl[k - 1] = s->cntl[k - 1];
         }
     ID_SET(F, n, (MUMPS_INT)n);
-    ID_SET(F, nnz, nnz);
-    ID_SET(F, nz, nnz <= INT_MAX ? (MUMPS_INT)nnz : 0);
-    ID_SET(F, irn, F->irn);
-    ID_SET(F, jcn, F->jcn);
-    if (F->single)
-        F->id.s.a = F->af;
-    else
-        F->id.d.a = F->a;
+    if (F->dist) { /* the single-precision path is not offered here */
+        ICNTL(F, 18) = MUMPS_DISTRIBUTED_INPUT;
+        F->id.d.nnz_loc = nnz;
+        F->id.d.nz_loc = nnz <= INT_MAX ? (MUMPS_INT)nnz : 0;
+        F->id.d.irn_loc = F->irn;
+        F->id.d.jcn_loc = F->jcn;
+        F->id.d.a_loc = F->a;
+    } else {
+        ID_SET(F, nnz, nnz);
+        ID_SET(F, nz, nnz <= INT_MAX ? (MUMPS_INT)nnz : 0);
+        ID_SET(F, irn, F->irn);
+        ID_SET(F, jcn, F->jcn);
+        if (F->single)
+            F->id.s.a = F->af;
+        else
+            F->id.d.a = F->a;
+    }
     mumps_job(F, *job = MUMPS_JOB_ANALYSE_FACTOR);
     /* Workspace errors come from the factorization phase, after a complete
      * analysis: only the factorization (JOB=2) is repeated. */
@@ -616,25 +801,33 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
     return (int)INFOG(F, 1);
 }
 
-/* Initializes MUMPS for A, analyses and factors it, in single precision when
- * the settings ask and the entries allow. */
-static int factor_new(silc_call *call, const silc_view *v, int sym, const settings *s,
+/* Initializes MUMPS for A (v: this rank's rows when c->dist), analyses and
+ * factors it, in single precision when the settings ask and the entries
+ * allow.  Collective: every rank returns the same status. */
+static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym, const settings *s,
                       mumps_factor **out)
 {
     mumps_factor *F = host->calloc(1, sizeof *F);
     int64_t nnz = 0;
-    int rc, code, job;
+    int rc = SILC_OK, code, job;
     double t0 = host->now();
     *out = NULL;
-    if (!F) return host->error(call, SILC_ENOMEM, "mumps: out of memory");
-    F->cond_est = -1;
-    F->opts = *s;
-    if (build_triplets(v, sym == 1, F, &nnz)) {
-        factor_free(F);
-        return host->error(call, SILC_ENOMEM, "mumps: out of memory for %lld triplets",
-                           (long long)v->nnz);
+    if (!F) {
+        rc = local_error(c, SILC_ENOMEM, "mumps: out of memory");
+    } else {
+        F->cond_est = -1;
+        F->opts = *s;
+        F->dist = c->dist;
+        F->comm_f = c->comm_f;
+        if (build_triplets(v, c->dist ? c->layout.first_row : 0, sym == 1, F, &nnz))
+            rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for %lld triplets",
+                             (long long)v->nnz);
     }
-    if (nnz == 0) { /* MUMPS would answer "NNZ out of range" (INFOG(1)=-2) */
+    if ((rc = agree(call, c, rc))) {
+        factor_free(F); /* not live yet: nothing collective */
+        return rc;
+    }
+    if (sum_ranks(c, nnz) == 0) { /* MUMPS would answer "NNZ out of range" (INFOG(1)=-2) */
         factor_free(F);
         return host->error(call, SILC_ESINGULAR, "mumps: singular matrix (no nonzero entries)");
     }
@@ -714,7 +907,7 @@ static void note_add(silc_report *r, const char *fmt, ...)
     va_end(ap);
 }
 
-static void fill_report(silc_report *r, const mumps_factor *F)
+static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *c)
 {
     int sym = (int)(F->single ? F->id.s.sym : F->id.d.sym);
     const char *fact = sym == 1 ? "LDL' Cholesky" : "LU";
@@ -728,6 +921,9 @@ static void fill_report(silc_report *r, const mumps_factor *F)
     r->rcond = -1;
     r->iterations = 0;
     r->note[0] = '\0';
+    if (c->dist)
+        note_add(r, "MUMPS on %d ranks: distributed assembled matrix (ICNTL(18)=3), right-hand side "
+                    "and solution centralized on rank 0, no condition estimate", c->size);
     if (F->single) {
         if (host->abi_minor >= 2) r->single_factor = 1;
         note_add(r, "SYM=%d, %s order", sym, ordering_name((int)INFOG(F, 7)));
@@ -756,6 +952,16 @@ static int ends_with_spd(const char *cls)
     return n >= 4 && strcmp(cls + n - 4, ".spd") == 0;
 }
 
+/* Rows of A: the view of a distributed A shows this rank's rows only. */
+static int64_t global_rows(const silc_value *v, const silc_view *view)
+{
+    silc_layout L;
+    if (host->struct_size >= SILC_HOST_NEEDS(layout) && host->layout(v, &L)) return L.m_global;
+    return view->m;
+}
+
+/* Every rank gets the same answer: the shapes are global, and props_part
+ * computes the symmetry collectively for a distributed A. */
 static int solve_accepts(const silc_call *call, const char **why)
 {
     silc_view a;
@@ -764,7 +970,7 @@ static int solve_accepts(const silc_call *call, const char **why)
         return 0;
     }
     host->view(call->in[0], &a);
-    if (a.m != a.n) {
+    if (global_rows(call->in[0], &a) != a.n) {
         *why = "needs a square matrix";
         return 0;
     }
@@ -779,84 +985,221 @@ static int solve_accepts(const silc_call *call, const char **why)
     return 1;
 }
 
-static int solve_run(silc_call *call)
+/* The error analysis (ICNTL(11) > 0) runs once per factorization, on its
+ * first one-column solve (see the top of the file); RINFOG is kept for the
+ * report. */
+static int analysis_due(const mumps_factor *F, int64_t nrhs)
 {
-    silc_view a, b, o;
+    return !F->analysed && nrhs == 1 && ICNTL(F, 11) > 0;
+}
+
+static void keep_analysis(mumps_factor *F)
+{
+    int k;
+    F->analysed = 1;
+    for (k = 0; k < 11; k++) F->rinfog[k] = F->single ? F->id.s.rinfog[k] : F->id.d.rinfog[k];
+}
+
+/* x = A \ b on whole operands, into a new X; with the condition estimate. */
+static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, const silc_view *b,
+                       silc_value **out)
+{
+    silc_view o;
     silc_report *r = call->report;
-    settings s;
-    mumps_factor *F;
     silc_value *X;
-    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, icntl11, analyse, estimate, fold;
-    const char *key;
+    int64_t n = b->m;
+    int rc, icntl11, analyse, estimate, fold;
     double t0, *rhs;
-    const char *why = NULL;
-    if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
-    if ((rc = read_settings(call, &s))) return rc;
-    /* Both precisions' factorizations can live on A at once. */
-    key = sym ? (s.single ? "mumps.ldlt.single" : "mumps.ldlt")
-              : (s.single ? "mumps.lu.single" : "mumps.lu");
-    host->view(call->in[0], &a);
-    host->view(call->in[1], &b);
-    if (b.m != a.n)
-        return host->error(call, SILC_EARG, "mumps: right-hand side has %lld rows, A has %lld",
-                           (long long)b.m, (long long)a.n);
-    if (b.n > INT_MAX)
-        return host->error(call, SILC_EARG, "mumps: too many right-hand sides (%lld)",
-                           (long long)b.n);
-    if (a.n == 0 || b.n == 0) { /* nothing to factor or solve; MUMPS refuses N=0 */
-        call->out = host->dense_new(b.m, b.n);
-        return call->out ? SILC_OK : host->error(call, SILC_ENOMEM, "mumps: out of memory");
-    }
-    F = host->attach_get(call->in[0], key);
-    if (F && same_settings(&F->opts, &s)) {
-        r->reused_factor = 1;
-    } else {
-        if ((rc = factor_new(call, &a, sym, &s, &F))) return rc;
-        if (host->attach_set(call->in[0], key, F, factor_free)) {
-            factor_free(F);
-            return host->error(call, SILC_ENOMEM, "mumps: cannot attach the factorization");
-        }
-        r->factor_seconds = F->factor_seconds;
-    }
+    *out = NULL;
     /* dense_copy, or the copy after a folded solve, writes every entry. */
-    X = host->dense_new_uninit(b.m, b.n);
+    X = host->dense_new_uninit(b->m, b->n);
     if (!X) return host->error(call, SILC_ENOMEM, "mumps: cannot allocate the %lldx%lld solution",
-                               (long long)b.m, (long long)b.n);
+                               (long long)b->m, (long long)b->n);
     host->view(X, &o);
     t0 = host->now();
-    /* The error analysis runs once per factorization (see the top of the file). */
     icntl11 = (int)ICNTL(F, 11);
-    analyse = !F->analysed && b.n == 1 && icntl11 > 0;
+    analyse = analysis_due(F, b->n);
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    estimate = s.condest && F->cond_est < 0;
+    estimate = s->condest && F->cond_est < 0;
     fold = estimate && !analyse;
     rhs = o.val;
-    if (fold && !(rhs = host->alloc((size_t)a.n * (size_t)(b.n + EST_COLS) * sizeof *rhs))) {
+    if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
         host->release(X);
         return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     }
     if (!analyse) ICNTL(F, 11) = 0; /* restored below, after the estimate */
     do {
-        dense_copy(&b, rhs);
-        if (fold) host->inv_norm1_start(a.n, EST_COLS, rhs + a.n * b.n);
-    } while ((rc = run_solve(call, F, rhs, b.n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
-    if (!rc && analyse) {
-        F->analysed = 1;
-        int k;
-        for (k = 0; k < 11; k++) F->rinfog[k] = F->single ? F->id.s.rinfog[k] : F->id.d.rinfog[k];
-    }
-    if (!rc && fold) memcpy(o.val, rhs, (size_t)(a.n * b.n) * sizeof *rhs);
+        dense_copy(b, rhs);
+        if (fold) host->inv_norm1_start(n, EST_COLS, rhs + n * b->n);
+    } while ((rc = run_solve(call, F, rhs, b->n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
+    if (!rc && analyse) keep_analysis(F);
+    if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n) * sizeof *rhs);
     r->solve_seconds = host->now() - t0;
     ICNTL(F, 11) = 0; /* the estimate's solves, if any, without it */
-    if (!rc && estimate) rc = estimate_cond(call, F, fold ? rhs + a.n * b.n : NULL);
+    if (!rc && estimate) rc = estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
     ICNTL(F, 11) = icntl11;
     if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);
         return rc;
     }
-    fill_report(r, F);
+    *out = X;
+    return SILC_OK;
+}
+
+#if SILC_MUMPS_MPI
+/* x = A \ b on distributed operands, collectively: b's blocks are gathered
+ * onto rank 0, MUMPS's host (centralized right-hand side, ICNTL(20)=0), all
+ * ranks take part in the solve, and the solution, centralized on rank 0
+ * (ICNTL(21)=0), is scattered back into this rank's block of a new X.  One
+ * MPI_Gatherv / MPI_Scatterv per column: the blocks are column-major. */
+static int solve_dist(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
+                      silc_value **out)
+{
+    int64_t n = c->layout.m_global, m = c->layout.m_local, j;
+    int *counts = NULL, *displs = NULL, rc = SILC_OK, r, icntl11 = (int)ICNTL(F, 11), analyse;
+    double *rhs = NULL, t0;
+    silc_value *X = host->dist_dense_new(call->in[1], b->n);
+    silc_view o;
+    *out = NULL;
+    if (!X) {
+        rc = local_error(c, SILC_ENOMEM, "mumps: cannot allocate this rank's %lldx%lld block of the solution",
+                         (long long)m, (long long)b->n);
+    } else if (c->rank == 0) {
+        rhs = host->alloc((size_t)n * (size_t)b->n * sizeof *rhs);
+        counts = host->alloc((size_t)c->size * sizeof *counts);
+        displs = host->alloc((size_t)c->size * sizeof *displs);
+        if (!rhs || !counts || !displs)
+            rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for the %lldx%lld right-hand side on rank 0",
+                             (long long)n, (long long)b->n);
+        else
+            for (r = 0; r < c->size; r++) { /* n <= INT_MAX (solve_accepts) */
+                counts[r] = (int)(c->layout.starts[r + 1] - c->layout.starts[r]);
+                displs[r] = (int)c->layout.starts[r];
+            }
+    }
+    if ((rc = agree(call, c, rc))) goto done;
+    host->view(X, &o);
+    t0 = host->now();
+    analyse = analysis_due(F, b->n);
+    if (!analyse) ICNTL(F, 11) = 0;
+    do {
+        rc = SILC_OK; /* SOLVE_AGAIN: refill */
+        for (j = 0; j < b->n && !rc; j++)
+            if (MPI_Gatherv(m ? b->val + j * m : b->val, (int)m, MPI_DOUBLE, rhs ? rhs + j * n : NULL,
+                            counts, displs, MPI_DOUBLE, 0, c->comm) != MPI_SUCCESS)
+                rc = local_error(c, SILC_ELIB, "mumps: MPI_Gatherv of the right-hand side failed");
+        if ((rc = agree(call, c, rc))) break;
+    } while ((rc = run_solve(call, F, rhs, b->n)) == SOLVE_AGAIN);
+    ICNTL(F, 11) = icntl11;
+    if (rc) goto done;
+    if (analyse) keep_analysis(F);
+    for (j = 0; j < b->n && !rc; j++)
+        if (MPI_Scatterv(rhs ? rhs + j * n : NULL, counts, displs, MPI_DOUBLE, m ? o.val + j * m : o.val,
+                         (int)m, MPI_DOUBLE, 0, c->comm) != MPI_SUCCESS)
+            rc = local_error(c, SILC_ELIB, "mumps: MPI_Scatterv of the solution failed");
+    rc = agree(call, c, rc);
+    call->report->solve_seconds = host->now() - t0;
+done:
+    host->free(rhs);
+    host->free(counts);
+    host->free(displs);
+    if (rc && X) host->release(X);
+    if (!rc) *out = X;
+    return rc;
+}
+#endif
+
+/* A collective call's operands as solve_dist expects them, checked on this
+ * rank (the answers could differ between ranks only if the host erred, but a
+ * rank must not stop alone): A in CSR rows matching its layout, B dense with
+ * the same row blocks. */
+static int check_dist(silc_call *call, solve_ctx *c, const silc_view *a, const silc_view *b)
+{
+    silc_layout Lb;
+    int rc = SILC_OK;
+    if (a->format != SILC_FMT_CSR || a->m != c->layout.m_local)
+        rc = local_error(c, SILC_EARG, "mumps: a distributed A must be CSR rows (%lld local rows, layout %lld)",
+                         (long long)a->m, (long long)c->layout.m_local);
+    else if (!host->layout(call->in[1], &Lb) || Lb.first_row != c->layout.first_row ||
+             Lb.m_local != c->layout.m_local || Lb.m_global != c->layout.m_global)
+        rc = local_error(c, SILC_EARG, "mumps: the right-hand side is not distributed like A's rows");
+    else if (b->format != SILC_FMT_DENSE || b->m != Lb.m_local)
+        rc = local_error(c, SILC_EARG, "mumps: a distributed right-hand side must be dense");
+    return agree(call, c, rc);
+}
+
+static int solve_run(silc_call *call)
+{
+    silc_view a, b;
+    silc_report *r = call->report;
+    settings s;
+    solve_ctx c;
+    mumps_factor *F;
+    silc_value *X = NULL;
+    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, attach_rc;
+    const char *key;
+    const char *why = NULL;
+    if ((rc = ctx_open(call, &c))) return rc;
+    if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
+    if ((rc = read_settings(call, &s))) return rc;
+    if (c.dist && s.single)
+        return host->error(call, SILC_EUNSUP,
+                           "mumps: mumps.precision = single is not supported on distributed operands");
+    /* Both precisions' factorizations can live on A at once. */
+    key = sym ? (s.single ? "mumps.ldlt.single" : "mumps.ldlt")
+              : (s.single ? "mumps.lu.single" : "mumps.lu");
+    host->view(call->in[0], &a);
+    host->view(call->in[1], &b);
+    if (c.dist) {
+        if ((rc = check_dist(call, &c, &a, &b))) return rc;
+    } else if (b.m != a.n) {
+        return host->error(call, SILC_EARG, "mumps: right-hand side has %lld rows, A has %lld",
+                           (long long)b.m, (long long)a.n);
+    }
+    if (b.n > INT_MAX)
+        return host->error(call, SILC_EARG, "mumps: too many right-hand sides (%lld)",
+                           (long long)b.n);
+    if (a.n == 0 || b.n == 0) { /* nothing to factor or solve; MUMPS refuses N=0 */
+        call->out = c.dist ? host->dist_dense_new(call->in[1], b.n) : host->dense_new(b.m, b.n);
+        rc = agree(call, &c, call->out ? SILC_OK : local_error(&c, SILC_ENOMEM, "mumps: out of memory"));
+        if (rc && call->out) {
+            host->release(call->out);
+            call->out = NULL;
+        }
+        return rc;
+    }
+    F = host->attach_get(call->in[0], key);
+    if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {
+        r->reused_factor = 1;
+    } else {
+        /* An instance with other settings goes first (JOB=-2 is collective:
+         * the attachments are alike on every rank); A keeps the dead F
+         * until the new one replaces it. */
+        if (F) factor_end(F);
+        if ((rc = factor_new(call, &c, &a, sym, &s, &F))) return rc;
+        attach_rc = host->attach_set(call->in[0], key, F, factor_free)
+                        ? local_error(&c, SILC_ENOMEM, "mumps: cannot attach the factorization")
+                        : SILC_OK;
+        if ((rc = agree(call, &c, attach_rc))) {
+            /* Where F was attached, A keeps it ended, with the other ranks. */
+            if (attach_rc)
+                factor_free(F);
+            else
+                factor_end(F);
+            return rc;
+        }
+        r->factor_seconds = F->factor_seconds;
+    }
+#if SILC_MUMPS_MPI
+    if (c.dist)
+        rc = solve_dist(call, &c, F, &b, &X);
+    else
+#endif
+        rc = solve_whole(call, F, &s, &b, &X);
+    if (rc) return rc;
+    fill_report(r, F, &c);
     call->out = X;
     return SILC_OK;
 }
@@ -867,8 +1210,23 @@ static const silc_op_entry mumps_ops[SILC_OP_COUNT] = {
     [SILC_OP_SOLVE] = {solve_run, solve_accepts},
 };
 
+#if SILC_MUMPS_MPI
+#define MUMPS_BUILD "MPI"
+#define MUMPS_BUILD_MORE "; SOLVE collective on row-distributed operands"
+/* SOLVE runs collectively on distributed operands (ABI 1.5). */
+static const uint32_t mumps_collective[] = {SILC_COLLECTIVE(SILC_OP_SOLVE)};
+#define MUMPS_COLLECTIVE mumps_collective
+#define MUMPS_HOST_NEEDS SILC_HOST_NEEDS(dist_dense_new)
+#else
+#define MUMPS_BUILD "sequential"
+#define MUMPS_BUILD_MORE ""
+#define MUMPS_COLLECTIVE NULL
+#define MUMPS_HOST_NEEDS SILC_HOST_NEEDS(dense_new_uninit)
+#endif
+
 static const silc_backend mumps_backends[] = {
-    {NULL, "MUMPS " MUMPS_VERSION " sequential multifrontal LU / LDL' (AMF order)", SILC_OP_COUNT,
+    {NULL, "MUMPS " MUMPS_VERSION " " MUMPS_BUILD " multifrontal LU / LDL' (AMF order" MUMPS_BUILD_MORE ")",
+     SILC_OP_COUNT,
      mumps_ops},
 };
 
@@ -879,12 +1237,14 @@ static silc_plugin mumps_plugin = {
     (int)(sizeof mumps_options / sizeof mumps_options[0]), mumps_options,
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     NULL,
+    MUMPS_COLLECTIVE,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
                                         const char **errmsg)
 {
-    if (silc_host_check(h, SILC_HOST_NEEDS(dense_new_uninit), errmsg) || !out) return 1;
+    /* The MPI build calls host->comm, layout and dist_dense_new (ABI 1.5). */
+    if (silc_host_check(h, MUMPS_HOST_NEEDS, errmsg) || !out) return 1;
     host = h;
     blas_threads_attach(&mumps_plugin); /* threaded only through its BLAS */
     *out = &mumps_plugin;
