@@ -57,5 +57,46 @@ void srv_log(int level, const char *fmt, ...)
  * opened (the handshake completed), else 0. */
 int srv_session(int fd, unsigned long id, volatile int *state);
 
+/* ---- silcd --mpi (mpi_server.c; docs/server.md, docs/distributed.md) ----
+ * Rank 0 holds every connection in one process and serves one request at a
+ * time; each session's engine runs on every rank (dist.h), so before rank
+ * 0's engine takes a step that the other ranks must share, it announces the
+ * step (command), and the other ranks, in srv_follow, take the same step on
+ * their engine of that session. */
+enum { SRV_CMD_OPEN = 1, SRV_CMD_CLOSE, SRV_CMD_PUT, SRV_CMD_GET, SRV_CMD_EXEC, SRV_CMD_DELETE,
+       SRV_CMD_STOP };
+struct silc_comm_ops;
+typedef struct srv_ranks {
+    int rank, size;
+    int64_t min_rows;            /* --dist-min-rows: smaller PUTs are copied whole to every rank */
+    /* rank 0: tells the others the next step of session id (text: its name or statements) */
+    int (*command)(struct srv_ranks *R, int cmd, unsigned long id, const char *text);
+    /* other ranks: the next step; *text malloc'd (NULL if none) */
+    int (*receive)(struct srv_ranks *R, int *cmd, unsigned long *id, char **text);
+    /* rank 0's *w to every rank (a verdict only rank 0 can reach) */
+    void (*word)(struct srv_ranks *R, int64_t *w);
+    /* a communicator for one session's engine (collective) */
+    struct silc_comm_ops *(*engine_comm)(struct srv_ranks *R, char *err, size_t errlen);
+    void *impl;
+} srv_ranks;
+extern srv_ranks *srv_mpi;       /* NULL unless silcd --mpi */
+
+/* The pieces of srv_session that rank 0 of silcd --mpi drives from its own
+ * poll loop: open (handshake and engine; NULL, fd closed, if it failed),
+ * one request (0, or -1 when the session is over), close. */
+typedef struct session session;
+session *srv_session_open(int fd, unsigned long id, volatile int *state);
+int srv_session_fd(const session *S);
+int srv_session_step(session *S);
+void srv_session_close(session *S);
+/* The other ranks of silcd --mpi: follow rank 0's commands until STOP. */
+int srv_follow(void);
+/* mpi_server.c, built when MPI is found (SILC_HAVE_MPI): MPI_Init and the
+ * control communicator (sets srv_mpi); rank 0's serving loop; the end
+ * (tells the others to stop, MPI_Finalize). */
+int srv_mpi_init(int *argc, char ***argv, int64_t min_rows);
+int srv_mpi_serve(int lfd, int is_tcp);
+void srv_mpi_finish(void);
+
 
 #endif

@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "api.h"
+#include "dist.h"
 #include "engine.h"
 #include "protocol.h"
 
@@ -38,14 +39,20 @@ typedef struct outbuf {
     int failed;
 } outbuf;
 
-typedef struct session {
+struct session {
     int fd;
     unsigned long id;
     volatile int *state;   /* shared with the parent: SLOT_* */
     silc_engine *E;
     outbuf out;
+    proto_stream st;
+    proto_limits lim;
+    int slot;              /* the state of a session of silcd --mpi (no parent to share it with) */
+    int announced;         /* silcd --mpi: the other ranks made an engine for it */
     char err[4096];
-} session;
+};
+
+srv_ranks *srv_mpi;
 
 /* The bindings and records an EXEC may change, to restore on rollback. */
 typedef struct snapshot {
@@ -213,13 +220,17 @@ static int do_exec(session *S, const char *text)
     char *warnings;
     uint64_t used;
     int rc, guarded = srv_cfg.max_session_bytes > 0, r;
+    int64_t over;
     if (guarded && snapshot_take(E, &snap)) {
         return reply_error(S, "out of memory preparing the statement");
     }
+    if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_EXEC, S->id, text);
     rc = api_exec(E, text, S->err, sizeof S->err);
     if (guarded) {
         used = session_bytes(E);
-        if (used > srv_cfg.max_session_bytes) {
+        over = used > srv_cfg.max_session_bytes;
+        if (srv_mpi) srv_mpi->word(srv_mpi, &over); /* rank 0's count decides for all */
+        if (over) {
             char done[512];
             snprintf(done, sizeof done, "%.500s", rc ? S->err : "");
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: the values bound "
@@ -273,6 +284,14 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
         srv_log(LOG_INFO, "session %lu: PUT '%s' abandoned: %s", S->id, q->text, S->err);
         return -1;
     }
+    if (srv_mpi) { /* to every rank: row blocks, or whole when small (dist_share) */
+        silc_value *w;
+        srv_mpi->command(srv_mpi, SRV_CMD_PUT, S->id, q->text);
+        rc = dist_share(S->E, v, srv_mpi->min_rows, &w);
+        val_release(v);
+        if (rc) return reply_error(S, S->E->err);
+        v = w;
+    }
     rc = api_bind(S->E, q->text, v, S->err, sizeof S->err);
     val_release(v);
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
@@ -287,6 +306,10 @@ static int do_get(session *S, const char *name)
     char why[256];
     int k, rc;
     v = (silc_value *)api_lookup(S->E, name, S->err, sizeof S->err);
+    if (v && dist_is(v)) { /* its blocks, gathered to rank 0 (once: kept with the value) */
+        srv_mpi->command(srv_mpi, SRV_CMD_GET, S->id, name);
+        if (!(v = (silc_value *)dist_whole(S->E, v, 0))) return reply_error(S, S->E->err);
+    }
     val_retain(v);
     if (!v) return reply_error(S, S->err);
     k = proto_value_iov(v, &d, body + 1);
@@ -308,6 +331,7 @@ static int do_delete(session *S, const char *name)
     if (!api_lookup(S->E, name, S->err, sizeof S->err)) {
         rc = -1;
     } else {
+        if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_DELETE, S->id, name);
         store_remove(&S->E->store, name);
         eng_info_remove(S->E, name);
     }
@@ -374,10 +398,31 @@ static int token_matches(const char *given)
 static void handshake_deadline(int ms)
 {
     struct itimerval t;
+    /* silcd --mpi holds all sessions in one process: a timer would end
+     * them all; there the handshake's reads time out one by one. */
+    if (srv_mpi) return;
     memset(&t, 0, sizeof t);
     t.it_value.tv_sec = ms / 1000;
     t.it_value.tv_usec = (ms % 1000) * 1000;
     setitimer(ITIMER_REAL, &t, NULL);
+}
+
+/* A session's engine, with the server's configuration; on every rank of
+ * silcd --mpi (collective there). */
+static int session_engine(silc_engine **E, char *err, size_t errlen)
+{
+    int rc;
+    if (srv_mpi) {
+        struct silc_comm_ops *comm = srv_mpi->engine_comm(srv_mpi, err, errlen);
+        rc = comm ? eng_create_comm(E, srv_cfg.engine_config, comm, err, errlen) : -1;
+    } else {
+        rc = eng_create(E, srv_cfg.engine_config, err, errlen);
+    }
+    if (!rc && srv_cfg.threads > 0) {
+        (*E)->threads = srv_cfg.threads;
+        ld_set_threads(*E, srv_cfg.threads);
+    }
+    return rc;
 }
 
 /* Hello both ways, then OK, or ERROR and -1. */
@@ -419,11 +464,9 @@ static int handshake(session *S)
         reply_error(S, why);
         return -1;
     }
-    rc = eng_create(&S->E, srv_cfg.engine_config, S->err, sizeof S->err);
-    if (!rc && srv_cfg.threads > 0) {
-        S->E->threads = srv_cfg.threads;
-        ld_set_threads(S->E, srv_cfg.threads);
-    }
+    if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_OPEN, S->id, NULL);
+    S->announced = srv_mpi != NULL;
+    rc = session_engine(&S->E, S->err, sizeof S->err);
     if (rc) {
         srv_log(LOG_ERROR, "session %lu: engine: %s", S->id, S->err);
         reply_error(S, S->err);
@@ -510,28 +553,158 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
     return rc;
 }
 
+session *srv_session_open(int fd, unsigned long id, volatile int *state)
+{
+    session *S = calloc(1, sizeof *S);
+    if (!S) {
+        srv_log(LOG_ERROR, "session %lu: out of memory", id);
+        close(fd);
+        return NULL;
+    }
+    S->fd = fd;
+    S->id = id;
+    S->state = state ? state : &S->slot;
+    S->lim.max_value_bytes = srv_cfg.max_value_bytes;
+    S->lim.max_text_bytes = srv_cfg.max_text_bytes;
+    S->st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
+    if (handshake(S)) {
+        srv_session_close(S);
+        return NULL;
+    }
+    *S->state = SLOT_READY;
+    srv_log(LOG_INFO, "session %lu: open", id);
+    return S;
+}
+
+int srv_session_fd(const session *S)
+{
+    return S->fd;
+}
+
+int srv_session_step(session *S)
+{
+    int rc = serve_one(S, &S->st, &S->lim);
+    *S->state = SLOT_READY;
+    return rc;
+}
+
+void srv_session_close(session *S)
+{
+    if (!S) return;
+    if (S->announced) srv_mpi->command(srv_mpi, SRV_CMD_CLOSE, S->id, NULL);
+    if (S->E) {
+        eng_destroy(&S->E);
+        srv_log(LOG_INFO, "session %lu: closed", S->id);
+    }
+    free(S->out.p);
+    close(S->fd);
+    free(S);
+}
+
 int srv_session(int fd, unsigned long id, volatile int *state)
 {
-    session S;
-    proto_stream st;
-    proto_limits lim;
-    int opened;
-    memset(&S, 0, sizeof S);
-    S.fd = fd;
-    S.id = id;
-    S.state = state;
-    lim.max_value_bytes = srv_cfg.max_value_bytes;
-    lim.max_text_bytes = srv_cfg.max_text_bytes;
-    st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
-    opened = handshake(&S) == 0;
-    if (opened) {
-        *S.state = SLOT_READY;
-        srv_log(LOG_INFO, "session %lu: open", id);
-        while (await_request(&S) == 0 && serve_one(&S, &st, &lim) == 0) *S.state = SLOT_READY;
+    session *S = srv_session_open(fd, id, state);
+    if (!S) return 0;
+    while (await_request(S) == 0 && srv_session_step(S) == 0) {}
+    srv_session_close(S);
+    return 1;
+}
+
+/* ---- the other ranks of silcd --mpi ------------------------------------------ */
+
+typedef struct follower {
+    unsigned long id;
+    silc_engine *E;
+    struct follower *next;
+} follower;
+
+static silc_engine *engine_of(follower *list, unsigned long id)
+{
+    for (; list; list = list->next)
+        if (list->id == id) return list->E;
+    return NULL;
+}
+
+static void quiet(void *user, const char *text)
+{
+    (void)user;
+    (void)text;
+}
+
+/* The engine-side half of each of rank 0's steps above, in the same order,
+ * so that both reach the same collectives: do_put's dist_share, do_get's
+ * dist_whole, do_exec's statements and verdict, do_delete, the engine's
+ * creation and end. */
+int srv_follow(void)
+{
+    follower *list = NULL, **pp, *f;
+    char err[4096];
+    for (;;) {
+        int cmd;
+        unsigned long id;
+        char *text = NULL;
+        silc_engine *E;
+        if (srv_mpi->receive(srv_mpi, &cmd, &id, &text)) break;
+        if (cmd == SRV_CMD_STOP) {
+            free(text);
+            break;
+        }
+        E = engine_of(list, id);
+        if (cmd == SRV_CMD_CLOSE && !E) {
+            /* its engine could not be made here: nothing to close */
+        } else if (cmd == SRV_CMD_OPEN) {
+            silc_engine *ne = NULL;
+            if (session_engine(&ne, err, sizeof err) == 0) {
+                if (!(f = calloc(1, sizeof *f))) {
+                    srv_log(LOG_ERROR, "rank %d: out of memory following session %lu", srv_mpi->rank, id);
+                    abort(); /* this rank can no longer follow rank 0: the job ends */
+                }
+                ne->output = quiet;
+                f->id = id;
+                f->E = ne;
+                f->next = list;
+                list = f;
+            }
+        } else if (!E) {
+            srv_log(LOG_ERROR, "rank %d: command %d for unknown session %lu", srv_mpi->rank, cmd, id);
+            abort();
+        } else if (cmd == SRV_CMD_CLOSE) {
+            for (pp = &list; *pp && (*pp)->id != id; pp = &(*pp)->next) {}
+            f = *pp;
+            *pp = f->next;
+            eng_destroy(&f->E);
+            free(f);
+        } else if (cmd == SRV_CMD_PUT) {
+            silc_value *w;
+            if (dist_share(E, NULL, srv_mpi->min_rows, &w) == 0) {
+                api_bind(E, text, w, err, sizeof err);
+                val_release(w);
+            }
+        } else if (cmd == SRV_CMD_GET) {
+            const silc_value *v = store_get(&E->store, text);
+            if (v) dist_whole(E, v, 0);
+        } else if (cmd == SRV_CMD_DELETE) {
+            store_remove(&E->store, text);
+            eng_info_remove(E, text);
+        } else if (cmd == SRV_CMD_EXEC) {
+            snapshot snap;
+            int guarded = srv_cfg.max_session_bytes > 0, have = 0;
+            int64_t over = 0;
+            if (guarded) have = snapshot_take(E, &snap) == 0;
+            api_exec(E, text, err, sizeof err);
+            if (guarded) {
+                srv_mpi->word(srv_mpi, &over);
+                if (over && have) snapshot_restore(E, &snap);
+                else if (have) snapshot_free(&snap);
+            }
+        }
+        free(text);
     }
-    eng_destroy(&S.E);
-    free(S.out.p);
-    close(fd);
-    srv_log(LOG_INFO, "session %lu: closed", id);
-    return opened;
+    while (list) {
+        f = list->next;
+        eng_destroy(&list->E);
+        free(list);
+        list = f;
+    }
+    return 0;
 }

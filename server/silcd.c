@@ -113,6 +113,10 @@ static void usage(FILE *f)
           "  --io-timeout SECONDS    drop a peer that stalls inside a frame (default 30)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
+          "  --mpi                   run on every rank of mpirun: rank 0 serves, every session's\n"
+          "                          engine runs on all ranks (docs/distributed.md)\n"
+          "  --dist-min-rows N       with --mpi: PUT values of N rows or more are split in row\n"
+          "                          blocks among the ranks, smaller ones copied whole (default 1000)\n"
           "  --help, --version\n", f);
 }
 
@@ -185,6 +189,9 @@ static int read_token(const char *path)
     return 0;
 }
 
+static int mpi_mode;               /* --mpi */
+static int64_t dist_min_rows = 1000; /* --dist-min-rows */
+
 static int parse_args(int argc, char **argv, const char **ready_file)
 {
     int i;
@@ -200,6 +207,10 @@ static int parse_args(int argc, char **argv, const char **ready_file)
         if (strcmp(opt, "--version") == 0) {
             printf("silcd %s (protocol %u)\n", SILC_VERSION, PROTO_VERSION);
             exit(0);
+        }
+        if (strcmp(opt, "--mpi") == 0) {
+            mpi_mode = 1;
+            continue;
         }
         if (strncmp(opt, "--", 2) != 0) {
             fprintf(stderr, "silcd: unexpected argument '%s'\n", opt);
@@ -242,6 +253,12 @@ static int parse_args(int argc, char **argv, const char **ready_file)
                     ok = 1;
                 }
         } else if (strcmp(name, "--ready-file") == 0) *ready_file = val;
+        else if (strcmp(name, "--dist-min-rows") == 0) {
+            char *end;
+            long long r = strtoll(val, &end, 10);
+            ok = end != val && !*end && r >= 1;
+            dist_min_rows = r;
+        }
         else {
             fprintf(stderr, "silcd: unknown option '%s' (see silcd --help)\n", name);
             return -1;
@@ -660,6 +677,25 @@ int main(int argc, char **argv)
         fprintf(stderr, "silcd: --listen: %s\n", err);
         return 2;
     }
+    if (mpi_mode) {
+#ifdef SILC_HAVE_MPI
+        if (srv_mpi_init(&argc, &argv, dist_min_rows)) return 1;
+        if (srv_mpi->rank != 0) {
+            /* mpirun forwards SIGTERM and SIGINT to every rank: rank 0
+             * alone decides when the others stop (SRV_CMD_STOP). */
+            signal(SIGTERM, SIG_IGN);
+            signal(SIGINT, SIG_IGN);
+            val_set_max_bytes(srv_cfg.max_value_bytes, "silcd --max-value-bytes");
+            srv_follow();
+            srv_mpi_finish();
+            return 0;
+        }
+#else
+        fprintf(stderr, "silcd: --mpi: this silcd was built without MPI (apt-get install "
+                        "libopenmpi-dev, then rebuild)\n");
+        return 2;
+#endif
+    }
     n_conns = srv_cfg.max_clients;
     conns = calloc((size_t)n_conns, sizeof *conns);
     conn_state = mmap(NULL, (size_t)n_conns * sizeof *conn_state, PROT_READ | PROT_WRITE,
@@ -698,11 +734,18 @@ int main(int argc, char **argv)
         fprintf(stderr, "silcd: cannot write ready file '%s'\n", ready_file);
         return 1;
     }
-    accept_loop(lfd, !addr.is_unix);
+#ifdef SILC_HAVE_MPI
+    if (srv_mpi) srv_mpi_serve(lfd, !addr.is_unix);
+    else
+#endif
+        accept_loop(lfd, !addr.is_unix);
     srv_log(LOG_INFO, "shutting down: waiting for %d session(s)", live_sessions());
     close(lfd);
     if (addr.is_unix) unlink(addr.path);
     drain_sessions();
+#ifdef SILC_HAVE_MPI
+    srv_mpi_finish();
+#endif
     srv_log(LOG_INFO, "stopped");
     free(srv_cfg.token);
     free(conns);
