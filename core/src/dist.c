@@ -102,30 +102,40 @@ int dist_size(const silc_engine *E)
     return E && E->dist ? E->dist->size : 1;
 }
 
+static uint64_t call_hash(const char *what, const char *text);
+
+/* A failure every rank met with the same message is the statement's, not a
+ * rank's (an undefined name, a shape mismatch: every engine evaluates the
+ * same text), and reads as it would on one process.  A failure of some
+ * ranks, or with messages that differ, names the lowest failing rank, so a
+ * user knows where to look. */
 int dist_agree(silc_engine *E, int rc)
 {
     dist_ctx *D = E->dist;
-    int64_t mine = rc, *all;
+    int64_t mine[2], *all;
     uint64_t msg[MSG_WORDS];
-    int r, first = -1;
+    int r, first = -1, alike = 1;
     if (!D || D->size == 1) return rc;
-    all = calloc((size_t)D->size, sizeof *all);
+    all = calloc((size_t)D->size * 2, sizeof *all);
     if (!all) die(D, "out of memory agreeing on a status");
-    allgather(D, &mine, 1, all);
-    for (r = 0; r < D->size && first < 0; r++)
-        if (all[r]) first = r;
+    mine[0] = rc;
+    mine[1] = rc ? (int64_t)call_hash("", E->err) : 0;
+    allgather(D, mine, 2, all);
+    for (r = 0; r < D->size; r++) {
+        if (all[2 * r] && first < 0) first = r;
+        if (!all[2 * r] || all[2 * r + 1] != all[1]) alike = 0;
+    }
     if (first < 0) {
         free(all);
         return 0;
     }
-    rc = (int)all[first];
+    rc = (int)all[2 * first];
     free(all);
+    if (alike) return rc ? rc : -1; /* E->err already holds the common message */
     memset(msg, 0, sizeof msg);
     if (D->rank == first) memcpy(msg, E->err[0] ? E->err : "failed", strlen(E->err[0] ? E->err : "failed"));
     bcast(D, msg, MSG_WORDS, first);
     ((char *)msg)[sizeof msg - 1] = 0;
-    /* Rank 0's own message needs no rank when it is the only one failing?
-     * No: the rank is always named, so a user knows where to look. */
     eng_error(E, "rank %d of %d: %.3900s", first, D->size, (const char *)msg);
     return rc ? rc : -1;
 }
@@ -625,10 +635,12 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
     w->scan_ready = pw.s.scan_ready;
     w->scan_nonfinite = pw.s.scan_nonfinite;
     w->scan_maxabs = pw.s.scan_maxabs;
-    if (D->rank == 0) { /* rank 0 keeps the whole value it was given: a GET moves nothing */
-        w->dist->whole = val_retain(v);
-        w->dist->where = DIST_WHOLE_ROOT;
-    }
+    /* Rank 0 keeps the whole value it was given, so a GET moves nothing.
+     * `where` must read the same on every rank (value.h): dist_whole decides
+     * from it whether to enter a gather, and a rank that gathered alone
+     * would wait there for ever. */
+    if (D->rank == 0) w->dist->whole = val_retain(v);
+    w->dist->where = DIST_WHOLE_ROOT;
     *out = w;
     return 0;
 oom:
