@@ -62,6 +62,19 @@ static const struct {
     {"solve.rect", "suitesparse.spqr, lapack, reference"},
 };
 
+/* For a solve whose operands are distributed (dist.h), the built-in lists
+ * start with the backends that solve on the row blocks where they lie --
+ * MUMPS (AMF ordering, the fastest of PETSc's direct packages here:
+ * docs/distributed.md), then PETSc -- before the sequential ones, which
+ * would gather the matrix to every rank. */
+static const struct {
+    const char *cls;
+    const char *list;
+} distributed_lists[] = {
+    {"solve.sparse", "mumps, petsc, suitesparse.umfpack, reference"},
+    {"solve.sparse.spd", "mumps, petsc, suitesparse.cholmod, suitesparse.umfpack, reference"},
+};
+
 #define DISP_MAX_LIST 33 /* the config's 32 plus the appended reference */
 
 /* The backends to try for one call, and where the list came from. */
@@ -170,8 +183,10 @@ static void split_list(blist *L, const char *text)
     }
 }
 
-static void resolve_list(const silc_engine *E, const char *const *chain, int nchain, blist *L)
+static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
+                         blist *L)
 {
+    int distributed = E->dist && dist_call_has(call);
     const char *forced = cfg_get(E, "backend"), *text = NULL;
     char key[160];
     size_t i;
@@ -192,7 +207,10 @@ static void resolve_list(const silc_engine *E, const char *const *chain, int nch
         text = "reference";
         for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
             if (strcmp(default_lists[i].cls, chain[0]) == 0) text = default_lists[i].list;
-        snprintf(L->source, sizeof L->source, "built-in default for %s", chain[0]);
+        for (i = 0; distributed && i < sizeof distributed_lists / sizeof distributed_lists[0]; i++)
+            if (strcmp(distributed_lists[i].cls, chain[0]) == 0) text = distributed_lists[i].list;
+        snprintf(L->source, sizeof L->source, "built-in default for %s%s", chain[0],
+                 distributed ? ", distributed operands" : "");
     }
     split_list(L, text);
     for (c = 0; c < L->n; c++)
@@ -434,6 +452,9 @@ int disp_run(silc_engine *E, silc_call *call)
     } else {
         silc_report *saved = call->report;
         scale_state S;
+        /* Read below whether or not scaling ran: unset, a distributed
+         * solve's ranks would disagree on deferring its backward error. */
+        memset(&S, 0, sizeof S);
         /* A distributed system is not rescaled (scale.c copies whole arrays). */
         int scaling = call->op == SILC_OP_SOLVE && !dist_call_has(call);
         if (scaling && !call->report) call->report = &local;
@@ -441,7 +462,7 @@ int disp_run(silc_engine *E, silc_call *call)
         if (scaling && scale_solve_begin(E, call, &S)) {
             rc = SILC_ENOMEM;
         } else {
-            resolve_list(E, chain, n, &L);
+            resolve_list(E, call, chain, n, &L);
             /* A scaled solve's deferred residual would be formed unscaled,
              * where it may overflow: no deferral then. */
             rc = walk(E, call, chain, n, &L, E->accuracy_defer && !S.ea && !S.eb);
@@ -477,7 +498,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         if (call->options) cfg_clear_call_options(E);
         return eng_error(E, "out of memory classifying the matrix of '\\'");
     }
-    resolve_list(E, chain, n, &L);
+    resolve_list(E, call, chain, n, &L);
     sb_printf(b, "%s\n", why);
     sb_printf(b, "backends (%s):", L.source);
     for (i = 0; i < L.n; i++) sb_printf(b, "%s %s", i ? "," : "", L.names[i]);
