@@ -1,38 +1,61 @@
 /*
- * petsc.c -- the "petsc" backend: sparse solves with PETSc's KSP and PC.
+ * petsc.c -- the "petsc" backend: sparse solves with PETSc's KSP and PC,
+ * sequential on whole operands, collective on row-distributed ones.
  *
- * One operation, SILC_OP_SOLVE, under "solve.sparse" and "solve.sparse.spd",
- * sequential (PETSC_COMM_SELF).  The user drives PETSc with its own option
- * syntax through the typed option petsc.options ("-ksp_type cg -pc_type
- * hypre"); the direct packages of this PETSc build are reachable the PETSc way
- * (-pc_type lu -pc_factor_mat_solver_type mumps|umfpack|klu|superlu|cholmod).
+ * One operation, SILC_OP_SOLVE, under "solve.sparse" and "solve.sparse.spd".
+ * The user drives PETSc with its own option syntax through the typed option
+ * petsc.options ("-ksp_type cg -pc_type hypre"); the direct packages of this
+ * PETSc build are reachable the PETSc way (-pc_type lu
+ * -pc_factor_mat_solver_type mumps|superlu_dist|umfpack|klu|superlu|cholmod).
  * Defaults are PETSc's own -- GMRES(30) with ILU(0), or ICC(0) when PETSc
- * knows A is symmetric (the plugin tells it when the host found it so), rtol
- * 1e-5, atol 1e-50, dtol 1e4, max_it 10000 -- except that the ".spd" class
- * starts from CG and a MUMPS factorization from the AMF ordering
- * (petsc_options.c says why).  `info` shows the tolerances in force.
+ * knows A is symmetric (the plugin tells it when the host found it so), block
+ * Jacobi with ILU(0) blocks on several ranks, rtol 1e-5, atol 1e-50, dtol
+ * 1e4, max_it 10000 -- except that the ".spd" class starts from CG and a
+ * MUMPS factorization from the AMF ordering (petsc_options.c says why).
+ * `info` shows the tolerances in force.
+ *
+ * Whole operands (host->comm gives NULL) are solved on PETSC_COMM_SELF with a
+ * MATSEQAIJ, even in an MPI process.  Operands distributed by row blocks (ABI
+ * 1.5: the backend declares SOLVE in collective_ops) are solved on the host's
+ * communicator: every rank runs solve_run at once, wraps its rows of A
+ * (global column indices) in a MATMPIAIJ and its rows of b and x in MPI
+ * vectors, and PETSc does the rest collectively.  The two are one code path
+ * with the communicator as a parameter (psc_ranks); what differs is the
+ * matrix and vector type and that a distributed solve has no condition
+ * estimate on more than one rank.  A failure found on one rank only (an
+ * allocation, a size check) is first agreed over the communicator (agree():
+ * the lowest failing rank's message on every rank), so that no rank is left
+ * waiting inside a collective PETSc call; PETSc's collective calls fail on
+ * every rank together and need no agreement.
  *
  * The matrix, its KSP (with the preconditioner or factorization PETSc built)
  * and the options database live in one attachment of A per class, so the
- * next solve with the same A and the same options only runs KSPSolve.  Every
- * solve reports the iterations, the true relative residual ||b - A x|| / ||b||
- * (computed here: PETSc's convergence test may watch a preconditioned norm),
- * and KSP's converged reason; a negative reason is an error naming it
- * (SILC_ENOTCONV for iteration limits, SILC_EBREAKDOWN for breakdowns,
- * SILC_ESINGULAR for a zero pivot in a factorization, SILC_ENOTSPD under the
- * ".spd" class when CG or a Cholesky factorization finds A indefinite, so the
- * dispatcher retries under "solve.sparse").  With a direct preconditioner
- * (lu, cholesky) the host's Hager-Higham estimator gives a 1-norm condition
- * estimate from a few extra triangular solves: the block form (ABI 1.3,
- * MatMatSolve) for MUMPS's factors, the one-column form for the others.
+ * next solve with the same A and the same options only runs KSPSolve.  On
+ * distributed operands the attachment is per rank, and the ranks agree on
+ * reusing it, since destroying a KSP (MUMPS's JOB=-2, hypre) is collective.
+ * Every solve reports the iterations, the true relative residual ||b - A x||
+ * / ||b|| (computed here, collectively: PETSc's convergence test may watch a
+ * preconditioned norm), and KSP's converged reason; a negative reason is an
+ * error naming it (SILC_ENOTCONV for iteration limits, SILC_EBREAKDOWN for
+ * breakdowns, SILC_ESINGULAR for a zero pivot in a factorization,
+ * SILC_ENOTSPD under the ".spd" class when CG or a Cholesky factorization
+ * finds A indefinite, so the dispatcher retries under "solve.sparse").  With
+ * a direct preconditioner (lu, cholesky) on one process the host's
+ * Hager-Higham estimator gives a 1-norm condition estimate from a few extra
+ * triangular solves: the block form (ABI 1.3, MatMatSolve) for MUMPS's
+ * factors, the one-column form for the others.
  *
  * PETSc and MPI start on the first solve, not at load: MPI_Init only if
  * nobody initialised MPI (a host or an MPI server may own it), PetscInitialize
- * only if PETSc is not running, with -no_signal_handler.  Each is finalized at
- * shutdown (process exit) only if this plugin started it.  OpenMPI's singleton
- * MPI_Init works as root here without OMPI_ALLOW_RUN_AS_ROOT (only mpirun
- * wants it).  Around every stretch of PETSc calls PetscReturnErrorHandler is
- * pushed, so errors come back as codes and PETSc never prints or aborts.
+ * only if PETSc is not running, with -no_signal_handler; when that first solve
+ * is collective, PETSC_COMM_WORLD becomes (a duplicate of) the host's
+ * communicator first, since PetscInitialize is collective over it.  Each is
+ * finalized at shutdown (process exit) only if this plugin started it and MPI
+ * is still running (an MPI program finalizes MPI before exit).  OpenMPI's
+ * singleton MPI_Init works as root here without OMPI_ALLOW_RUN_AS_ROOT (only
+ * mpirun wants it).  Around every stretch of PETSc calls
+ * PetscReturnErrorHandler is pushed, so errors come back as codes and PETSc
+ * never prints or aborts.
  */
 #include "petsc_plugin.h"
 
@@ -40,6 +63,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,18 +76,32 @@
 const silc_host_api *psc_host;
 #define host psc_host
 
+/* The host has ABI 1.5's comm, layout and dist_dense_new: only then does the
+ * plugin declare its collective SOLVE and ask for the call's communicator. */
+static int host_dist;
+
 /* ---- starting and stopping PETSc ------------------------------------------------ */
 
 static enum { START_NONE, START_OK, START_FAILED } start_state;
 static char start_error[256];
 static int began_mpi, began_petsc, finished;
+static MPI_Comm petsc_world = MPI_COMM_NULL; /* our duplicate, when PETSC_COMM_WORLD is it */
 
 /* PetscInitialize keeps pointers to its arguments for the life of the process. */
 static char arg0[] = "silc", arg1[] = "-no_signal_handler";
 static char *petsc_argv[] = {arg0, arg1, NULL};
 static int petsc_argc = 2;
 
-static int petsc_start(silc_call *call)
+static int mpi_down(void)
+{
+    int down = 0;
+    MPI_Finalized(&down);
+    return down;
+}
+
+/* comm: the host's communicator when the first solve is collective (every
+ * rank of it is here at once), else NULL. */
+static int petsc_start(silc_call *call, const MPI_Comm *comm)
 {
     int flag = 0, rc;
     PetscBool running = PETSC_FALSE;
@@ -74,6 +112,12 @@ static int petsc_start(silc_call *call)
     start_state = START_FAILED;
     rc = MPI_Initialized(&flag);
     if (rc == MPI_SUCCESS && !flag) {
+        /* A communicator from the host means the program started MPI. */
+        if (comm) {
+            snprintf(start_error, sizeof start_error,
+                     "petsc: the host gave a communicator but MPI is not initialized");
+            return host->error(call, SILC_EINTERNAL, "%s", start_error);
+        }
         rc = MPI_Init(NULL, NULL);
         if (rc != MPI_SUCCESS) {
             char text[MPI_MAX_ERROR_STRING] = "";
@@ -85,6 +129,19 @@ static int petsc_start(silc_call *call)
         began_mpi = 1;
     }
     if ((ierr = PetscInitialized(&running)) == 0 && !running) {
+        /* PetscInitialize is collective over PETSC_COMM_WORLD, which would
+         * otherwise be MPI_COMM_WORLD: the host's ranks may be fewer.  A
+         * duplicate of our own, because the host frees its communicator when
+         * its context closes and PETSc needs its world until PetscFinalize. */
+        if (comm) {
+            rc = MPI_Comm_dup(*comm, &petsc_world);
+            if (rc != MPI_SUCCESS) {
+                snprintf(start_error, sizeof start_error, "MPI_Comm_dup of the host's communicator "
+                         "failed (MPI error %d)", rc);
+                return host->error(call, SILC_ELIB, "%s", start_error);
+            }
+            PETSC_COMM_WORLD = petsc_world;
+        }
         ierr = PetscInitialize(&petsc_argc, &argv, NULL, NULL);
         if (ierr) {
             snprintf(start_error, sizeof start_error, "PetscInitialize failed (PETSc error %d)",
@@ -109,19 +166,40 @@ static void leave(void)
     PetscPopErrorHandler();
 }
 
+/* At process exit.  An MPI program has called MPI_Finalize by then, after
+ * which neither PETSc nor MPI may be called: PETSc is then left as it is. */
 static void petsc_shutdown(void)
 {
     if (start_state != START_OK || finished) return;
     finished = 1;
+    if (mpi_down()) return;
     if (began_petsc) PetscFinalize();
-    if (began_mpi) {
-        int done = 0;
-        MPI_Finalized(&done);
-        if (!done) MPI_Finalize();
-    }
+    if (petsc_world != MPI_COMM_NULL) MPI_Comm_free(&petsc_world);
+    if (began_mpi) MPI_Finalize();
 }
 
 /* ---- errors ------------------------------------------------------------------- */
+
+/* A message held back during a rank-local phase (psc_error, agree). */
+static struct {
+    int on, status;
+    char msg[1024];
+} pending;
+
+int psc_error(silc_call *call, int status, const char *fmt, ...)
+{
+    char text[sizeof pending.msg];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    if (!pending.on) return host->error(call, status, "%s", text);
+    if (!pending.status) {
+        pending.status = status;
+        memcpy(pending.msg, text, sizeof text);
+    }
+    return status;
+}
 
 int psc_fail(silc_call *call, const char *what, PetscErrorCode ierr)
 {
@@ -144,15 +222,82 @@ int psc_fail(silc_call *call, const char *what, PetscErrorCode ierr)
     case PETSC_ERR_MISSING_FACTOR: status = SILC_EUNSUP; break;
     default: break;
     }
-    return host->error(call, status, "%s: %s (PETSc error %d%s)", what,
-                       msg[0] ? msg : "failed", (int)ierr, gen);
+    return psc_error(call, status, "%s: %s (PETSc error %d%s)", what, msg[0] ? msg : "failed",
+                     (int)ierr, gen);
+}
+
+/* ---- the ranks of a call ---------------------------------------------------------- */
+
+/* Who takes part in a solve.  dist: A and B are distributed by rows over comm
+ * (a collective call), layout is A's.  Otherwise the operands are whole and
+ * comm is PETSC_COMM_SELF, size 1. */
+typedef struct psc_ranks {
+    int dist;
+    MPI_Comm comm;
+    int rank, size;
+    silc_layout layout;
+} psc_ranks;
+
+static void ranks_open(silc_call *call, psc_ranks *R)
+{
+    const void *comm = NULL;
+    memset(R, 0, sizeof *R);
+    R->size = 1;
+    if (host_dist) comm = host->comm(call, &R->rank, &R->size);
+    if (comm) {
+        R->dist = 1;
+        R->comm = *(const MPI_Comm *)comm;
+    } else {
+        R->comm = PETSC_COMM_SELF;
+        R->rank = 0;
+        R->size = 1;
+    }
+}
+
+/* From here to agree(), psc_error keeps a distributed solve's failure back. */
+static void local_begin(const psc_ranks *R)
+{
+    pending.on = R->dist;
+    pending.status = 0;
+    pending.msg[0] = '\0';
+}
+
+/* Every rank passes its local status (0, or psc_error's); all return the
+ * same: the lowest failing rank's status and message, naming that rank.  On
+ * whole operands the failure was reported already and rc comes back. */
+static int agree(silc_call *call, const psc_ranks *R, int rc)
+{
+    struct {
+        int rank, status;
+    } in, out;
+    pending.on = 0;
+    if (!R->dist) return rc;
+    if (rc && !pending.status) snprintf(pending.msg, sizeof pending.msg, "petsc: failed (status %d)", rc);
+    in.rank = rc ? R->rank : INT_MAX;
+    in.status = rc;
+    /* MINLOC on MPI_2INT keeps the status that goes with the lowest rank. */
+    if (MPI_Allreduce(&in, &out, 1, MPI_2INT, MPI_MINLOC, R->comm) != MPI_SUCCESS)
+        return host->error(call, SILC_ELIB, "petsc: MPI_Allreduce failed agreeing on a status");
+    if (out.rank == INT_MAX) return SILC_OK;
+    if (MPI_Bcast(pending.msg, (int)sizeof pending.msg, MPI_CHAR, out.rank, R->comm) != MPI_SUCCESS)
+        return host->error(call, out.status, "petsc: failed on rank %d of %d", out.rank, R->size);
+    pending.msg[sizeof pending.msg - 1] = '\0';
+    return host->error(call, out.status, "%s (on rank %d of %d)", pending.msg, out.rank, R->size);
+}
+
+/* 1 if flag is non-zero on every rank. */
+static int all_ranks(const psc_ranks *R, int flag)
+{
+    int all = flag != 0;
+    if (R->dist) MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_LAND, R->comm);
+    return all;
 }
 
 /* ---- the solver attachment ---------------------------------------------------- */
 
 typedef struct psc_solver {
     Mat A;
-    KSP ksp;
+    KSP ksp;             /* NULL once cleared (solver_clear): not reusable */
     PetscOptions opts;   /* pushed as PETSc's default around every use of ksp */
     char *text;          /* the user's option string it was configured from */
     int spd;             /* built under the ".spd" class */
@@ -164,18 +309,28 @@ typedef struct psc_solver {
     char method[64];
 } psc_solver;
 
-static void solver_free(void *p)
+/* Destroys the PETSc objects (collective over the solver's communicator),
+ * keeping the rest.  After PetscFinalize or MPI_Finalize (values freed late
+ * at exit) they are gone with PETSc, or can no longer be destroyed. */
+static void solver_clear(psc_solver *S)
 {
-    psc_solver *S = p;
-    if (!S) return;
-    /* After PetscFinalize (values freed late at exit) PETSc objects are gone with it. */
-    if (!finished && start_state == START_OK) {
+    if (!finished && start_state == START_OK && !mpi_down()) {
         enter();
         KSPDestroy(&S->ksp);
         MatDestroy(&S->A);
         PetscOptionsDestroy(&S->opts);
         leave();
     }
+    S->ksp = NULL;
+    S->A = NULL;
+    S->opts = NULL;
+}
+
+static void solver_free(void *p)
+{
+    psc_solver *S = p;
+    if (!S) return;
+    solver_clear(S);
     host->free(S->text);
     host->free(S);
 }
@@ -189,27 +344,55 @@ static void solver_free(void *p)
         }                                                                                          \
     } while (0)
 
-/* A as a MATSEQAIJ (PETSc copies the arrays; PetscInt is 32-bit in this build). */
-static int build_matrix(silc_call *call, const silc_view *a, int spd, Mat *out)
+/* This rank's rows of A as PetscInt arrays (PetscInt is 32-bit in this build;
+ * solve_accepts and check_local saw that the counts fit).  Rank-local. */
+typedef struct psc_csr {
+    PetscInt *ia, *ja;
+} psc_csr;
+
+static int csr_indices(silc_call *call, const silc_view *a, psc_csr *c)
 {
-    PetscInt *ia = host->alloc((size_t)(a->n + 1) * sizeof *ia);
-    PetscInt *ja = host->alloc((size_t)(a->nnz > 0 ? a->nnz : 1) * sizeof *ja);
-    Mat M = NULL;
     int64_t k;
+    c->ia = host->alloc((size_t)(a->m + 1) * sizeof *c->ia);
+    c->ja = host->alloc((size_t)(a->nnz > 0 ? a->nnz : 1) * sizeof *c->ja);
+    if (!c->ia || !c->ja)
+        return psc_error(call, SILC_ENOMEM, "out of memory for %lld PetscInt indices",
+                         (long long)(a->nnz + a->m + 1));
+    for (k = 0; k <= a->m; k++) c->ia[k] = (PetscInt)a->rowptr[k];
+    for (k = 0; k < a->nnz; k++) c->ja[k] = (PetscInt)a->colind[k];
+    return SILC_OK;
+}
+
+static void csr_free(psc_csr *c)
+{
+    host->free(c->ia);
+    host->free(c->ja);
+    c->ia = c->ja = NULL;
+}
+
+/* A on R's communicator, PETSc copying the arrays: a MATSEQAIJ on one
+ * process, else a MATMPIAIJ of which this rank holds the rows of a (columns
+ * global; the diagonal block is square, as PETSc's vectors are split like
+ * the rows).  Collective. */
+static int build_matrix(silc_call *call, const psc_ranks *R, const silc_view *a, const psc_csr *c,
+                        int spd, Mat *out)
+{
+    Mat M = NULL;
     int rc = SILC_OK;
+    PetscInt m = (PetscInt)a->m, n = (PetscInt)a->n;
     *out = NULL;
-    if (!ia || !ja) {
-        rc = host->error(call, SILC_ENOMEM, "out of memory for %lld PetscInt indices",
-                         (long long)(a->nnz + a->n + 1));
-        goto done;
+    TRY(MatCreate(R->comm, &M), "MatCreate");
+    TRY(MatSetSizes(M, m, m, n, n), "MatSetSizes");
+    if (R->size > 1) {
+        TRY(MatSetType(M, MATMPIAIJ), "MatSetType");
+        TRY(MatMPIAIJSetPreallocationCSR(M, c->ia, c->ja, a->val), "MatMPIAIJSetPreallocationCSR");
+    } else {
+        TRY(MatSetType(M, MATSEQAIJ), "MatSetType");
+        TRY(MatSeqAIJSetPreallocationCSR(M, c->ia, c->ja, a->val), "MatSeqAIJSetPreallocationCSR");
     }
-    for (k = 0; k <= a->n; k++) ia[k] = (PetscInt)a->rowptr[k];
-    for (k = 0; k < a->nnz; k++) ja[k] = (PetscInt)a->colind[k];
-    TRY(MatCreate(PETSC_COMM_SELF, &M), "MatCreate");
-    TRY(MatSetSizes(M, (PetscInt)a->n, (PetscInt)a->n, (PetscInt)a->n, (PetscInt)a->n), "MatSetSizes");
-    TRY(MatSetType(M, MATSEQAIJ), "MatSetType");
-    TRY(MatSeqAIJSetPreallocationCSR(M, ia, ja, a->val), "MatSeqAIJSetPreallocationCSR");
-    /* What the host knows about A helps GAMG (CG eigenvalue estimates), MUMPS (SYM) and others. */
+    /* What the host knows about A helps GAMG (CG eigenvalue estimates), MUMPS
+     * (SYM) and others.  The properties are global (the host computes those
+     * of a distributed A collectively). */
     if (silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         TRY(MatSetOption(M, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
         TRY(MatSetOption(M, MAT_SYMMETRY_ETERNAL, PETSC_TRUE), "MatSetOption(MAT_SYMMETRY_ETERNAL)");
@@ -219,9 +402,15 @@ static int build_matrix(silc_call *call, const silc_view *a, int spd, Mat *out)
     M = NULL;
 done:
     MatDestroy(&M);
-    host->free(ia);
-    host->free(ja);
     return rc;
+}
+
+/* A vector over this rank's m of the n rows, its array placed later
+ * (VecPlaceArray): sequential on one process, else MPI.  Collective. */
+static PetscErrorCode vec_wrap(const psc_ranks *R, int64_t m, int64_t n, Vec *v)
+{
+    if (R->size > 1) return VecCreateMPIWithArray(R->comm, 1, (PetscInt)m, (PetscInt)n, NULL, v);
+    return VecCreateSeqWithArray(R->comm, 1, (PetscInt)n, NULL, v);
 }
 
 static int pc_is(PC pc, const char *type)
@@ -258,25 +447,46 @@ static void describe(psc_solver *S)
              detail ? " (" : "", detail ? detail : "", detail ? ")" : "");
 }
 
-/* A failed preconditioner: a zero pivot is a singular matrix, or under the
- * ".spd" class a matrix that is not positive definite. */
-static int pc_failed(silc_call *call, psc_solver *S, const char *where)
+/* The preconditioner's failed reason, a factorization's error counting as
+ * one, agreed over the ranks: a sub-block's ILU may fail on one rank only,
+ * and every rank must take the same branch.  The largest reason wins, any
+ * failure over PC_NOERROR. */
+static PCFailedReason pc_reason(const psc_ranks *R, psc_solver *S)
 {
     PC pc = NULL;
     PCFailedReason fr = PC_NOERROR;
-    int status = SILC_ELIB;
+    int code;
     KSPGetPC(S->ksp, &pc);
     PCGetFailedReason(pc, &fr);
+    if (pc_is_factor(pc) && fr == PC_NOERROR) {
+        Mat F = NULL;
+        MatFactorError fe = MAT_FACTOR_NOERROR;
+        if (!PCFactorGetMatrix(pc, &F) && F && !MatFactorGetError(F, &fe) && fe != MAT_FACTOR_NOERROR)
+            PCSetFailedReason(pc, (PCFailedReason)fe);
+        PCGetFailedReason(pc, &fr);
+    }
+    if (!R->dist) return fr;
+    /* PC_SETUP_ERROR is -1, below PC_NOERROR: no error counts as -2 here. */
+    code = fr == PC_NOERROR ? -2 : (int)fr;
+    MPI_Allreduce(MPI_IN_PLACE, &code, 1, MPI_INT, MPI_MAX, R->comm);
+    return code == -2 ? PC_NOERROR : (PCFailedReason)code;
+}
+
+/* A failed preconditioner (fr, from pc_reason): a zero pivot is a singular
+ * matrix, or under the ".spd" class a matrix that is not positive definite. */
+static int pc_failed(silc_call *call, psc_solver *S, PCFailedReason fr, const char *where)
+{
+    int status = SILC_ELIB;
     if (fr == PC_FACTOR_STRUCT_ZEROPIVOT || fr == PC_FACTOR_NUMERIC_ZEROPIVOT)
         status = S->spd ? SILC_ENOTSPD : SILC_ESINGULAR;
     else if (fr == PC_FACTOR_OUTMEMORY)
         status = SILC_ENOMEM;
-    return host->error(call, status, "%s: preconditioner failed: PC_%s (%s)%s", where,
-                       fr >= PC_SETUP_ERROR && fr <= PC_SUBPC_ERROR ? PCFailedReasons[fr] : "?",
-                       S->method,
-                       status == SILC_ESINGULAR ? ": the matrix is singular"
-                       : status == SILC_ENOTSPD ? ": the matrix is not positive definite"
-                                                : "");
+    return psc_error(call, status, "%s: preconditioner failed: PC_%s (%s)%s", where,
+                     fr >= PC_SETUP_ERROR && fr <= PC_SUBPC_ERROR ? PCFailedReasons[fr] : "?",
+                     S->method,
+                     status == SILC_ESINGULAR ? ": the matrix is singular"
+                     : status == SILC_ENOTSPD ? ": the matrix is not positive definite"
+                                              : "");
 }
 
 /* ---- condition estimate through the factorization ------------------------------ */
@@ -286,6 +496,7 @@ typedef struct cond_ctx {
     Vec in, out;
     int symmetric;
     PetscInt n;
+    MPI_Comm comm;       /* of one process: PETSC_COMM_SELF or a 1-rank host comm */
     double *block;       /* n x COND_COLS scratch of cond_apply_block */
 } cond_ctx;
 
@@ -314,8 +525,8 @@ static int cond_apply_block(void *ctx, double *X, int t, int trans)
 {
     cond_ctx *c = ctx;
     Mat B = NULL, Y = NULL;
-    PetscErrorCode ierr = MatCreateSeqDense(PETSC_COMM_SELF, c->n, t, X, &B);
-    if (!ierr) ierr = MatCreateSeqDense(PETSC_COMM_SELF, c->n, t, c->block, &Y);
+    PetscErrorCode ierr = MatCreateSeqDense(c->comm, c->n, t, X, &B);
+    if (!ierr) ierr = MatCreateSeqDense(c->comm, c->n, t, c->block, &Y);
     if (!ierr)
         ierr = trans && !c->symmetric ? MatMatSolveTranspose(c->F, B, Y) : MatMatSolve(c->F, B, Y);
     MatDestroy(&B);
@@ -343,9 +554,11 @@ static int block_estimate_pays(Mat F, int symmetric)
     return mat_solve && (symmetric || mat_solve_t);
 }
 
-static double condition_estimate(psc_solver *S, int64_t n, double norm1)
+/* Only on one process (R->size 1): the host's estimators work on whole
+ * vectors. */
+static double condition_estimate(const psc_ranks *R, psc_solver *S, int64_t n, double norm1)
 {
-    cond_ctx c = {NULL, NULL, NULL, 0, (PetscInt)n, NULL};
+    cond_ctx c = {NULL, NULL, NULL, 0, (PetscInt)n, R->comm, NULL};
     PC pc = NULL;
     double *work = NULL, est = -1;
     KSPGetPC(S->ksp, &pc);
@@ -359,8 +572,8 @@ static double condition_estimate(psc_solver *S, int64_t n, double norm1)
         S->cond_block = est >= 0;
     }
     if (!S->cond_block && (work = host->alloc((size_t)n * sizeof *work))) {
-        if (!VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.in) &&
-            !VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &c.out))
+        if (!VecCreateSeqWithArray(R->comm, 1, (PetscInt)n, NULL, &c.in) &&
+            !VecCreateSeqWithArray(R->comm, 1, (PetscInt)n, NULL, &c.out))
             est = host->inv_norm1_est(n, cond_apply, &c, work);
         VecDestroy(&c.in);
         VecDestroy(&c.out);
@@ -369,34 +582,30 @@ static double condition_estimate(psc_solver *S, int64_t n, double norm1)
     return est >= 0 && isfinite(est) ? norm1 * est : -1;
 }
 
-/* Builds matrix, options and KSP, and sets the preconditioner up (PETSc's options
- * database pushed by the caller). */
-static int solver_setup(silc_call *call, psc_solver *S, const silc_view *a)
+/* Builds the matrix and the KSP on R's communicator, and sets the
+ * preconditioner up (PETSc's options database pushed by the caller).
+ * Collective. */
+static int solver_setup(silc_call *call, const psc_ranks *R, psc_solver *S, const silc_view *a,
+                        const psc_csr *csr)
 {
     PC pc = NULL;
     PCFailedReason fr = PC_NOERROR;
     double t0 = host->now();
     int rc = SILC_OK;
-    if ((rc = build_matrix(call, a, S->spd, &S->A))) return rc;
-    TRY(KSPCreate(PETSC_COMM_SELF, &S->ksp), "KSPCreate");
+    if ((rc = build_matrix(call, R, a, csr, S->spd, &S->A))) return rc;
+    TRY(KSPCreate(R->comm, &S->ksp), "KSPCreate");
     TRY(PetscObjectSetOptions((PetscObject)S->ksp, S->opts), "PetscObjectSetOptions");
     TRY(KSPSetOperators(S->ksp, S->A, S->A), "KSPSetOperators");
     TRY(KSPSetFromOptions(S->ksp), "KSPSetFromOptions");
     TRY(KSPSetUp(S->ksp), "KSPSetUp");
     describe(S);
     TRY(KSPGetPC(S->ksp, &pc), "KSPGetPC");
-    TRY(PCGetFailedReason(pc, &fr), "PCGetFailedReason");
-    if (pc_is_factor(pc) && fr == PC_NOERROR) {
-        Mat F = NULL;
-        MatFactorError fe = MAT_FACTOR_NOERROR;
-        if (!PCFactorGetMatrix(pc, &F) && F && !MatFactorGetError(F, &fe) && fe != MAT_FACTOR_NOERROR)
-            PCSetFailedReason(pc, (PCFailedReason)fe);
-        PCGetFailedReason(pc, &fr);
-    }
-    if (fr != PC_NOERROR) return pc_failed(call, S, "KSPSetUp");
+    if ((fr = pc_reason(R, S)) != PC_NOERROR) return pc_failed(call, S, fr, "KSPSetUp");
     S->direct = pc_is(pc, PCLU) || pc_is(pc, PCCHOLESKY);
-    if (S->direct && S->condest)
-        S->cond_est = condition_estimate(S, a->n, silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1);
+    /* The properties' norms are asked for on every rank or none (R->size
+     * is the same everywhere). */
+    if (S->direct && S->condest && R->size == 1)
+        S->cond_est = condition_estimate(R, S, a->n, silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1);
     S->setup_seconds = host->now() - t0;
 done:
     return rc;
@@ -410,9 +619,25 @@ static int ends_with_spd(const char *cls)
     return n >= 4 && strcmp(cls + n - 4, ".spd") == 0;
 }
 
+static int distributed(const silc_value *v, silc_layout *L)
+{
+    return host_dist && host->layout(v, L);
+}
+
+/* Rows of A: the view of a distributed A shows this rank's rows only. */
+static int64_t global_rows(const silc_value *v, const silc_view *view)
+{
+    silc_layout L;
+    return distributed(v, &L) ? L.m_global : view->m;
+}
+
+/* Every rank of a collective call gets the same answer: it looks at global
+ * shapes and properties only (the host computes a distributed A's
+ * collectively); the local entry count is check_local's. */
 static int solve_accepts(const silc_call *call, const char **why)
 {
     silc_view a;
+    silc_layout L;
     if (call->nin < 2) {
         *why = "needs a right-hand side";
         return 0;
@@ -428,11 +653,11 @@ static int solve_accepts(const silc_call *call, const char **why)
         *why = "needs a sparse (CSR) matrix";
         return 0;
     }
-    if (a.m != a.n) {
+    if (global_rows(call->in[0], &a) != a.n) {
         *why = "needs a square matrix";
         return 0;
     }
-    if (a.n >= PETSC_MAX_INT || a.nnz >= PETSC_MAX_INT) {
+    if (a.n >= PETSC_MAX_INT || (!distributed(call->in[0], &L) && a.nnz >= PETSC_MAX_INT)) {
         *why = "matrix too large for this PETSc's 32-bit PetscInt";
         return 0;
     }
@@ -443,6 +668,28 @@ static int solve_accepts(const silc_call *call, const char **why)
     return 1;
 }
 
+/* A collective call's operands, checked on this rank (rank-local: the caller
+ * agrees): A's rows as its layout says, with an entry count PetscInt holds,
+ * and B dense, distributed like A's rows. */
+static int check_local(silc_call *call, psc_ranks *R, const silc_view *a, const silc_view *b)
+{
+    silc_layout Lb;
+    if (!host->layout(call->in[0], &R->layout))
+        return psc_error(call, SILC_EARG, "petsc: a collective solve needs A distributed by rows");
+    if (a->m != R->layout.m_local)
+        return psc_error(call, SILC_EARG, "petsc: A's block has %lld rows, its layout %lld",
+                         (long long)a->m, (long long)R->layout.m_local);
+    if (a->nnz >= PETSC_MAX_INT)
+        return psc_error(call, SILC_EDECLINE, "matrix too large for this PETSc's 32-bit PetscInt "
+                         "(%lld entries in this rank's rows)", (long long)a->nnz);
+    if (!host->layout(call->in[1], &Lb) || Lb.first_row != R->layout.first_row ||
+        Lb.m_local != R->layout.m_local || Lb.m_global != R->layout.m_global)
+        return psc_error(call, SILC_EARG, "petsc: the right-hand side is not distributed like A's rows");
+    if (b->format != SILC_FMT_DENSE || b->m != Lb.m_local)
+        return psc_error(call, SILC_EARG, "petsc: a distributed right-hand side must be dense");
+    return SILC_OK;
+}
+
 /* Entry (i, j) of a dense or band view, 0 outside the band. */
 static double full_get(const silc_view *v, int64_t i, int64_t j)
 {
@@ -451,7 +698,8 @@ static double full_get(const silc_view *v, int64_t i, int64_t j)
     return v->val[(v->ku + i - j) + j * v->ld];
 }
 
-/* B (any format) as a dense column-major copy: KSPSolve may scale b in place. */
+/* B (any format; a distributed one: this rank's rows) as a dense
+ * column-major copy: KSPSolve may scale b in place. */
 static void dense_copy(const silc_view *b, double *x)
 {
     int64_t i, j, k;
@@ -472,26 +720,29 @@ static const char *reason_name(KSPConvergedReason r)
     return r >= KSP_DIVERGED_PC_FAILED && r <= KSP_CONVERGED_ATOL_NORMAL ? KSPConvergedReasons[r] : "UNKNOWN";
 }
 
-/* The error of a negative converged reason. */
-static int diverged(silc_call *call, psc_solver *S, KSPConvergedReason reason, PetscInt its,
-                    double resid, int64_t column, int64_t ncols)
+/* The error of a negative converged reason (the same on every rank: PETSc
+ * decides it from global norms). */
+static int diverged(silc_call *call, const psc_ranks *R, psc_solver *S, KSPConvergedReason reason,
+                    PetscInt its, double resid, int64_t column, int64_t ncols)
 {
     int status = SILC_EBREAKDOWN;
     char where[48] = "";
-    if (reason == KSP_DIVERGED_PC_FAILED) return pc_failed(call, S, "KSPSolve");
+    if (reason == KSP_DIVERGED_PC_FAILED) return pc_failed(call, S, pc_reason(R, S), "KSPSolve");
     if (reason == KSP_DIVERGED_ITS || reason == KSP_DIVERGED_DTOL) status = SILC_ENOTCONV;
     if (S->spd && (reason == KSP_DIVERGED_INDEFINITE_PC || reason == KSP_DIVERGED_INDEFINITE_MAT))
         status = SILC_ENOTSPD;
     if (ncols > 1) snprintf(where, sizeof where, " on right-hand side %lld", (long long)column + 1);
-    return host->error(call, status,
-                       "KSPSolve: diverged (KSP_%s) after %lld iteration%s%s, relative "
-                       "residual %.3g (%s)",
-                       reason_name(reason), (long long)its, its == 1 ? "" : "s", where, resid,
-                       S->method);
+    return psc_error(call, status,
+                     "KSPSolve: diverged (KSP_%s) after %lld iteration%s%s, relative "
+                     "residual %.3g (%s)",
+                     reason_name(reason), (long long)its, its == 1 ? "" : "s", where, resid,
+                     S->method);
 }
 
-/* Solves column by column; fills X and the report. */
-static int run_solves(silc_call *call, psc_solver *S, double *B, double *X, int64_t n, int64_t ncols)
+/* Solves column by column; fills X and the report.  B and X hold this
+ * rank's m of the n rows, column-major.  Collective. */
+static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double *B, double *X,
+                      int64_t m, int64_t n, int64_t ncols)
 {
     silc_report *r = call->report;
     Vec b = NULL, x = NULL, res = NULL;
@@ -502,13 +753,13 @@ static int run_solves(silc_call *call, psc_solver *S, double *B, double *X, int6
     double worst = 0;
     int64_t j, max_its = 0;
     int rc = SILC_OK, len;
-    TRY(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &b), "VecCreateSeqWithArray");
-    TRY(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, (PetscInt)n, NULL, &x), "VecCreateSeqWithArray");
-    TRY(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)n, &res), "VecCreateSeq");
+    TRY(vec_wrap(R, m, n, &b), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
+    TRY(vec_wrap(R, m, n, &x), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
+    TRY(VecDuplicate(b, &res), "VecDuplicate");
     for (j = 0; j < ncols; j++) {
         double rel;
-        TRY(VecPlaceArray(b, B + j * n), "VecPlaceArray");
-        TRY(VecPlaceArray(x, X + j * n), "VecPlaceArray");
+        TRY(VecPlaceArray(b, B + j * m), "VecPlaceArray");
+        TRY(VecPlaceArray(x, X + j * m), "VecPlaceArray");
         TRY(KSPSolve(S->ksp, b, x), "KSPSolve");
         TRY(KSPGetConvergedReason(S->ksp, &reason), "KSPGetConvergedReason");
         TRY(KSPGetIterationNumber(S->ksp, &its), "KSPGetIterationNumber");
@@ -521,15 +772,15 @@ static int run_solves(silc_call *call, psc_solver *S, double *B, double *X, int6
         VecResetArray(x);
         rel = nb > 0 ? (double)(nr / nb) : (double)nr;
         if (reason < 0) {
-            rc = diverged(call, S, reason, its, rel, j, ncols);
+            rc = diverged(call, R, S, reason, its, rel, j, ncols);
             goto done;
         }
         if (!isfinite(rel)) {
-            rc = host->error(call, S->direct ? SILC_ESINGULAR : SILC_EBREAKDOWN,
-                             "KSPSolve: the solution has NaN or Inf entries after %lld "
-                             "iteration%s (KSP_%s, %s)%s",
-                             (long long)its, its == 1 ? "" : "s", reason_name(reason), S->method,
-                             S->direct ? ": the matrix is singular" : "");
+            rc = psc_error(call, S->direct ? SILC_ESINGULAR : SILC_EBREAKDOWN,
+                           "KSPSolve: the solution has NaN or Inf entries after %lld "
+                           "iteration%s (KSP_%s, %s)%s",
+                           (long long)its, its == 1 ? "" : "s", reason_name(reason), S->method,
+                           S->direct ? ": the matrix is singular" : "");
             goto done;
         }
         if (j == 0) first = reason;
@@ -546,8 +797,8 @@ static int run_solves(silc_call *call, psc_solver *S, double *B, double *X, int6
                  "; %lld right-hand sides (iterations and residual: the worst)", (long long)ncols);
 done:
     if (rc) {
-        VecResetArray(b);
-        VecResetArray(x);
+        if (b) VecResetArray(b);
+        if (x) VecResetArray(x);
     }
     VecDestroy(&b);
     VecDestroy(&x);
@@ -555,77 +806,14 @@ done:
     return rc;
 }
 
-static int solve_run(silc_call *call)
+/* Fills the report's method and condition estimate once the solves passed. */
+static void report_method(silc_report *r, const psc_ranks *R, const psc_solver *S)
 {
-    silc_view a, bv, o;
-    silc_report *r = call->report;
-    psc_solver *S = NULL;
-    silc_value *X = NULL;
-    double *B = NULL, t0;
-    const char *why = NULL, *text;
-    int spd = ends_with_spd(call->op_class), rc, pushed = 0, fresh = 0;
-    PetscErrorCode ierr;
-    const char *key = spd ? "petsc.ksp.spd" : "petsc.ksp";
-    int64_t condest = 1;
-    if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
-    text = host->option_string(call, "options", "");
-    if (!text) text = "";
-    if ((rc = host->option_int(call, "condest", 1, &condest))) return rc;
-    host->view(call->in[0], &a);
-    host->view(call->in[1], &bv);
-    if (bv.m != a.n)
-        return host->error(call, SILC_EARG, "right-hand side has %lld rows, A has %lld",
-                           (long long)bv.m, (long long)a.n);
-    if ((rc = petsc_start(call))) return rc;
-    X = host->dense_new(bv.m, bv.n);
-    if (!X) return host->error(call, SILC_ENOMEM, "cannot allocate the %lldx%lld solution",
-                               (long long)bv.m, (long long)bv.n);
-    if (a.n == 0 || bv.n == 0) {
-        call->out = X;
-        return SILC_OK;
-    }
-    host->view(X, &o);
-    enter();
-    B = host->alloc((size_t)(bv.m * bv.n) * sizeof *B);
-    if (!B) {
-        rc = host->error(call, SILC_ENOMEM, "out of memory for the right-hand side");
-        goto done;
-    }
-    dense_copy(&bv, B);
-    S = host->attach_get(call->in[0], key);
-    if (S && strcmp(S->text, text) == 0 && S->condest == (condest != 0)) {
-        r->reused_factor = 1;
-    } else {
-        size_t len = strlen(text) + 1;
-        fresh = 1;
-        S = host->calloc(1, sizeof *S);
-        if (!S || !(S->text = host->alloc(len))) {
-            rc = host->error(call, SILC_ENOMEM, "out of memory");
-            goto done;
-        }
-        memcpy(S->text, text, len);
-        S->spd = spd;
-        S->condest = condest != 0;
-        S->cond_est = -1;
-        if ((rc = psc_options_create(call, text, spd, &S->opts))) goto done;
-    }
-    if ((ierr = PetscOptionsPush(S->opts))) {
-        rc = psc_fail(call, "PetscOptionsPush", ierr);
-        goto done;
-    }
-    pushed = 1;
-    if (fresh) {
-        if ((rc = solver_setup(call, S, &a))) goto done;
-        r->factor_seconds = S->setup_seconds;
-    }
-    t0 = host->now();
-    if ((rc = run_solves(call, S, B, o.val, a.n, bv.n))) goto done;
-    r->solve_seconds = host->now() - t0;
-    if (!S->checked) {
-        if ((rc = psc_options_check_used(call, S->opts, text, spd, S->A))) goto done;
-        S->checked = 1;
-    }
     snprintf(r->method, sizeof r->method, "%s", S->method);
+    if (R->dist) {
+        size_t len = strlen(r->method);
+        snprintf(r->method + len, sizeof r->method - len, " on %d rank%s", R->size, R->size == 1 ? "" : "s");
+    }
     r->cond_est = S->cond_est;
     if (S->cond_est >= 0) {
         size_t len = strlen(r->note);
@@ -637,23 +825,141 @@ static int solve_run(silc_call *call)
             snprintf(r->note + len, sizeof r->note - len,
                      "; 1-norm condition estimate: Hager-Higham (MatSolve)");
     }
+}
+
+/* x = A \ b.  Whole operands: on this process alone.  Distributed ones: on
+ * every rank of the host's communicator at once, in three phases -- a
+ * rank-local one (checks, allocations, the options database, A's indices)
+ * that ends in agree(); the collective PETSc work (matrix, KSP set-up,
+ * solves, the unused-option check), whose failures every rank sees; and
+ * attaching the solver to A, agreed again. */
+static int solve_run(silc_call *call)
+{
+    silc_view a, bv, o;
+    silc_report *r = call->report;
+    psc_ranks R;
+    psc_csr csr = {NULL, NULL};
+    psc_solver *S = NULL;
+    silc_value *X = NULL;
+    double *B = NULL, t0;
+    const char *why = NULL, *text;
+    int spd = ends_with_spd(call->op_class), rc, pushed = 0, fresh = 0, entered = 0, reuse;
+    PetscErrorCode ierr;
+    const char *key = spd ? "petsc.ksp.spd" : "petsc.ksp";
+    int64_t condest = 1;
+    if (!solve_accepts(call, &why)) return host->error(call, SILC_EDECLINE, "%s", why);
+    text = host->option_string(call, "options", "");
+    if (!text) text = "";
+    if ((rc = host->option_int(call, "condest", 1, &condest))) return rc;
+    ranks_open(call, &R);
+    host->view(call->in[0], &a);
+    host->view(call->in[1], &bv);
+    if (!R.dist && bv.m != a.n)
+        return host->error(call, SILC_EARG, "right-hand side has %lld rows, A has %lld",
+                           (long long)bv.m, (long long)a.n);
+    if ((rc = petsc_start(call, R.dist ? &R.comm : NULL))) return rc;
+    /* Reusing A's solver is decided first, by every rank, before a rank-local
+     * failure could make one rank skip this collective step. */
+    S = host->attach_get(call->in[0], key);
+    reuse = all_ranks(&R, S && S->ksp && strcmp(S->text, text) == 0 && S->condest == (condest != 0));
+
+    /* Rank-local phase. */
+    local_begin(&R);
+    if (R.dist && (rc = check_local(call, &R, &a, &bv))) goto agreed;
+    X = R.dist ? host->dist_dense_new(call->in[1], bv.n) : host->dense_new(bv.m, bv.n);
+    if (!X) {
+        rc = psc_error(call, SILC_ENOMEM, "cannot allocate the %lldx%lld solution",
+                       (long long)global_rows(call->in[1], &bv), (long long)bv.n);
+        goto agreed;
+    }
+    if (a.n == 0 || bv.n == 0) goto agreed; /* nothing to solve: the same on every rank */
+    host->view(X, &o);
+    enter();
+    entered = 1;
+    /* At least one element: a rank may hold no rows. */
+    B = host->alloc((size_t)(bv.m * bv.n > 0 ? bv.m * bv.n : 1) * sizeof *B);
+    if (!B) {
+        rc = psc_error(call, SILC_ENOMEM, "out of memory for the right-hand side");
+        goto agreed;
+    }
+    dense_copy(&bv, B);
+    if (reuse) {
+        r->reused_factor = 1;
+    } else {
+        size_t len = strlen(text) + 1;
+        fresh = 1;
+        S = host->calloc(1, sizeof *S);
+        if (!S || !(S->text = host->alloc(len))) {
+            rc = psc_error(call, SILC_ENOMEM, "out of memory");
+            goto agreed;
+        }
+        memcpy(S->text, text, len);
+        S->spd = spd;
+        S->condest = condest != 0;
+        S->cond_est = -1;
+        if ((rc = psc_options_create(call, text, spd, &S->opts))) goto agreed;
+        if ((rc = csr_indices(call, &a, &csr))) goto agreed;
+    }
+agreed:
+    if ((rc = agree(call, &R, rc))) goto done;
+    if (a.n == 0 || bv.n == 0) goto done;
+
+    /* Collective phase. */
+    if ((ierr = PetscOptionsPush(S->opts))) {
+        rc = psc_fail(call, "PetscOptionsPush", ierr);
+        goto done;
+    }
+    pushed = 1;
     if (fresh) {
+        rc = solver_setup(call, &R, S, &a, &csr);
+        csr_free(&csr);
+        if (rc) goto done;
+        r->factor_seconds = S->setup_seconds;
+    }
+    t0 = host->now();
+    if ((rc = run_solves(call, &R, S, B, o.val, bv.m, a.n, bv.n))) goto done;
+    r->solve_seconds = host->now() - t0;
+    if (!S->checked) {
+        if ((rc = psc_options_check_used(call, R.comm, S->opts, text, spd, S->A))) goto done;
+        S->checked = 1;
+    }
+    report_method(r, &R, S);
+
+    /* Attaching: rank-local, agreed. */
+    if (fresh) {
+        psc_solver *old = host->attach_get(call->in[0], key);
+        int attach_rc;
         if (pushed) PetscOptionsPop();
         pushed = 0;
-        /* attach_set destroys the solver of other options it replaces. */
-        if (host->attach_set(call->in[0], key, S, solver_free)) {
-            rc = host->error(call, SILC_ENOMEM, "cannot attach the solver");
+        /* attach_set destroys the solver of other options it replaces; on
+         * distributed operands that destruction is collective, so it is done
+         * here, on every rank at once (the attachments are alike on every
+         * rank), and attach_set only frees memory. */
+        if (R.dist && old) solver_clear(old);
+        local_begin(&R);
+        attach_rc = host->attach_set(call->in[0], key, S, solver_free)
+                        ? psc_error(call, SILC_ENOMEM, "cannot attach the solver")
+                        : SILC_OK;
+        if ((rc = agree(call, &R, attach_rc))) {
+            /* Attached here but not elsewhere: its PETSc objects end now, with
+             * the other ranks' (solver_free below), and A keeps the shell. */
+            if (!attach_rc) {
+                solver_clear(S);
+                fresh = 0;
+            }
             goto done;
         }
         fresh = 0;
     }
 done:
+    pending.on = 0;
     if (pushed) PetscOptionsPop();
     if (fresh) solver_free(S);
-    leave();
+    csr_free(&csr);
+    if (entered) leave();
     host->free(B);
     if (rc) {
-        host->release(X);
+        if (X) host->release(X);
         return rc;
     }
     call->out = X;
@@ -667,19 +973,25 @@ static const silc_op_entry petsc_ops[SILC_OP_COUNT] = {
 };
 
 static const silc_backend petsc_backends[] = {
-    {NULL, "PETSc " PETSC_VERSION_TEXT " KSP/PC, sequential (options: -ksp_type, -pc_type, ...)",
+    {NULL,
+     "PETSc " PETSC_VERSION_TEXT " KSP/PC, sequential, or collective (MPIAIJ) on row-distributed "
+     "operands (options: -ksp_type, -pc_type, ...)",
      SILC_OP_COUNT, petsc_ops},
 };
+
+/* SOLVE runs collectively on distributed operands (ABI 1.5), declared only
+ * to a host that has comm, layout and dist_dense_new. */
+static const uint32_t petsc_collective[] = {SILC_COLLECTIVE(SILC_OP_SOLVE)};
 
 static const silc_option_spec petsc_options[] = {
     {"options", SILC_OPT_STRING, "",
      "PETSc options for the KSP and PC, e.g. -ksp_type cg -pc_type hypre -ksp_rtol 1e-10; empty = "
-     "PETSc's defaults: GMRES(30) + ILU(0) (ICC(0) for a symmetric A), rtol 1e-5, atol 1e-50, "
-     "max_it 10000, CG under solve.sparse.spd; options PETSc does not read are errors "
-     "(-options_left no: warnings)"},
+     "PETSc's defaults: GMRES(30) + ILU(0) (ICC(0) for a symmetric A; block Jacobi + ILU(0) on "
+     "several ranks), rtol 1e-5, atol 1e-50, max_it 10000, CG under solve.sparse.spd; options "
+     "PETSc does not read are errors (-options_left no: warnings)"},
     {"condest", SILC_OPT_BOOL, "true",
-     "estimate the 1-norm condition number when the PC is a direct factorization (lu, cholesky): "
-     "2-10 extra triangular solves per factorization"},
+     "estimate the 1-norm condition number when the PC is a direct factorization (lu, cholesky) "
+     "on one process: 2-10 extra triangular solves per factorization"},
 };
 
 static silc_plugin petsc_plugin = {
@@ -689,6 +1001,7 @@ static silc_plugin petsc_plugin = {
     (int)(sizeof petsc_options / sizeof petsc_options[0]), petsc_options,
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     petsc_shutdown,
+    NULL, /* collective_ops: silc_plugin_init sets it on a 1.5 host */
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
@@ -696,6 +1009,9 @@ SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugi
 {
     if (silc_host_check(h, SILC_HOST_NEEDS(inv_norm1_est_block), errmsg) || !out) return 1;
     host = h;
+    /* An older host never hands over distributed operands: sequential only. */
+    host_dist = h->struct_size >= SILC_HOST_NEEDS(dist_dense_new);
+    petsc_plugin.collective_ops = host_dist ? petsc_collective : NULL;
     blas_threads_attach(&petsc_plugin); /* threaded only through its BLAS */
     *out = &petsc_plugin;
     return 0;

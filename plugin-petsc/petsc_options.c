@@ -12,7 +12,10 @@
  * option is an error, because a misspelt -ksp_rtol silently gives the user
  * the default tolerance.  The suggestion comes from the option names the same
  * KSP/PC configuration prints under -help, captured through PetscHelpPrintf,
- * plus a short list of the options people type most.
+ * plus a short list of the options people type most.  On a collective solve
+ * the check is collective too: the ranks agree on the unread option, so they
+ * all return the same answer and all take part in rebuilding the
+ * configuration for the suggestion.
  */
 #include "petsc_plugin.h"
 
@@ -210,8 +213,11 @@ static PetscErrorCode capture_vfprintf(FILE *fd, const char fmt[], va_list ap)
 
 /* Collects the options a KSP configured from the user's string would read.
  * PETSc prints each options block's help once per process and prefix, so the
- * throw-away KSP gets a prefix of its own every time. */
-static void collect_names(silc_call *call, const char *user, int spd, Mat A, names *L)
+ * throw-away KSP gets a prefix of its own every time.  The KSP lives on A's
+ * communicator comm (KSPSetOperators wants the same), so this is collective
+ * over it; every rank captures the help text, whatever rank PETSc would
+ * print it on. */
+static void collect_names(silc_call *call, MPI_Comm comm, const char *user, int spd, Mat A, names *L)
 {
     static unsigned serial;
     char prefix[40];
@@ -234,7 +240,7 @@ static void collect_names(silc_call *call, const char *user, int spd, Mat A, nam
     capture_into = L;
     PetscHelpPrintf = capture_help;
     PetscVFPrintf = capture_vfprintf;
-    if (!KSPCreate(PETSC_COMM_SELF, &ksp) && !KSPSetOptionsPrefix(ksp, prefix) &&
+    if (!KSPCreate(comm, &ksp) && !KSPSetOptionsPrefix(ksp, prefix) &&
         !KSPSetOperators(ksp, A, A))
         KSPSetFromOptions(ksp);
     PetscHelpPrintf = saved_help;
@@ -282,15 +288,52 @@ static const char *suggest(const names *L, const char *unread)
 
 /* ---- the check ----------------------------------------------------------------- */
 
-int psc_options_check_used(silc_call *call, PetscOptions opts, const char *user, int spd, Mat A)
+/* On several ranks, each checked its own database (alike, but a sub-block's
+ * solver reads its options on its own rank only): all take the lowest rank
+ * with an unread option, its name and whether it saw others, so every rank
+ * returns the same and all or none enter collect_names. */
+static int agree_unread(MPI_Comm comm, int size, char *unread, PetscInt *first, PetscInt *others)
+{
+    struct {
+        int missing, rank;
+    } in, out;
+    struct {
+        char name[NAME_MAX_LEN];
+        int others;
+    } what;
+    if (size <= 1) return 0;
+    MPI_Comm_rank(comm, &in.rank);
+    in.missing = *first < 0;
+    if (MPI_Allreduce(&in, &out, 1, MPI_2INT, MPI_MINLOC, comm) != MPI_SUCCESS) return -1;
+    if (out.missing) {
+        *first = -1;
+        return 0;
+    }
+    memset(&what, 0, sizeof what);
+    if (in.rank == out.rank) {
+        memcpy(what.name, unread, NAME_MAX_LEN);
+        what.others = *others > 0;
+    }
+    if (MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, out.rank, comm) != MPI_SUCCESS) return -1;
+    memcpy(unread, what.name, NAME_MAX_LEN);
+    unread[NAME_MAX_LEN - 1] = '\0';
+    *first = 0;
+    *others = what.others;
+    return 0;
+}
+
+int psc_options_check_used(silc_call *call, MPI_Comm comm, PetscOptions opts, const char *user,
+                           int spd, Mat A)
 {
     PetscInt n = 0, i, first = -1, others = 0;
-    char **nm = NULL, **val = NULL, unread[NAME_MAX_LEN];
+    char **nm = NULL, **val = NULL, unread[NAME_MAX_LEN] = "";
     PetscBool strict = PETSC_TRUE, set = PETSC_FALSE;
     PetscErrorCode ierr;
     names L = {NULL, 0, 0, ""};
     const char *best;
-    int rc;
+    int rc, rank = 0, size = 1;
+    MPI_Comm_size(comm, &size);
+    MPI_Comm_rank(comm, &rank);
     /* -options_left no: PETSc's way of saying "unused options are fine". */
     if ((ierr = PetscOptionsGetBool(opts, NULL, "-options_left", &strict, &set)))
         return psc_fail(call, "PetscOptionsGetBool(-options_left)", ierr);
@@ -306,13 +349,17 @@ int psc_options_check_used(silc_call *call, PetscOptions opts, const char *user,
             }
         }
     PetscOptionsLeftRestore(opts, &n, &nm, &val);
+    if (agree_unread(comm, size, unread, &first, &others))
+        return psc_host->error(call, SILC_ELIB, "petsc: MPI failed agreeing on the unused options");
     if (first < 0) return SILC_OK;
     if (!strict) {
-        psc_host->log(1, "petsc: option -%s was not used%s", unread,
-                      others ? " (nor were others)" : "");
+        /* Once, not once per rank. */
+        if (rank == 0)
+            psc_host->log(1, "petsc: option -%s was not used%s", unread,
+                          others ? " (nor were others)" : "");
         return SILC_OK;
     }
-    collect_names(call, user, spd, A, &L);
+    collect_names(call, comm, user, spd, A, &L);
     best = suggest(&L, unread);
     if (best)
         rc = psc_host->error(call, SILC_EARG, "option -%s was not used (misspelt? did you mean -%s?)%s",
