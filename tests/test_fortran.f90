@@ -1,6 +1,8 @@
 ! test_fortran.f90 -- tests of the Fortran binding (module silc): scalars,
 ! vectors, dense 2-D arrays in column-major order, 1-based CSR in both integer
-! kinds, shape checks on silc_get, and error statuses with their messages.
+! kinds, shape checks on silc_get, error statuses with their messages, and the
+! row-block calls of MPI programs on one process (silc_rank, silc_put_rows,
+! silc_get_rows: the block is the whole value, first row 1).
 ! Prints "N passed, N failed" as its last line, like the C tests (tests/check.h),
 ! and ends with error stop when anything failed.  Runs embedded, or remote when
 ! SILC_SERVER is set.
@@ -18,8 +20,10 @@ program test_fortran
   call test_csr_int64()
   call test_csr_mistakes()
   call test_errors()
+  call test_rows()
   call check_ok(silc_finalize(), 'silc_finalize')
   call check_fails(silc_exec('x = 1'), '', 'exec after silc_finalize')
+  call test_rows_closed()
 
   print '(i0, a, i0, a)', passed, ' passed, ', failed, ' failed'
   if (failed > 0) error stop 1
@@ -181,6 +185,70 @@ contains
     call check_ok(silc_get('ok' // repeat(' ', 10), x), 'a name with trailing blanks')
     call check(x > 0.5_c_double, 'value fetched by a blank-padded name')
   end subroutine test_errors
+
+  ! One process: rank 0 of 1, and a block of rows is the whole value.
+  subroutine test_rows()
+    real(c_double) :: v(3) = [1, 2, 3], x(2, 3)
+    real(c_double), allocatable :: got(:), got2(:, :), vals(:)
+    integer :: rank, nranks, first, i
+    integer(c_int64_t) :: first64
+    integer, allocatable :: rp(:), ci(:)
+    integer :: m, n
+    call check_ok(silc_rank(rank, nranks), 'silc_rank')
+    call check(rank == 0 .and. nranks == 1, 'one process is rank 0 of 1')
+
+    call check_ok(silc_put_rows('rv', 1, v), 'put_rows of a whole vector')
+    call check_ok(silc_exec('rw = 2 * rv'), 'exec on rv')
+    first = -1
+    call check_ok(silc_get_rows('rw', first, got), 'get_rows into an unallocated array')
+    call check(first == 1 .and. allocated(got), 'get_rows allocates, first row 1')
+    if (allocated(got)) call check(size(got) == 3 .and. all(got == 2 * v), 'get_rows values')
+    got = [9.0_c_double]
+    call check_ok(silc_get_rows('rv', first, got), 'get_rows reallocates')
+    call check(size(got) == 3 .and. all(got == v), 'reallocated get_rows values')
+    first64 = -1
+    call check_ok(silc_get_rows('rv', first64, got), 'get_rows with an int64 first_row')
+    call check(first64 == 1, 'int64 first row 1')
+
+    x = reshape([(real(i, c_double), i = 1, 6)], [2, 3])
+    call check_ok(silc_put_rows('RX', 1_c_int64_t, x), 'put_rows of a dense 2x3 block')
+    call check_ok(silc_get_rows('RX', first, got2), 'get_rows into a 2-D array')
+    call check(first == 1 .and. all(shape(got2) == [2, 3]), 'shape of the 2-D block')
+    if (all(shape(got2) == [2, 3])) call check(all(got2 == x), 'dense block round trip')
+    call check_fails(silc_get_rows('RX', first, got), '3 columns', 'get_rows of a matrix into 1-D')
+
+    ! The 3x3 CSR of test_csr as a block of rows.
+    call check_ok(silc_put_rows('RA', 1, 3, 3, [1, 3, 6, 8], [1, 2, 1, 2, 3, 2, 3], &
+                                [4.0_c_double, -1.0_c_double, -1.0_c_double, 4.0_c_double, &
+                                 -1.0_c_double, -1.0_c_double, 4.0_c_double]), 'put_rows of a CSR block')
+    call check_ok(silc_get_csr('RA', m, n, rp, ci, vals), 'get_csr of RA')
+    call check(m == 3 .and. n == 3 .and. all(rp == [1, 3, 6, 8]) .and. all(ci == [1, 2, 1, 2, 3, 2, 3]), &
+               'CSR block round trip')
+    call check_ok(silc_put_rows('RA64', 1_c_int64_t, 1_c_int64_t, 2_c_int64_t, &
+                                [1_c_int64_t, 2_c_int64_t], [2_c_int64_t], [5.0_c_double]), &
+                  'put_rows of an int64 CSR block')
+    call check_ok(silc_get_rows('RA64', first, got2), 'CSR into a 2-D block')
+    call check(all(shape(got2) == [1, 2]), 'shape of the CSR block')
+    if (all(shape(got2) == [1, 2])) call check(got2(1, 1) == 0 .and. got2(1, 2) == 5, 'CSR block values')
+
+    ! Mistakes: 0-based rows, a block that is not the whole value, bad CSR.
+    call check_fails(silc_put_rows('Zr', 0, v), 'numbered from 1', 'first_row 0')
+    call check_fails(silc_put_rows('Zr', 2, v), 'whole value', 'first_row 2 on one process')
+    call check_fails(silc_put_rows('Zr', 1, 2, 2, [0, 1, 2], [0, 1], v), '1-based', '0-based CSR block')
+    call check_fails(silc_put_rows('Zr', 1, 2, 2, [0, 1, 2], [0, 1], v), 'silc_put_rows', &
+                     'CSR block mistakes name silc_put_rows')
+    call check_fails(silc_exec('z = Zr'), 'Zr', 'no failed put_rows left Zr behind')
+    call check_fails(silc_get_rows('nosuchname', first, got), 'nosuchname', 'get_rows of an undefined name')
+  end subroutine test_rows
+
+  ! After silc_finalize the row calls fail with a message, not a crash.
+  subroutine test_rows_closed()
+    real(c_double), allocatable :: got(:)
+    integer :: rank, nranks, first
+    call check_fails(silc_rank(rank, nranks), 'silc_init', 'silc_rank without a context')
+    call check_fails(silc_put_rows('v', 1, [1.0_c_double]), 'silc_init', 'put_rows without a context')
+    call check_fails(silc_get_rows('v', first, got), 'silc_init', 'get_rows without a context')
+  end subroutine test_rows_closed
 
   ! Passes when status is 0; otherwise shows the library's message.
   subroutine check_ok(status, what)

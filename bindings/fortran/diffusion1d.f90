@@ -3,8 +3,10 @@
 ! with u(x, 0) = sin x and u = 0 at both ends, whose exact solution is
 ! e^{-t} sin x.
 !
-!     diffusion1d [N [steps [T]]]      defaults: N = 100 interior points,
-!                                      steps = 500 (dt = 1e-3), T = 0.5
+!     diffusion1d [N [steps [T [FILE]]]]   defaults: N = 100 interior points,
+!                                          steps = 500 (dt = 1e-3), T = 0.5;
+!                                          FILE: write the final u there, one
+!                                          value a line, 17 digits
 !
 ! The tridiagonal matrices A = I - dt/2 L and B = I + dt/2 L are assembled here
 ! as 1-based CSR and deposited once; u stays inside SILC between steps, each
@@ -13,6 +15,7 @@
 ! ~ T h^2 e^{-T} / 12 (2.4e-5 at the defaults); the program exits with status 1
 ! if it exceeds max(1e-4, 4 x that estimate), i.e. if the scheme went wrong.
 ! Set SILC_SERVER=tcp://host:port to run the same program against silcd.
+! diffusion1d_mpi.f90 is the same run as an MPI program, each rank its rows.
 program diffusion1d
   use, intrinsic :: iso_c_binding, only: c_double
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
@@ -23,12 +26,15 @@ program diffusion1d
   real(c_double) :: t_end, dt, h, err, estimate, tol
   real(c_double), allocatable :: u(:), x(:)
   integer(int64) :: clock0, clock1, rate
+  character(len=:), allocatable :: out_file
 
   n = 100
   steps = 500
   t_end = 0.5_c_double
+  out_file = ''
   if (parse_args() /= 0) then
-    write (error_unit, '(a)') 'usage: diffusion1d [N [steps [T]]]   (N, steps positive integers, T >= 0)'
+    write (error_unit, '(a)') 'usage: diffusion1d [N [steps [T [FILE]]]]   (N, steps positive integers, ' // &
+      'T >= 0, FILE receives the final u)'
     stop 2
   end if
   dt = t_end / steps
@@ -56,6 +62,7 @@ program diffusion1d
     ' dt=', num(dt), ' time=', num(real(clock1 - clock0, c_double) / rate), 's'
   write (*, '(a, es10.3, a, es10.3, a)') 'max error=', err, &
     ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
+  if (len(out_file) > 0) call write_field(out_file, u)
   deallocate(u, x)
   if (.not. (err <= tol)) then   ! written so that a NaN fails too
     write (error_unit, '(a, es10.3, a)') 'diffusion1d: error above the tolerance ', tol, &
@@ -90,11 +97,11 @@ contains
   end function put_shifted_laplacian
 
   integer function parse_args() result(status)
-    character(len=64) :: arg
-    integer :: nargs
+    character(len=4096) :: arg
+    integer :: nargs, length
     status = 0
     nargs = command_argument_count()
-    if (nargs > 3) status = 1
+    if (nargs > 4) status = 1
     if (nargs >= 1 .and. status == 0) then
       call get_command_argument(1, arg)
       read (arg, *, iostat=status) n
@@ -110,7 +117,26 @@ contains
       read (arg, *, iostat=status) t_end
       if (status == 0 .and. .not. (t_end >= 0)) status = 1
     end if
+    if (nargs >= 4 .and. status == 0) then
+      call get_command_argument(4, arg, length=length)
+      if (length < 1 .or. length > len(arg)) status = 1
+      out_file = trim(arg)
+    end if
   end function parse_args
+
+  ! The field, one value a line with 17 significant digits (round-trip exact).
+  subroutine write_field(path, v)
+    character(len=*), intent(in) :: path
+    real(c_double), intent(in) :: v(:)
+    integer :: unit, ios
+    open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
+    if (ios == 0) write (unit, '(es25.17e3)', iostat=ios) v
+    if (ios == 0) close (unit, iostat=ios)
+    if (ios /= 0) then
+      write (error_unit, '(a)') 'diffusion1d: cannot write ' // path
+      stop 1
+    end if
+  end subroutine write_field
 
   ! A number as C's %g would print it: 0.5, 0.001, 2.000E-07.
   function num(v) result(text)

@@ -12,8 +12,38 @@
 !     ierr = silc_finalize()
 !
 ! The module is pure ISO_C_BINDING over the public C API (the default-context
-! calls SILC_INIT/PUT/GET/EXEC/FINALIZE and the envelope constructors), so it
-! runs embedded or against a server (SILC_SERVER=tcp://host:port) unchanged.
+! calls SILC_INIT/PUT/GET/EXEC/FINALIZE, the row-block calls silc_put_rows/
+! silc_get_rows/silc_context_rank on silc_default_context(), and the envelope
+! constructors), so it runs embedded or against a server
+! (SILC_SERVER=tcp://host:port) unchanged.
+!
+! MPI programs (SPMD, silc.h "MPI programs"): link libsilc_mpi as well
+! (CMake: target_link_libraries(prog PRIVATE silc_fortran silc_mpi)), call
+! MPI_Init, and run with SILC_MODE=spmd: silc_init() then opens the default
+! context over MPI_COMM_WORLD, one engine per rank (there is no silc_init_mpi
+! taking a communicator: SILC_MODE=spmd is the way).  Every call is then
+! collective -- all ranks make the same calls in the same order -- and each
+! rank deposits and fetches only its own rows:
+!
+!     call MPI_Init(ierr)
+!     if (silc_init() /= 0) error stop silc_errmsg()           ! SILC_MODE=spmd
+!     ierr = silc_rank(rank, nranks)                         ! 0-based, as MPI
+!     ierr = silc_put_rows('A', first, m, n, rowptr, colind, values)  ! my m rows
+!     ierr = silc_put_rows('b', first, b)                    ! b(1:m): my rows
+!     ierr = silc_exec('x = A \ b')
+!     ierr = silc_get_rows('x', first, x)                    ! allocates x(1:m)
+!     ierr = silc_finalize()
+!     call MPI_Finalize(ierr)
+!
+! Row numbers are 1-based here (first = 1 on the rank holding the first row;
+! the C API's are 0-based and converted).  The blocks of the ranks, in rank
+! order, must tile the rows with no gap or overlap; a CSR block has the
+! value's global column count n, local rowptr (rowptr(1) = 1) and global
+! 1-based column indices.  On one process (embedded, remote, or SPMD under
+! mpirun -np 1) the block is the whole value, first = 1, so the same program
+! runs without MPI too.  A failure found here before the collective call
+! (e.g. first < 1) still makes that call, so the other ranks fail with it
+! instead of waiting.
 !
 ! Every function returns an integer status, 0 on success; after a failure
 ! silc_errmsg() says why.  Arrays are real(c_double).  A 1-D array is a vector
@@ -30,6 +60,7 @@ module silc
   public :: silc_init, silc_finalize, silc_put, silc_get, silc_exec
   public :: silc_put_csr, silc_get_csr, silc_get_shape
   public :: silc_errmsg, silc_warnings
+  public :: silc_put_rows, silc_get_rows, silc_rank
 
   ! silc_format_t of silc.h.
   enum, bind(c)
@@ -63,6 +94,21 @@ module silc
     module procedure get_csr_int, get_csr_int64
   end interface silc_get_csr
 
+  ! silc_put_rows(name, first_row, x) for a dense block (1-D or 2-D), and
+  ! silc_put_rows(name, first_row, m, n, rowptr, colind, values) for a CSR
+  ! block; first_row is 1-based, default integer or integer(c_int64_t) (for
+  ! CSR of the kind of the other integers).
+  interface silc_put_rows
+    module procedure put_rows_vector, put_rows_vector_int64, put_rows_matrix, put_rows_matrix_int64
+    module procedure put_rows_csr_int, put_rows_csr_int64
+  end interface silc_put_rows
+
+  ! silc_get_rows(name, first_row, x): this rank's rows into an allocatable
+  ! 1-D or 2-D array, first_row (1-based, intent(out)) the first of them.
+  interface silc_get_rows
+    module procedure get_rows_vector, get_rows_vector_int64, get_rows_matrix, get_rows_matrix_int64
+  end interface silc_get_rows
+
   ! The C API (core/include/silc.h) and strlen.
   interface
     integer(c_int) function c_silc_init() bind(c, name='SILC_INIT')
@@ -89,6 +135,32 @@ module silc
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: text(*)
     end function c_silc_exec
+
+    type(c_ptr) function c_silc_default_context() bind(c, name='silc_default_context')
+      import :: c_ptr
+    end function c_silc_default_context
+
+    integer(c_int) function c_silc_put_rows(ctx, name, first_row, e) bind(c, name='silc_put_rows')
+      import :: c_int, c_int64_t, c_char, c_ptr, silc_envelope_t
+      type(c_ptr), value :: ctx
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int64_t), value :: first_row
+      type(silc_envelope_t), intent(in) :: e
+    end function c_silc_put_rows
+
+    integer(c_int) function c_silc_get_rows(ctx, e, first_row, name) bind(c, name='silc_get_rows')
+      import :: c_int, c_int64_t, c_char, c_ptr, silc_envelope_t
+      type(c_ptr), value :: ctx
+      type(silc_envelope_t), intent(inout) :: e
+      integer(c_int64_t), intent(out) :: first_row
+      character(kind=c_char), intent(in) :: name(*)
+    end function c_silc_get_rows
+
+    integer(c_int) function c_silc_context_rank(ctx, rank, size) bind(c, name='silc_context_rank')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), intent(out) :: rank, size
+    end function c_silc_context_rank
 
     type(c_ptr) function c_silc_errmsg() bind(c, name='silc_errmsg')
       import :: c_ptr
@@ -356,6 +428,158 @@ contains
     call c_envelope_free(e)
   end function get_csr_int64
 
+  ! ---- rows (MPI programs, SPMD) ----------------------------------------------
+
+  !> This process's rank (0-based, as MPI numbers ranks) and the number of
+  !> ranks of the default context: 0 and 1 unless it is an SPMD one.
+  integer function silc_rank(rank, size) result(status)
+    integer, intent(out) :: rank, size
+    type(c_ptr) :: ctx
+    integer(c_int) :: r, p
+    own_failure = .false.
+    rank = 0
+    size = 1
+    status = default_context('silc_rank: ', ctx)
+    if (status /= 0) return
+    status = int(c_silc_context_rank(ctx, r, p))
+    if (status == 0) then
+      rank = int(r)
+      size = int(p)
+    end if
+  end function silc_rank
+
+  !> Deposits this rank's rows first_row..first_row+size(x)-1 (1-based) of the
+  !> vector name; the ranks' blocks, in rank order, tile the whole vector.
+  integer function put_rows_vector(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row
+    real(c_double), intent(in) :: x(:)
+    own_failure = .false.
+    status = put_rows_dense(name, int(first_row, c_int64_t), int(size(x), c_int64_t), 1_c_int64_t, x)
+  end function put_rows_vector
+
+  integer function put_rows_vector_int64(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row
+    real(c_double), intent(in) :: x(:)
+    own_failure = .false.
+    status = put_rows_dense(name, first_row, int(size(x), c_int64_t), 1_c_int64_t, x)
+  end function put_rows_vector_int64
+
+  !> A dense block: this rank's size(x, 1) rows, all size(x, 2) columns.
+  integer function put_rows_matrix(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row
+    real(c_double), intent(in) :: x(:, :)
+    own_failure = .false.
+    status = put_rows_dense(name, int(first_row, c_int64_t), int(size(x, 1), c_int64_t), &
+                            int(size(x, 2), c_int64_t), x)
+  end function put_rows_matrix
+
+  integer function put_rows_matrix_int64(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row
+    real(c_double), intent(in) :: x(:, :)
+    own_failure = .false.
+    status = put_rows_dense(name, first_row, int(size(x, 1), c_int64_t), int(size(x, 2), c_int64_t), x)
+  end function put_rows_matrix_int64
+
+  !> A CSR block: this rank's m rows (first_row..first_row+m-1) of a matrix
+  !> with n columns, as 1-based CSR of the block (rowptr(1) = 1, m+1 entries)
+  !> with global column indices 1..n.
+  integer function put_rows_csr_int(name, first_row, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row, m, n, rowptr(:), colind(:)
+    real(c_double), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = int(rowptr, c_int64_t)
+    ci(:) = int(colind, c_int64_t)
+    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, values, &
+                            int(first_row, c_int64_t))
+  end function put_rows_csr_int
+
+  integer function put_rows_csr_int64(name, first_row, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row, m, n, rowptr(:), colind(:)
+    real(c_double), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = rowptr
+    ci(:) = colind
+    status = put_csr_0based(name, m, n, rp, ci, values, first_row)
+  end function put_rows_csr_int64
+
+  !> Fetches this rank's rows of the vector name into x, allocated (or
+  !> reallocated) here, and the first of them (1-based) into first_row: a
+  !> value computed from distributed operands keeps their rows, a whole value
+  !> is split evenly.  On one process x is the whole vector, first_row 1.
+  integer function get_rows_vector(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: first_row
+    real(c_double), allocatable, intent(inout) :: x(:)
+    integer(c_int64_t) :: first
+    first_row = 0
+    status = get_rows_vector_int64(name, first, x)
+    if (status /= 0) return
+    if (first + size(x, kind=c_int64_t) - 1 > huge(first_row)) then
+      status = fail('silc_get_rows: the rows of ''' // trim(name) // ''' go beyond ' // &
+                    int_text(int(huge(first_row), c_int64_t)) // '; use an integer(c_int64_t) first_row')
+    else
+      first_row = int(first)
+    end if
+  end function get_rows_vector
+
+  integer function get_rows_vector_int64(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: first_row
+    real(c_double), allocatable, intent(inout) :: x(:)
+    type(silc_envelope_t) :: e
+    own_failure = .false.
+    first_row = 0
+    status = get_rows_envelope(name, .true., e, first_row)
+    if (status /= 0) return
+    if (allocated(x)) deallocate(x)
+    allocate(x(e%m))
+    status = int(c_envelope_to_dense(e, x))
+    call c_envelope_free(e)
+  end function get_rows_vector_int64
+
+  !> This rank's rows of a matrix (dense, or sparse made dense) into x(:, :),
+  !> allocated here with the block's shape.
+  integer function get_rows_matrix(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: first_row
+    real(c_double), allocatable, intent(inout) :: x(:, :)
+    integer(c_int64_t) :: first
+    first_row = 0
+    status = get_rows_matrix_int64(name, first, x)
+    if (status /= 0) return
+    if (first + size(x, 1, kind=c_int64_t) - 1 > huge(first_row)) then
+      status = fail('silc_get_rows: the rows of ''' // trim(name) // ''' go beyond ' // &
+                    int_text(int(huge(first_row), c_int64_t)) // '; use an integer(c_int64_t) first_row')
+    else
+      first_row = int(first)
+    end if
+  end function get_rows_matrix
+
+  integer function get_rows_matrix_int64(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: first_row
+    real(c_double), allocatable, intent(inout) :: x(:, :)
+    type(silc_envelope_t) :: e
+    own_failure = .false.
+    first_row = 0
+    status = get_rows_envelope(name, .false., e, first_row)
+    if (status /= 0) return
+    if (allocated(x)) deallocate(x)
+    allocate(x(e%m, e%n))
+    status = int(c_envelope_to_dense(e, x))
+    call c_envelope_free(e)
+  end function get_rows_matrix_int64
+
   ! ---- helpers ---------------------------------------------------------------
 
   integer function put_dense(name, m, n, x) result(status)
@@ -377,17 +601,47 @@ contains
   end function put_envelope
 
   ! Checks 1-based CSR, so a mistake is reported in the caller's own indices,
-  ! then shifts rp and ci to 0-based in place and deposits.
-  integer function put_csr_0based(name, m, n, rp, ci, values) result(status)
+  ! then shifts rp and ci to 0-based in place and deposits: the whole value,
+  ! or with first (1-based) the block of rows first..first+m-1 (silc_put_rows).
+  integer function put_csr_0based(name, m, n, rp, ci, values, first) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(in) :: m, n
     integer(c_int64_t), intent(inout) :: rp(:), ci(:)
     real(c_double), intent(in) :: values(:)
-    character(len=*), parameter :: who = 'silc_put_csr: '
+    integer(c_int64_t), intent(in), optional :: first
     type(silc_envelope_t) :: e
+
+    if (present(first)) then
+      status = check_csr('silc_put_rows: ', m, n, rp, ci, values)
+      if (status /= 0) then
+        call spoil_put_rows(name)
+        return
+      end if
+    else
+      status = check_csr('silc_put_csr: ', m, n, rp, ci, values)
+      if (status /= 0) return
+    end if
+    rp = rp - 1
+    ci = ci - 1
+    e = empty_envelope()
+    ! colind/values may be empty: the C side reads nnz = rp(m+1) entries, none.
+    status = int(c_envelope_csr(e, m, n, rp, ci, values))
+    if (present(first)) then
+      status = put_rows_envelope(name, first, e, status)
+    else if (status == 0) then
+      status = put_envelope(name, e)
+    end if
+  end function put_csr_0based
+
+  ! The checks of put_csr_0based, messages prefixed with who.
+  integer function check_csr(who, m, n, rp, ci, values) result(status)
+    character(len=*), intent(in) :: who
+    integer(c_int64_t), intent(in) :: m, n, rp(:), ci(:)
+    real(c_double), intent(in) :: values(:)
     integer(c_int64_t) :: i, k, nnz
     integer(c_int64_t), allocatable :: seen(:)
 
+    status = 0
     if (m < 0 .or. n < 0) then
       status = fail(who // 'invalid size ' // shape_text(m, n))
       return
@@ -436,14 +690,91 @@ contains
         seen(ci(k)) = i
       end do
     end do
+  end function check_csr
 
-    rp = rp - 1
-    ci = ci - 1
+  ! The default context, or a failure naming who if silc_init has not opened it.
+  integer function default_context(who, ctx) result(status)
+    character(len=*), intent(in) :: who
+    type(c_ptr), intent(out) :: ctx
+    status = 0
+    ctx = c_silc_default_context()
+    if (.not. c_associated(ctx)) status = fail(who // 'silc_init has not been called')
+  end function default_context
+
+  integer function put_rows_dense(name, first, m, n, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first, m, n
+    real(c_double), intent(in) :: x(*)
+    type(silc_envelope_t) :: e
     e = empty_envelope()
-    ! colind/values may be empty: the C side reads nnz = rp(m+1) entries, none.
-    status = int(c_envelope_csr(e, m, n, rp, ci, values))
-    if (status == 0) status = put_envelope(name, e)
-  end function put_csr_0based
+    status = int(c_envelope_dense(e, m, n, x))
+    status = put_rows_envelope(name, first, e, status)
+  end function put_rows_dense
+
+  ! Deposits e as the rows first.. (1-based) of name and frees it whatever
+  ! happens.  status_in is the verdict so far (nonzero: building e failed):
+  ! a failure still makes the collective call, through spoil_put_rows.
+  integer function put_rows_envelope(name, first, e, status_in) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first
+    type(silc_envelope_t), intent(inout) :: e
+    integer, intent(in) :: status_in
+    type(c_ptr) :: ctx
+    status = status_in
+    if (status == 0 .and. first < 1) &
+      status = fail('silc_put_rows ''' // trim(name) // ''': first_row is ' // int_text(first) // &
+                    ', but rows are numbered from 1 (the value''s first row is 1)')
+    if (status /= 0) then
+      call spoil_put_rows(name)
+    else
+      status = default_context('silc_put_rows: ', ctx)
+      if (status == 0) status = int(c_silc_put_rows(ctx, c_string(name), first - 1, e))
+    end if
+    call c_envelope_free(e)
+  end function put_rows_envelope
+
+  ! After a failure found here, makes the call the other ranks of an SPMD
+  ! context are making too (with a row number the library refuses), so that
+  ! they fail with this rank instead of waiting for it; this rank keeps its
+  ! own message.
+  subroutine spoil_put_rows(name)
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable :: msg
+    type(c_ptr) :: ctx
+    type(silc_envelope_t) :: none
+    integer :: ignored
+    msg = silc_errmsg()
+    ctx = c_silc_default_context()
+    if (c_associated(ctx)) then
+      none = empty_envelope()
+      ignored = int(c_silc_put_rows(ctx, c_string(name), -1_c_int64_t, none))
+    end if
+    ignored = fail(msg)
+  end subroutine spoil_put_rows
+
+  ! Fetches this rank's rows of name (e to be freed by the caller on success)
+  ! and the first of them, 1-based; a vector must have one column.
+  integer function get_rows_envelope(name, vector, e, first) result(status)
+    character(len=*), intent(in) :: name
+    logical, intent(in) :: vector
+    type(silc_envelope_t), intent(out) :: e
+    integer(c_int64_t), intent(out) :: first
+    type(c_ptr) :: ctx
+    integer(c_int64_t) :: first0
+    e = empty_envelope()
+    first = 0
+    status = default_context('silc_get_rows: ', ctx)
+    if (status /= 0) return
+    status = int(c_silc_get_rows(ctx, e, first0, c_string(name)))
+    if (status /= 0) return
+    if (vector .and. e%n /= 1) then
+      status = fail('silc_get_rows: ''' // trim(name) // ''' has ' // int_text(e%n) // &
+                    ' columns, not 1; fetch its rows into an allocatable 2-D array')
+      call c_envelope_free(e)
+      return
+    end if
+    first = first0 + 1
+  end function get_rows_envelope
 
   integer function get_envelope(name, e) result(status)
     character(len=*), intent(in) :: name
