@@ -2,8 +2,12 @@
 # remote_server.sh -- starts or stops the silcd that the remote variants of the
 # test suite talk to (a ctest fixture: tests/remote.cmake).
 #
-#     sh tests/remote_server.sh start SILCD SOCKET STATEDIR
+#     sh tests/remote_server.sh start SILCD SOCKET STATEDIR [EXTRA SILCD ARGS...]
 #     sh tests/remote_server.sh stop  SILCD SOCKET STATEDIR
+#
+# With SILC_LAUNCH set (e.g. "mpirun -np 2"), silcd starts under it, for
+# silcd --mpi (then pass --mpi among the extra arguments); stop signals the
+# launcher, which forwards SIGTERM to the ranks.
 #
 # start waits until the server listens (its --ready-file appears) and fails if
 # it does not within 20 s; stop sends SIGTERM, waits for a clean exit and fails
@@ -13,6 +17,7 @@ cmd=${1:?usage: remote_server.sh start|stop SILCD SOCKET STATEDIR}
 SILCD=$2
 SOCK=$3
 DIR=$4
+shift 4
 mkdir -p "$DIR"
 case $cmd in
 start)
@@ -21,8 +26,9 @@ start)
         sleep 1
     fi
     rm -f "$DIR/ready" "$DIR/silcd.pid"
-    "$SILCD" --listen "unix:$SOCK" --ready-file "$DIR/ready" --io-timeout 10 \
-        --log-level warn >"$DIR/silcd.log" 2>&1 </dev/null &
+    # shellcheck disable=SC2086 # SILC_LAUNCH is a command with its arguments
+    ${SILC_LAUNCH:-} "$SILCD" --listen "unix:$SOCK" --ready-file "$DIR/ready" --io-timeout 10 \
+        --log-level warn "$@" >"$DIR/silcd.log" 2>&1 </dev/null &
     echo $! >"$DIR/silcd.pid"
     i=0
     while [ ! -f "$DIR/ready" ]; do
