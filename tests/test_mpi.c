@@ -36,6 +36,7 @@
 #endif
 
 static int rank = 0, nranks = 1, spmd = 0;
+static int engine_ranks = 1; /* the ranks the engine runs on: ours (SPMD) or the server's */
 
 /* The same verdict on every rank (a check failed anywhere fails everywhere). */
 static int all_ok(int ok)
@@ -117,11 +118,23 @@ typedef struct solve_case {
     double tol;             /* relative agreement per unit of condition */
 } solve_case;
 
-/* bytes of matrices the statement that bound `name` moved, from `info`. */
+/* Bytes of matrices the statement that bound `name` moved, from `info`
+ * ("... moved between ranks by the statement: M bytes of matrices, V bytes
+ * of vectors"); the vectors' count in *vectors when asked. */
+static long long moved_bytes(silc_context *c, tl_capture *cap, const char *name, long long *vectors)
+{
+    const char *t = tl_info(c, cap, name), *p = strstr(t, "moved between ranks by the statement: "), *q;
+    if (vectors) *vectors = -1;
+    if (!p) return -1;
+    p += strlen("moved between ranks by the statement: ");
+    q = strstr(p, "matrices, ");
+    if (vectors && q) *vectors = atoll(q + strlen("matrices, "));
+    return atoll(p);
+}
+
 static long long matrix_bytes(silc_context *c, tl_capture *cap, const char *name)
 {
-    const char *t = tl_info(c, cap, name), *p = strstr(t, "moved between ranks by the statement: ");
-    return p ? atoll(p + strlen("moved between ranks by the statement: ")) : -1;
+    return moved_bytes(c, cap, name, NULL);
 }
 
 static void check_solve(silc_context *c, silc_context *ref, tl_capture *cap, const solve_case *k)
@@ -187,7 +200,10 @@ static void check_diffusion(silc_context *c, silc_context *ref, tl_capture *cap)
     silc_envelope_t A, B, u;
     double *u0 = calloc((size_t)n, sizeof *u0), *ud = calloc((size_t)n, sizeof *ud);
     double *ur = calloc((size_t)n, sizeof *ur), sd = 0, sr = 0;
-    long long moved_first = -1, moved_later = 0, mb;
+    long long moved_first = -1, moved_later = 0, mb, vb, vec_later = -1;
+    /* A step's product B * u receives only the ghosts: one grid row of u
+     * from each neighbouring block, k values per block boundary each way. */
+    const long long halo = 2 * 8 * k * (engine_ranks - 1);
     int step, ok;
     memset(&A, 0, sizeof A), memset(&B, 0, sizeof B), memset(&u, 0, sizeof u);
     ok = u0 && ud && ur && diff_shifted_laplacian_rows(2, k, h, -dt / 2, 0, n, &A) == 0 &&
@@ -207,9 +223,10 @@ static void check_diffusion(silc_context *c, silc_context *ref, tl_capture *cap)
         CHECK(all_ok(ok), "diffusion step %d: %s", step, silc_context_errmsg(c));
         CHECK(silc_exec(ref, "u = A \\ (B * u)") == 0, "reference step: %s", silc_context_errmsg(ref));
         if (ok) {
-            mb = matrix_bytes(c, cap, "u");
+            mb = moved_bytes(c, cap, "u", &vb);
             if (step == 0) moved_first = mb;
             else if (mb != 0) moved_later = mb;
+            if (step > 0 && vb != halo) vec_later = vb;
         }
     }
     if (ok) {
@@ -222,9 +239,12 @@ static void check_diffusion(silc_context *c, silc_context *ref, tl_capture *cap)
         /* Server: the PUT moved the matrices, not a step; SPMD: they never move. */
         CHECK(moved_first >= 0, "info u shows no byte count:\n%s", tl_capture_text(cap));
         CHECK(moved_later == 0, "a later step moved %lld bytes of matrices", moved_later);
+        CHECK(vec_later < 0, "a later step moved %lld bytes of vectors, the halo is %lld:\n%s", vec_later, halo,
+              tl_capture_text(cap));
         if (rank == 0)
             printf("  diffusion %lldx%lld, 10 steps: sum(u) %.17g (embedded %.17g), matrix bytes per "
-                   "step after the first: %lld\n", (long long)k, (long long)k, sd, sr, moved_later);
+                   "step after the first: %lld, vector bytes %lld (the halo)\n", (long long)k, (long long)k, sd,
+                   sr, moved_later, halo);
     }
 out:
     silc_envelope_free(&A), silc_envelope_free(&B), silc_envelope_free(&u);
@@ -326,8 +346,9 @@ int main(int argc, char **argv)
         t = tl_info(c, &cap, "probe");
         p = strstr(t, "ranks: ");
         CHECK(p != NULL, "the server's info names no ranks (not silcd --mpi?):\n%s", t);
-        if (p) printf("server ranks: %d\n", atoi(p + 7));
+        if (p) printf("server ranks: %d\n", engine_ranks = atoi(p + 7));
     }
+    if (spmd) engine_ranks = nranks;
     if (rank == 0) printf("test_mpi %s on %d rank(s)\n", spmd ? "spmd" : "server", nranks);
     for (i = 0; i < sizeof cases / sizeof cases[0]; i++) check_solve(c, ref, &cap, &cases[i]);
     check_diffusion(c, ref, &cap);

@@ -968,18 +968,205 @@ done:
 
 /* A * x with A distributed by rows: each rank multiplies its rows by the
  * whole x (gathered once per x value). */
+/* ---- the halo exchange of a sparse product ---------------------------------- */
+
+/* y = A x with A and x distributed alike needs, on each rank, x's entries at
+ * the columns its rows use: its own rows of x and the "ghosts" other ranks
+ * own.  Gathering all of x would move (P-1) n words per product; PETSc's
+ * VecScatter moves only the ghosts, and so does this.  The plan is made
+ * once per matrix (collectively, kept as an attachment of A's block, so it
+ * dies with A on every rank at once): which ghosts this rank needs, which of
+ * its entries each other rank needs, and A's block with its columns
+ * renumbered into [own rows | ghosts], so that the product is an ordinary
+ * local CSR times dense product on [x block; ghosts]. */
+#define HALO_KEY "dist.halo"
+
+typedef struct halo_plan {
+    silc_value *loc;           /* m_local x (nl + ng): own columns first, then ghosts */
+    int64_t nl, ng;            /* own rows of x, ghosts */
+    int64_t *sidx;             /* local indices of x to send, by destination rank */
+    int64_t *sc, *sd, *rc, *rd; /* words sent to / received from each rank, and offsets */
+    int64_t total_ghosts;      /* summed over the ranks: the words one product moves per column */
+} halo_plan;
+
+static void halo_free(void *p)
+{
+    halo_plan *h = p;
+    if (!h) return;
+    val_release(h->loc);
+    free(h->sidx);
+    free(h->sc);
+    free(h);
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Position of c in the sorted g[0..n), or -1. */
+static int64_t find_i64(const int64_t *g, int64_t n, int64_t c)
+{
+    int64_t lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (g[mid] == c) return mid;
+        if (g[mid] < c) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+/* Builds A's plan (collective).  NULL on every rank when any rank ran out
+ * of memory. */
+static halo_plan *halo_build(dist_ctx *D, const silc_value *A)
+{
+    const dist_part *P = A->dist->part;
+    const silc_value *b = A->dist->block;
+    int64_t first = part_first(P, D->rank), nl = part_rows(P, D->rank), nnz = b->rowptr[b->m];
+    int64_t *g = malloc((size_t)(nnz ? nnz : 1) * sizeof *g), ng = 0, i, k, *allc = NULL;
+    halo_plan *h = calloc(1, sizeof *h);
+    int r, failed;
+    if (h) h->sc = calloc((size_t)D->size * 4, sizeof *h->sc);
+    failed = !g || !h || !h->sc;
+    if (!failed) {
+        h->sd = h->sc + D->size, h->rc = h->sd + D->size, h->rd = h->rc + D->size;
+        for (k = 0; k < nnz; k++)
+            if (b->colind[k] < first || b->colind[k] >= first + nl) g[ng++] = b->colind[k];
+        qsort(g, (size_t)ng, sizeof *g, cmp_i64);
+        for (i = 0, k = 0; i < ng; i++)
+            if (k == 0 || g[i] != g[k - 1]) g[k++] = g[i];
+        ng = k;
+        /* Sorted ghosts are grouped by owner, owners ascending. */
+        for (i = 0, r = 0; i < ng; i++) {
+            while (g[i] >= P->starts[r + 1]) r++;
+            h->rc[r]++;
+        }
+        for (r = 1; r < D->size; r++) h->rd[r] = h->rd[r - 1] + h->rc[r - 1];
+        allc = calloc((size_t)D->size * (size_t)D->size, sizeof *allc);
+        h->loc = val_csr_new(b->m, nl + ng, nnz);
+        failed = !allc || !h->loc;
+    }
+    if (any_rank(D, failed)) goto fail;
+    /* What each rank needs of me: row `rank` of everybody's counts. */
+    allgather(D, h->rc, D->size, allc);
+    for (r = 0; r < D->size; r++) h->sc[r] = allc[r * D->size + D->rank];
+    for (r = 1; r < D->size; r++) h->sd[r] = h->sd[r - 1] + h->sc[r - 1];
+    free(allc);
+    allc = NULL;
+    h->sidx = malloc((size_t)(h->sd[D->size - 1] + h->sc[D->size - 1] + 1) * sizeof *h->sidx);
+    if (any_rank(D, !h->sidx)) goto fail;
+    COMM(D, alltoallv(D->ops->impl, g, h->rc, h->rd, h->sidx, h->sc, h->sd, MSG));
+    for (i = 0; i < h->sd[D->size - 1] + h->sc[D->size - 1]; i++) h->sidx[i] -= first;
+    /* The block renumbered; per row: own columns, then ghosts below the
+     * own range, then above (each group keeps its sorted order, and that is
+     * the order of the new numbers). */
+    {
+        silc_value *L = h->loc;
+        int64_t at = 0, row, pass;
+        L->rowptr[0] = 0;
+        for (row = 0; row < b->m; row++) {
+            for (pass = 0; pass < 3; pass++)
+                for (k = b->rowptr[row]; k < b->rowptr[row + 1]; k++) {
+                    int64_t c = b->colind[k];
+                    int grp = c < first ? 1 : c >= first + nl ? 2 : 0;
+                    if (grp != pass) continue;
+                    L->colind[at] = grp ? nl + find_i64(g, ng, c) : c - first;
+                    L->val[at++] = b->val[k];
+                }
+            L->rowptr[row + 1] = at;
+        }
+        val_csr_set_nnz(L, at);
+    }
+    h->nl = nl;
+    h->ng = ng;
+    {
+        double t = (double)ng;
+        reduce(D, &t, 1, 0);
+        h->total_ghosts = (int64_t)t;
+    }
+    free(g);
+    return h;
+fail:
+    free(g);
+    free(allc);
+    halo_free(h);
+    return NULL;
+}
+
+/* For a product of A with x distributed alike (A square CSR): A's plan and
+ * [x's block; the ghosts] as a new dense value, each of x's columns moved
+ * once.  1: not this case (the caller gathers); -1: out of memory (every
+ * rank); 0: done. */
+static int halo_operands(dist_ctx *D, const silc_value *A, const silc_value *x, const halo_plan **plan,
+                         silc_value **xbuf)
+{
+    const silc_value *xb;
+    halo_plan *h;
+    double *send;
+    int64_t j, i, nsend;
+    *xbuf = NULL;
+    if (!dist_is(A) || !dist_is(x) || A->format != SILC_FMT_CSR || x->format != SILC_FMT_DENSE ||
+        A->m != A->n || x->m != A->n || !part_same(A->dist->part, x->dist->part))
+        return 1;
+    if (!(h = val_attach_get(A->dist->block, HALO_KEY))) {
+        if (!(h = halo_build(D, A))) return -1;
+        if (any_rank(D, val_attach_set(A->dist->block, HALO_KEY, h, halo_free) != 0)) {
+            if (val_attach_get(A->dist->block, HALO_KEY) != h) halo_free(h);
+            return -1;
+        }
+    }
+    xb = x->dist->block;
+    nsend = h->sd[D->size - 1] + h->sc[D->size - 1];
+    *xbuf = val_new_unset(SILC_FMT_DENSE, h->nl + h->ng, x->n, 0, 0, 0);
+    send = malloc((size_t)(nsend ? nsend : 1) * sizeof *send);
+    if (any_rank(D, !*xbuf || !send)) {
+        val_release(*xbuf);
+        *xbuf = NULL;
+        free(send);
+        return -1;
+    }
+    for (j = 0; j < x->n; j++) {
+        double *col = (*xbuf)->val + j * (h->nl + h->ng);
+        memcpy(col, xb->val + j * h->nl, (size_t)h->nl * sizeof *col);
+        for (i = 0; i < nsend; i++) send[i] = xb->val[h->sidx[i] + j * h->nl];
+        COMM(D, alltoallv(D->ops->impl, send, h->sc, h->sd, col + h->nl, h->rc, h->rd, MSG));
+    }
+    free(send);
+    D->moved_vector += (uint64_t)h->total_ghosts * 8u * (uint64_t)x->n;
+    *plan = h;
+    return 0;
+}
+
 static int matmul(silc_engine *E, silc_call *call, int *rc)
 {
     const silc_value *A = call->in[0], *x = call->in[1];
     silc_call c = *call;
+    const halo_plan *h = NULL;
+    silc_value *xbuf = NULL;
+    int halo;
     if (!dist_is(A)) return 1;
-    if (!(c.in[1] = dist_whole(E, x, 1))) {
+    /* x distributed like A: only the ghosts move; else x whole on every rank. */
+    halo = halo_operands(E->dist, A, x, &h, &xbuf);
+    if (halo < 0) {
+        eng_error(E, "out of memory exchanging the entries of a %lldx%lld product's vector",
+                  (long long)A->m, (long long)A->n);
         *rc = SILC_ENOMEM;
         return 0;
     }
-    c.in[0] = A->dist->block;
+    if (halo == 0) {
+        c.in[0] = h->loc;
+        c.in[1] = xbuf;
+    } else if (!(c.in[1] = dist_whole(E, x, 1))) {
+        *rc = SILC_ENOMEM;
+        return 0;
+    } else {
+        c.in[0] = A->dist->block;
+    }
     c.out = NULL;
     *rc = dist_agree(E, run_on_blocks(E, &c, A->dist->part, A->m, x->n));
+    val_release(xbuf);
     if (*rc) val_release(c.out), c.out = NULL;
     call->out = c.out;
     return 0;
@@ -1163,8 +1350,19 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
     int64_t i, j, k = X->n;
     memset(&E0, 0, sizeof E0);
     E0.dist = D;
+    const halo_plan *h = NULL;
+    silc_value *xbuf = NULL;
+    int halo;
     if (A->format != SILC_FMT_CSR || B->format != SILC_FMT_DENSE || !dist_is(B) || !dist_is(X)) return -1;
-    if (!(xw = dist_whole(&E0, X, 1))) return -1;
+    /* X's ghosts only, as in a product; else X whole on every rank. */
+    halo = halo_operands(D, A, X, &h, &xbuf);
+    if (halo < 0) return -1;
+    if (halo == 0) {
+        a = h->loc;
+        xw = xbuf;
+    } else if (!(xw = dist_whole(&E0, X, 1))) {
+        return -1;
+    }
     for (j = 0; j < k; j++)
         for (i = 0; i < a->m; i++) {
             double r = b->val[i + j * b->m];
@@ -1173,6 +1371,7 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
             r = fabs(r);
             if (!(r <= nR)) nR = r; /* NaN sticks */
         }
+    val_release(xbuf);
     reduce(D, &nR, 1, 1);
     nA = val_props_part(A, SILC_PROPS_NORMS)->norminf;
     nX = val_max_abs(X);
@@ -1198,9 +1397,16 @@ void dist_explain(silc_engine *E, const silc_call *call, strbuf *b)
         sb_puts(b, "; each rank computes its rows (nothing moves)\n");
         break;
     case SILC_OP_MATMUL:
-        sb_puts(b, dist_is(call->in[0]) ? "; each rank multiplies its rows by the whole right operand "
-                                          "(gathered once per value)\n"
-                                        : "; operands gathered to every rank, run there\n");
+        if (!dist_is(call->in[0]))
+            sb_puts(b, "; operands gathered to every rank, run there\n");
+        else if (call->nin > 1 && dist_is(call->in[1]) && call->in[0]->format == SILC_FMT_CSR &&
+                 call->in[1]->format == SILC_FMT_DENSE && call->in[0]->m == call->in[0]->n &&
+                 part_same(call->in[0]->dist->part, call->in[1]->dist->part))
+            sb_puts(b, "; each rank multiplies its rows, receiving only the right operand's entries "
+                       "its rows use (halo exchange, planned once per matrix)\n");
+        else
+            sb_puts(b, "; each rank multiplies its rows by the whole right operand (gathered once per "
+                       "value)\n");
         break;
     case SILC_OP_REDUCE:
         sb_puts(b, "; each rank reduces its rows, the parts are combined\n");
