@@ -49,31 +49,6 @@ static int parse_num(const char *opt, const char *s, double lo, double hi, int i
     return 0;
 }
 
-/* Rows from the top (largest y) down, so the picture has y pointing up. */
-static int write_pgm(const char *path, int64_t n, const double *u, double umax)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        fprintf(stderr, "diffusion2d: cannot write '%s'\n", path);
-        return 1;
-    }
-    unsigned char *row = malloc((size_t)n);
-    int rc = !row || fprintf(f, "P5\n%lld %lld\n255\n", (long long)n, (long long)n) < 0;
-    for (int64_t j = n - 1; j >= 0 && !rc; j--) {
-        for (int64_t i = 0; i < n; i++) {
-            double v = umax > 0 ? u[i + j * n] / umax : 0;
-            row[i] = (unsigned char)lround(255.0 * (v < 0 ? 0 : v > 1 ? 1 : v));
-        }
-        rc = fwrite(row, 1, (size_t)n, f) != (size_t)n;
-    }
-    free(row);
-    if (fclose(f) || rc) {
-        fprintf(stderr, "diffusion2d: error writing '%s'\n", path);
-        return 1;
-    }
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     double nd = 100, stepsd = 50, dt = 2e-4;
@@ -129,7 +104,7 @@ int main(int argc, char **argv)
         printf("steps=%d N=%lld unknowns=%lld time=%.2fs max=%.6g sum=%.6g\n", steps,
                (long long)n, (long long)(n * n), secs, umax, sum);
         printf("heat=%.10g (initially %.10g, t=%g)\n", diff2d_heat(n, u), heat0, steps * dt);
-        rc = write_pgm(out, n, u, umax);
+        rc = diff2d_write_pgm("diffusion2d", out, n, u, umax);
         if (!rc) printf("wrote %s (%lldx%lld PGM)\n", out, (long long)n, (long long)n);
     }
     free(u);

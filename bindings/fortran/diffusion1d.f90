@@ -20,6 +20,7 @@ program diffusion1d
   use, intrinsic :: iso_c_binding, only: c_double
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use silc
+  use diffusion1d_common
   implicit none
   real(c_double), parameter :: pi = acos(-1.0_c_double)
   integer :: n, steps, s, i
@@ -32,7 +33,7 @@ program diffusion1d
   steps = 500
   t_end = 0.5_c_double
   out_file = ''
-  if (parse_args() /= 0) then
+  if (diff1d_parse_args(n, steps, t_end, out_file) /= 0) then
     write (error_unit, '(a)') 'usage: diffusion1d [N [steps [T [FILE]]]]   (N, steps positive integers, ' // &
       'T >= 0, FILE receives the final u)'
     stop 2
@@ -58,8 +59,8 @@ program diffusion1d
   err = maxval(abs(u - exp(-t_end) * sin(x)))
   estimate = t_end * h**2 * exp(-t_end) / 12
   tol = max(1.0e-4_c_double, 4 * estimate)
-  write (*, '(a, i0, a, i0, 7a)') 'N=', n, ' steps=', steps, ' T=', num(t_end), &
-    ' dt=', num(dt), ' time=', num(real(clock1 - clock0, c_double) / rate), 's'
+  write (*, '(a, i0, a, i0, 7a)') 'N=', n, ' steps=', steps, ' T=', diff1d_num(t_end), &
+    ' dt=', diff1d_num(dt), ' time=', diff1d_num(real(clock1 - clock0, c_double) / rate), 's'
   write (*, '(a, es10.3, a, es10.3, a)') 'max error=', err, &
     ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
   if (len(out_file) > 0) call write_field(out_file, u)
@@ -72,57 +73,15 @@ program diffusion1d
 
 contains
 
-  ! Deposits I + c L as 1-based CSR, L the second-difference matrix / h^2 with
-  ! zero Dirichlet ends; columns ascend within each row.
+  ! Deposits I + c L, whole (diffusion1d_common.f90 assembles it).
   integer function put_shifted_laplacian(name, c) result(status)
     character(len=*), intent(in) :: name
     real(c_double), intent(in) :: c
     integer, allocatable :: rowptr(:), colind(:)
     real(c_double), allocatable :: values(:)
-    real(c_double) :: off
-    integer :: j, k, nz
-    allocate(rowptr(n + 1), colind(3 * n), values(3 * n))
-    off = c / h**2
-    nz = 0
-    do k = 1, n
-      rowptr(k) = nz + 1
-      do j = max(k - 1, 1), min(k + 1, n)
-        nz = nz + 1
-        colind(nz) = j
-        values(nz) = merge(1 - 2 * off, off, j == k)
-      end do
-    end do
-    rowptr(n + 1) = nz + 1
+    call diff1d_laplacian_rows(n, h, c, 1, n, rowptr, colind, values)
     status = silc_put_csr(name, n, n, rowptr, colind, values)
   end function put_shifted_laplacian
-
-  integer function parse_args() result(status)
-    character(len=4096) :: arg
-    integer :: nargs, length
-    status = 0
-    nargs = command_argument_count()
-    if (nargs > 4) status = 1
-    if (nargs >= 1 .and. status == 0) then
-      call get_command_argument(1, arg)
-      read (arg, *, iostat=status) n
-      if (status == 0 .and. n < 1) status = 1
-    end if
-    if (nargs >= 2 .and. status == 0) then
-      call get_command_argument(2, arg)
-      read (arg, *, iostat=status) steps
-      if (status == 0 .and. steps < 1) status = 1
-    end if
-    if (nargs >= 3 .and. status == 0) then
-      call get_command_argument(3, arg)
-      read (arg, *, iostat=status) t_end
-      if (status == 0 .and. .not. (t_end >= 0)) status = 1
-    end if
-    if (nargs >= 4 .and. status == 0) then
-      call get_command_argument(4, arg, length=length)
-      if (length < 1 .or. length > len(arg)) status = 1
-      out_file = trim(arg)
-    end if
-  end function parse_args
 
   ! The field, one value a line with 17 significant digits (round-trip exact).
   subroutine write_field(path, v)
@@ -137,26 +96,6 @@ contains
       stop 1
     end if
   end subroutine write_field
-
-  ! A number as C's %g would print it: 0.5, 0.001, 2.000E-07.
-  function num(v) result(text)
-    real(c_double), intent(in) :: v
-    character(len=:), allocatable :: text
-    character(len=32) :: buf
-    if (abs(v) < tiny(v) .or. (abs(v) >= 1.0e-3_c_double .and. abs(v) < 1.0e6_c_double)) then
-      write (buf, '(f0.6)') v
-      text = trim(buf)
-      do while (text(len(text):len(text)) == '0')
-        text = text(:len(text) - 1)
-      end do
-      if (text(len(text):len(text)) == '.') text = text(:len(text) - 1)
-      if (text(1:1) == '.') text = '0' // text
-      if (text == '') text = '0'
-    else
-      write (buf, '(es10.3)') v
-      text = trim(adjustl(buf))
-    end if
-  end function num
 
   subroutine die(what)
     character(len=*), intent(in) :: what
