@@ -505,6 +505,16 @@ typedef union props_words {
     uint64_t w[(sizeof(silc_props) + 4 * sizeof(double) + 7) / 8 + 1];
 } props_words;
 
+/* What rank 0 knew of the value it shared, on the new value of every rank. */
+static void props_set(silc_value *w, const props_words *pw)
+{
+    w->props = pw->s.p;
+    w->props_have = pw->s.have;
+    w->scan_ready = pw->s.scan_ready;
+    w->scan_nonfinite = pw->s.scan_nonfinite;
+    w->scan_maxabs = pw->s.scan_maxabs;
+}
+
 int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out)
 {
     dist_ctx *D = E->dist;
@@ -553,11 +563,7 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
             count_moved(D, (int)h[H_FORMAT], counts, 1, 0);
             free(counts);
         }
-        w->props = pw.s.p;
-        w->props_have = pw.s.have;
-        w->scan_ready = pw.s.scan_ready;
-        w->scan_nonfinite = pw.s.scan_nonfinite;
-        w->scan_maxabs = pw.s.scan_maxabs;
+        props_set(w, &pw);
         *out = w;
         return 0;
     }
@@ -630,11 +636,7 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
     }
     if (!(w = val_dist_new(h[H_M], h[H_N], (int)h[H_FORMAT], D, P, blk))) die(D, "out of memory");
     dist_part_unref(P);
-    w->props = pw.s.p;
-    w->props_have = pw.s.have;
-    w->scan_ready = pw.s.scan_ready;
-    w->scan_nonfinite = pw.s.scan_nonfinite;
-    w->scan_maxabs = pw.s.scan_maxabs;
+    props_set(w, &pw);
     /* Rank 0 keeps the whole value it was given, so a GET moves nothing.
      * `where` must read the same on every rank (value.h): dist_whole decides
      * from it whether to enter a gather, and a rank that gathered alone
