@@ -64,6 +64,7 @@ program diffusion1d
   write (*, '(a, es10.3, a, es10.3, a)') 'max error=', err, &
     ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
   if (len(out_file) > 0) call write_field(out_file, u)
+  deallocate(out_file)   ! a main program's allocatables are never freed for it
   deallocate(u, x)
   if (.not. (err <= tol)) then   ! written so that a NaN fails too
     write (error_unit, '(a, es10.3, a)') 'diffusion1d: error above the tolerance ', tol, &

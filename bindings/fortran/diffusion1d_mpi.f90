@@ -101,6 +101,7 @@ program diffusion1d_mpi
       ' (spatial error estimate T h^2 e^-T / 12 = ', estimate, ')'
   end if
   if (len(out_file) > 0) call write_field(out_file)
+  deallocate(out_file)   ! a main program's allocatables are never freed for it
   deallocate(u, x)
   call MPI_Finalize(ierr)
   if (.not. (err <= tol)) then

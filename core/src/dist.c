@@ -491,6 +491,7 @@ int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_valu
     free(all);
     if (!v) die(D, "out of memory");
     if (store_set(&E->store, name, v)) die(D, "out of memory storing a value"); /* rank-local: no agreement possible */
+    val_release(v); /* the store holds it now */
     eng_info_remove(E, name);
     return 0;
 }
