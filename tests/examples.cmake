@@ -13,3 +13,19 @@ add_test(NAME example_diffusion2d
 add_test(NAME test_cli COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/test_cli.sh $<TARGET_FILE:silc_cli>)
 set_tests_properties(example_diffusion1d example_diffusion2d test_cli PROPERTIES
   ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
+
+# The cloth program (examples/cloth, built when libpng is found): its
+# drivers against each other and physics, its scene reader and its frames.
+if(TARGET silc_cloth)
+  silc_add_test(test_cloth_example SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_cloth_example.c)
+  target_link_libraries(test_cloth_example PRIVATE silc_cloth)
+  foreach(t scene frame)
+    silc_add_test(test_cloth_${t} SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_cloth_${t}.c)
+    target_link_libraries(test_cloth_${t} PRIVATE silc_cloth)
+  endforeach()
+  set_tests_properties(test_cloth_scene PROPERTIES
+    ENVIRONMENT "${SILC_TEST_ENV};SILC_CLOTH_SCENES=${PROJECT_SOURCE_DIR}/examples/cloth/scenes")
+  add_test(NAME example_cloth COMMAND cloth ${PROJECT_SOURCE_DIR}/examples/cloth/scenes/hanging.scene
+           --mode cmp --steps 20 --frames ${CMAKE_CURRENT_BINARY_DIR}/cloth-frames)
+  set_tests_properties(example_cloth PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
+endif()

@@ -78,7 +78,7 @@ set_tests_properties(silcd_start PROPERTIES FIXTURES_SETUP silcd ENVIRONMENT "${
 set_tests_properties(silcd_stop PROPERTIES FIXTURES_CLEANUP silcd)
 
 set(_remote_env "${SILC_TEST_ENV};SILC_SERVER=unix:${SILC_TEST_SOCKET}")
-foreach(t test_api test_lang test_truth test_examples)
+foreach(t test_api test_lang test_truth test_examples test_cloth_example)
   if(TARGET ${t})
     add_test(NAME ${t}_remote COMMAND ${t})
     set_tests_properties(${t}_remote PROPERTIES ENVIRONMENT "${_remote_env}" TIMEOUT 600

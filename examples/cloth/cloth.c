@@ -1,0 +1,160 @@
+/*
+ * cloth.c -- the seeds' cloth simulation as a program: a scene file, one of
+ * three drivers, PNG frames and a summary (cloth.h, README.md here).
+ *
+ *     cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR]
+ *                 [--solver OPTIONS] [--tol T] [--size WxH]
+ *     cloth --keys                      the scene keys with their defaults
+ *
+ * --solver passes per-call options to every SILC solve (ltd, cmp), e.g.
+ * "backend = lis-style; lis-style.options = -i cg -p ic -tol 1e-8"; without
+ * it SILC's configured dispatch solves (a sparse Cholesky by default).
+ * --tol is the original driver's CG tolerance; by default the scene's
+ * accuracy / 100, relative to ||b|| per step.  The exit status is 1 on any
+ * failure, with the message on stderr, 2 on a usage error.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cloth.h"
+
+static const char usage[] =
+    "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver OPTIONS]\n"
+    "                   [--tol T] [--size WxH]\n"
+    "       cloth --keys\n";
+
+static int bad_usage(const char *why)
+{
+    fprintf(stderr, "cloth: %s\n%s", why, usage);
+    return 2;
+}
+
+static int write_frame(const char *dir, const cloth_scene *s, cloth_mode mode, int step, const double *x,
+                       int w, int h)
+{
+    char path[4096], err[512];
+    snprintf(path, sizeof path, "%s/%s_%s_%05d.png", dir, s->name, cloth_mode_name(mode), step);
+    if (frame_write_png(path, s, x, w, h, err, sizeof err)) {
+        fprintf(stderr, "cloth: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *scene_path = NULL, *frames = NULL, *solver = NULL;
+    cloth_mode mode = CLOTH_ORIGINAL;
+    int steps = -1, w = 640, h = 480, a, step;
+    double tol = -1, ek0, es0, ek, es, pinned = 0;
+    cloth_scene scene;
+    cloth_model m;
+    cloth_driver *d;
+    cloth_times t = {0, 0, 0, 0};
+    char err[1024];
+    for (a = 1; a < argc; a++) {
+        const char *opt = argv[a], *arg = a + 1 < argc ? argv[a + 1] : NULL;
+        char *end = NULL;
+        if (!strcmp(opt, "--keys")) {
+            scene_print_keys(stdout);
+            return 0;
+        } else if (!strcmp(opt, "-h") || !strcmp(opt, "--help")) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (opt[0] != '-') {
+            if (scene_path) return bad_usage("more than one scene given");
+            scene_path = opt;
+            continue;
+        }
+        if (!arg) return bad_usage("an option is missing its value");
+        a++;
+        errno = 0;
+        if (!strcmp(opt, "--mode")) {
+            if (!strcmp(arg, "original")) mode = CLOTH_ORIGINAL;
+            else if (!strcmp(arg, "ltd")) mode = CLOTH_LTD;
+            else if (!strcmp(arg, "cmp")) mode = CLOTH_CMP;
+            else return bad_usage("--mode is original, ltd or cmp");
+        } else if (!strcmp(opt, "--steps")) {
+            long v = strtol(arg, &end, 10);
+            if (*end || errno || v < 1 || v > 10000000) return bad_usage("--steps takes an integer >= 1");
+            steps = (int)v;
+        } else if (!strcmp(opt, "--tol")) {
+            tol = strtod(arg, &end);
+            if (*end || errno || !(tol > 0 && tol < 1)) return bad_usage("--tol takes a number in (0, 1)");
+        } else if (!strcmp(opt, "--size")) {
+            if (sscanf(arg, "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 4096 || h > 4096)
+                return bad_usage("--size takes WxH, each 16..4096");
+        } else if (!strcmp(opt, "--frames")) {
+            frames = arg;
+        } else if (!strcmp(opt, "--solver")) {
+            solver = arg;
+        } else {
+            return bad_usage("unknown option");
+        }
+    }
+    if (!scene_path) return bad_usage("no scene file given");
+    if (scene_read(scene_path, &scene, err, sizeof err)) {
+        fprintf(stderr, "cloth: %s\n", err);
+        return 1;
+    }
+    if (steps > 0) scene.steps = steps;
+    if (tol < 0) tol = scene.accuracy / 100;
+    if (frames && mkdir(frames, 0777) && errno != EEXIST) {
+        fprintf(stderr, "cloth: cannot create '%s': %s\n", frames, strerror(errno));
+        return 1;
+    }
+    if (cloth_model_init(&m, &scene, err, sizeof err)) {
+        fprintf(stderr, "cloth: %s\n", err);
+        return 1;
+    }
+    if (!(d = cloth_driver_open(&m, mode, solver, tol, err, sizeof err))) {
+        fprintf(stderr, "cloth: %s\n", err);
+        cloth_model_free(&m);
+        return 1;
+    }
+    cloth_energy(&m, m.x, m.v, &ek0, &es0);
+    if (frames && scene.frame_every > 0 && write_frame(frames, &scene, mode, 0, m.x, w, h)) goto fail;
+    for (step = 1; step <= scene.steps; step++) {
+        if (cloth_driver_step(d, &t, err, sizeof err)) {
+            fprintf(stderr, "cloth: step %d: %s\n", step, err);
+            goto fail;
+        }
+        if (frames && scene.frame_every > 0 && step % scene.frame_every == 0) {
+            if (cloth_driver_sync(d, err, sizeof err)) {
+                fprintf(stderr, "cloth: %s\n", err);
+                goto fail;
+            }
+            if (write_frame(frames, &scene, mode, step, m.x, w, h)) goto fail;
+        }
+    }
+    if (cloth_driver_sync(d, err, sizeof err)) {
+        fprintf(stderr, "cloth: %s\n", err);
+        goto fail;
+    }
+    cloth_energy(&m, m.x, m.v, &ek, &es);
+    for (a = 0; a < scene.npins; a++) {
+        int p = scene.pin_j[a] * scene.nx + scene.pin_i[a], k;
+        for (k = 0; k < 3; k++) pinned = fmax(pinned, fabs(m.x[3 * p + k] - m.x0[3 * p + k]));
+    }
+    printf("scene %s: %dx%d particles, %d springs, mode %s, %d steps of %g s\n", scene.name, scene.nx,
+           scene.ny, m.ns, cloth_mode_name(mode), scene.steps, scene.dt);
+    printf("time per step: %.3f ms (assembly %.3f, solve %.3f, update %.3f)\n",
+           1e3 * (t.assembly + t.solve + t.update) / scene.steps, 1e3 * t.assembly / scene.steps,
+           1e3 * t.solve / scene.steps, 1e3 * t.update / scene.steps);
+    if (mode == CLOTH_ORIGINAL)
+        printf("CG: tolerance %.1e, %.1f iterations per step\n", tol, (double)t.cg_iterations / scene.steps);
+    printf("max displacement %.6g m; pinned particles moved %.3g m\n", cloth_max_displacement(&m, m.x), pinned);
+    printf("energy: kinetic %.6g J, spring %.6g J (at start %.6g, %.6g)\n", ek, es, ek0, es0);
+    cloth_driver_close(d);
+    cloth_model_free(&m);
+    return isfinite(ek + es) ? 0 : 1;
+fail:
+    cloth_driver_close(d);
+    cloth_model_free(&m);
+    return 1;
+}

@@ -1,0 +1,293 @@
+/*
+ * cloth_drivers.c -- the three ways the seeds ran the cloth (cloth.h):
+ * original (plain C with its own CG), ltd (C assembles, SILC solves) and
+ * cmp (every step as SILC statements, tests/test_cloth.c's, positions
+ * fetched only when asked).
+ *
+ * Each step is timed in three phases so the summary can say where the time
+ * goes: assembly (forces, A and b), solve, update (v, x, the obstacle).  In
+ * ltd the solve phase includes the PUTs of A and b and the GET of dv, the
+ * price of the mode.  In cmp each phase is one EXEC.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "cloth.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "silc.h"
+
+struct cloth_driver {
+    cloth_mode mode;
+    cloth_model *m;
+    silc_context *ctx;
+    double tol;
+    char solve_stmt[1024];   /* ltd and cmp: the solve statement */
+    char update_stmt[1024];  /* cmp: v, x and the obstacle */
+    double *f, *a_val, *b, *dv;
+};
+
+static const char cmp_assembly[] =
+    "p = Y_L * x - Y_R * x; P = sparse(P_row, P_col, p, 3*s, s); z = sqrt(diagvec(P' * P)); "
+    "fij = P * (K_stiff *@ (z - L) /@ z); C1 = diag(X * sqrt(K_stiff)); "
+    "A1 = Y_LT * C1 - Y_RT * C1; T1 = -A1 * A1'; "
+    "f = Y_RT * fij - Y_LT * fij + M * g; DfDx = T1; DfDv = -damping * M; "
+    "A = M - (dt * dt) * DfDx - dt * DfDv; b = dt * (f + dt * (DfDx * v))";
+
+const char *cloth_mode_name(cloth_mode mode)
+{
+    return mode == CLOTH_ORIGINAL ? "original" : mode == CLOTH_LTD ? "ltd" : "cmp";
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int silc_fail(cloth_driver *d, const char *what, char *err, size_t errlen)
+{
+    snprintf(err, errlen, "%s: %s", what, d->ctx ? silc_context_errmsg(d->ctx) : silc_errmsg());
+    return -1;
+}
+
+/* ---- putting the model into SILC ------------------------------------------- */
+
+static int put_vector(silc_context *c, const char *name, int64_t n, const double *x)
+{
+    silc_envelope_t e;
+    int rc;
+    if (silc_envelope_dense(&e, n, 1, x)) return -1;
+    rc = silc_put(c, name, &e);
+    silc_envelope_free(&e);
+    return rc;
+}
+
+static int put_scalar(silc_context *c, const char *name, double x)
+{
+    return put_vector(c, name, 1, &x);
+}
+
+/* An m x n CSR matrix with at most one entry per row, (row, col[row], val[row]);
+ * col[row] < 0 leaves the row empty. */
+static int put_selection(silc_context *c, const char *name, int64_t m, int64_t n, const int64_t *col,
+                         const double *val)
+{
+    int64_t *rp = malloc((size_t)(m + 1) * sizeof *rp), *ci = malloc((size_t)(m ? m : 1) * sizeof *ci);
+    double *v = malloc((size_t)(m ? m : 1) * sizeof *v);
+    int64_t r, nz = 0;
+    silc_envelope_t e;
+    int rc = -1;
+    if (!rp || !ci || !v) goto out;
+    rp[0] = 0;
+    for (r = 0; r < m; r++) {
+        if (col[r] >= 0) ci[nz] = col[r], v[nz++] = val ? val[r] : 1;
+        rp[r + 1] = nz;
+    }
+    if (silc_envelope_csr(&e, m, n, rp, ci, v) == 0) {
+        rc = silc_put(c, name, &e);
+        silc_envelope_free(&e);
+    }
+out:
+    free(rp), free(ci), free(v);
+    return rc;
+}
+
+/* The transpose of a selection: n x m, row j holding the rows r with col[r] = j
+ * (each column of a spring selection is used by several springs). */
+static int put_selection_t(silc_context *c, const char *name, int64_t m, int64_t n, const int64_t *col)
+{
+    int64_t *rp = calloc((size_t)(n + 1), sizeof *rp), *ci = malloc((size_t)(m ? m : 1) * sizeof *ci);
+    int64_t *fill = calloc((size_t)(n ? n : 1), sizeof *fill), r;
+    double *v = malloc((size_t)(m ? m : 1) * sizeof *v);
+    silc_envelope_t e;
+    int rc = -1;
+    if (!rp || !ci || !fill || !v) goto out;
+    for (r = 0; r < m; r++)
+        if (col[r] >= 0) rp[col[r] + 1]++;
+    for (r = 0; r < n; r++) rp[r + 1] += rp[r];
+    for (r = 0; r < m; r++)
+        if (col[r] >= 0) ci[rp[col[r]] + fill[col[r]]] = r, v[rp[col[r]] + fill[col[r]]++] = 1;
+    if (silc_envelope_csr(&e, n, m, rp, ci, v) == 0) {
+        rc = silc_put(c, name, &e);
+        silc_envelope_free(&e);
+    }
+out:
+    free(rp), free(ci), free(fill), free(v);
+    return rc;
+}
+
+/* Everything the cmp statements read, PUT once (tests/test_cloth.c's names). */
+static int cmp_setup(cloth_driver *d)
+{
+    cloth_model *m = d->m;
+    const cloth_scene *s = m->scene;
+    int64_t N = 3 * (int64_t)m->n, S3 = 3 * (int64_t)m->ns, k, dd;
+    int64_t *colL = malloc((size_t)S3 * sizeof *colL), *colR = malloc((size_t)S3 * sizeof *colR);
+    int64_t *colX = malloc((size_t)S3 * sizeof *colX), *diag = malloc((size_t)N * sizeof *diag);
+    double *prow = malloc((size_t)S3 * sizeof *prow), *pcol = malloc((size_t)S3 * sizeof *pcol);
+    int rc = -1;
+    if (!colL || !colR || !colX || !diag || !prow || !pcol) goto out;
+    for (k = 0; k < m->ns; k++)
+        for (dd = 0; dd < 3; dd++) {
+            colL[3 * k + dd] = 3 * (int64_t)m->sl[k] + dd;
+            colR[3 * k + dd] = 3 * (int64_t)m->sr[k] + dd;
+            colX[3 * k + dd] = k;
+            prow[3 * k + dd] = (double)(3 * k + dd + 1);
+            pcol[3 * k + dd] = (double)(k + 1);
+        }
+    for (k = 0; k < N; k++) diag[k] = k;
+    rc = put_selection(d->ctx, "Y_L", S3, N, colL, NULL) || put_selection(d->ctx, "Y_R", S3, N, colR, NULL) ||
+         put_selection_t(d->ctx, "Y_LT", S3, N, colL) || put_selection_t(d->ctx, "Y_RT", S3, N, colR) ||
+         put_selection(d->ctx, "X", S3, m->ns, colX, NULL) || put_selection(d->ctx, "M", N, N, diag, m->mass) ||
+         put_vector(d->ctx, "x", N, m->x) || put_vector(d->ctx, "v", N, m->v) ||
+         put_vector(d->ctx, "g", N, m->gvec) || put_vector(d->ctx, "fixed", N, m->fixed) ||
+         put_vector(d->ctx, "K_stiff", m->ns, m->k) || put_vector(d->ctx, "L", m->ns, m->rest) ||
+         put_vector(d->ctx, "P_row", S3, prow) || put_vector(d->ctx, "P_col", S3, pcol) ||
+         put_scalar(d->ctx, "s", m->ns) || put_scalar(d->ctx, "dt", s->dt) ||
+         put_scalar(d->ctx, "damping", s->damping);
+    /* The obstacle as statements: per-particle sums through Q (n x 3n). */
+    if (!rc && s->obstacle != OBSTACLE_NONE) {
+        int64_t *colQ = malloc((size_t)N * sizeof *colQ);
+        double *cvec = malloc((size_t)N * sizeof *cvec);
+        if (!colQ || !cvec) rc = -1;
+        for (k = 0; !rc && k < N; k++) {
+            colQ[k] = k / 3;
+            cvec[k] = s->obstacle == OBSTACLE_SPHERE ? s->center[k % 3] : (k % 3 == 2 ? s->floor_z : -INFINITY);
+        }
+        rc = rc || put_selection_t(d->ctx, "Q", N, m->n, colQ) || put_selection(d->ctx, "QT", N, m->n, colQ, NULL) ||
+             put_vector(d->ctx, s->obstacle == OBSTACLE_SPHERE ? "C" : "F", N, cvec) ||
+             put_scalar(d->ctx, "R", s->radius);
+        free(colQ), free(cvec);
+    }
+out:
+    free(colL), free(colR), free(colX), free(diag), free(prow), free(pcol);
+    return rc ? -1 : 0;
+}
+
+/* ---- the driver ------------------------------------------------------------ */
+
+cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *solve_options, double tol,
+                                char *err, size_t errlen)
+{
+    cloth_driver *d = calloc(1, sizeof *d);
+    int64_t N = 3 * (int64_t)m->n;
+    if (!d) goto oom;
+    d->mode = mode;
+    d->m = m;
+    d->tol = tol;
+    d->f = malloc((size_t)N * sizeof *d->f);
+    d->b = malloc((size_t)N * sizeof *d->b);
+    d->dv = malloc((size_t)N * sizeof *d->dv);
+    d->a_val = malloc((size_t)m->nnz * sizeof *d->a_val);
+    if (!d->f || !d->b || !d->dv || !d->a_val) goto oom;
+    if (solve_options && *solve_options) {
+        if (strchr(solve_options, '"')) {
+            snprintf(err, errlen, "solver options may not contain '\"'");
+            cloth_driver_close(d);
+            return NULL;
+        }
+        snprintf(d->solve_stmt, sizeof d->solve_stmt, "dv = solve(A, b, \"%s\")", solve_options);
+    } else {
+        snprintf(d->solve_stmt, sizeof d->solve_stmt, "dv = A \\ b");
+    }
+    snprintf(d->update_stmt, sizeof d->update_stmt, "v += dv *@ fixed; x += dt * v%s",
+             m->scene->obstacle == OBSTACLE_SPHERE
+                 ? "; dx = x - C; r = sqrt(Q * (dx *@ dx)); keep = QT * (r >= R); "
+                   "x = C + dx *@ (QT * max(ones(rows(r), 1), R /@ r)); v = v *@ keep"
+             : m->scene->obstacle == OBSTACLE_FLOOR
+                 ? "; keep = QT * (Q * (x >= F)) > 2.5; x = max(x, F); v = v *@ keep"
+                 : "");
+    if (mode == CLOTH_ORIGINAL) return d;
+    if (silc_open(&d->ctx, NULL)) {
+        snprintf(err, errlen, "silc_open: %s", silc_errmsg());
+        cloth_driver_close(d);
+        return NULL;
+    }
+    if (mode == CLOTH_CMP && cmp_setup(d)) {
+        silc_fail(d, "putting the cloth into SILC", err, errlen);
+        cloth_driver_close(d);
+        return NULL;
+    }
+    return d;
+oom:
+    snprintf(err, errlen, "out of memory for the %s driver", cloth_mode_name(mode));
+    cloth_driver_close(d);
+    return NULL;
+}
+
+static int ltd_solve(cloth_driver *d)
+{
+    cloth_model *m = d->m;
+    silc_envelope_t A, b, dv;
+    int rc;
+    if (silc_envelope_csr(&A, 3 * (int64_t)m->n, 3 * (int64_t)m->n, m->rowptr, m->colind, d->a_val)) return -1;
+    rc = silc_put(d->ctx, "A", &A);
+    silc_envelope_free(&A);
+    if (rc || silc_envelope_dense(&b, 3 * (int64_t)m->n, 1, d->b)) return -1;
+    rc = silc_put(d->ctx, "b", &b);
+    silc_envelope_free(&b);
+    if (rc || silc_exec(d->ctx, d->solve_stmt) || silc_get(d->ctx, &dv, "dv")) return -1;
+    rc = dv.m == 3 * (int64_t)m->n && dv.n == 1 ? silc_envelope_to_dense(&dv, d->dv) : -1;
+    silc_envelope_free(&dv);
+    return rc;
+}
+
+int cloth_driver_step(cloth_driver *d, cloth_times *t, char *err, size_t errlen)
+{
+    cloth_model *m = d->m;
+    double t0 = now(), t1, t2;
+    if (d->mode == CLOTH_CMP) {
+        if (silc_exec(d->ctx, cmp_assembly)) return silc_fail(d, "cmp assembly", err, errlen);
+        t1 = now();
+        if (silc_exec(d->ctx, d->solve_stmt)) return silc_fail(d, d->solve_stmt, err, errlen);
+        t2 = now();
+        if (silc_exec(d->ctx, d->update_stmt)) return silc_fail(d, "cmp update", err, errlen);
+    } else {
+        cloth_forces(m, m->x, d->f);
+        cloth_system(m, d->f, m->v, d->a_val, d->b);
+        t1 = now();
+        if (d->mode == CLOTH_LTD) {
+            if (ltd_solve(d)) return silc_fail(d, d->solve_stmt, err, errlen);
+        } else {
+            int it = cloth_cg(m, d->a_val, d->b, d->dv, d->tol);
+            if (it < 0) {
+                snprintf(err, errlen, "original: CG did not reach %.1e in %d iterations", d->tol, 30 * m->n);
+                return -1;
+            }
+            t->cg_iterations += it;
+        }
+        t2 = now();
+        cloth_update(m, d->dv);
+    }
+    t->assembly += t1 - t0;
+    t->solve += t2 - t1;
+    t->update += now() - t2;
+    return 0;
+}
+
+int cloth_driver_sync(cloth_driver *d, char *err, size_t errlen)
+{
+    silc_envelope_t e;
+    int k, rc = 0;
+    if (d->mode != CLOTH_CMP) return 0;
+    for (k = 0; k < 2 && !rc; k++) {
+        const char *name = k ? "v" : "x";
+        if (silc_get(d->ctx, &e, name)) return silc_fail(d, name, err, errlen);
+        rc = e.m == 3 * (int64_t)d->m->n && e.n == 1 ? silc_envelope_to_dense(&e, k ? d->m->v : d->m->x) : -1;
+        silc_envelope_free(&e);
+    }
+    if (rc) snprintf(err, errlen, "cmp: x or v came back with the wrong shape");
+    return rc;
+}
+
+void cloth_driver_close(cloth_driver *d)
+{
+    if (!d) return;
+    if (d->ctx) silc_close(&d->ctx);
+    free(d->f), free(d->b), free(d->dv), free(d->a_val);
+    free(d);
+}
