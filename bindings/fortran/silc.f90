@@ -523,13 +523,7 @@ contains
     integer(c_int64_t) :: first
     first_row = 0
     status = get_rows_vector_int64(name, first, x)
-    if (status /= 0) return
-    if (first + size(x, kind=c_int64_t) - 1 > huge(first_row)) then
-      status = fail('silc_get_rows: the rows of ''' // trim(name) // ''' go beyond ' // &
-                    int_text(int(huge(first_row), c_int64_t)) // '; use an integer(c_int64_t) first_row')
-    else
-      first_row = int(first)
-    end if
+    if (status == 0) status = narrow_first_row(name, first, size(x, kind=c_int64_t), first_row)
   end function get_rows_vector
 
   integer function get_rows_vector_int64(name, first_row, x) result(status)
@@ -556,14 +550,24 @@ contains
     integer(c_int64_t) :: first
     first_row = 0
     status = get_rows_matrix_int64(name, first, x)
-    if (status /= 0) return
-    if (first + size(x, 1, kind=c_int64_t) - 1 > huge(first_row)) then
+    if (status == 0) status = narrow_first_row(name, first, size(x, 1, kind=c_int64_t), first_row)
+  end function get_rows_matrix
+
+  ! first_row for a default-integer caller: an error when the block's rows
+  ! (first .. first + rows - 1) do not all fit a default integer.
+  integer function narrow_first_row(name, first, rows, first_row) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first, rows
+    integer, intent(out) :: first_row
+    status = 0
+    first_row = 0
+    if (first + rows - 1 > huge(first_row)) then
       status = fail('silc_get_rows: the rows of ''' // trim(name) // ''' go beyond ' // &
                     int_text(int(huge(first_row), c_int64_t)) // '; use an integer(c_int64_t) first_row')
     else
       first_row = int(first)
     end if
-  end function get_rows_matrix
+  end function narrow_first_row
 
   integer function get_rows_matrix_int64(name, first_row, x) result(status)
     character(len=*), intent(in) :: name
