@@ -814,6 +814,47 @@ static void test_cache(void)
     silc_close(&c);
 }
 
+/* sparse(i, j, v, m, n) keeps what it learnt of i and j on i: a second call
+ * with the same i and j only scatters v.  Each result must equal the dense
+ * sum of its triplets, whatever was reused: new values, duplicates summed
+ * in the order given, another j, another shape. */
+static void test_sparse_reuse(void)
+{
+    static const struct {
+        const char *stmt;
+        double want[6]; /* 2x3, column-major */
+    } steps[] = {
+        {"S = dense(sparse(I, J, [1; 2; 3; 4], 2, 3))", {1, 0, 5, 4, 0, 0}},
+        {"S = dense(sparse(I, J, [10; 20; 30; 40], 2, 3))", {10, 0, 50, 40, 0, 0}},
+        {"S = dense(sparse(I, J, 7, 2, 3))", {7, 0, 14, 7, 0, 0}},
+        {"S = dense(sparse(I, J2, [1; 2; 3; 4], 2, 3))", {1, 0, 2, 0, 3, 4}},
+        {"T = sparse(I, J, [1; 2; 3; 4], 3, 3); S = dense(T[1:2, :])", {1, 0, 5, 4, 0, 0}},
+        {"S = dense(sparse(I, J, [1; 2; 3; 4], 2, 3))", {1, 0, 5, 4, 0, 0}},
+    };
+    silc_context *c = fixture();
+    size_t k;
+    int64_t m, n, i;
+    double *x;
+    if (!c) return;
+    /* Entries (1,1), (1,2) twice, (2,2); with J2 (1,1), (1,2), (1,3), (2,3). */
+    CHECK(silc_exec(c, "I = [1; 1; 1; 2]; J = [1; 2; 2; 2]; J2 = [1; 2; 3; 3]") == 0, "triplets: %s",
+          silc_context_errmsg(c));
+    for (k = 0; k < sizeof steps / sizeof steps[0]; k++) {
+        int rc = silc_exec(c, steps[k].stmt);
+        CHECK(rc == 0, "%s: %s", steps[k].stmt, silc_context_errmsg(c));
+        if (rc || fetch(c, "S", &m, &n, &x) != 6) continue;
+        for (i = 0; i < 6; i++)
+            CHECK(x[i] == steps[k].want[i], "%s: entry %lld is %g, want %g", steps[k].stmt, (long long)i, x[i],
+                  steps[k].want[i]);
+        free(x);
+    }
+    /* An index out of range is refused even where a plan for other sizes exists. */
+    CHECK(silc_exec(c, "S = sparse(I, J, 1, 1, 3)") != 0 &&
+              !strcmp(silc_context_errmsg(c), "sparse: row index 2 (entry 4) is out of range 1..1"),
+          "smaller m: %s", silc_context_errmsg(c));
+    silc_close(&c);
+}
+
 static void test_clear(void)
 {
     silc_context *c = fixture();
@@ -990,6 +1031,7 @@ int main(void)
     test_atomicity();
     test_cache();
     test_clear();
+    test_sparse_reuse();
     test_rand_reproducible();
     test_formats();
     test_nesting_limits();

@@ -194,8 +194,7 @@ static int bi_count(lang_ev *V, const ast_node *call, silc_value **a, int n, sil
 }
 
 typedef struct triplet {
-    int64_t i, j;
-    double v;
+    int64_t i, j, k; /* k: the entry's place in the arguments, for a stable order */
 } triplet;
 
 static int cmp_triplet(const void *pa, const void *pb)
@@ -203,14 +202,98 @@ static int cmp_triplet(const void *pa, const void *pb)
     const triplet *a = pa, *b = pb;
     if (a->i != b->i) return a->i < b->i ? -1 : 1;
     if (a->j != b->j) return a->j < b->j ? -1 : 1;
-    return 0;
+    return (a->k > b->k) - (a->k < b->k);
 }
 
-/* sparse(i, j, v, m, n): sorted CSR with duplicates summed. */
+/* What sparse(i, j, v, m, n) learnt of i and j: where each entry lands in
+ * the CSR result, and the result's pattern.  Kept on i (an attachment, so
+ * it dies with i) for the next call with the same i, j, m and n -- a time
+ * loop that assembles the same pattern with new values every step, as the
+ * seeds' cloth does -- which then only scatters v: no index checks, no
+ * sort.  Values never change in place without a new id, so equal ids mean
+ * equal indices. */
+#define SPARSE_PLAN_KEY "core.sparse_plan"
+
+typedef struct sparse_plan {
+    uint64_t j_id;
+    int64_t m, n, len, nnz;
+    int64_t *dest;   /* len: the CSR slot of each entry (duplicates share one) */
+    silc_index *rowptr; /* m + 1 */
+    silc_index *colind; /* nnz */
+} sparse_plan;
+
+static void sparse_plan_free(void *p)
+{
+    sparse_plan *s = p;
+    if (!s) return;
+    free(s->dest);
+    free(s->rowptr);
+    free(s->colind);
+    free(s);
+}
+
+/* The plan for i, j (checked here, with the messages of sparse()). */
+static sparse_plan *sparse_plan_make(lang_ev *V, silc_value **a, int64_t m, int64_t n, int64_t len)
+{
+    sparse_plan *s = calloc(1, sizeof *s);
+    triplet *tr = malloc((size_t)(len ? len : 1) * sizeof *tr);
+    int64_t k, nnz = 0;
+    if (s) {
+        s->dest = malloc((size_t)(len ? len : 1) * sizeof *s->dest);
+        s->rowptr = calloc((size_t)m + 1, sizeof *s->rowptr);
+        s->colind = malloc((size_t)(len ? len : 1) * sizeof *s->colind);
+    }
+    if (!s || !tr || !s->dest || !s->rowptr || !s->colind) {
+        free(tr);
+        sparse_plan_free(s);
+        oom(V);
+        return NULL;
+    }
+    for (k = 0; k < len; k++) {
+        double ii = val_get(a[0], a[0]->m == 1 ? 0 : k, a[0]->m == 1 ? k : 0);
+        double jj = val_get(a[1], a[1]->m == 1 ? 0 : k, a[1]->m == 1 ? k : 0);
+        char num[40];
+        if (!(ii == floor(ii) && ii >= 1 && ii <= (double)m)) {
+            util_fmt_double(num, sizeof num, ii);
+            eng_error(V->E, "sparse: row index %s (entry %lld) is out of range 1..%lld", num, (long long)k + 1,
+                      (long long)m);
+            goto fail;
+        }
+        if (!(jj == floor(jj) && jj >= 1 && jj <= (double)n)) {
+            util_fmt_double(num, sizeof num, jj);
+            eng_error(V->E, "sparse: column index %s (entry %lld) is out of range 1..%lld", num,
+                      (long long)k + 1, (long long)n);
+            goto fail;
+        }
+        tr[k].i = (int64_t)ii - 1;
+        tr[k].j = (int64_t)jj - 1;
+        tr[k].k = k;
+    }
+    qsort(tr, (size_t)len, sizeof *tr, cmp_triplet);
+    for (k = 0; k < len; k++) {
+        if (!(nnz > 0 && tr[k - 1].i == tr[k].i && tr[k - 1].j == tr[k].j)) {
+            s->rowptr[tr[k].i + 1]++;
+            s->colind[nnz++] = tr[k].j;
+        }
+        s->dest[tr[k].k] = nnz - 1;
+    }
+    for (k = 0; k < m; k++) s->rowptr[k + 1] += s->rowptr[k];
+    s->j_id = a[1]->id;
+    s->m = m, s->n = n, s->len = len, s->nnz = nnz;
+    free(tr);
+    return s;
+fail:
+    free(tr);
+    sparse_plan_free(s);
+    return NULL;
+}
+
+/* sparse(i, j, v, m, n): sorted CSR with duplicates summed (in the order
+ * they were given, so a reused plan gives the same bits). */
 static int sparse_triplets(lang_ev *V, const ast_node *call, silc_value **a, silc_value **out)
 {
-    int64_t m, n, k, t, nnz = 0, len;
-    triplet *tr;
+    int64_t m, n, k, len;
+    sparse_plan *s;
     silc_value *r;
     if (vector_arg(V, call, a, 0) || vector_arg(V, call, a, 1) || int_arg(V, call, a, 3, 0, &m) ||
         int_arg(V, call, a, 4, 0, &n))
@@ -222,48 +305,29 @@ static int sparse_triplets(lang_ev *V, const ast_node *call, silc_value **a, sil
     if (!val_is_scalar(a[2]) && a[2]->m * a[2]->n != len)
         return eng_error(V->E, "sparse: i has %lld entries but v has %lld (v may also be a scalar)",
                          (long long)len, (long long)(a[2]->m * a[2]->n));
-    tr = malloc((size_t)(len ? len : 1) * sizeof *tr);
-    if (!tr) return oom(V);
-    for (k = 0; k < len; k++) {
-        double ii = val_get(a[0], a[0]->m == 1 ? 0 : k, a[0]->m == 1 ? k : 0);
-        double jj = val_get(a[1], a[1]->m == 1 ? 0 : k, a[1]->m == 1 ? k : 0);
-        char num[40];
-        if (!(ii == floor(ii) && ii >= 1 && ii <= (double)m)) {
-            util_fmt_double(num, sizeof num, ii);
-            free(tr);
-            return eng_error(V->E, "sparse: row index %s (entry %lld) is out of range 1..%lld", num,
-                             (long long)k + 1, (long long)m);
+    s = val_attach_get(a[0], SPARSE_PLAN_KEY);
+    if (!s || s->j_id != a[1]->id || s->m != m || s->n != n || s->len != len) {
+        /* The plan is as large as the result: refuse both before allocating. */
+        char what[96];
+        snprintf(what, sizeof what, "a %lldx%lld csr value", (long long)m, (long long)n);
+        if (val_claim(((double)m + 1) * sizeof(silc_index) + (double)len * (sizeof(silc_index) + sizeof(double)),
+                      what))
+            return oom(V);
+        if (!(s = sparse_plan_make(V, a, m, n, len))) return -1;
+        /* Without room to keep it, this call still uses it. */
+        if (val_attach_set(a[0], SPARSE_PLAN_KEY, s, sparse_plan_free)) {
+            sparse_plan_free(s);
+            return oom(V);
         }
-        if (!(jj == floor(jj) && jj >= 1 && jj <= (double)n)) {
-            util_fmt_double(num, sizeof num, jj);
-            free(tr);
-            return eng_error(V->E, "sparse: column index %s (entry %lld) is out of range 1..%lld",
-                             num, (long long)k + 1, (long long)n);
-        }
-        tr[k].i = (int64_t)ii - 1;
-        tr[k].j = (int64_t)jj - 1;
-        tr[k].v = val_is_scalar(a[2]) ? val_scalar(a[2])
-                                      : val_get(a[2], a[2]->m == 1 ? 0 : k, a[2]->m == 1 ? k : 0);
     }
-    qsort(tr, (size_t)len, sizeof *tr, cmp_triplet);
-    for (k = 0; k < len; k++) {
-        if (nnz > 0 && tr[nnz - 1].i == tr[k].i && tr[nnz - 1].j == tr[k].j)
-            tr[nnz - 1].v += tr[k].v;
-        else
-            tr[nnz++] = tr[k];
-    }
-    if (!(r = val_csr_new(m, n, nnz))) {
-        free(tr);
-        return oom(V);
-    }
-    for (t = 0; t < nnz; t++) {
-        r->rowptr[tr[t].i + 1]++;
-        r->colind[t] = tr[t].j;
-        r->val[t] = tr[t].v;
-    }
-    for (k = 0; k < m; k++) r->rowptr[k + 1] += r->rowptr[k];
-    val_csr_set_nnz(r, nnz);
-    free(tr);
+    if (!(r = val_csr_new(m, n, s->nnz))) return oom(V);
+    memcpy(r->rowptr, s->rowptr, (size_t)(m + 1) * sizeof *r->rowptr);
+    memcpy(r->colind, s->colind, (size_t)s->nnz * sizeof *r->colind);
+    memset(r->val, 0, (size_t)s->nnz * sizeof *r->val);
+    for (k = 0; k < len; k++)
+        r->val[s->dest[k]] += val_is_scalar(a[2]) ? val_scalar(a[2])
+                                                  : val_get(a[2], a[2]->m == 1 ? 0 : k, a[2]->m == 1 ? k : 0);
+    val_csr_set_nnz(r, s->nnz);
     *out = r;
     note_core(V, call, r);
     return 0;
