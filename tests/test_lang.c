@@ -818,6 +818,50 @@ static void test_cache(void)
  * with the same i and j only scatters v.  Each result must equal the dense
  * sum of its triplets, whatever was reused: new values, duplicates summed
  * in the order given, another j, another shape. */
+/* An operation repeated on unchanged operands gives the value it gave
+ * before (memo.c), so a matrix a loop rebuilds from constants keeps its
+ * identity and its factorization: from the third pass on the solve reuses
+ * it.  A changed operand (M rebound) gives a new result, and values stay
+ * right whichever path ran. */
+static void test_memo(void)
+{
+    silc_context *c = fixture();
+    int pass, want;
+    int64_t m, n;
+    double *x;
+    const char *t;
+    if (!c) return;
+    silc_set_output(c, capture, NULL);
+    CHECK(silc_exec(c, "M = sparse([1; 2; 3], [1; 2; 3], [4; 5; 6], 3, 3); r = ones(3, 1)") == 0, "memo set-up");
+    for (pass = 1; pass <= 4; pass++) {
+        captured[0] = 0;
+        CHECK(silc_exec(c, "A = M + M; y = A \\ r; info y") == 0, "memo pass %d: %s", pass, silc_context_errmsg(c));
+        /* An engine on several ranks (silcd --mpi: `info` names the ranks)
+         * keeps no such results: there the matrix is new every pass. */
+        want = pass >= 3 && !strstr(captured, "\n  ranks: ");
+        t = strstr(captured, "reused factorization: ");
+        CHECK(t && !strncmp(t + 22, want ? "yes" : "no", want ? 3 : 2),
+              "pass %d: the solve %s have reused A's factorization:\n%s", pass, want ? "should" : "should not",
+              captured);
+        if (fetch(c, "y", &m, &n, &x) == 3) {
+            CHECK(x[0] == 1.0 / 8 && x[1] == 1.0 / 10 && x[2] == 1.0 / 12, "pass %d: y = %g %g %g", pass, x[0],
+                  x[1], x[2]);
+            free(x);
+        }
+    }
+    /* M changes: A is computed anew, with the new values. */
+    captured[0] = 0;
+    CHECK(silc_exec(c, "M = 2 * M; A = M + M; y = A \\ r; info y") == 0, "memo after a change: %s",
+          silc_context_errmsg(c));
+    t = strstr(captured, "reused factorization: ");
+    CHECK(t && !strncmp(t + 22, "no", 2), "a changed M reused a factorization:\n%s", captured);
+    if (fetch(c, "y", &m, &n, &x) == 3) {
+        CHECK(x[0] == 1.0 / 16 && x[2] == 1.0 / 24, "after the change y = %g .. %g", x[0], x[2]);
+        free(x);
+    }
+    silc_close(&c);
+}
+
 static void test_sparse_reuse(void)
 {
     static const struct {
@@ -1032,6 +1076,7 @@ int main(void)
     test_cache();
     test_clear();
     test_sparse_reuse();
+    test_memo();
     test_rand_reproducible();
     test_formats();
     test_nesting_limits();

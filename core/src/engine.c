@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
+#include "memo.h"
 #include "dist.h"
 #include "accuracy.h"
 #include "tuner.h"
@@ -119,6 +120,7 @@ void eng_destroy(silc_engine **pE)
     /* Values first: their attachments may belong to plugins still loaded.
      * The tuner holds some too. */
     tuner_free(E);
+    memo_free(E);
     store_free(&E->store);
     if (E->lang_cache_free && E->lang_cache) E->lang_cache_free(E->lang_cache);
     for (e = E->infos; e; e = next) {

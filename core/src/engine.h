@@ -26,6 +26,7 @@
 typedef struct silc_engine silc_engine;
 typedef struct cfg_db cfg_db;
 typedef struct ld_set ld_set;
+typedef struct eng_memo eng_memo;
 
 /* The operands and result of a solve whose backward error is deferred
  * (accuracy.h); all NULL when none is. */
@@ -69,6 +70,7 @@ struct silc_engine {
                                            the fuzzers set so `while 1 {}` ends; no option */
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     struct dist_ctx *dist;              /* the communicator of an SPMD engine (dist.h), NULL = one process */
+    struct eng_memo *memo;              /* repeated operations' results (memo.h), NULL until needed */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
 };

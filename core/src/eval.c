@@ -17,6 +17,7 @@
 #include "tuner.h"
 #include "refine.h"
 #include "accuracy.h"
+#include "memo.h"
 #include "dist.h"
 
 #include <math.h>
@@ -148,6 +149,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
 {
     silc_engine *E = V->E;
     silc_report rep;
+    size_t warned;
     int i, rc;
     *out = NULL;
     call->out = NULL;
@@ -184,6 +186,12 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
             return *out ? 0 : eng_oom(E);
         }
     }
+    /* The same operation on the same operands as before (memo.c): its value. */
+    if ((call->out = memo_lookup(E, call))) {
+        *out = call->out;
+        return 0;
+    }
+    warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
     rc = dist_run(E, call);
@@ -203,6 +211,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         if (!E->dist) tuner_note_solve(E, call); /* the tuner times one process (issue 18) */
     }
     call->report = NULL;
+    memo_note(E, call, call->out, E->warnings.len != warned);
     *out = call->out;
     return 0;
 }
