@@ -859,6 +859,28 @@ static void test_memo(void)
         CHECK(x[0] == 1.0 / 16 && x[2] == 1.0 / 24, "after the change y = %g .. %g", x[0], x[2]);
         free(x);
     }
+    /* A PUT of what the name already holds keeps the value (and its
+     * factorization); a PUT of anything else replaces it. */
+    {
+        static const int64_t rp[4] = {0, 1, 2, 3}, ci[3] = {0, 1, 2};
+        double val[3] = {2, 4, 8};
+        silc_envelope_t e;
+        for (pass = 1; pass <= 3; pass++) {
+            if (pass == 3) val[1] = 5;
+            CHECK(silc_envelope_csr(&e, 3, 3, rp, ci, val) == 0 && silc_put(c, "P", &e) == 0, "put P: %s",
+                  silc_context_errmsg(c));
+            silc_envelope_free(&e);
+            captured[0] = 0;
+            CHECK(silc_exec(c, "z = P \\ r; info z") == 0, "solve with P: %s", silc_context_errmsg(c));
+            want = pass == 2;
+            t = strstr(captured, "reused factorization: ");
+            CHECK(t && !strncmp(t + 22, want ? "yes" : "no", want ? 3 : 2), "PUT pass %d:\n%s", pass, captured);
+            if (fetch(c, "z", &m, &n, &x) == 3) {
+                CHECK(x[1] == 1 / val[1], "PUT pass %d: z(2) = %g, want %g", pass, x[1], 1 / val[1]);
+                free(x);
+            }
+        }
+    }
     silc_close(&c);
 }
 

@@ -357,6 +357,22 @@ double val_get(const silc_value *v, int64_t i, int64_t j)
     }
 }
 
+int val_same_contents(const silc_value *a, const silc_value *b)
+{
+    silc_view x, y;
+    if (!a || !b || a->dist || b->dist) return 0;
+    if (a == b) return 1;
+    val_view(a, &x);
+    val_view(b, &y);
+    if (x.format != y.format || x.m != y.m || x.n != y.n || x.nnz != y.nnz || x.kl != y.kl || x.ku != y.ku)
+        return 0;
+    if (x.format == SILC_FMT_CSR &&
+        (memcmp(x.rowptr, y.rowptr, (size_t)(x.m + 1) * sizeof *x.rowptr) ||
+         memcmp(x.colind, y.colind, (size_t)x.nnz * sizeof *x.colind)))
+        return 0;
+    return !memcmp(x.val, y.val, (size_t)x.nnz * sizeof *x.val);
+}
+
 size_t val_bytes(const silc_value *v)
 {
     size_t b;

@@ -139,6 +139,9 @@ void val_mutated(silc_value *v);
 int val_is_scalar(const silc_value *v);   /* 1x1 */
 double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
 double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
+/* 1 when a and b hold the same format, shape, pattern and value bits (whole
+ * values only). */
+int val_same_contents(const silc_value *a, const silc_value *b);
 size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
 const char *val_format_name(int format);  /* "dense", "csr", "band" */
 
