@@ -4,6 +4,7 @@
  * through silcd).
  *
  *     cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]
+ *     cloth_bench SCENE... --trade [--steps N] [--svg DIR]
  *
  * For each scene it runs original (plain C, its own CG), ltd and cmp from the
  * scene's start for N steps (default 50), R rounds (default 3), the drivers
@@ -16,6 +17,14 @@
  * (a sparse Cholesky).  The largest position difference to original at the
  * end is printed too, so a fast wrong run shows.  SILC_SERVER, when set,
  * sends ltd and cmp to silcd; --label says so in the rows.
+ *
+ * --trade: the speed/accuracy trade.  The scene runs N steps with the solve
+ * by original's CG, lis-style CG + IC(0) and CG + SA-AMG, PETSc CG + ICC at
+ * tolerances 1e-2 ... 1e-12, and a direct solve, each against a direct run
+ * of the same steps: ms per step against the largest particle error
+ * relative to the cloth size.  It prints a table marking the Pareto front
+ * and the point the scene's accuracy selects (the fastest that meets it),
+ * and with --svg DIR writes DIR/cloth_trade_SCENE.svg.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -65,23 +74,227 @@ static int run(const cloth_scene *s, const variant *v, int steps, double tol, cl
     return k == steps ? 0 : -1;
 }
 
+/* ---- --trade: time against accuracy ------------------------------------------ */
+
+/* One solver of the trade study; %g in opts is the tolerance. */
+typedef struct trade_solver {
+    const char *name, *opts; /* opts NULL with mode original: own CG; NULL with ltd: default (direct) */
+    cloth_mode mode;
+    const char *color;
+} trade_solver;
+
+static const trade_solver trade_solvers[] = {
+    {"original CG + Jacobi", NULL, CLOTH_ORIGINAL, "#444444"},
+    {"lis-style CG + IC(0)", "backend = lis-style; lis-style.options = -i cg -p ic -tol %g", CLOTH_LTD, "#1f77b4"},
+    {"lis-style CG + SA-AMG", "backend = lis-style; lis-style.options = -i cg -p saamg -tol %g", CLOTH_LTD,
+     "#2ca02c"},
+    {"petsc CG + ICC", "backend = petsc; petsc.options = -ksp_type cg -pc_type icc -ksp_rtol %g -ksp_atol 0",
+     CLOTH_LTD, "#d62728"},
+    {"direct (CHOLMOD)", NULL, CLOTH_LTD, "#9467bd"},
+};
+enum { NTS = sizeof trade_solvers / sizeof trade_solvers[0], NTOL = 6 };
+static const double trade_tols[NTOL] = {1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
+
+typedef struct trade_point {
+    int solver;
+    double tol, ms, err; /* err: max particle distance to the direct run / cloth size */
+    int pareto;
+} trade_point;
+
+static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np, int chosen)
+{
+    const double W = 640, H = 420, L = 70, R = 190, T = 30, B = 50;
+    double emin = 1e300, emax = 0, tmin = 1e300, tmax = 0;
+    int i, k;
+    for (i = 0; i < np; i++) {
+        double e = fmax(p[i].err, 1e-16);
+        emin = fmin(emin, e), emax = fmax(emax, e), tmin = fmin(tmin, p[i].ms), tmax = fmax(tmax, p[i].ms);
+    }
+    emin = floor(log10(emin)), emax = ceil(log10(emax)), tmin = log10(tmin) - 0.1, tmax = log10(tmax) + 0.1;
+    if (emax <= emin) emax = emin + 1;
+#define PX(e) (L + (log10(fmax((e), 1e-16)) - emin) / (emax - emin) * (W - L - R))
+#define PY(t) (H - B - (log10(t) - tmin) / (tmax - tmin) * (H - T - B))
+    fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' "
+               "font-size='11'>\n<rect width='100%%' height='100%%' fill='white'/>\n", W, H);
+    fprintf(f, "<text x='%g' y='18' font-size='13'>%s %dx%d: time per step against position error "
+               "(accuracy %g)</text>\n", L, s->name, s->nx, s->ny, s->accuracy);
+    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/><line x1='%g' y1='%g' x2='%g' y2='%g' "
+               "stroke='black'/>\n", L, H - B, W - R, H - B, L, T, L, H - B);
+    for (k = (int)emin; k <= (int)emax; k++)
+        fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>1e%d</text>\n", PX(pow(10, k)), H - B + 15, k);
+    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>max |x - x_direct| / cloth size</text>\n",
+            (L + W - R) / 2, H - 12);
+    fprintf(f, "<text x='14' y='%g' transform='rotate(-90 14 %g)' text-anchor='middle'>ms per step "
+               "(log)</text>\n", (T + H - B) / 2, (T + H - B) / 2);
+    for (k = (int)floor(tmin); k <= (int)ceil(tmax); k++)
+        if (k >= tmin && k <= tmax)
+            fprintf(f, "<text x='%g' y='%g' text-anchor='end'>%g</text>\n", L - 4, PY(pow(10, k)) + 4, pow(10, k));
+    /* the scene's accuracy as a vertical line */
+    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='#888' stroke-dasharray='4 3'/>\n",
+            PX(s->accuracy), T, PX(s->accuracy), H - B);
+    /* the Pareto front, joined in order of error */
+    fprintf(f, "<polyline fill='none' stroke='#ff7f0e' stroke-width='1.5' points='");
+    /* (sorted by error: an insertion sort, the points are few) */
+    {
+        int order[64], n = 0, a, b;
+        for (i = 0; i < np && n < 64; i++)
+            if (p[i].pareto) order[n++] = i;
+        for (a = 1; a < n; a++)
+            for (b = a; b > 0 && p[order[b]].err < p[order[b - 1]].err; b--) {
+                int t = order[b];
+                order[b] = order[b - 1], order[b - 1] = t;
+            }
+        for (a = 0; a < n; a++) fprintf(f, "%.1f,%.1f ", PX(p[order[a]].err), PY(p[order[a]].ms));
+    }
+    fprintf(f, "'/>\n");
+    for (i = 0; i < np; i++)
+        fprintf(f, "<circle cx='%.1f' cy='%.1f' r='%d' fill='%s'%s><title>%s, tol %g: %.3g ms, error %.2g</title>"
+                   "</circle>\n",
+                PX(p[i].err), PY(p[i].ms), p[i].pareto ? 5 : 3, trade_solvers[p[i].solver].color,
+                i == chosen ? " stroke='black' stroke-width='2.5'" : "", trade_solvers[p[i].solver].name, p[i].tol,
+                p[i].ms, p[i].err);
+    for (k = 0; k < NTS; k++)
+        fprintf(f, "<circle cx='%g' cy='%g' r='4' fill='%s'/><text x='%g' y='%g'>%s</text>\n", W - R + 12,
+                T + 10 + 16.0 * k, trade_solvers[k].color, W - R + 20, T + 14 + 16.0 * k, trade_solvers[k].name);
+    fprintf(f, "<polyline points='%g,%g %g,%g' stroke='#ff7f0e' stroke-width='1.5'/><text x='%g' y='%g'>Pareto "
+               "front</text>\n", W - R + 6, T + 10 + 16.0 * NTS, W - R + 18, T + 10 + 16.0 * NTS, W - R + 20,
+            T + 14 + 16.0 * NTS);
+    fprintf(f, "<circle cx='%g' cy='%g' r='5' fill='none' stroke='black' stroke-width='2.5'/><text x='%g' y='%g'>"
+               "chosen by the accuracy</text>\n</svg>\n", W - R + 12, T + 10 + 16.0 * (NTS + 1), W - R + 20,
+            T + 14 + 16.0 * (NTS + 1));
+#undef PX
+#undef PY
+}
+
+/* One run of the trade study: ms per step and the largest particle error
+ * against xref. */
+static int trade_run(const cloth_scene *s, const trade_solver *ts, double tol, int steps, const double *xref,
+                     double *ms, double *err_out, char *err, size_t errlen)
+{
+    cloth_times t;
+    char opts[256];
+    cloth_model m;
+    cloth_driver *d;
+    int ok = 1, k;
+    double e = 0;
+    memset(&t, 0, sizeof t);
+    snprintf(opts, sizeof opts, ts->opts ? ts->opts : "", tol);
+    if (cloth_model_init(&m, s, err, errlen)) return -1;
+    d = cloth_driver_open(&m, ts->mode, ts->opts ? opts : NULL, tol, err, errlen);
+    for (k = 0; d && ok && k < steps; k++) ok = cloth_driver_step(d, &t, err, errlen) == 0;
+    ok = d && ok && cloth_driver_sync(d, err, errlen) == 0;
+    for (k = 0; ok && k < 3 * m.n; k++) e = fmax(e, fabs(m.x[k] - xref[k]));
+    *ms = 1e3 * (t.assembly + t.solve + t.update) / steps;
+    *err_out = e;
+    cloth_driver_close(d);
+    cloth_model_free(&m);
+    return ok ? 0 : -1;
+}
+
+/* Every solver at every tolerance against a direct run of the same steps. */
+static int trade(const char *path, int steps, const char *svg_dir)
+{
+    cloth_scene s;
+    char err[1024];
+    trade_point pts[NTS * NTOL];
+    variant v;
+    double *xref, size;
+    int np = 0, i, j, n3, chosen = -1;
+    if (scene_read(path, &s, err, sizeof err)) {
+        fprintf(stderr, "cloth_bench: %s\n", err);
+        return -1;
+    }
+    n3 = 3 * s.nx * s.ny;
+    size = fmax(s.width, s.height);
+    xref = calloc((size_t)n3, sizeof *xref);
+    if (!xref) return -1;
+    v.mode = CLOTH_LTD, v.solver = NULL;
+    {
+        cloth_times t;
+        if (run(&s, &v, steps, 1e-12, &t, xref)) return -1;
+    }
+    for (i = 0; i < NTS; i++)
+        for (j = 0; j < NTOL; j++) {
+            const trade_solver *ts = &trade_solvers[i];
+            double ms, ms2, e;
+            if (!ts->opts && ts->mode == CLOTH_LTD && j > 0) break; /* direct: one point */
+            /* Twice, the faster kept: a library's first run pays its start-up
+             * (PETSc's is 0.25 s), which is no part of a step. */
+            if (trade_run(&s, ts, trade_tols[j], steps, xref, &ms, &e, err, sizeof err) ||
+                trade_run(&s, ts, trade_tols[j], steps, xref, &ms2, &e, err, sizeof err)) {
+                printf("| %s | %s | %g | failed: %.80s | | |\n", s.name, ts->name, trade_tols[j], err);
+                continue;
+            }
+            pts[np].solver = i;
+            pts[np].tol = ts->opts || ts->mode == CLOTH_ORIGINAL ? trade_tols[j] : 0;
+            pts[np].ms = fmin(ms, ms2);
+            pts[np].err = isfinite(e) ? e / size : INFINITY;
+            pts[np].pareto = 0;
+            np++;
+        }
+    /* Pareto: no other point is as fast and as accurate, and better in one.
+     * 1: on the front of all points; 2: on the front of the iterative ones
+     * (where a direct solve with a reused factorization beats them all, the
+     * front of all is that one point). */
+    for (i = 0; i < np; i++) {
+        int all = isfinite(pts[i].err), iter = all && trade_solvers[pts[i].solver].opts;
+        iter = iter || (all && trade_solvers[pts[i].solver].mode == CLOTH_ORIGINAL);
+        for (j = 0; j < np; j++)
+            if (j != i && pts[j].ms <= pts[i].ms && pts[j].err <= pts[i].err &&
+                (pts[j].ms < pts[i].ms || pts[j].err < pts[i].err)) {
+                all = 0;
+                if (pts[j].tol > 0) iter = 0;
+            }
+        pts[i].pareto = all ? 1 : iter ? 2 : 0;
+        if (pts[i].err <= s.accuracy && (chosen < 0 || pts[i].ms < pts[chosen].ms)) chosen = i;
+    }
+    printf("\n%s %dx%d, %d steps, accuracy %g (max particle error / cloth size against a direct run):\n\n",
+           s.name, s.nx, s.ny, steps, s.accuracy);
+    printf("| solver | tolerance | ms/step | error | meets the accuracy | Pareto |\n|---|---:|---:|---:|---|---|\n");
+    for (i = 0; i < np; i++)
+        printf("| %s | %s | %.3f | %.2g | %s | %s |\n", trade_solvers[pts[i].solver].name,
+               pts[i].tol > 0 ? (snprintf(err, sizeof err, "%g", pts[i].tol), err) : "-", pts[i].ms, pts[i].err,
+               pts[i].err <= s.accuracy ? (i == chosen ? "yes: chosen (fastest that does)" : "yes") : "no",
+               pts[i].pareto == 1 ? "front" : pts[i].pareto == 2 ? "front of the iterative" : "");
+    if (svg_dir) {
+        char file[1024];
+        FILE *f;
+        snprintf(file, sizeof file, "%s/cloth_trade_%s.svg", svg_dir, s.name);
+        if ((f = fopen(file, "w"))) {
+            svg_plot(f, &s, pts, np, chosen);
+            fclose(f);
+            printf("\n(plot: %s)\n", file);
+        }
+    }
+    free(xref);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     int steps = 50, rounds = 3, a, sc, nscenes = 0;
-    const char *label = "embedded", *scenes[16];
+    const char *label = "embedded", *scenes[16], *svg_dir = NULL;
+    int trading = 0;
     for (a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--steps") && a + 1 < argc) steps = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--rounds") && a + 1 < argc) rounds = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--label") && a + 1 < argc) label = argv[++a];
+        else if (!strcmp(argv[a], "--trade")) trading = 1;
+        else if (!strcmp(argv[a], "--svg") && a + 1 < argc) svg_dir = argv[++a];
         else if (argv[a][0] != '-' && nscenes < 16) scenes[nscenes++] = argv[a];
         else {
-            fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]\n");
+            fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT] | --trade [--svg DIR]\n");
             return 2;
         }
     }
     if (!nscenes || steps < 1 || rounds < 1) {
-        fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]\n");
+        fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT] | --trade [--svg DIR]\n");
         return 2;
+    }
+    if (trading) {
+        for (sc = 0; sc < nscenes; sc++)
+            if (trade(scenes[sc], steps, svg_dir)) return 1;
+        return 0;
     }
     printf("| scene | where | driver, solver | ms/step | assembly | solve | update | ratio to original | "
            "max |x - x_original| |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
