@@ -3,14 +3,17 @@
  * three drivers, PNG frames and a summary (cloth.h, README.md here).
  *
  *     cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR]
- *                 [--solver OPTIONS] [--tol T] [--size WxH]
+ *                 [--solver OPTIONS | --tune] [--tol T] [--size WxH]
  *     cloth --keys                      the scene keys with their defaults
  *
  * --solver passes per-call options to every SILC solve (ltd, cmp), e.g.
  * "backend = lis-style; lis-style.options = -i cg -p ic -tol 1e-8"; without
  * it SILC's configured dispatch solves (a sparse Cholesky by default).
- * --tol is the original driver's CG tolerance; by default the scene's
- * accuracy / 100, relative to ||b|| per step.  The exit status is 1 on any
+ * --tune lets SILC's tuner choose the backend (and threads) for the run,
+ * under a backward-error target of the scene's accuracy / 100, and the
+ * summary says what it chose.  --tol is the original driver's CG
+ * tolerance; by default the scene's accuracy / 100, relative to ||b|| per
+ * step.  The exit status is 1 on any
  * failure, with the message on stderr, 2 on a usage error.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -24,7 +27,7 @@
 #include "cloth.h"
 
 static const char usage[] =
-    "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver OPTIONS]\n"
+    "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver OPTIONS | --tune]\n"
     "                   [--tol T] [--size WxH]\n"
     "       cloth --keys\n";
 
@@ -50,7 +53,7 @@ int main(int argc, char **argv)
 {
     const char *scene_path = NULL, *frames = NULL, *solver = NULL;
     cloth_mode mode = CLOTH_ORIGINAL;
-    int steps = -1, w = 640, h = 480, a, step;
+    int steps = -1, w = 640, h = 480, a, step, tune = 0;
     double tol = -1, ek0, es0, ek, es, pinned = 0;
     cloth_scene scene;
     cloth_model m;
@@ -66,6 +69,9 @@ int main(int argc, char **argv)
         } else if (!strcmp(opt, "-h") || !strcmp(opt, "--help")) {
             fputs(usage, stdout);
             return 0;
+        } else if (!strcmp(opt, "--tune")) {
+            tune = 1;
+            continue;
         } else if (opt[0] != '-') {
             if (scene_path) return bad_usage("more than one scene given");
             scene_path = opt;
@@ -117,6 +123,15 @@ int main(int argc, char **argv)
         cloth_model_free(&m);
         return 1;
     }
+    if (tune && solver) {
+        cloth_driver_close(d);
+        cloth_model_free(&m);
+        return bad_usage("--tune and --solver both choose the solver: give one");
+    }
+    if (tune && cloth_driver_tune(d, scene.accuracy / 100, scene.steps, err, sizeof err)) {
+        fprintf(stderr, "cloth: %s\n", err);
+        goto fail;
+    }
     cloth_energy(&m, m.x, m.v, &ek0, &es0);
     if (frames && scene.frame_every > 0 && write_frame(frames, &scene, mode, 0, m.x, w, h)) goto fail;
     for (step = 1; step <= scene.steps; step++) {
@@ -148,6 +163,11 @@ int main(int argc, char **argv)
            1e3 * t.solve / scene.steps, 1e3 * t.update / scene.steps);
     if (mode == CLOTH_ORIGINAL)
         printf("CG: tolerance %.1e, %.1f iterations per step\n", tol, (double)t.cg_iterations / scene.steps);
+    if (mode != CLOTH_ORIGINAL) {
+        char used[400];
+        cloth_driver_solver(d, used, sizeof used);
+        printf("solve%s: %s\n", tune ? " (chosen by the tuner, backward error <= accuracy / 100)" : "", used);
+    }
     printf("max displacement %.6g m; pinned particles moved %.3g m\n", cloth_max_displacement(&m, m.x), pinned);
     printf("energy: kinetic %.6g J, spring %.6g J (at start %.6g, %.6g)\n", ek, es, ek0, es0);
     cloth_driver_close(d);

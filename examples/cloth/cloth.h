@@ -140,6 +140,13 @@ int cloth_driver_step(cloth_driver *d, cloth_times *t, char *err, size_t errlen)
 /* The current positions (and velocities) in m->x, m->v (cmp fetches them). */
 int cloth_driver_sync(cloth_driver *d, char *err, size_t errlen);
 void cloth_driver_close(cloth_driver *d);
+/* ltd and cmp: let SILC's tuner pick the solve's backend (and threads) for a
+ * run of `steps` steps, under the backward-error target `accuracy` (tune
+ * on, tune.accuracy; docs/tuner.md).  0, or -1 with err. */
+int cloth_driver_tune(cloth_driver *d, double accuracy, int steps, char *err, size_t errlen);
+/* ltd and cmp: what ran the last solve, from `info dv` ("backend, method"),
+ * into buf; "" for original. */
+void cloth_driver_solver(cloth_driver *d, char *buf, size_t len);
 const char *cloth_mode_name(cloth_mode mode);
 
 #endif

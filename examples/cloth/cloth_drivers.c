@@ -13,6 +13,7 @@
 #include "cloth.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -290,4 +291,44 @@ void cloth_driver_close(cloth_driver *d)
     if (d->ctx) silc_close(&d->ctx);
     free(d->f), free(d->b), free(d->dv), free(d->a_val);
     free(d);
+}
+
+int cloth_driver_tune(cloth_driver *d, double accuracy, int steps, char *err, size_t errlen)
+{
+    char text[160];
+    if (d->mode == CLOTH_ORIGINAL) return 0;
+    snprintf(text, sizeof text, "set tune.accuracy = %.3g; tune on %d", accuracy, steps);
+    return silc_exec(d->ctx, text) ? silc_fail(d, text, err, errlen) : 0;
+}
+
+/* Collects `info` output (silc_set_output). */
+static void collect(void *user, const char *text)
+{
+    char *buf = user;
+    size_t have = strlen(buf);
+    if (have < 2047) snprintf(buf + have, 2048 - have, "%s", text);
+}
+
+/* The value of `key: ` in an info text, to the end of its line. */
+static void info_field(const char *text, const char *key, char *out, size_t len)
+{
+    const char *p = strstr(text, key), *e;
+    if (!p) return;
+    p += strlen(key);
+    e = strchr(p, '\n');
+    snprintf(out, len, "%.*s", (int)(e ? e - p : (ptrdiff_t)strlen(p)), p);
+}
+
+void cloth_driver_solver(cloth_driver *d, char *buf, size_t len)
+{
+    char text[2048] = "", backend[128] = "", method[256] = "";
+    buf[0] = '\0';
+    if (d->mode == CLOTH_ORIGINAL) return;
+    silc_set_output(d->ctx, collect, text);
+    if (silc_exec(d->ctx, "info dv") == 0) {
+        info_field(text, "  backend: ", backend, sizeof backend);
+        info_field(text, "  solve: ", method, sizeof method);
+        snprintf(buf, len, "%s, %s", backend, method);
+    }
+    silc_set_output(d->ctx, NULL, NULL);
 }
