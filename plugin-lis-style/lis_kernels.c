@@ -8,6 +8,13 @@
  * a few thousand entries stay serial, because a fork costs more than the
  * work.  Dot products reduce with OpenMP's reduction clause, so their
  * rounding differs between thread counts in the last bits only.
+ *
+ * A loop that runs on one thread -- short, or the budget is one thread --
+ * runs as a plain loop, not as a parallel region of one: even that region
+ * is a call into libgomp and an outlined function per kernel, and a CG
+ * iteration calls six kernels.  On the 3072-unknown cloth that was a third
+ * of CG's time (docs/cloth.md).  One thread's reduction adds in the same
+ * order as the plain loop, so the bits do not change.
  */
 #include "lis_kernels.h"
 
@@ -19,6 +26,37 @@
 
 /* Below this many entries a loop is not worth a parallel region. */
 #define LK_PAR_MIN 4096
+
+static int lk_serial(int64_t n)
+{
+#ifdef _OPENMP
+    return n <= LK_PAR_MIN || omp_get_max_threads() == 1;
+#else
+    (void)n;
+    return 1;
+#endif
+}
+
+/* for (i = 0; i < n; i++) BODY, in parallel only when worth it. */
+#define LK_FOR(n, i, BODY)                                                                         \
+    do {                                                                                           \
+        if (lk_serial(n)) {                                                                        \
+            for (i = 0; i < (n); i++) { BODY; }                                                    \
+        } else {                                                                                   \
+            _Pragma("omp parallel for schedule(static)") for (i = 0; i < (n); i++) { BODY; }      \
+        }                                                                                          \
+    } while (0)
+
+/* for (i = 0; i < n; i++) STEP, a reduction: in parallel (OPCLAUSE, the
+ * pragma's text with its reduction clause) only when worth it. */
+#define LK_REDUCE(n, i, OPCLAUSE, STEP)                                                         \
+    do {                                                                                           \
+        if (lk_serial(n)) {                                                                        \
+            for (i = 0; i < (n); i++) { STEP; }                                                    \
+        } else {                                                                                   \
+            _Pragma(OPCLAUSE) for (i = 0; i < (n); i++) { STEP; }                                 \
+        }                                                                                          \
+    } while (0)
 
 void lk_set_threads(int nthreads)
 {
@@ -43,12 +81,8 @@ void lk_spmv(const lk_csr *A, const double *x, double *y)
     const int64_t *rp = A->rp, *ci = A->ci;
     const double *v = A->v;
     int64_t i, m = A->m;
-#pragma omp parallel for schedule(static) if (m > LK_PAR_MIN)
-    for (i = 0; i < m; i++) {
-        double s = 0.0;
-        for (int64_t k = rp[i]; k < rp[i + 1]; k++) s += v[k] * x[ci[k]];
-        y[i] = s;
-    }
+    LK_FOR(m, i, double s = 0.0; for (int64_t k = rp[i]; k < rp[i + 1]; k++) s += v[k] * x[ci[k]];
+           y[i] = s);
 }
 
 void lk_residual(const lk_csr *A, const double *b, const double *x, double *r)
@@ -56,20 +90,15 @@ void lk_residual(const lk_csr *A, const double *b, const double *x, double *r)
     const int64_t *rp = A->rp, *ci = A->ci;
     const double *v = A->v;
     int64_t i, m = A->m;
-#pragma omp parallel for schedule(static) if (m > LK_PAR_MIN)
-    for (i = 0; i < m; i++) {
-        double s = b[i];
-        for (int64_t k = rp[i]; k < rp[i + 1]; k++) s -= v[k] * x[ci[k]];
-        r[i] = s;
-    }
+    LK_FOR(m, i, double s = b[i]; for (int64_t k = rp[i]; k < rp[i + 1]; k++) s -= v[k] * x[ci[k]];
+           r[i] = s);
 }
 
 double lk_dot(int64_t n, const double *x, const double *y)
 {
     double s = 0.0;
     int64_t i;
-#pragma omp parallel for schedule(static) reduction(+ : s) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) s += x[i] * y[i];
+    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(+ : s)", s += x[i] * y[i]);
     return s;
 }
 
@@ -85,57 +114,47 @@ double lk_nrm2(int64_t n, const double *x)
     int e;
     if (s >= 1e-290 && s <= 1e290) return sqrt(s);
     if (s != s) return s;
-#pragma omp parallel for schedule(static) reduction(max : mx) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) mx = fmax(mx, fabs(x[i]));
+    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(max : mx)", mx = fmax(mx, fabs(x[i])));
     if (mx == 0 || isinf(mx)) return mx;
     frexp(mx, &e);
     s = 0;
-#pragma omp parallel for schedule(static) reduction(+ : s) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) {
-        double t = ldexp(x[i], -e);
-        s += t * t;
-    }
+    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(+ : s)", double t = ldexp(x[i], -e);
+              s += t * t);
     return ldexp(sqrt(s), e);
 }
 
 void lk_copy(int64_t n, const double *x, double *y)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) y[i] = x[i];
+    LK_FOR(n, i, y[i] = x[i]);
 }
 
 void lk_zero(int64_t n, double *y)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) y[i] = 0.0;
+    LK_FOR(n, i, y[i] = 0.0);
 }
 
 void lk_scale(int64_t n, double a, double *x)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) x[i] *= a;
+    LK_FOR(n, i, x[i] *= a);
 }
 
 void lk_axpy(int64_t n, double a, const double *x, double *y)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) y[i] += a * x[i];
+    LK_FOR(n, i, y[i] += a * x[i]);
 }
 
 void lk_xpay(int64_t n, const double *x, double a, double *y)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) y[i] = x[i] + a * y[i];
+    LK_FOR(n, i, y[i] = x[i] + a * y[i]);
 }
 
 void lk_waxpby(int64_t n, double a, const double *x, double b, const double *y, double *w)
 {
     int64_t i;
-#pragma omp parallel for schedule(static) if (n > LK_PAR_MIN)
-    for (i = 0; i < n; i++) w[i] = a * x[i] + b * y[i];
+    LK_FOR(n, i, w[i] = a * x[i] + b * y[i]);
 }
