@@ -34,44 +34,48 @@
 
 #include "cloth.h"
 
+/* SILC's CG + Jacobi at the tolerance (%g): original's algorithm and
+ * stopping rule, so a ratio to original is the cost of the mode. */
+#define CG_JACOBI "backend = lis-style; lis-style.options = -i cg -p jacobi -tol %g"
+
 typedef struct variant {
     cloth_mode mode;
-    const char *solver; /* NULL: configured dispatch; "cg": CG + Jacobi at the tolerance */
+    const char *solver; /* per-call solve options, %g the tolerance; NULL: configured dispatch */
 } variant;
 
 static const variant variants[] = {
-    {CLOTH_ORIGINAL, NULL}, {CLOTH_LTD, "cg"}, {CLOTH_CMP, "cg"}, {CLOTH_LTD, NULL}, {CLOTH_CMP, NULL},
+    {CLOTH_ORIGINAL, NULL}, {CLOTH_LTD, CG_JACOBI}, {CLOTH_CMP, CG_JACOBI}, {CLOTH_LTD, NULL}, {CLOTH_CMP, NULL},
 };
 enum { NV = sizeof variants / sizeof variants[0] };
 
-/* One run: per-step times and the final positions (3n, in x). */
-static int run(const cloth_scene *s, const variant *v, int steps, double tol, cloth_times *t, double *x)
+/* One run from the scene's start: per-step times and the final positions
+ * (3n, in x).  solver as in variant; tol is also original's CG tolerance.
+ * -1 with err on failure. */
+static int run(const cloth_scene *s, cloth_mode mode, const char *solver, double tol, int steps, cloth_times *t,
+               double *x, char *err, size_t errlen)
 {
     cloth_model m;
     cloth_driver *d;
-    char err[1024], opts[256];
-    int k;
+    char opts[256];
+    int k, ok = 1;
     memset(t, 0, sizeof *t);
-    if (cloth_model_init(&m, s, err, sizeof err)) {
-        fprintf(stderr, "cloth_bench: %s\n", err);
-        return -1;
-    }
-    snprintf(opts, sizeof opts, "backend = lis-style; lis-style.options = -i cg -p jacobi -tol %.3g", tol);
-    if (!(d = cloth_driver_open(&m, v->mode, v->solver ? opts : NULL, tol, err, sizeof err))) {
-        fprintf(stderr, "cloth_bench: %s\n", err);
-        cloth_model_free(&m);
-        return -1;
-    }
-    for (k = 0; k < steps; k++)
-        if (cloth_driver_step(d, t, err, sizeof err)) {
-            fprintf(stderr, "cloth_bench: %s %s step %d: %s\n", s->name, cloth_mode_name(v->mode), k, err);
-            break;
-        }
-    if (k == steps && cloth_driver_sync(d, err, sizeof err) == 0) memcpy(x, m.x, (size_t)3 * m.n * sizeof *x);
-    else k = -1;
+    if (cloth_model_init(&m, s, err, errlen)) return -1;
+    if (solver) snprintf(opts, sizeof opts, solver, tol);
+    d = cloth_driver_open(&m, mode, solver ? opts : NULL, tol, err, errlen);
+    for (k = 0; d && ok && k < steps; k++) ok = cloth_driver_step(d, t, err, errlen) == 0;
+    ok = d && ok && cloth_driver_sync(d, err, errlen) == 0;
+    if (ok) memcpy(x, m.x, (size_t)3 * m.n * sizeof *x);
     cloth_driver_close(d);
     cloth_model_free(&m);
-    return k == steps ? 0 : -1;
+    return ok ? 0 : -1;
+}
+
+static double max_diff(const double *a, const double *b, int n)
+{
+    double d = 0;
+    int i;
+    for (i = 0; i < n; i++) d = fmax(d, fabs(a[i] - b[i]));
+    return d;
 }
 
 /* ---- --trade: time against accuracy ------------------------------------------ */
@@ -171,24 +175,18 @@ static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np
 static int trade_run(const cloth_scene *s, const trade_solver *ts, double tol, int steps, const double *xref,
                      double *ms, double *err_out, char *err, size_t errlen)
 {
+    int n3 = 3 * s->nx * s->ny, rc;
+    double *x = malloc((size_t)n3 * sizeof *x);
     cloth_times t;
-    char opts[256];
-    cloth_model m;
-    cloth_driver *d;
-    int ok = 1, k;
-    double e = 0;
-    memset(&t, 0, sizeof t);
-    snprintf(opts, sizeof opts, ts->opts ? ts->opts : "", tol);
-    if (cloth_model_init(&m, s, err, errlen)) return -1;
-    d = cloth_driver_open(&m, ts->mode, ts->opts ? opts : NULL, tol, err, errlen);
-    for (k = 0; d && ok && k < steps; k++) ok = cloth_driver_step(d, &t, err, errlen) == 0;
-    ok = d && ok && cloth_driver_sync(d, err, errlen) == 0;
-    for (k = 0; ok && k < 3 * m.n; k++) e = fmax(e, fabs(m.x[k] - xref[k]));
+    if (!x) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    rc = run(s, ts->mode, ts->opts, tol, steps, &t, x, err, errlen);
     *ms = 1e3 * (t.assembly + t.solve + t.update) / steps;
-    *err_out = e;
-    cloth_driver_close(d);
-    cloth_model_free(&m);
-    return ok ? 0 : -1;
+    *err_out = rc ? NAN : max_diff(x, xref, n3);
+    free(x);
+    return rc;
 }
 
 /* Every solver at every tolerance against a direct run of the same steps. */
@@ -197,7 +195,6 @@ static int trade(const char *path, int steps, const char *svg_dir)
     cloth_scene s;
     char err[1024];
     trade_point pts[NTS * NTOL];
-    variant v;
     double *xref, size;
     int np = 0, i, j, n3, chosen = -1;
     if (scene_read(path, &s, err, sizeof err)) {
@@ -208,10 +205,13 @@ static int trade(const char *path, int steps, const char *svg_dir)
     size = fmax(s.width, s.height);
     xref = calloc((size_t)n3, sizeof *xref);
     if (!xref) return -1;
-    v.mode = CLOTH_LTD, v.solver = NULL;
     {
         cloth_times t;
-        if (run(&s, &v, steps, 1e-12, &t, xref)) return -1;
+        if (run(&s, CLOTH_LTD, NULL, 1e-12, steps, &t, xref, err, sizeof err)) {
+            fprintf(stderr, "cloth_bench: %s direct reference: %s\n", s.name, err);
+            free(xref);
+            return -1;
+        }
     }
     for (i = 0; i < NTS; i++)
         for (j = 0; j < NTOL; j++) {
@@ -317,10 +317,13 @@ int main(int argc, char **argv)
             for (v = 0; v < NV; v++) {
                 cloth_times t;
                 double per;
-                if (run(&s, &variants[v], steps, tol, &t, v == 0 ? x0 : x)) continue;
+                if (run(&s, variants[v].mode, variants[v].solver, tol, steps, &t, v == 0 ? x0 : x, err,
+                        sizeof err)) {
+                    fprintf(stderr, "cloth_bench: %s %s: %s\n", s.name, cloth_mode_name(variants[v].mode), err);
+                    continue;
+                }
                 per = (t.assembly + t.solve + t.update) / steps;
-                if (v > 0) diff[v] = 0;
-                for (a = 0; v > 0 && a < n3; a++) diff[v] = fmax(diff[v], fabs(x[a] - x0[a]));
+                if (v > 0) diff[v] = max_diff(x, x0, n3);
                 if (per < best[v]) {
                     best[v] = per;
                     split[v][0] = t.assembly / steps, split[v][1] = t.solve / steps, split[v][2] = t.update / steps;

@@ -324,9 +324,12 @@ static int sparse_triplets(lang_ev *V, const ast_node *call, silc_value **a, sil
     memcpy(r->rowptr, s->rowptr, (size_t)(m + 1) * sizeof *r->rowptr);
     memcpy(r->colind, s->colind, (size_t)s->nnz * sizeof *r->colind);
     memset(r->val, 0, (size_t)s->nnz * sizeof *r->val);
-    for (k = 0; k < len; k++)
-        r->val[s->dest[k]] += val_is_scalar(a[2]) ? val_scalar(a[2])
-                                                  : val_get(a[2], a[2]->m == 1 ? 0 : k, a[2]->m == 1 ? k : 0);
+    if (val_is_scalar(a[2])) {
+        double c = val_scalar(a[2]);
+        for (k = 0; k < len; k++) r->val[s->dest[k]] += c;
+    } else {
+        for (k = 0; k < len; k++) r->val[s->dest[k]] += val_get(a[2], a[2]->m == 1 ? 0 : k, a[2]->m == 1 ? k : 0);
+    }
     val_csr_set_nnz(r, s->nnz);
     *out = r;
     note_core(V, call, r);

@@ -969,8 +969,6 @@ done:
     return 0;
 }
 
-/* A * x with A distributed by rows: each rank multiplies its rows by the
- * whole x (gathered once per x value). */
 /* ---- the halo exchange of a sparse product ---------------------------------- */
 
 /* y = A x with A and x distributed alike needs, on each rank, x's entries at
@@ -1098,7 +1096,15 @@ fail:
     return NULL;
 }
 
-/* For a product of A with x distributed alike (A square CSR): A's plan and
+/* A product the halo exchange serves: A square CSR, x dense, both
+ * distributed by the same rows. */
+static int halo_applies(const silc_value *A, const silc_value *x)
+{
+    return dist_is(A) && dist_is(x) && A->format == SILC_FMT_CSR && x->format == SILC_FMT_DENSE &&
+           A->m == A->n && x->m == A->n && part_same(A->dist->part, x->dist->part);
+}
+
+/* For a product of A with x distributed alike (halo_applies): A's plan and
  * [x's block; the ghosts] as a new dense value, each of x's columns moved
  * once.  1: not this case (the caller gathers); -1: out of memory (every
  * rank); 0: done. */
@@ -1110,9 +1116,7 @@ static int halo_operands(dist_ctx *D, const silc_value *A, const silc_value *x, 
     double *send;
     int64_t j, i, nsend;
     *xbuf = NULL;
-    if (!dist_is(A) || !dist_is(x) || A->format != SILC_FMT_CSR || x->format != SILC_FMT_DENSE ||
-        A->m != A->n || x->m != A->n || !part_same(A->dist->part, x->dist->part))
-        return 1;
+    if (!halo_applies(A, x)) return 1;
     if (!(h = val_attach_get(A->dist->block, HALO_KEY))) {
         if (!(h = halo_build(D, A))) return -1;
         if (any_rank(D, val_attach_set(A->dist->block, HALO_KEY, h, halo_free) != 0)) {
@@ -1142,6 +1146,9 @@ static int halo_operands(dist_ctx *D, const silc_value *A, const silc_value *x, 
     return 0;
 }
 
+/* A * x with A distributed by rows: each rank multiplies its rows, by
+ * [its rows of x; the ghosts] (halo_operands) or by the whole x (gathered
+ * once per x value). */
 static int matmul(silc_engine *E, silc_call *call, int *rc)
 {
     const silc_value *A = call->in[0], *x = call->in[1];
@@ -1402,9 +1409,7 @@ void dist_explain(silc_engine *E, const silc_call *call, strbuf *b)
     case SILC_OP_MATMUL:
         if (!dist_is(call->in[0]))
             sb_puts(b, "; operands gathered to every rank, run there\n");
-        else if (call->nin > 1 && dist_is(call->in[1]) && call->in[0]->format == SILC_FMT_CSR &&
-                 call->in[1]->format == SILC_FMT_DENSE && call->in[0]->m == call->in[0]->n &&
-                 part_same(call->in[0]->dist->part, call->in[1]->dist->part))
+        else if (call->nin > 1 && halo_applies(call->in[0], call->in[1]))
             sb_puts(b, "; each rank multiplies its rows, receiving only the right operand's entries "
                        "its rows use (halo exchange, planned once per matrix)\n");
         else

@@ -50,10 +50,14 @@ struct eng_memo {
     uint64_t clock, bytes;
 };
 
-static int key_of(const silc_call *call, memo_key *k)
+/* The call's key; -1 for a call never kept: a solve (its report and
+ * warnings belong to each statement), one with per-call options, or one on
+ * an SPMD engine (ranks number values differently, and every rank must
+ * take the same path). */
+static int key_of(const silc_engine *E, const silc_call *call, memo_key *k)
 {
     int i;
-    if (call->op == SILC_OP_SOLVE || call->options || call->nin < 1 || call->nin > 3) return -1;
+    if (E->dist || call->op == SILC_OP_SOLVE || call->options || call->nin < 1 || call->nin > 3) return -1;
     memset(k, 0, sizeof *k);
     k->op = call->op;
     k->sub = call->sub;
@@ -105,16 +109,11 @@ static memo_slot *make_room(eng_memo *M)
     return &M->slot[M->n++];
 }
 
-static int usable(const silc_engine *E, const silc_call *call)
-{
-    return !E->dist && call->op != SILC_OP_SOLVE;
-}
-
 silc_value *memo_lookup(silc_engine *E, const silc_call *call)
 {
     memo_key k;
     memo_slot *s;
-    if (!E->memo || !usable(E, call) || key_of(call, &k)) return NULL;
+    if (!E->memo || key_of(E, call, &k)) return NULL;
     s = find(E->memo, &k);
     if (!s || !s->result) return NULL;
     s->used = ++E->memo->clock;
@@ -127,7 +126,7 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
     memo_key k;
     memo_slot *s;
     uint64_t bytes;
-    if (!usable(E, call) || key_of(call, &k)) return;
+    if (key_of(E, call, &k)) return;
     if (!E->memo && !(E->memo = calloc(1, sizeof *E->memo))) return; /* no table: nothing kept, nothing lost */
     M = E->memo;
     s = find(M, &k);

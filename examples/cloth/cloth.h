@@ -91,9 +91,13 @@ typedef struct cloth_model {
     double *mass;               /* 3n: each coordinate's particle mass (M's diagonal) */
     double *fixed;              /* 3n: 0 for a pinned particle's coordinates, 1 else */
     double *gvec;               /* 3n: gravity per coordinate */
-    /* A's pattern, fixed for the mesh: 3n x 3n CSR, sorted columns. */
+    /* A's pattern, fixed for the mesh: 3n x 3n CSR, sorted columns; and
+     * where each entry the assembly adds to lies in it, found once: diag[r]
+     * for (r, r), and for spring k and direction d the slots of (l, l),
+     * (r, r), (l, r), (r, l) at spring_slot[12 k + 4 d ..]. */
     int64_t *rowptr, *colind;
     int64_t nnz;
+    int64_t *diag, *spring_slot;
 } cloth_model;
 
 int cloth_model_init(cloth_model *m, const cloth_scene *s, char *err, size_t errlen);

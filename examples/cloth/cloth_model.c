@@ -65,6 +65,18 @@ static int add_springs(cloth_model *m)
     return 0;
 }
 
+/* Position of column c in row r of m's pattern (it is there by construction). */
+static int64_t entry(const cloth_model *m, int64_t r, int64_t c)
+{
+    int64_t lo = m->rowptr[r], hi = m->rowptr[r + 1] - 1;
+    while (lo < hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (m->colind[mid] < c) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 /* A's pattern: row 3p+d holds columns 3q+d for p and every spring neighbour q. */
 static int build_pattern(cloth_model *m)
 {
@@ -98,6 +110,15 @@ static int build_pattern(cloth_model *m)
         }
     }
     m->nnz = at;
+    m->diag = malloc((size_t)(3 * n) * sizeof *m->diag);
+    m->spring_slot = malloc((size_t)(12 * (m->ns ? m->ns : 1)) * sizeof *m->spring_slot);
+    if (!m->diag || !m->spring_slot) goto out;
+    for (p = 0; p < 3 * n; p++) m->diag[p] = entry(m, p, p);
+    for (k = 0; k < m->ns; k++)
+        for (d = 0; d < 3; d++) {
+            int64_t l = 3 * (int64_t)m->sl[k] + d, r = 3 * (int64_t)m->sr[k] + d, *slot = m->spring_slot + 12 * k + 4 * d;
+            slot[0] = entry(m, l, l), slot[1] = entry(m, r, r), slot[2] = entry(m, l, r), slot[3] = entry(m, r, l);
+        }
     rc = 0;
 out:
     free(deg);
@@ -152,7 +173,7 @@ void cloth_model_free(cloth_model *m)
 {
     free(m->sl), free(m->sr), free(m->k), free(m->rest);
     free(m->x), free(m->v), free(m->x0), free(m->mass), free(m->fixed), free(m->gvec);
-    free(m->rowptr), free(m->colind);
+    free(m->rowptr), free(m->colind), free(m->diag), free(m->spring_slot);
     memset(m, 0, sizeof *m);
 }
 
@@ -171,18 +192,6 @@ void cloth_forces(const cloth_model *m, const double *x, double *f)
     }
 }
 
-/* Position of column c in row r of m's pattern (it is there by construction). */
-static int64_t entry(const cloth_model *m, int64_t r, int64_t c)
-{
-    int64_t lo = m->rowptr[r], hi = m->rowptr[r + 1] - 1;
-    while (lo < hi) {
-        int64_t mid = lo + (hi - lo) / 2;
-        if (m->colind[mid] < c) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
-}
-
 void cloth_system(const cloth_model *m, const double *f, const double *v, double *a_val, double *b)
 {
     const cloth_scene *s = m->scene;
@@ -191,17 +200,18 @@ void cloth_system(const cloth_model *m, const double *f, const double *v, double
     int k, d;
     memset(a_val, 0, (size_t)m->nnz * sizeof *a_val);
     for (r = 0; r < 3 * m->n; r++) {
-        a_val[entry(m, r, r)] = (1 + dt * s->damping) * m->mass[r];
+        a_val[m->diag[r]] = (1 + dt * s->damping) * m->mass[r];
         b[r] = f[r];
     }
     for (k = 0; k < m->ns; k++)
         for (d = 0; d < 3; d++) {
             int64_t l = 3 * m->sl[k] + d, q = 3 * m->sr[k] + d;
+            const int64_t *slot = m->spring_slot + 12 * k + 4 * d;
             double kk = m->k[k];
-            a_val[entry(m, l, l)] += dt2 * kk;
-            a_val[entry(m, q, q)] += dt2 * kk;
-            a_val[entry(m, l, q)] -= dt2 * kk;
-            a_val[entry(m, q, l)] -= dt2 * kk;
+            a_val[slot[0]] += dt2 * kk;
+            a_val[slot[1]] += dt2 * kk;
+            a_val[slot[2]] -= dt2 * kk;
+            a_val[slot[3]] -= dt2 * kk;
             /* b = dt (f + dt DfDx v), DfDx v = -(K (v_l - v_r)) on l, +... on r */
             b[l] -= dt * kk * (v[l] - v[q]);
             b[q] += dt * kk * (v[l] - v[q]);
@@ -283,7 +293,7 @@ int cloth_cg(const cloth_model *m, const double *a_val, const double *b, double 
     int it = -1, k;
     if (!r || !z || !p || !q || !dinv) goto out;
     for (i = 0; i < N; i++) {
-        dinv[i] = 1 / a_val[entry(m, i, i)];
+        dinv[i] = 1 / a_val[m->diag[i]];
         x[i] = 0;
         r[i] = b[i];
         z[i] = dinv[i] * r[i];
