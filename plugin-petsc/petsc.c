@@ -807,13 +807,10 @@ done:
 }
 
 /* Fills the report's method and condition estimate once the solves passed. */
-static void report_method(silc_report *r, const psc_ranks *R, const psc_solver *S)
+static void report_method(silc_report *r, const psc_solver *S)
 {
+    /* How many ranks ran a collective solve the host adds (dispatch.c). */
     snprintf(r->method, sizeof r->method, "%s", S->method);
-    if (R->dist) {
-        size_t len = strlen(r->method);
-        snprintf(r->method + len, sizeof r->method - len, " on %d rank%s", R->size, R->size == 1 ? "" : "s");
-    }
     r->cond_est = S->cond_est;
     if (S->cond_est >= 0) {
         size_t len = strlen(r->note);
@@ -923,7 +920,7 @@ agreed:
         if ((rc = psc_options_check_used(call, R.comm, S->opts, text, spd, S->A))) goto done;
         S->checked = 1;
     }
-    report_method(r, &R, S);
+    report_method(r, S);
 
     /* Attaching: rank-local, agreed. */
     if (fresh) {
