@@ -204,6 +204,10 @@ void lv_matvec_t(const lis_ctx *c, const lis_vec *x, lis_vec *y);       /* y = A
 void lv_psolve(lis_ctx *c, const lis_vec *x, lis_vec *y);               /* y = M^-1 x */
 void lv_psolve_t(lis_ctx *c, const lis_vec *x, lis_vec *y);             /* y = M^-T x */
 void lv_residual(const lis_ctx *c, const lis_vec *x, lis_vec *r);       /* r = b - A x */
+dd lv_matvec_dot(const lis_ctx *c, const lis_vec *x, lis_vec *y);         /* y = A x; x'y */
+dd lv_axpy2_nrm2(const lis_ctx *c, dd a, const lis_vec *p, const lis_vec *q, lis_vec *x,
+                 lis_vec *r);                                 /* x += a p, r -= a q; ||r|| */
+dd lv_psolve_dot(lis_ctx *c, const lis_vec *r, lis_vec *z);             /* z = M^-1 r; r'z */
 
 /* One iteration finished with residual norm rnorm (absolute, 2-norm):
  * counts it, logs it under -print out, and returns LIS_CONVERGED, LIS_NAN or

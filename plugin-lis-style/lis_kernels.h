@@ -27,11 +27,19 @@ void lk_spmv(const lk_csr *A, const double *x, double *y);              /* y = A
 void lk_residual(const lk_csr *A, const double *b, const double *x, double *r); /* r = b - A x */
 double lk_dot(int64_t n, const double *x, const double *y);
 double lk_nrm2(int64_t n, const double *x);                             /* ||x||_2, scaled */
+double lk_nrm2_sumsq(int64_t n, const double *x, double sumsq); /* the same, given x'x */
 void lk_copy(int64_t n, const double *x, double *y);                    /* y = x          */
 void lk_zero(int64_t n, double *y);
 void lk_scale(int64_t n, double a, double *x);                          /* x = a x        */
 void lk_axpy(int64_t n, double a, const double *x, double *y);          /* y = y + a x    */
 void lk_xpay(int64_t n, const double *x, double a, double *y);          /* y = x + a y    */
 void lk_waxpby(int64_t n, double a, const double *x, double b, const double *y, double *w); /* w = a x + b y */
+
+/* Fused passes for CG-like loops: each is two or three of the above in one
+ * sweep over memory, with the same arithmetic per entry. */
+double lk_spmv_dot(const lk_csr *A, const double *x, double *y);        /* y = A x; x'y   */
+double lk_axpy2_sumsq(int64_t n, double a, const double *p, const double *q, double *x,
+                      double *r);                       /* x += a p, r -= a q; r'r */
+double lk_mul_dot(int64_t n, const double *d, const double *r, double *z); /* z = d.*r; r'z */
 
 #endif

@@ -102,19 +102,14 @@ int lis_cg(lis_ctx *c, lis_vec *x)
     int st = LIS_MAXITER;
     if (lv_new_many(c, v, 4)) return LIS_NOMEM;
     lv_residual(c, x, r);
-    lv_psolve(c, r, z);
+    rho = lv_psolve_dot(c, r, z);
     lv_copy(c, z, p);
-    rho = lv_dot(c, r, z);
     while (!lis_limit(c)) {
-        lv_matvec(c, p, q);
-        pq = lv_dot(c, p, q);
+        pq = lv_matvec_dot(c, p, q);
         if (!(pq.hi > 0)) FAIL(pq, "p'Ap <= 0: A or the preconditioner is not positive definite");
         alpha = s_div(c, rho, pq);
-        lv_axpy(c, alpha, p, x);
-        lv_axpy(c, dd_neg(alpha), q, r);
-        STEP(lv_nrm2(c, r));
-        lv_psolve(c, r, z);
-        rho1 = lv_dot(c, r, z);
+        STEP(lv_axpy2_nrm2(c, alpha, p, q, x, r));
+        rho1 = lv_psolve_dot(c, r, z);
         FAIL_IF_ZERO(rho1, "r'M^-1 r = 0");
         lv_xpay(c, z, s_div(c, rho1, rho), p);
         rho = rho1;

@@ -113,6 +113,34 @@ void lv_matvec(const lis_ctx *c, const lis_vec *x, lis_vec *y)
     else lk_spmv(c->A, x->h, y->h);
 }
 
+/* The fused forms of the three CG phases (lis_kernels.c says why); in
+ * double-double they are the separate operations. */
+dd lv_matvec_dot(const lis_ctx *c, const lis_vec *x, lis_vec *y)
+{
+    if (c->quad) {
+        lv_matvec(c, x, y);
+        return lv_dot(c, x, y);
+    }
+    return dd_d(lk_spmv_dot(c->A, x->h, y->h));
+}
+
+dd lv_axpy2_nrm2(const lis_ctx *c, dd a, const lis_vec *p, const lis_vec *q, lis_vec *x, lis_vec *r)
+{
+    if (c->quad) {
+        lv_axpy(c, a, p, x);
+        lv_axpy(c, dd_neg(a), q, r);
+        return lv_nrm2(c, r);
+    }
+    return dd_d(lk_nrm2_sumsq(c->n, r->h, lk_axpy2_sumsq(c->n, a.hi, p->h, q->h, x->h, r->h)));
+}
+
+dd lv_psolve_dot(lis_ctx *c, const lis_vec *r, lis_vec *z)
+{
+    if (!c->quad && c->pc && c->pc->kind == LIS_PC_JACOBI) return dd_d(lk_mul_dot(c->n, c->pc->dinv, r->h, z->h));
+    lv_psolve(c, r, z);
+    return lv_dot(c, r, z);
+}
+
 void lv_matvec_t(const lis_ctx *c, const lis_vec *x, lis_vec *y)
 {
     if (c->quad) ldd_spmv(c->At, x->h, x->l, y->h, y->l);
