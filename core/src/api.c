@@ -290,6 +290,12 @@ int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e)
         if (env_check(e, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
         return ctx_result(ctx, rem_put(ctx->R, name, e, ctx->err, sizeof ctx->err));
     }
+    if (!ctx->E->dist && env_same_as_value(e, store_get(&ctx->E->store, name))) {
+        /* What the name holds already: keep it, as api_bind would after a
+         * copy and a comparison; this is the comparison alone. */
+        eng_info_remove(ctx->E, name);
+        return ctx_result(ctx, 0);
+    }
     rc = env_to_value(e, &v, err, sizeof err);
     if (rc) ctx_error(ctx, "'%s': %s", name, err);
     if (spmd_enter(ctx, "PUT", name, rc)) {

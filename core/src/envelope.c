@@ -449,6 +449,24 @@ int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errl
     return csr_fill(v, e, err, errlen);
 }
 
+int env_same_as_value(const silc_envelope_t *e, const silc_value *v)
+{
+    silc_view x, y;
+    if (!e || !v || v->dist || !e->values) return 0;
+    val_view(v, &y);
+    if ((int)e->format != y.format || e->m != y.m || e->n != y.n) return 0;
+    x = y;
+    x.val = e->values;
+    if (y.format == SILC_FMT_CSR) {
+        if (!e->rowptr || !e->colind || e->nnz != y.nnz) return 0;
+        x.rowptr = e->rowptr;
+        x.colind = e->colind;
+    } else if (y.format == SILC_FMT_BAND) {
+        if (e->kl != y.kl || e->ku != y.ku || y.ld != y.kl + y.ku + 1) return 0;
+    }
+    return view_same_contents(&x, &y);
+}
+
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
 {
     silc_value *v;

@@ -26,6 +26,11 @@ int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t e
  * the value's shape computed on the way (val_csr_fill_checked).  0, or -1
  * with the reason in err. */
 int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen);
+/* 1 when e holds exactly v's format, shape, pattern and value bits: then a
+ * PUT of e to the name holding v need copy nothing (silc_put).  Reads no
+ * array of e beyond what v's shape says a valid e has; 0 for anything that
+ * is not such an e. */
+int env_same_as_value(const silc_envelope_t *e, const silc_value *v);
 /* Copies a value into a freshly built envelope of the same format. */
 int env_from_value(const silc_value *v, silc_envelope_t *e);
 

@@ -364,13 +364,20 @@ int val_same_contents(const silc_value *a, const silc_value *b)
     if (a == b) return 1;
     val_view(a, &x);
     val_view(b, &y);
-    if (x.format != y.format || x.m != y.m || x.n != y.n || x.nnz != y.nnz || x.kl != y.kl || x.ku != y.ku)
+    return view_same_contents(&x, &y);
+}
+
+int view_same_contents(const silc_view *x, const silc_view *y)
+{
+    if (x->format != y->format || x->m != y->m || x->n != y->n || x->nnz != y->nnz || x->kl != y->kl ||
+        x->ku != y->ku)
         return 0;
-    if (x.format == SILC_FMT_CSR &&
-        (memcmp(x.rowptr, y.rowptr, (size_t)(x.m + 1) * sizeof *x.rowptr) ||
-         memcmp(x.colind, y.colind, (size_t)x.nnz * sizeof *x.colind)))
+    /* rowptr first: when it matches, nnz entries of colind are there to read. */
+    if (x->format == SILC_FMT_CSR &&
+        (memcmp(x->rowptr, y->rowptr, (size_t)(x->m + 1) * sizeof *x->rowptr) ||
+         memcmp(x->colind, y->colind, (size_t)x->nnz * sizeof *x->colind)))
         return 0;
-    return !memcmp(x.val, y.val, (size_t)x.nnz * sizeof *x.val);
+    return x->nnz == 0 || !memcmp(x->val, y->val, (size_t)x->nnz * sizeof *x->val);
 }
 
 size_t val_bytes(const silc_value *v)

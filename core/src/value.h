@@ -142,6 +142,8 @@ double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any forma
 /* 1 when a and b hold the same format, shape, pattern and value bits (whole
  * values only). */
 int val_same_contents(const silc_value *a, const silc_value *b);
+/* The same for two views (val_same_contents and env_same_as_value). */
+int view_same_contents(const silc_view *x, const silc_view *y);
 size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
 const char *val_format_name(int format);  /* "dense", "csr", "band" */
 
