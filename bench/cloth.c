@@ -34,17 +34,15 @@
 
 #include "cloth.h"
 
-/* SILC's CG + Jacobi at the tolerance (%g): original's algorithm and
- * stopping rule, so a ratio to original is the cost of the mode. */
-#define CG_JACOBI "backend = lis-style; lis-style.options = -i cg -p jacobi -tol %g"
-
 typedef struct variant {
     cloth_mode mode;
-    const char *solver; /* per-call solve options, %g the tolerance; NULL: configured dispatch */
+    const char *solver; /* a cloth_solver_options name */
 } variant;
 
+/* "cg" is original's algorithm and stopping rule in SILC, so its ratio to
+ * original is the cost of the mode; "direct" is what a user gets. */
 static const variant variants[] = {
-    {CLOTH_ORIGINAL, NULL}, {CLOTH_LTD, CG_JACOBI}, {CLOTH_CMP, CG_JACOBI}, {CLOTH_LTD, NULL}, {CLOTH_CMP, NULL},
+    {CLOTH_ORIGINAL, "cg"}, {CLOTH_LTD, "cg"}, {CLOTH_CMP, "cg"}, {CLOTH_LTD, "direct"}, {CLOTH_CMP, "direct"},
 };
 enum { NV = sizeof variants / sizeof variants[0] };
 
@@ -56,12 +54,10 @@ static int run(const cloth_scene *s, cloth_mode mode, const char *solver, double
 {
     cloth_model m;
     cloth_driver *d;
-    char opts[256];
     int k, ok = 1;
     memset(t, 0, sizeof *t);
     if (cloth_model_init(&m, s, err, errlen)) return -1;
-    if (solver) snprintf(opts, sizeof opts, solver, tol);
-    d = cloth_driver_open(&m, mode, solver ? opts : NULL, tol, err, errlen);
+    d = cloth_driver_open(&m, mode, solver, tol, err, errlen);
     for (k = 0; d && ok && k < steps; k++) ok = cloth_driver_step(d, t, err, errlen) == 0;
     ok = d && ok && cloth_driver_sync(d, err, errlen) == 0;
     if (ok) memcpy(x, m.x, (size_t)3 * m.n * sizeof *x);
@@ -80,22 +76,27 @@ static double max_diff(const double *a, const double *b, int n)
 
 /* ---- --trade: time against accuracy ------------------------------------------ */
 
-/* One solver of the trade study; %g in opts is the tolerance. */
+/* One solver of the trade study, at each of trade_tols. */
 typedef struct trade_solver {
-    const char *name, *opts; /* opts NULL with mode original: own CG; NULL with ltd: default (direct) */
+    const char *name;   /* the legend's */
+    const char *solver; /* a cloth_solver_options name ("cg" with mode original: its own CG) */
     cloth_mode mode;
     const char *color;
 } trade_solver;
 
 static const trade_solver trade_solvers[] = {
-    {"original CG + Jacobi", NULL, CLOTH_ORIGINAL, "#444444"},
-    {"lis-style CG + IC(0)", "backend = lis-style; lis-style.options = -i cg -p ic -tol %g", CLOTH_LTD, "#1f77b4"},
-    {"lis-style CG + SA-AMG", "backend = lis-style; lis-style.options = -i cg -p saamg -tol %g", CLOTH_LTD,
-     "#2ca02c"},
-    {"petsc CG + ICC", "backend = petsc; petsc.options = -ksp_type cg -pc_type icc -ksp_rtol %g -ksp_atol 0",
-     CLOTH_LTD, "#d62728"},
-    {"direct (CHOLMOD)", NULL, CLOTH_LTD, "#9467bd"},
+    {"original CG + Jacobi", "cg", CLOTH_ORIGINAL, "#444444"},
+    {"lis-style CG + IC(0)", "cg-ic", CLOTH_LTD, "#1f77b4"},
+    {"lis-style CG + SA-AMG", "cg-amg", CLOTH_LTD, "#2ca02c"},
+    {"petsc CG + ICC", "petsc-cg", CLOTH_LTD, "#d62728"},
+    {"direct (CHOLMOD)", "direct", CLOTH_LTD, "#9467bd"},
 };
+
+/* An iterative point: one per tolerance.  A direct solve has one point. */
+static int trade_iterative(const trade_solver *ts)
+{
+    return strcmp(ts->solver, "direct") != 0;
+}
 enum { NTS = sizeof trade_solvers / sizeof trade_solvers[0], NTOL = 6 };
 static const double trade_tols[NTOL] = {1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
 
@@ -182,7 +183,7 @@ static int trade_run(const cloth_scene *s, const trade_solver *ts, double tol, i
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    rc = run(s, ts->mode, ts->opts, tol, steps, &t, x, err, errlen);
+    rc = run(s, ts->mode, ts->solver, tol, steps, &t, x, err, errlen);
     *ms = 1e3 * (t.assembly + t.solve + t.update) / steps;
     *err_out = rc ? NAN : max_diff(x, xref, n3);
     free(x);
@@ -207,7 +208,7 @@ static int trade(const char *path, int steps, const char *svg_dir)
     if (!xref) return -1;
     {
         cloth_times t;
-        if (run(&s, CLOTH_LTD, NULL, 1e-12, steps, &t, xref, err, sizeof err)) {
+        if (run(&s, CLOTH_LTD, "direct", 1e-12, steps, &t, xref, err, sizeof err)) {
             fprintf(stderr, "cloth_bench: %s direct reference: %s\n", s.name, err);
             free(xref);
             return -1;
@@ -217,7 +218,7 @@ static int trade(const char *path, int steps, const char *svg_dir)
         for (j = 0; j < NTOL; j++) {
             const trade_solver *ts = &trade_solvers[i];
             double ms, ms2, e;
-            if (!ts->opts && ts->mode == CLOTH_LTD && j > 0) break; /* direct: one point */
+            if (!trade_iterative(ts) && j > 0) break;
             /* Twice, the faster kept: a library's first run pays its start-up
              * (PETSc's is 0.25 s), which is no part of a step. */
             if (trade_run(&s, ts, trade_tols[j], steps, xref, &ms, &e, err, sizeof err) ||
@@ -226,7 +227,7 @@ static int trade(const char *path, int steps, const char *svg_dir)
                 continue;
             }
             pts[np].solver = i;
-            pts[np].tol = ts->opts || ts->mode == CLOTH_ORIGINAL ? trade_tols[j] : 0;
+            pts[np].tol = trade_iterative(ts) ? trade_tols[j] : 0;
             pts[np].ms = fmin(ms, ms2);
             pts[np].err = isfinite(e) ? e / size : INFINITY;
             pts[np].pareto = 0;
@@ -237,7 +238,7 @@ static int trade(const char *path, int steps, const char *svg_dir)
      * (where a direct solve with a reused factorization beats them all, the
      * front of all is that one point). */
     for (i = 0; i < np; i++) {
-        int all = isfinite(pts[i].err), iter = all && trade_solvers[pts[i].solver].opts;
+        int all = isfinite(pts[i].err), iter = all && trade_iterative(&trade_solvers[pts[i].solver]);
         iter = iter || (all && trade_solvers[pts[i].solver].mode == CLOTH_ORIGINAL);
         for (j = 0; j < np; j++)
             if (j != i && pts[j].ms <= pts[i].ms && pts[j].err <= pts[i].err &&
@@ -336,9 +337,7 @@ int main(int argc, char **argv)
                 continue;
             }
             snprintf(what, sizeof what, "%s, %s", cloth_mode_name(variants[v].mode),
-                     variants[v].mode == CLOTH_ORIGINAL ? "own CG + Jacobi"
-                     : variants[v].solver             ? "lis-style CG + Jacobi"
-                                                      : "default (CHOLMOD)");
+                     variants[v].mode == CLOTH_ORIGINAL ? "own CG + Jacobi" : cloth_solver_label(variants[v].solver));
             {
                 char d[32] = "-";
                 if (v) snprintf(d, sizeof d, "%.2g", diff[v]);

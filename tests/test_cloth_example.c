@@ -39,8 +39,9 @@ static int scene_of(cloth_scene *s, const char *extra)
     return 0;
 }
 
-/* Runs `steps` steps of `mode` from the scene's start; positions into x (3n). */
-static int run(const cloth_scene *s, cloth_mode mode, int steps, double *x)
+/* Runs `steps` steps of `mode` with `solver` at tol from the scene's start;
+ * positions into x (3n). */
+static int run_with(const cloth_scene *s, cloth_mode mode, const char *solver, double tol, int steps, double *x)
 {
     cloth_model m;
     cloth_driver *d;
@@ -51,7 +52,7 @@ static int run(const cloth_scene *s, cloth_mode mode, int steps, double *x)
         CHECK(0, "model: %s", err);
         return -1;
     }
-    d = cloth_driver_open(&m, mode, NULL, 1e-13, err, sizeof err);
+    d = cloth_driver_open(&m, mode, solver, tol, err, sizeof err);
     CHECK(d != NULL, "%s: %s", cloth_mode_name(mode), err);
     for (k = 0; d && k < steps && !rc; k++) {
         rc = cloth_driver_step(d, &t, err, sizeof err);
@@ -65,6 +66,12 @@ static int run(const cloth_scene *s, cloth_mode mode, int steps, double *x)
     cloth_driver_close(d);
     cloth_model_free(&m);
     return d && !rc ? 0 : -1;
+}
+
+/* The direct solve (and original's CG to 1e-13). */
+static int run(const cloth_scene *s, cloth_mode mode, int steps, double *x)
+{
+    return run_with(s, mode, NULL, 1e-13, steps, x);
 }
 
 static double max_diff(const double *a, const double *b, int n)
@@ -94,6 +101,54 @@ static void check_three_ways(const char *extra, const char *what)
            s.steps, max_diff(x[0], x[1], n3), max_diff(x[0], x[2], n3), max_diff(x[1], x[2], n3));
 out:
     for (mode = 0; mode < 3; mode++) free(x[mode]);
+}
+
+/* A named solver runs at the tolerance it is given: tight, it agrees with
+ * the direct solve; loose, it is off by more (so the tolerance reached the
+ * solver).  An unknown name is refused with the names a user may give. */
+static void check_named_solvers(void)
+{
+    static const char *const names[] = {"cg", "cg-ic", "cg-amg"};
+    cloth_scene s;
+    cloth_model m;
+    char opts[256], err[512];
+    double *xd, *xt, *xl;
+    int n3, k, mode;
+    CHECK(cloth_solver_options("cg", 1e-7, opts, sizeof opts, err, sizeof err) == 0 &&
+              strstr(opts, "-i cg -p jacobi -tol 1e-07"),
+          "cg at 1e-7 gives '%s'", opts);
+    CHECK(cloth_solver_options("direct", 1e-7, opts, sizeof opts, err, sizeof err) == 0 && !opts[0],
+          "direct gives options '%s'", opts);
+    CHECK(cloth_solver_options("backend = reference", 1e-7, opts, sizeof opts, err, sizeof err) == 0 &&
+              !strcmp(opts, "backend = reference"),
+          "options pass as they are: '%s'", opts);
+    CHECK(cloth_solver_options("cgg", 1e-7, opts, sizeof opts, err, sizeof err) == -1 &&
+              strstr(err, "unknown solver 'cgg' (one of direct, cg, cg-ic, cg-amg, petsc-cg"),
+          "unknown solver: '%s'", err);
+    if (scene_of(&s, SPRINGS)) return;
+    if (cloth_model_init(&m, &s, err, sizeof err) == 0) {
+        CHECK(cloth_driver_open(&m, CLOTH_LTD, "cgg", 1e-7, err, sizeof err) == NULL &&
+                  strstr(err, "unknown solver 'cgg'"),
+              "driver with an unknown solver: '%s'", err);
+        cloth_model_free(&m);
+    }
+    n3 = 3 * s.nx * s.ny;
+    xd = calloc((size_t)n3, sizeof *xd), xt = calloc((size_t)n3, sizeof *xt), xl = calloc((size_t)n3, sizeof *xl);
+    if (xd && xt && xl && run(&s, CLOTH_LTD, s.steps, xd) == 0)
+        for (k = 0; k < 3; k++)
+            for (mode = CLOTH_LTD; mode <= CLOTH_CMP; mode++) {
+                double tight, loose;
+                if (run_with(&s, (cloth_mode)mode, names[k], 1e-11, s.steps, xt) ||
+                    run_with(&s, (cloth_mode)mode, names[k], 1e-2, s.steps, xl))
+                    continue;
+                tight = max_diff(xd, xt, n3), loose = max_diff(xd, xl, n3);
+                CHECK(tight <= 1e-8, "%s %s at 1e-11: %.3g from the direct solve", cloth_mode_name(mode), names[k],
+                      tight);
+                CHECK(loose > 10 * tight, "%s %s at 1e-2 (%.3g) is no further from the direct solve than at "
+                      "1e-11 (%.3g): the tolerance did not reach the solver", cloth_mode_name(mode), names[k],
+                      loose, tight);
+            }
+    free(xd), free(xt), free(xl);
 }
 
 /* Pins hold exactly; the rest falls. */
@@ -229,6 +284,7 @@ int main(void)
     check_matrix();
     check_three_ways(SPRINGS, "hanging 8x7");
     check_three_ways("k_bend = 0\nk_shear = 0\ntilt = 30\n", "structural only, tilted");
+    check_named_solvers();
     check_pins();
     check_energy();
     check_obstacle(SPRINGS "obstacle = sphere 0.5 0.45 -0.4 0.3\n", "sphere");

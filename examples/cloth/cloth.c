@@ -3,18 +3,20 @@
  * three drivers, PNG frames and a summary (cloth.h, README.md here).
  *
  *     cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR]
- *                 [--solver OPTIONS | --tune] [--tol T] [--size WxH]
+ *                 [--solver NAME|OPTIONS | --tune] [--tol T] [--size WxH]
  *     cloth --keys                      the scene keys with their defaults
  *
- * --solver passes per-call options to every SILC solve (ltd, cmp), e.g.
- * "backend = lis-style; lis-style.options = -i cg -p ic -tol 1e-8"; without
- * it SILC's configured dispatch solves (a sparse Cholesky by default).
+ * The scene's accuracy sets the tolerance T of every iterative solve: the
+ * original driver's CG and, in ltd and cmp, the solver --solver names
+ * (direct, cg, cg-ic, cg-amg, petsc-cg: cloth.h) stop at a residual of T
+ * relative to ||b||, T = accuracy / 100 unless --tol says otherwise.
+ * Without --solver, ltd and cmp use SILC's configured dispatch (a sparse
+ * Cholesky by default); --solver also takes SILC solve options as they
+ * are ("backend = lis-style; lis-style.options = -i cg -p ic -tol 1e-8").
  * --tune lets SILC's tuner choose the backend (and threads) for the run,
- * under a backward-error target of the scene's accuracy / 100, and the
- * summary says what it chose.  --tol is the original driver's CG
- * tolerance; by default the scene's accuracy / 100, relative to ||b|| per
- * step.  The exit status is 1 on any
- * failure, with the message on stderr, 2 on a usage error.
+ * under a backward-error target of T, and the summary says what it chose.
+ * The exit status is 1 on any failure, with the message on stderr, 2 on a
+ * usage error.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -27,7 +29,7 @@
 #include "cloth.h"
 
 static const char usage[] =
-    "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver OPTIONS | --tune]\n"
+    "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver NAME|OPTIONS | --tune]\n"
     "                   [--tol T] [--size WxH]\n"
     "       cloth --keys\n";
 
@@ -167,6 +169,8 @@ int main(int argc, char **argv)
         char used[400];
         cloth_driver_solver(d, used, sizeof used);
         printf("solve%s: %s\n", tune ? " (chosen by the tuner, backward error <= accuracy / 100)" : "", used);
+        if (solver && strcmp(solver, "direct") && !strchr(solver, '='))
+            printf("tolerance %.1e relative to ||b|| (%s)\n", tol, cloth_solver_label(solver));
     }
     printf("max displacement %.6g m; pinned particles moved %.3g m\n", cloth_max_displacement(&m, m.x), pinned);
     printf("energy: kinetic %.6g J, spring %.6g J (at start %.6g, %.6g)\n", ek, es, ek0, es0);

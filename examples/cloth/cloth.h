@@ -132,13 +132,25 @@ typedef struct cloth_times {
 
 typedef struct cloth_driver cloth_driver;
 
+/* The solvers a run may name, each with its tolerance taken from the
+ * scene: "direct" (SILC's configured dispatch: a sparse Cholesky), "cg"
+ * (lis-style CG + Jacobi: original's algorithm and stopping rule), "cg-ic"
+ * (+ IC(0)), "cg-amg" (+ SA-AMG) and "petsc-cg" (PETSc CG + ICC).  Each
+ * iterative one stops at a residual of tol relative to ||b||. */
+/* What `solver` sends with every solve at tolerance tol, into buf: a name
+ * above gives its options ("" for direct); text holding '=' is SILC solve
+ * options already and is passed as it is.  NULL or "" is "direct".  0, or
+ * -1 with err for an unknown name. */
+int cloth_solver_options(const char *solver, double tol, char *buf, size_t len, char *err, size_t errlen);
+/* "lis-style CG + Jacobi" for "cg"; the text itself for anything else. */
+const char *cloth_solver_label(const char *solver);
+
 /* A driver for m in `mode`; ltd and cmp open a SILC context (embedded, or
- * the server SILC_SERVER names) and send `solve_options` with every solve
- * (e.g. "backend = lis-style; lis-style.options = -i cg -tol 1e-10"; NULL or
- * "" for the configured dispatch).  tol is the original driver's CG
- * tolerance.  NULL with err on failure. */
-cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *solve_options, double tol,
-                                char *err, size_t errlen);
+ * the server SILC_SERVER names) and solve with `solver` (a name or options,
+ * as cloth_solver_options) at tolerance tol, which is also the original
+ * driver's CG tolerance.  NULL with err on failure. */
+cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *solver, double tol, char *err,
+                                size_t errlen);
 /* One step; 0 or -1 with err. */
 int cloth_driver_step(cloth_driver *d, cloth_times *t, char *err, size_t errlen);
 /* The current positions (and velocities) in m->x, m->v (cmp fetches them). */

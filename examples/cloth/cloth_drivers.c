@@ -28,6 +28,10 @@ struct cloth_driver {
     char solve_stmt[1024];   /* ltd and cmp: the solve statement */
     char update_stmt[1024];  /* cmp: v, x and the obstacle */
     double *f, *a_val, *b, *dv;
+    /* ltd: the program's envelopes for A and b, built once; a_val and b
+     * point into them, so cloth_system writes each step's values straight
+     * into what is PUT, as a PETSc program refills its Mat's values. */
+    silc_envelope_t A_env, b_env;
 };
 
 static const char cmp_assembly[] =
@@ -169,13 +173,72 @@ out:
     return rc ? -1 : 0;
 }
 
+/* ---- the solvers a run names ------------------------------------------------------ */
+
+typedef struct named_solver {
+    const char *name, *label;
+    const char *options; /* %g: the tolerance; NULL: the configured dispatch */
+} named_solver;
+
+static const named_solver named_solvers[] = {
+    {"direct", "direct (configured dispatch)", NULL},
+    {"cg", "lis-style CG + Jacobi", "backend = lis-style; lis-style.options = -i cg -p jacobi -tol %g"},
+    {"cg-ic", "lis-style CG + IC(0)", "backend = lis-style; lis-style.options = -i cg -p ic -tol %g"},
+    {"cg-amg", "lis-style CG + SA-AMG", "backend = lis-style; lis-style.options = -i cg -p saamg -tol %g"},
+    {"petsc-cg", "PETSc CG + ICC",
+     "backend = petsc; petsc.options = -ksp_type cg -pc_type icc -ksp_rtol %g -ksp_atol 0"},
+};
+enum { N_NAMED = sizeof named_solvers / sizeof named_solvers[0] };
+
+static const named_solver *find_solver(const char *solver)
+{
+    int k;
+    for (k = 0; k < N_NAMED; k++)
+        if (!strcmp(solver ? solver : "direct", named_solvers[k].name)) return &named_solvers[k];
+    return NULL;
+}
+
+const char *cloth_solver_label(const char *solver)
+{
+    const named_solver *s = find_solver(solver && *solver ? solver : NULL);
+    return s ? s->label : solver;
+}
+
+int cloth_solver_options(const char *solver, double tol, char *buf, size_t len, char *err, size_t errlen)
+{
+    const named_solver *s;
+    int k, at;
+    buf[0] = '\0';
+    if (solver && strchr(solver, '=')) {
+        if ((size_t)snprintf(buf, len, "%s", solver) >= len) {
+            snprintf(err, errlen, "solver options are longer than %zu characters", len - 1);
+            return -1;
+        }
+        return 0;
+    }
+    if ((s = find_solver(solver && *solver ? solver : NULL))) {
+        if (s->options) snprintf(buf, len, s->options, tol);
+        return 0;
+    }
+    at = snprintf(err, errlen, "unknown solver '%s' (one of", solver);
+    for (k = 0; k < N_NAMED && at > 0 && (size_t)at < errlen; k++)
+        at += snprintf(err + at, errlen - (size_t)at, "%s %s", k ? "," : "", named_solvers[k].name);
+    if (at > 0 && (size_t)at < errlen) snprintf(err + at, errlen - (size_t)at, ", or SILC solve options)");
+    return -1;
+}
+
 /* ---- the driver ------------------------------------------------------------ */
 
-cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *solve_options, double tol,
-                                char *err, size_t errlen)
+cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *solver, double tol, char *err,
+                                size_t errlen)
 {
     cloth_driver *d = calloc(1, sizeof *d);
     int64_t N = 3 * (int64_t)m->n;
+    char solve_options[sizeof d->solve_stmt - 64];
+    if (cloth_solver_options(solver, tol, solve_options, sizeof solve_options, err, errlen)) {
+        free(d);
+        return NULL;
+    }
     if (!d) goto oom;
     d->mode = mode;
     d->m = m;
@@ -183,9 +246,17 @@ cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *sol
     d->f = malloc((size_t)N * sizeof *d->f);
     d->b = malloc((size_t)N * sizeof *d->b);
     d->dv = malloc((size_t)N * sizeof *d->dv);
-    d->a_val = malloc((size_t)m->nnz * sizeof *d->a_val);
+    d->a_val = calloc((size_t)m->nnz > 0 ? (size_t)m->nnz : 1, sizeof *d->a_val);
     if (!d->f || !d->b || !d->dv || !d->a_val) goto oom;
-    if (solve_options && *solve_options) {
+    if (mode == CLOTH_LTD) {
+        if (silc_envelope_csr(&d->A_env, N, N, m->rowptr, m->colind, d->a_val) ||
+            silc_envelope_dense(&d->b_env, N, 1, NULL))
+            goto oom;
+        free(d->a_val), free(d->b);
+        d->a_val = d->A_env.values;
+        d->b = d->b_env.values;
+    }
+    if (*solve_options) {
         if (strchr(solve_options, '"')) {
             snprintf(err, errlen, "solver options may not contain '\"'");
             cloth_driver_close(d);
@@ -223,15 +294,9 @@ oom:
 static int ltd_solve(cloth_driver *d)
 {
     cloth_model *m = d->m;
-    silc_envelope_t A, b, dv;
+    silc_envelope_t dv;
     int rc;
-    if (silc_envelope_csr(&A, 3 * (int64_t)m->n, 3 * (int64_t)m->n, m->rowptr, m->colind, d->a_val)) return -1;
-    rc = silc_put(d->ctx, "A", &A);
-    silc_envelope_free(&A);
-    if (rc || silc_envelope_dense(&b, 3 * (int64_t)m->n, 1, d->b)) return -1;
-    rc = silc_put(d->ctx, "b", &b);
-    silc_envelope_free(&b);
-    if (rc || silc_exec(d->ctx, d->solve_stmt) || silc_get(d->ctx, &dv, "dv")) return -1;
+    if (silc_put(d->ctx, "A", &d->A_env) || silc_put(d->ctx, "b", &d->b_env) || silc_exec(d->ctx, d->solve_stmt) || silc_get(d->ctx, &dv, "dv")) return -1;
     rc = dv.m == 3 * (int64_t)m->n && dv.n == 1 ? silc_envelope_to_dense(&dv, d->dv) : -1;
     silc_envelope_free(&dv);
     return rc;
@@ -289,7 +354,15 @@ void cloth_driver_close(cloth_driver *d)
 {
     if (!d) return;
     if (d->ctx) silc_close(&d->ctx);
-    free(d->f), free(d->b), free(d->dv), free(d->a_val);
+    if (d->mode == CLOTH_LTD) {
+        if (d->a_val != d->A_env.values) free(d->a_val);
+        if (d->b != d->b_env.values) free(d->b);
+        silc_envelope_free(&d->A_env);
+        silc_envelope_free(&d->b_env);
+    } else {
+        free(d->a_val), free(d->b);
+    }
+    free(d->f), free(d->dv);
     free(d);
 }
 
