@@ -14,7 +14,8 @@ cd "$(dirname "$0")"
 # Why each package is here: see README.md, "Dependencies".
 PACKAGES=(cmake make gcc gfortran pkg-config libinih-dev libreadline-dev
           libopenblas-dev liblapacke-dev libsuitesparse-dev libmumps-seq-dev libmumps-dev
-          petsc-dev openmpi-bin libopenmpi-dev python3-numpy python3-scipy clang libpng-dev)
+          petsc-dev openmpi-bin libopenmpi-dev python3-numpy python3-scipy clang libpng-dev
+          default-jdk-headless)
 
 install_missing() {
     local missing=()

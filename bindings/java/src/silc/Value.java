@@ -1,0 +1,16 @@
+/*
+ * Value.java -- what can be PUT to and GOT from a SILC server: a sparse CRS
+ * matrix, a dense matrix or a column vector.  Every value knows its shape;
+ * the client turns each into the wire protocol's value descriptor and arrays
+ * (docs/protocol.md).
+ */
+package silc;
+
+/** A matrix or vector that travels between a Java program and SILC. */
+public sealed interface Value permits CRS, DenseMatrix, ColumnVector {
+    /** Rows. */
+    int rows();
+
+    /** Columns. */
+    int cols();
+}
