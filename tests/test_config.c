@@ -211,7 +211,7 @@ static void test_classes(silc_engine *E)
     static const double rect[] = {1, 2, 3, 4, 5, 6};
     double tri[20 * 20] = {0};
     silc_value *D = dense_rows(3, 3, diag), *L = dense_rows(3, 3, lower), *S = dense_rows(3, 3, spd);
-    silc_value *G = dense_rows(3, 3, gen), *R = dense_rows(3, 2, rect), *T, *Sc, *Gc, *Bd, *b;
+    silc_value *G = dense_rows(3, 3, gen), *R = dense_rows(3, 2, rect), *T, *Tc, *Sc, *Gc, *Bd, *b, *b20;
     int i;
     for (i = 0; i < 20; i++) {
         tri[i * 20 + i] = 4;
@@ -219,11 +219,13 @@ static void test_classes(silc_engine *E)
         if (i < 19) tri[i * 20 + i + 1] = -2;
     }
     T = dense_rows(20, 20, tri);
+    Tc = to_csr(T);
+    b20 = dense_rows(20, 1, tri);
     Sc = to_csr(S);
     Gc = to_csr(G);
     Bd = val_band_new(4, 4, 1, 1);
     b = dense_rows(3, 1, rect);
-    if (!D || !L || !S || !G || !R || !T || !Sc || !Gc || !Bd || !b) {
+    if (!D || !L || !S || !G || !R || !T || !Tc || !b20 || !Sc || !Gc || !Bd || !b) {
         CHECK(0, "value allocation");
         return;
     }
@@ -232,6 +234,7 @@ static void test_classes(silc_engine *E)
     classes_are(E, L, "solve.triangular", NULL);
     classes_are(E, T, "solve.band", NULL);
     classes_are(E, Bd, "solve.band", NULL);
+    classes_are(E, Tc, "solve.band", NULL); /* a banded CSR matrix, nothing configured */
     classes_are(E, S, "solve.dense.spd", "solve.dense");
     classes_are(E, Sc, "solve.sparse.spd", "solve.sparse");
     classes_are(E, G, "solve.dense", NULL);
@@ -249,6 +252,16 @@ static void test_classes(silc_engine *E)
     explain_has(E, G, b, "backend = reference", "per-call option backend = reference",
                 "  reference -> would run");
     explain_has(E, R, b, NULL, "A is 3x2 dense, not square (least squares) -> solve.rect", NULL);
+    /* ... and banded CSR systems, unless solve.band is configured too; a
+     * dense banded matrix stays LAPACK's band system. */
+    classes_are(E, Tc, "solve.sparse", NULL);
+    classes_are(E, T, "solve.band", NULL);
+    explain_has(E, Tc, b20, NULL,
+                "A is 20x20 csr, banded, but a sparse class is configured and solve.band is not -> solve.sparse",
+                "backends (config key dispatch.solve.sparse): reference");
+    CHECK(cfg_set(E, CFG_SCOPE_SESSION, "dispatch.solve.band", "reference") == 0, "set: %s", E->err);
+    classes_are(E, Tc, "solve.band", NULL);
+    explain_has(E, Tc, b20, NULL, "banded (kl=1, ku=1) -> solve.band", "config key dispatch.solve.band");
     value_is(E, "backend", NULL);
 
     val_release(D);
@@ -257,6 +270,8 @@ static void test_classes(silc_engine *E)
     val_release(G);
     val_release(R);
     val_release(T);
+    val_release(Tc);
+    val_release(b20);
     val_release(Sc);
     val_release(Gc);
     val_release(Bd);

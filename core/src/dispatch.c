@@ -88,14 +88,24 @@ typedef struct blist {
 
 /* ---- classes --------------------------------------------------------------- */
 
+/* 1 when the configuration (or the call's options) names a backend list
+ * for a sparse solve class and none for solve.band: then a banded CSR
+ * matrix is the user's sparse system, not LAPACK's band one (a config that
+ * says `solve.sparse = lis-style` means every sparse solve). */
+static int sparse_governs_band(const silc_engine *E)
+{
+    return E && !cfg_get(E, "dispatch.solve.band") &&
+           (cfg_get(E, "dispatch.solve.sparse") || cfg_get(E, "dispatch.solve.sparse.spd"));
+}
+
 /* The class chain of call, with a readable reason in why (may be NULL). */
-static int classify(const silc_call *call, const char *out[4], char *why, size_t whylen)
+static int classify(const silc_engine *E, const silc_call *call, const char *out[4], char *why, size_t whylen)
 {
     const silc_value *A, *B;
     const silc_props *p;
     const char *reason;
-    char band_reason[96];
-    int sparse, n = 0;
+    char band_reason[160];
+    int sparse, banded = 0, n = 0;
     if (why && whylen) why[0] = '\0';
     if (!call || call->op < 0 || call->op >= SILC_OP_COUNT || call->nin < 1 || !call->in[0])
         return 0;
@@ -115,9 +125,10 @@ static int classify(const silc_call *call, const char *out[4], char *why, size_t
         } else if (p->lower || p->upper) {
             out[n++] = "solve.triangular";
             reason = p->lower ? "lower triangular" : "upper triangular";
-        } else if (A->format == SILC_FMT_BAND ||
-                   ((double)p->nnz >= 0.5 * (double)(p->kl + p->ku + 1) * (double)A->n &&
-                    2 * (p->kl + p->ku + 1) < A->n)) {
+        } else if ((banded = A->format == SILC_FMT_BAND ||
+                             ((double)p->nnz >= 0.5 * (double)(p->kl + p->ku + 1) * (double)A->n &&
+                              2 * (p->kl + p->ku + 1) < A->n)) &&
+                   !(sparse && sparse_governs_band(E))) {
             out[n++] = "solve.band";
             snprintf(band_reason, sizeof band_reason, "banded (kl=%lld, ku=%lld)",
                      (long long)p->kl, (long long)p->ku);
@@ -125,7 +136,12 @@ static int classify(const silc_call *call, const char *out[4], char *why, size_t
         } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric) {
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
-            reason = "symmetric with positive diagonal";
+            reason = banded ? "banded, but a sparse class is configured and solve.band is not; symmetric with "
+                              "positive diagonal"
+                            : "symmetric with positive diagonal";
+        } else if (banded) {
+            out[n++] = "solve.sparse";
+            reason = "banded, but a sparse class is configured and solve.band is not";
         } else {
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
             reason = why && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric
@@ -161,8 +177,7 @@ static int classify(const silc_call *call, const char *out[4], char *why, size_t
 
 int disp_classes(silc_engine *E, const silc_call *call, const char *out[4])
 {
-    (void)E;
-    return classify(call, out, NULL, 0);
+    return classify(E, call, out, NULL, 0);
 }
 
 /* ---- backend lists --------------------------------------------------------- */
@@ -434,7 +449,7 @@ int disp_run(silc_engine *E, silc_call *call)
     call->out = NULL;
     own_options = call->options != NULL;
     if (own_options && cfg_set_call_options(E, call->options)) return SILC_EARG;
-    n = classify(call, chain, NULL, 0);
+    n = classify(E, call, chain, NULL, 0);
     if (n == 0) {
         eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
         rc = SILC_EARG;
@@ -489,7 +504,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     int n, i, chosen = 0;
     if (!E || !call || !b) return -1;
     if (call->options && cfg_set_call_options(E, call->options)) return -1;
-    n = classify(call, chain, why, sizeof why);
+    n = classify(E, call, chain, why, sizeof why);
     if (n == 0) {
         if (call->options) cfg_clear_call_options(E);
         return eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
