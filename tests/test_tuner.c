@@ -7,10 +7,13 @@
  * No assertion depends on a clock: whole runs are driven through
  * tuner_observe() with step times computed from a synthetic model of the
  * thread count the tuner has just set, so the same decisions come out on any
- * machine.  Only the backend test runs real solves, and it checks which
- * candidates the accuracy target admits, never which one is faster.
+ * machine (the synthetic machines have 8 threads to sample: tune.max_threads
+ * = 8).  Only the backend tests run real solves; they check which candidates
+ * the accuracy target admits and that the trials wait for the budget, never
+ * which one is faster.
  */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* sched_setaffinity */
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,6 +64,15 @@ static int status_has(silc_engine *E, const char *text)
     if (captured.s) captured.s[0] = 0;
     if (lang_exec(E, "tune status")) return 0;
     return strstr(sb_str(&captured), text) != NULL;
+}
+
+/* Reads "spent = S s of A s allowed" from `tune status`. */
+static int status_account(silc_engine *E, double *spent_s, double *allowed_s)
+{
+    const char *at;
+    if (!status_has(E, "spent = ")) return -1;
+    at = strstr(sb_str(&captured), "spent = ");
+    return sscanf(at, "spent = %lg s of %lg s allowed", spent_s, allowed_s) == 2 ? 0 : -1;
 }
 
 /* A synthetic machine: f(p) = 4/p + 0.25 p + 1, best at p = 4, with a small
@@ -157,7 +169,7 @@ static void test_thread_tuning(const char *wisdom)
     silc_engine *E = open_engine(wisdom);
     int expect;
     CHECK(lang_exec(E, "tune forget") == 0, "tune forget: %s", E->err);
-    CHECK(lang_exec(E, "set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
+    CHECK(lang_exec(E, "set tune.budget = 1; set tune.max_threads = 8; tune on") == 0, "tune on: %s", E->err);
     run_steps(E, 60);
     CHECK(status_has(E, "state = tuned"), "tuning finished: %s", sb_str(&captured));
     CHECK(status_int(E, "p_opt") == 4, "p_opt 4: %s", sb_str(&captured));
@@ -170,7 +182,7 @@ static void test_thread_tuning(const char *wisdom)
 
     /* the next run starts tuned: one period lock plus one step, no sampling */
     E = open_engine(wisdom);
-    CHECK(lang_exec(E, "tune on") == 0, "tune on: %s", E->err);
+    CHECK(lang_exec(E, "set tune.max_threads = 8; tune on") == 0, "tune on: %s", E->err);
     run_steps(E, 5);
     CHECK(status_has(E, "from the wisdom file"), "wisdom used: %s", sb_str(&captured));
     CHECK(E->threads == 4, "wisdom's p_opt applied (threads %d)", E->threads);
@@ -182,7 +194,7 @@ static void test_thread_tuning(const char *wisdom)
 
     /* the budget: a 20-step run may spend 5 % on sampling */
     E = open_engine(wisdom);
-    CHECK(lang_exec(E, "tune on 20") == 0, "tune on 20: %s", E->err);
+    CHECK(lang_exec(E, "set tune.max_threads = 8; tune on 20") == 0, "tune on 20: %s", E->err);
     run_steps(E, 20);
     CHECK(status_has(E, "tune.budget"), "stopped by the budget: %s", sb_str(&captured));
     expect = status_int(E, "sampled steps");
@@ -209,13 +221,13 @@ static void test_measured_beats_model(const char *wisdom)
     silc_engine *E;
     /* The premise, on this machine's candidates: the fit through the step
      * alone would not pick p = 2 (on 2 cores it picks 1). */
-    n = tuner_candidates(ncores < 1 ? 1 : (int)ncores, cands);
+    n = tuner_candidates(ncores < 1 ? 1 : (int)ncores, 8, cands);
     for (k = 0; k < n; k++) p[k] = cands[k], t[k] = oversubscribed(cands[k], 0);
     if (tuner_fit(p, t, n, cands[0], cands[n - 1], &m) == 0) model_p = m.p_opt;
     if (ncores == 2) CHECK(model_p == 1, "on 2 cores the model alone picks %d", model_p);
     E = open_engine(wisdom);
     CHECK(lang_exec(E, "tune forget") == 0, "tune forget: %s", E->err);
-    CHECK(lang_exec(E, "set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
+    CHECK(lang_exec(E, "set tune.budget = 1; set tune.max_threads = 8; tune on") == 0, "tune on: %s", E->err);
     for (k = 0; k < 80; k++) tuner_observe(E, "u = A \\ (B * u)", oversubscribed(E->threads, k));
     CHECK(status_has(E, "state = tuned"), "tuning finished: %s", sb_str(&captured));
     CHECK(status_int(E, "p_opt") == 2 && E->threads == 2, "p_opt 2 (threads %d): %s", E->threads,
@@ -227,6 +239,61 @@ static void test_measured_beats_model(const char *wisdom)
     remove(wisdom);
 }
 
+/* Unknown run length, tune.budget = 0.05: the samples that cost more than
+ * the run has earned wait (at the best p so far), and resume as the run goes
+ * on; in the end p_opt is found and the account is within the allowance. */
+static void test_budget_of_unknown_run(const char *wisdom)
+{
+    silc_engine *E = open_engine(wisdom);
+    double spent_s = -1, allowed_s = -1;
+    int k, waited = 0;
+    CHECK(lang_exec(E, "tune forget; set tune.max_threads = 8; tune on") == 0, "tune on: %s", E->err);
+    for (k = 0; k < 600 && !status_has(E, "state = tuned"); k++) {
+        tuner_observe(E, "u = A \\ (B * u)", synthetic(E->threads, k));
+        if (status_has(E, "waits for the budget")) waited = 1;
+    }
+    CHECK(waited, "a sample waited for the budget");
+    CHECK(status_has(E, "state = tuned") || status_has(E, "timing backends"), "tuning finished: %s",
+          sb_str(&captured));
+    CHECK(status_int(E, "p_opt") == 4, "p_opt 4 found all the same: %s", sb_str(&captured));
+    /* The first samples are owed (nothing is known before them); the run
+     * at p_opt pays them off. */
+    for (k = 0; k < 200; k++) tuner_observe(E, "u = A \\ (B * u)", synthetic(E->threads, k));
+    k = status_account(E, &spent_s, &allowed_s);
+    CHECK(k == 0 && spent_s <= allowed_s, "spent %g s within the %g s allowed: %s", spent_s, allowed_s,
+          sb_str(&captured));
+    eng_destroy(&E);
+    remove(wisdom);
+}
+
+/* The tuner samples no more threads than the process may run on: pinned to
+ * one CPU it tries p = 1 only; tune.max_threads = 2 lets it try 2 there. */
+static void test_affinity(const char *wisdom)
+{
+    cpu_set_t old, one;
+    silc_engine *E;
+    int k;
+    if (sched_getaffinity(0, sizeof old, &old)) return;
+    CPU_ZERO(&one);
+    for (k = 0; k < CPU_SETSIZE && !CPU_ISSET(k, &old); k++) continue;
+    CPU_SET(k, &one);
+    CHECK(sched_setaffinity(0, sizeof one, &one) == 0, "pin to CPU %d", k);
+    E = open_engine(wisdom);
+    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
+    run_steps(E, 30);
+    CHECK(status_has(E, "every candidate") && status_has(E, "p = 1:") && !status_has(E, "p = 2:"),
+          "one CPU, one candidate: %s", sb_str(&captured));
+    eng_destroy(&E);
+    E = open_engine(wisdom);
+    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; set tune.max_threads = 2; tune on") == 0,
+          "tune on: %s", E->err);
+    run_steps(E, 30);
+    CHECK(status_has(E, "p = 2:"), "tune.max_threads = 2 samples p = 2 on one CPU: %s", sb_str(&captured));
+    eng_destroy(&E);
+    sched_setaffinity(0, sizeof old, &old);
+    remove(wisdom);
+}
+
 static void test_explicit_steps(const char *wisdom, const char *svg)
 {
     silc_engine *E = open_engine(wisdom);
@@ -234,7 +301,7 @@ static void test_explicit_steps(const char *wisdom, const char *svg)
     FILE *f;
     char buf[8192];
     size_t n;
-    CHECK(lang_exec(E, "set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
+    CHECK(lang_exec(E, "set tune.budget = 1; set tune.max_threads = 8; tune on") == 0, "tune on: %s", E->err);
     for (k = 0; k < 60; k++) {
         /* the texts change every step: only the marks can delimit the step */
         char text[64];
@@ -326,13 +393,35 @@ static void check_candidate(const char *backend, const char *variant)
     printf("candidate: %s\n", line);
 }
 
+/* Runs stmt as a time loop until the tuner is done (at most 60 steps). */
+static void solve_until_tuned(silc_engine *E, const char *stmt)
+{
+    int i;
+    for (i = 0; i < 60 && !status_has(E, "state = tuned"); i++)
+        CHECK(lang_exec(E, stmt) == 0, "%s: %s", stmt, E->err);
+}
+
 static void test_backends(const char *wisdom)
 {
     silc_engine *E = open_engine(wisdom);
+    double spent_s = -1, allowed_s = -1;
     int i;
     put_laplacian(E, 30);
-    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
-    for (i = 0; i < 6; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "solve: %s", E->err);
+    /* A run of unknown length pays for trials only once it has lasted long
+     * enough: each trial (two factorizations) costs more than tune.budget =
+     * 0.05 of a dozen back-substitution steps, so none runs. */
+    CHECK(lang_exec(E, "tune forget; tune on") == 0, "tune on: %s", E->err);
+    for (i = 0; i < 12; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "solve: %s", E->err);
+    CHECK(!status_has(E, "backends for"), "no trial within the budget: %s", sb_str(&captured));
+    CHECK(status_account(E, &spent_s, &allowed_s) == 0, "the account is shown: %s", sb_str(&captured));
+    CHECK(status_has(E, "run so far"), "the allowance is of the run so far: %s", sb_str(&captured));
+    eng_destroy(&E);
+
+    /* A long expected run affords them all. */
+    E = open_engine(wisdom);
+    put_laplacian(E, 30);
+    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on 100000") == 0, "tune on: %s", E->err);
+    solve_until_tuned(E, "x = A \\ b");
     CHECK(status_has(E, "backends for solve.sparse.spd"), "table shown: %s", sb_str(&captured));
     CHECK(status_has(E, "fastest accurate"), "a winner: %s", sb_str(&captured));
     /* lis-style's multigrid is a candidate for the SPD class. */
@@ -363,8 +452,8 @@ static void test_backends(const char *wisdom)
         store_set(&E->store, "b", b);
         val_release(A), val_release(b);
     }
-    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on") == 0, "tune on: %s", E->err);
-    for (i = 0; i < 6; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "dense solve: %s", E->err);
+    CHECK(lang_exec(E, "tune forget; set tune.budget = 1; tune on 100000") == 0, "tune on: %s", E->err);
+    solve_until_tuned(E, "x = A \\ b");
     CHECK(status_has(E, "backends for solve.dense"), "dense table shown: %s", sb_str(&captured));
     if (strstr(sb_str(&captured), "\n  lapack "))
         CHECK(strstr(sb_str(&captured), "\n  lapack precision = mixed ") != NULL,
@@ -373,10 +462,10 @@ static void test_backends(const char *wisdom)
 
     /* an impossible target: every candidate is refused and dispatch stays */
     E = open_engine(wisdom);
-    CHECK(lang_exec(E, "tune forget; set tune.accuracy = 1e-300; set tune.budget = 1; tune on") == 0,
+    CHECK(lang_exec(E, "tune forget; set tune.accuracy = 1e-300; set tune.budget = 1; tune on 100000") == 0,
           "tight target: %s", E->err);
     put_laplacian(E, 5);
-    for (i = 0; i < 6; i++) CHECK(lang_exec(E, "x = A \\ b") == 0, "solve: %s", E->err);
+    solve_until_tuned(E, "x = A \\ b");
     CHECK(status_has(E, "too inaccurate") || status_has(E, "no candidate met"),
           "the target rules candidates out: %s", sb_str(&captured));
     eng_destroy(&E);
@@ -397,6 +486,8 @@ int main(void)
     test_language();
     test_thread_tuning(wisdom);
     test_measured_beats_model(wisdom);
+    test_budget_of_unknown_run(wisdom);
+    test_affinity(wisdom);
     test_explicit_steps(wisdom, svg);
     test_backends(wisdom);
     wisdom[strlen(wisdom) - 2] = 0;

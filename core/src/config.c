@@ -4,7 +4,7 @@
  * options of solve(A, b, "...")).
  *
  * A key is "section.name": dispatch.<class> (an ordered list of backends),
- * tune.threads / tune.accuracy / tune.budget / tune.wisdom, core.plugin_path / core.threads,
+ * tune.threads / tune.accuracy / tune.budget / tune.wisdom / tune.max_threads, core.plugin_path / core.threads,
  * solve.refine / solve.refine_residual (iterative refinement, refine.c) and
  * solve.backward_error (deferred | always | on_request, accuracy.h) -- per call these may be
  * written without the section: "refine = 2" --, and
@@ -38,7 +38,7 @@ struct cfg_db {
 };
 
 static const char *const scope_names[3] = {"file", "session", "call"};
-static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom"};
+static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
 static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error"};
 
@@ -355,8 +355,10 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
             if (parse_double(value, &acc) || acc <= 0 || acc > 1)
                 return eng_error(E, "tune.budget expects a share of the run above 0 and at most 1, "
                                     "got '%s'", value);
+        } else if (strcmp(name, "max_threads") == 0) {
+            if (check_threads(E, "tune.max_threads", value)) return -1;
         } else if (strcmp(name, "wisdom") != 0) {
-            return unknown_key(E, section, name, tune_keys, 4);
+            return unknown_key(E, section, name, tune_keys, 5);
         }
         return keep_value(E, norm, section, name, value);
     }

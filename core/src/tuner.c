@@ -5,30 +5,43 @@
  * The tuner watches the stream of top-level EXEC texts.  A time-stepping
  * program repeats the same texts every step, so the smallest k for which the
  * last 3k texts repeat with period k is the step (or the program says so with
- * `tune step`).  Once two whole steps are seen the tuner (1) times every
- * loaded backend that accepts each solve class of the step on copies of the
- * live matrices, factoring and back-solving separately, and picks the one
- * with the least predicted cost for the rest of the run among those meeting
- * tune.accuracy; (2) times whole steps at candidate thread counts, keeping the
- * minimum of m repeats, until the leave-one-out rule says the fit is settled
- * or the sampling would exceed tune.budget of the expected run; (3) fits
- * f(p) = a/p + b*p + c and continues at p_opt; (4) writes the result to the
- * wisdom file, keyed by machine and problem signature, so the next run with
- * the same step skips straight to (3)'s answer.
+ * `tune step`).  Once two whole steps are seen the tuner (1) times whole steps
+ * at candidate thread counts -- never more threads than the process may run
+ * on unless tune.max_threads allows it -- keeping the minimum of m repeats,
+ * until the leave-one-out rule says the fit is settled; (2) fits
+ * f(p) = a/p + b*p + c and continues at p_opt; (3) times every loaded
+ * backend that accepts each solve class of the step on copies of the live
+ * matrices, factoring and back-solving separately, and picks the one with
+ * the least predicted cost for the rest of the run among those meeting
+ * tune.accuracy; (4) writes the result to the wisdom file, keyed by machine
+ * and problem signature, so the next run with the same step skips straight
+ * to the answer.
+ *
+ * The tuner pays for itself: what it spends beyond the program's own work
+ * (steps sampled at a slower p, the backend trials) stays under tune.budget
+ * of the run -- of the expected run when `tune on N` gave its length, else of
+ * the time elapsed so far.  A sample or trial the budget cannot afford yet
+ * waits until the run has lasted long enough (a run of unknown length that
+ * stops early never paid more than its share); a sample already slower than
+ * the best by more than the budget allows is not repeated.  A trial's cost
+ * is predicted as two of the program's own slowest solves of the class (its
+ * factorizations), or as the dearest trial so far if that was dearer.
  *
  * Thread counts change only between steps, so every timed step ran at one p.
  * Step times are the sum of the EXECs' own wall times: what SILC's thread
  * count can change, without the program's work between EXECs.
  */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "tuner.h"
 
 #include <errno.h>
 #include <math.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #define T_HIST 192          /* EXEC hashes kept for period detection */
@@ -38,7 +51,7 @@
 #define T_MAXB 16           /* candidate backends per class */
 #define T_DEFAULT_STEPS 100 /* run length assumed for backend cost when unknown */
 
-enum { PH_OFF, PH_WAIT, PH_WAIT2, PH_SAMPLE, PH_DONE };
+enum { PH_OFF, PH_WAIT, PH_WAIT2, PH_SAMPLE, PH_TRIALS, PH_DONE };
 
 typedef struct t_point {
     int p;
@@ -54,6 +67,8 @@ typedef struct t_class {
     int count;              /* solves of this class in the step */
     int reuse;              /* the matrix kept its id from the previous step */
     char ran[64];           /* backend the program's solve used */
+    double own_max;         /* the program's slowest solve of this class (a factorization) */
+    int next;               /* trials: the next candidate to time */
     tuner_cand cand[T_MAXB];
     int ncand, winner;      /* winner -1: none met the accuracy target */
     char reason[320];
@@ -75,8 +90,19 @@ typedef struct tuner {
     int npend, ncur, nref;
     t_class tab[T_MAXCLS];  /* backend tables of the tuned classes, no operands */
     int ntab;
+    t_class trial[T_MAXCLS]; /* classes whose backends are being timed, with operands */
+    int ntrial;
+    /* the account: what the run took, what tuning spent beyond it */
+    double run_secs;        /* EXEC time of the whole steps seen since tuning began */
+    double trial_secs;      /* wall time of the backend trials */
+    int waiting;            /* sampling paused until the budget allows the next point */
+    double trial_max;       /* the dearest trial so far */
+    /* the slowest solve of each class since tuning was configured, steps or
+     * not: the program's first solve factors before any step is seen */
+    struct { char cls[40]; double secs; } slowest[T_MAXCLS];
+    int nslowest;
     /* thread sampling */
-    int phase, warmup;
+    int phase;
     int cands[T_MAXC], ncands, ci;
     t_point pts[T_MAXC];
     int npts;
@@ -269,23 +295,36 @@ int tuner_rank(tuner_cand *c, int n, double accuracy, double steps, int per_step
 
 /* ---- machine, candidates, configuration ------------------------------------ */
 
+/* The CPUs this process may run on (its affinity mask: taskset, a cgroup's
+ * cpuset), not the machine's: past them a step measures oversubscription,
+ * 10-25x slower on a 2-core box (docs/tuner.md). */
 static int cores(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0) {
+        int c = CPU_COUNT(&set);
+        if (c >= 1 && (n < 1 || c < n)) n = c;
+    }
     return n < 1 ? 1 : n > 4096 ? 4096 : (int)n;
 }
 
-int tuner_candidates(int ncores, int *out)
+int tuner_candidates(int ncores, int max_threads, int *out)
 {
-    int n = 0, p, i;
+    int n = 0, p, i, top = max_threads < ncores ? max_threads : ncores;
     static const int over[] = {3, 4, 6, 8};   /* halves of the core count: 1.5x .. 4x */
-    for (p = 1; p < ncores && n < T_MAXC - 5; p *= 2) out[n++] = p;
-    out[n++] = ncores;
-    if (ncores <= 4)
-        for (i = 0; i < 4; i++) {
-            int q = over[i] * ncores / 2;
-            if (q > out[n - 1]) out[n++] = q;
-        }
+    if (top < 1) top = 1;
+    for (p = 1; p < top && n < T_MAXC - 5; p *= 2) out[n++] = p;
+    out[n++] = top;
+    if (max_threads > ncores) {
+        if (ncores <= 4)
+            for (i = 0; i < 4; i++) {
+                int q = over[i] * ncores / 2;
+                if (q > out[n - 1] && q <= max_threads) out[n++] = q;
+            }
+        if (out[n - 1] < max_threads && n < T_MAXC) out[n++] = max_threads;
+    }
     return n;
 }
 
@@ -338,13 +377,32 @@ static double cfg_number(silc_engine *E, const char *key, double def)
     return end != v && !*end ? x : def;
 }
 
+/* tune.max_threads: the most threads a sample may use (default: the CPUs
+ * the process may run on). */
+static int max_threads(silc_engine *E)
+{
+    const char *v = cfg_get(E, "tune.max_threads");
+    char *end;
+    long n;
+    if (!v || !strcmp(v, "auto")) return cores();
+    n = strtol(v, &end, 10);
+    return end != v && !*end && n >= 1 && n <= 4096 ? (int)n : cores();
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static tuner *tuner_get(silc_engine *E)
 {
     tuner *T = E->tuner;
     if (T) return T;
     T = calloc(1, sizeof *T);
     if (!T) return NULL;
-    T->ncands = tuner_candidates(cores(), T->cands);
+    T->ncands = tuner_candidates(cores(), cores(), T->cands);
     T->loo_tol = 0.02;
     T->rep_tol = 0.02;
     T->max_rep = 4;
@@ -402,9 +460,22 @@ static void pend_merge(tuner *T)
         c->a = p->a, c->b = p->b, c->a_id = p->a_id;
         p->a = p->b = NULL;
         c->count += p->count;
+        if (p->own_max > c->own_max) c->own_max = p->own_max;
         snprintf(c->ran, sizeof c->ran, "%s", p->ran);
     }
     classes_clear(T->pend, &T->npend);
+}
+
+/* The slowest solve of class cls seen so far (0 if none). */
+static double *slowest(tuner *T, const char *cls)
+{
+    int i;
+    for (i = 0; i < T->nslowest; i++)
+        if (!strcmp(T->slowest[i].cls, cls)) return &T->slowest[i].secs;
+    if (T->nslowest == T_MAXCLS) return NULL;
+    snprintf(T->slowest[T->nslowest].cls, sizeof T->slowest[0].cls, "%s", cls);
+    T->slowest[T->nslowest].secs = 0;
+    return &T->slowest[T->nslowest++].secs;
 }
 
 void tuner_note_solve(silc_engine *E, const silc_call *call)
@@ -412,8 +483,12 @@ void tuner_note_solve(silc_engine *E, const silc_call *call)
     tuner *T = E->tuner;
     const char *chain[4];
     t_class *c;
-    if (!T || !T->enabled || T->phase == PH_DONE || call->nin < 2) return;
-    if (disp_classes(E, call, chain) < 1) return;
+    double *worst;
+    if (!T && cfg_get(E, "tune.threads")) T = tuner_get(E);
+    if (!T || call->nin < 2 || disp_classes(E, call, chain) < 1) return;
+    if (call->report && (worst = slowest(T, chain[0])) && call->report->seconds > *worst)
+        *worst = call->report->seconds;
+    if (!T->enabled || T->phase == PH_DONE) return;
     c = class_find(T->pend, T->npend, chain[0]);
     if (!c) {
         if (T->npend >= T_MAXCLS) return;
@@ -426,7 +501,10 @@ void tuner_note_solve(silc_engine *E, const silc_call *call)
     c->b = val_retain((silc_value *)call->in[1]);
     c->a_id = call->in[0]->id;
     c->count++;
-    if (call->report) snprintf(c->ran, sizeof c->ran, "%s", call->report->backend);
+    if (call->report) {
+        snprintf(c->ran, sizeof c->ran, "%s", call->report->backend);
+        if (call->report->seconds > c->own_max) c->own_max = call->report->seconds;
+    }
 }
 
 /* ---- progress and wisdom ----------------------------------------------------- */
@@ -681,21 +759,18 @@ static const struct {
     {"mumps", "solve.sparse", ""}, {"mumps", "solve.sparse", "precision = single"},
 };
 
-static void trial_one(silc_engine *E, t_class *c, const char *backend, const char *variant)
+/* Times candidate k of class c: a solve that factors, then one that reuses. */
+static void trial_one(silc_engine *E, t_class *c, tuner_cand *k)
 {
-    tuner_cand *k = &c->cand[c->ncand++];
     silc_value *a;
     silc_report r1, r2;
     char opts[200];
-    memset(k, 0, sizeof *k);
-    snprintf(k->backend, sizeof k->backend, "%s", backend);
-    snprintf(k->opts, sizeof k->opts, "%s", variant ? variant : "");
-    if (variant) {
+    if (k->opts[0]) {
         char key[80];
-        const char *value = variant_setting(backend, variant, key, sizeof key);
-        snprintf(opts, sizeof opts, "backend = %s; %s = %s", backend, key, value);
+        const char *value = variant_setting(k->backend, k->opts, key, sizeof key);
+        snprintf(opts, sizeof opts, "backend = %s; %s = %s", k->backend, key, value);
     } else {
-        snprintf(opts, sizeof opts, "backend = %s", backend);
+        snprintf(opts, sizeof opts, "backend = %s", k->backend);
     }
     a = val_copy(c->a);
     if (!a) {
@@ -714,14 +789,14 @@ static void trial_one(silc_engine *E, t_class *c, const char *backend, const cha
     val_release(a);
 }
 
-static void trial_class(silc_engine *E, tuner *T, t_class *c)
+/* Lists the candidates of class c (every loaded backend that accepts its
+ * operands, with the variants above) without timing any. */
+static void plan_class(silc_engine *E, t_class *c)
 {
     const char **names = NULL;
-    size_t nn = ld_backend_names(E, &names), i;
-    double steps = T->expect_steps > T->steps ? T->expect_steps - T->steps : T_DEFAULT_STEPS;
-    double acc = cfg_number(E, "tune.accuracy", 1e-10);
+    size_t nn = ld_backend_names(E, &names), i, v;
     silc_call probe;
-    c->ncand = 0;
+    c->ncand = c->next = 0;
     memset(&probe, 0, sizeof probe);
     probe.op = SILC_OP_SOLVE;
     probe.nin = 2;
@@ -732,30 +807,31 @@ static void trial_class(silc_engine *E, tuner *T, t_class *c)
         const ld_backend *lb = ld_find(E, names[i]);
         const silc_op_entry *op;
         const char *why = NULL;
-        size_t v, nv;
+        int nv = 0;
         if (!lb || lb->backend->n_ops <= SILC_OP_SOLVE) continue;
         op = &lb->backend->ops[SILC_OP_SOLVE];
         if (!op->run || (op->accepts && !op->accepts(&probe, &why))) continue;
-        nv = 0;
-        for (v = 0; v < sizeof variants / sizeof variants[0]; v++)
-            if (!strcmp(variants[v].backend, names[i]) && c->ncand < T_MAXB &&
-                (!variants[v].cls || !strncmp(c->cls, variants[v].cls, strlen(variants[v].cls))))
-                trial_one(E, c, names[i], variants[v].opts[0] ? variants[v].opts : NULL), nv++;
-        if (!nv) trial_one(E, c, names[i], NULL);
+        for (v = 0; v <= sizeof variants / sizeof variants[0] && c->ncand < T_MAXB; v++) {
+            const char *opts;
+            tuner_cand *k;
+            if (v < sizeof variants / sizeof variants[0]) {
+                if (strcmp(variants[v].backend, names[i]) ||
+                    (variants[v].cls && strncmp(c->cls, variants[v].cls, strlen(variants[v].cls))))
+                    continue;
+                opts = variants[v].opts;
+            } else if (!nv) {
+                opts = ""; /* no variant listed: the backend's defaults */
+            } else {
+                break;
+            }
+            k = &c->cand[c->ncand++];
+            memset(k, 0, sizeof *k);
+            snprintf(k->backend, sizeof k->backend, "%s", names[i]);
+            snprintf(k->opts, sizeof k->opts, "%s", opts);
+            nv++;
+        }
     }
     free(names);
-    c->winner = tuner_rank(c->cand, c->ncand, acc, steps, c->count, c->reuse);
-    if (c->winner < 0) {
-        snprintf(c->reason, sizeof c->reason,
-                 "no candidate met tune.accuracy = %.2g; dispatch left as configured", acc);
-        return;
-    }
-    snprintf(c->reason, sizeof c->reason,
-             "%s%s%s: least predicted cost (%.3g s) for %.0f more steps x %d solve(s), factor %s, "
-             "among backends with backward error <= %.2g",
-             c->cand[c->winner].backend, c->cand[c->winner].opts[0] ? " " : "",
-             c->cand[c->winner].opts, c->cand[c->winner].cost, steps, c->count,
-             c->reuse ? "once (matrix kept)" : "every step (matrix changes)", acc);
 }
 
 /* The user's own dispatch.<cls> wins over the tuner: it is reported, not
@@ -771,25 +847,91 @@ static int user_set(silc_engine *E, t_class *c)
     return 1;
 }
 
-/* Times the backends of every class in the step; returns 1 if the dispatch
- * changed (the next step refactors, so it is not a fair sample). */
-static int trial_backends(silc_engine *E, tuner *T)
+/* Every candidate of c timed: rank them, apply the winner, keep the table. */
+static void judge_class(silc_engine *E, tuner *T, t_class *c)
+{
+    double steps = T->expect_steps > T->steps ? T->expect_steps - T->steps : T_DEFAULT_STEPS;
+    double acc = cfg_number(E, "tune.accuracy", 1e-10);
+    c->winner = tuner_rank(c->cand, c->ncand, acc, steps, c->count, c->reuse);
+    if (c->winner < 0) {
+        snprintf(c->reason, sizeof c->reason,
+                 "no candidate met tune.accuracy = %.2g; dispatch left as configured", acc);
+    } else {
+        snprintf(c->reason, sizeof c->reason,
+                 "%s%s%s: least predicted cost (%.3g s) for %.0f more steps x %d solve(s), factor %s, "
+                 "among backends with backward error <= %.2g",
+                 c->cand[c->winner].backend, c->cand[c->winner].opts[0] ? " " : "",
+                 c->cand[c->winner].opts, c->cand[c->winner].cost, steps, c->count,
+                 c->reuse ? "once (matrix kept)" : "every step (matrix changes)", acc);
+        if (!user_set(E, c)) apply_winner(E, c->cls, &c->cand[c->winner], c->ran);
+    }
+    if (T->ntab < T_MAXCLS) {
+        T->tab[T->ntab] = *c;
+        T->tab[T->ntab].a = T->tab[T->ntab].b = NULL;
+        T->ntab++;
+    }
+}
+
+/* ---- the budget ------------------------------------------------------------------ */
+
+static double best_time(const tuner *T, int *best_p)
+{
+    double best = INFINITY;
+    int i;
+    if (best_p) *best_p = T->npts ? T->pts[0].p : 1;
+    for (i = 0; i < T->npts; i++)
+        if (T->pts[i].tmin < best) {
+            best = T->pts[i].tmin;
+            if (best_p) *best_p = T->pts[i].p;
+        }
+    return best;
+}
+
+/* What tuning has cost beyond the program's own work: the sampled steps'
+ * time over the best p's, and the trials. */
+static double spent(const tuner *T)
+{
+    double best = best_time(T, NULL), excess = T->npts ? T->sample_total - T->sample_steps * best : 0;
+    return (excess > 0 ? excess : 0) + T->trial_secs;
+}
+
+/* What tuning may have cost by now: tune.budget of the expected run when
+ * `tune on N` gave its length, else of the run so far. */
+static double allowance(silc_engine *E, const tuner *T)
+{
+    double budget = cfg_number(E, "tune.budget", 0.05), per_step = T->steps ? T->run_secs / T->steps : 0;
+    if (T->expect_steps > 0) return budget * T->expect_steps * per_step;
+    return budget * T->run_secs;
+}
+
+/* Times pending trials while the budget affords them (predicted: two of
+ * the program's slowest solves of the class); judges each class whose
+ * candidates are all timed.  Returns 1 when every class is judged. */
+static int run_trials(silc_engine *E, tuner *T)
 {
     char err[sizeof E->err];
     size_t wlen = E->warnings.len;
-    int i, changed = 0, wfailed = E->warnings.failed;
+    int i, done = 1, wfailed = E->warnings.failed;
     memcpy(err, E->err, sizeof err);
-    for (i = 0; i < T->ncur; i++) {
-        t_class *c = &T->cur[i];
-        t_class *prev = class_find(T->ref, T->nref, c->cls);
-        c->reuse = prev && prev->a_id == c->a_id;
-        trial_class(E, T, c);
-        if (c->winner >= 0 && !user_set(E, c) && apply_winner(E, c->cls, &c->cand[c->winner], c->ran))
-            changed = 1;
-        if (T->ntab < T_MAXCLS) {
-            T->tab[T->ntab] = *c;
-            T->tab[T->ntab].a = T->tab[T->ntab].b = NULL;
-            T->ntab++;
+    for (i = 0; i < T->ntrial; i++) {
+        t_class *c = &T->trial[i];
+        while (c->next < c->ncand) {
+            const double *worst = slowest(T, c->cls);
+            double t0, took, predicted = 2 * (c->own_max > 0 ? c->own_max : 1e-6);
+            if (worst && 2 * *worst > predicted) predicted = 2 * *worst;
+            if (T->trial_max > predicted) predicted = T->trial_max;
+            if (spent(T) + predicted > allowance(E, T)) break;
+            t0 = now();
+            trial_one(E, c, &c->cand[c->next++]);
+            took = now() - t0;
+            T->trial_secs += took;
+            if (took > T->trial_max) T->trial_max = took;
+        }
+        if (c->next < c->ncand) done = 0;
+        else if (c->a) {
+            judge_class(E, T, c);
+            val_release(c->a), val_release(c->b);
+            c->a = c->b = NULL;
         }
     }
     memcpy(E->err, err, sizeof err);
@@ -798,7 +940,7 @@ static int trial_backends(silc_engine *E, tuner *T)
         E->warnings.s[wlen] = 0;
     }
     E->warnings.failed = wfailed;   /* the trials' warnings are dropped, their failures too */
-    return changed;
+    return done;
 }
 
 /* ---- thread sampling ----------------------------------------------------------- */
@@ -809,6 +951,15 @@ static void points(const tuner *T, double *p, double *t)
     for (i = 0; i < T->npts; i++) p[i] = T->pts[i].p, t[i] = T->pts[i].tmin;
 }
 
+/* The tuning is over: forget the operands, keep the answer. */
+static void done(silc_engine *E, tuner *T)
+{
+    T->phase = PH_DONE;
+    classes_clear(T->trial, &T->ntrial);
+    wisdom_write(E, T);
+}
+
+/* Thread sampling is over: continue at p_opt, then time the backends. */
 static void finish(silc_engine *E, tuner *T, const char *why)
 {
     double p[T_MAXC], t[T_MAXC];
@@ -842,20 +993,47 @@ static void finish(silc_engine *E, tuner *T, const char *why)
         T->p_opt = T->pts[best].p;
     }
     snprintf(T->stop, sizeof T->stop, "%s", why);
-    T->phase = PH_DONE;
+    T->waiting = 0;
     progress(T, 1);
     ld_set_threads(E, T->p_opt);
-    wisdom_write(E, T);
     classes_clear(T->ref, &T->nref);
+    T->phase = PH_TRIALS;
+    if (run_trials(E, T)) done(E, T);
+    else wisdom_write(E, T); /* the threads' answer, while the backends wait for the budget */
+}
+
+/* Whether the budget affords the next thread count's sample now. */
+static int next_affordable(silc_engine *E, tuner *T, const t_point *pt)
+{
+    double p[T_MAXC], t[T_MAXC], best = best_time(T, NULL), next_t = pt->tmin;
+    tuner_model m;
+    points(T, p, t);
+    if (T->ci + 1 < T->ncands && T->npts >= 3 && !tuner_fit(p, t, T->npts, 1, 1 << 20, &m) && !m.guarded)
+        next_t = tuner_model_eval(&m, T->cands[T->ci + 1]);
+    /* two repeats at least, each next_t - best slower than the best */
+    return spent(T) + 2 * (next_t > best ? next_t - best : 0) <= allowance(E, T);
+}
+
+static void advance(silc_engine *E, tuner *T)
+{
+    T->ci++;
+    ld_set_threads(E, T->cands[T->ci]);
+    progress(T, 0);
 }
 
 static void sample(silc_engine *E, tuner *T, double secs)
 {
     t_point *pt = NULL;
-    double p[T_MAXC], t[T_MAXC], best, budget, excess, next_cost;
-    int i, complete;
-    if (T->warmup) {
-        T->warmup = 0;
+    double p[T_MAXC], t[T_MAXC], best;
+    int i, complete, best_p;
+    if (T->waiting) {
+        /* At the best p so far, until the run has earned the next sample. */
+        for (i = 0; i < T->npts; i++)
+            if (T->pts[i].p == T->cands[T->ci]) pt = &T->pts[i];
+        if (pt && next_affordable(E, T, pt)) {
+            T->waiting = 0;
+            advance(E, T);
+        }
         return;
     }
     for (i = 0; i < T->npts; i++)
@@ -874,9 +1052,9 @@ static void sample(silc_engine *E, tuner *T, double secs)
     /* m: the two best repeats agree, or the cap is reached */
     complete = pt->reps >= T->max_rep || (pt->reps >= 2 && pt->t2 - pt->tmin <= T->rep_tol * pt->tmin) ||
                T->max_rep == 1;
-    best = INFINITY;
-    for (i = 0; i < T->npts; i++)
-        if (T->pts[i].tmin < best) best = T->pts[i].tmin;
+    best = best_time(T, &best_p);
+    /* a sample slower than the best is not repeated past what the budget allows */
+    if (!complete && pt->tmin > best && spent(T) > allowance(E, T)) complete = 1;
     /* n: leave-one-out stability, the budget, or the end of the candidates */
     points(T, p, t);
     if (complete && T->npts >= 4 &&
@@ -884,34 +1062,30 @@ static void sample(silc_engine *E, tuner *T, double secs)
         finish(E, T, "p_opt and its predicted time stable under leave-one-out");
         return;
     }
-    budget = cfg_number(E, "tune.budget", 0.05);
-    if (T->expect_steps > 0) {
-        double next_t = pt->tmin;
-        tuner_model m;
-        if (complete && T->ci + 1 < T->ncands && T->npts >= 3 &&
-            !tuner_fit(p, t, T->npts, 1, 1 << 20, &m) && !m.guarded)
-            next_t = tuner_model_eval(&m, T->cands[T->ci + 1]);
-        excess = T->sample_total - T->sample_steps * best;
-        next_cost = (complete ? 2 : 1) * (next_t > best ? next_t - best : 0);
-        if (excess + next_cost > budget * T->expect_steps * best) {
-            finish(E, T, "sampling would exceed tune.budget of the expected run");
-            return;
-        }
-    }
     if (!complete) return;
     if (T->ci + 1 >= T->ncands) {
         finish(E, T, "every candidate thread count sampled");
         return;
     }
-    T->ci++;
-    ld_set_threads(E, T->cands[T->ci]);
-    progress(T, 0);
+    if (!next_affordable(E, T, pt)) {
+        if (T->expect_steps > 0) {
+            finish(E, T, "sampling would exceed tune.budget of the expected run");
+            return;
+        }
+        /* The run's length is unknown: its allowance grows as it goes on. */
+        T->waiting = 1;
+        ld_set_threads(E, best_p);
+        return;
+    }
+    advance(E, T);
 }
 
 /* A whole step ended after secs seconds of EXEC time. */
 static void step_done(silc_engine *E, tuner *T, double secs)
 {
+    int i;
     T->steps++;
+    T->run_secs += secs;
     switch (T->phase) {
     case PH_WAIT:
         signature(T);
@@ -930,8 +1104,18 @@ static void step_done(silc_engine *E, tuner *T, double secs)
         T->phase = PH_WAIT2;
         break;
     case PH_WAIT2:
-        T->warmup = trial_backends(E, T);
-        classes_clear(T->ref, &T->nref);
+        /* The backends to time later, on this step's operands (kept). */
+        classes_clear(T->trial, &T->ntrial);
+        for (i = 0; i < T->ncur && T->ntrial < T_MAXCLS; i++) {
+            t_class *c = &T->trial[T->ntrial++], *prev = class_find(T->ref, T->nref, T->cur[i].cls);
+            *c = T->cur[i];
+            c->a = val_retain(c->a);
+            c->b = val_retain(c->b);
+            c->reuse = prev && prev->a_id == c->a_id;
+            if (prev && prev->own_max > c->own_max) c->own_max = prev->own_max;
+            plan_class(E, c);
+        }
+        T->ncands = tuner_candidates(cores(), max_threads(E), T->cands);
         T->phase = PH_SAMPLE;
         T->ci = 0;
         ld_set_threads(E, T->cands[0]);
@@ -939,6 +1123,9 @@ static void step_done(silc_engine *E, tuner *T, double secs)
         break;
     case PH_SAMPLE:
         sample(E, T, secs);
+        break;
+    case PH_TRIALS:
+        if (run_trials(E, T)) done(E, T);
         break;
     default:
         break;
@@ -963,7 +1150,9 @@ static void reset(tuner *T)
     memset(T->tab, 0, sizeof T->tab);
     T->ntab = 0;
     T->nhist = T->period = T->pos = T->step_open = T->steps = 0;
-    T->npts = T->ci = T->sample_steps = T->have_model = T->from_wisdom = T->warmup = 0;
+    T->npts = T->ci = T->sample_steps = T->have_model = T->from_wisdom = T->waiting = 0;
+    classes_clear(T->trial, &T->ntrial);
+    T->run_secs = T->trial_secs = T->trial_max = 0;
     T->choice[0] = 0;
     T->sample_total = 0;
     T->stop[0] = T->signature[0] = 0;
@@ -1067,7 +1256,9 @@ static const char *phase_name(const tuner *T)
     case PH_WAIT:
     case PH_WAIT2: return T->period || T->explicit_steps ? "waiting for two whole steps"
                                                          : "looking for the time step";
-    case PH_SAMPLE: return "sampling thread counts";
+    case PH_SAMPLE: return T->waiting ? "sampling thread counts (the next sample waits for the budget)"
+                                      : "sampling thread counts";
+    case PH_TRIALS: return "timing backends (as the budget allows)";
     case PH_DONE: return "tuned";
     default: return "off";
     }
@@ -1083,6 +1274,9 @@ static void describe(silc_engine *E, const tuner *T, strbuf *b)
     if (T->explicit_steps) sb_puts(b, "step = marked by 'tune step'\n");
     else if (T->period) sb_printf(b, "period = %d EXEC%s\n", T->period, T->period > 1 ? "s" : "");
     sb_printf(b, "steps = %d\n", T->steps);
+    if (T->phase != PH_OFF)
+        sb_printf(b, "spent = %.3g s of %.3g s allowed (tune.budget of the %s)\n", spent(T), allowance(E, T),
+                  T->expect_steps > 0 ? "expected run" : "run so far");
     sb_printf(b, "threads = %d\n", E->threads);
     if (T->signature[0]) sb_printf(b, "signature = %s\n", T->signature);
     if (T->npts) {
@@ -1097,7 +1291,7 @@ static void describe(silc_engine *E, const tuner *T, strbuf *b)
         if (T->model.guarded)
             sb_puts(b, "fit has no interior minimum (a <= 0 or b <= 0): p_opt is the best sample\n");
     }
-    if (T->phase == PH_DONE) {
+    if (T->phase == PH_DONE || T->phase == PH_TRIALS) {
         sb_printf(b, "p_opt = %d\n", T->p_opt);
         if (T->choice[0]) sb_printf(b, "chosen because = %s\n", T->choice);
         else if (T->have_model)
@@ -1298,6 +1492,7 @@ int tuner_command(silc_engine *E, const char *word, const double *xs, int nx, co
         progress(T, 1);
         classes_clear(T->pend, &T->npend);
         classes_clear(T->ref, &T->nref);
+        classes_clear(T->trial, &T->ntrial);
         if (T->phase != PH_DONE) T->phase = PH_OFF;
         return 0;
     }
@@ -1338,6 +1533,7 @@ void tuner_free(silc_engine *E)
     classes_clear(T->pend, &T->npend);
     classes_clear(T->cur, &T->ncur);
     classes_clear(T->ref, &T->nref);
+    classes_clear(T->trial, &T->ntrial);
     free(T);
     E->tuner = NULL;
 }

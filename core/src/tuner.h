@@ -82,10 +82,12 @@ void tuner_explain(silc_engine *E, const silc_call *call, strbuf *b);
 void tuner_free(silc_engine *E);
 
 /* ---- internals exposed for tests and the bench ---------------------------- */
-/* Candidate thread counts for a machine with `cores` cores: 1, 2, 4, ... up
- * to cores (and cores itself), then, when cores <= 4, the oversubscribed
- * 1.5x, 2x, 3x and 4x points.  Returns the count (<= 16). */
-int tuner_candidates(int cores, int *out);
+/* Candidate thread counts for a process that may run on `cores` CPUs and
+ * use at most max_threads (tune.max_threads, default cores): 1, 2, 4, ... up
+ * to the smaller of the two (and it itself); only when max_threads exceeds
+ * cores, the oversubscribed points up to it (1.5x, 2x, 3x and 4x of cores
+ * when cores <= 4, then max_threads).  Returns the count (<= 16). */
+int tuner_candidates(int cores, int max_threads, int *out);
 /* Machine key for wisdom: "<cpu model>|<cores>" with blanks as '_'. */
 void tuner_machine(char *out, size_t len);
 /* Wisdom file path: tune.wisdom, else $SILC_WISDOM, else ~/.cache/silc/wisdom. */
