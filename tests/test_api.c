@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "check.h"
 
@@ -606,6 +607,57 @@ static void test_recycled_arrays(void)
     free(sevens);
 }
 
+static void capture_text(void *user, const char *text)
+{
+    size_t have = strlen((char *)user), add = strlen(text);
+    if (have + add < 8192) memcpy((char *)user + have, text, add + 1);
+}
+
+/* `tune status`'s integer after "key = ", or -1. */
+static int tune_status_int(silc_context *c, char *out, const char *key)
+{
+    char pat[64];
+    const char *at;
+    out[0] = 0;
+    if (silc_exec(c, "tune status")) return -1;
+    snprintf(pat, sizeof pat, "\n%s = ", key);
+    at = strstr(out, pat);
+    return at ? atoi(at + strlen(pat)) : -1;
+}
+
+/* The tuner finds the steps wherever they repeat (issue 18): a program's
+ * EXEC loop, and a `while` loop inside one EXEC (a `silc run` script); the
+ * same embedded and through silcd (test_api_remote). */
+static void test_tuning_loops(void)
+{
+    static char out[8192];
+    char setup[256];
+    silc_context *c = NULL;
+    int k;
+    snprintf(setup, sizeof setup,
+             "set tune.wisdom = /tmp/silc-test-api-wisdom-%ld; tune forget; tune on 100000; n = 40; "
+             "A = sparse(4 * eye(n) + 0.5 * ones(n, n)); b = ones(n, 1)", (long)getpid());
+    for (k = 0; k < 2; k++) {
+        CHECK(silc_open(&c, NULL) == 0, "silc_open: %s", silc_errmsg());
+        if (!c) return;
+        silc_set_output(c, capture_text, out);
+        CHECK(silc_exec(c, setup) == 0, "setup: %s", silc_context_errmsg(c));
+        if (k == 0) {
+            int i;
+            for (i = 0; i < 30; i++) CHECK(silc_exec(c, "x = A \\ b") == 0, "solve: %s", silc_context_errmsg(c));
+            CHECK(tune_status_int(c, out, "steps") >= 20 && strstr(out, "period = 1 EXEC"),
+                  "an EXEC loop is found: %s", out);
+        } else {
+            CHECK(silc_exec(c, "i = 0; while (i < 40) { y = A \\ b; i = i + 1 }") == 0, "loop: %s",
+                  silc_context_errmsg(c));
+            CHECK(tune_status_int(c, out, "steps") == 40, "every iteration of the loop is a step: %s", out);
+            CHECK(strstr(out, "sampled steps = ") != NULL, "the loop's steps were sampled: %s", out);
+        }
+        CHECK(silc_exec(c, "tune forget") == 0, "tune forget: %s", silc_context_errmsg(c));
+        silc_close(&c);
+    }
+}
+
 int main(void)
 {
     test_before_init();
@@ -623,6 +675,7 @@ int main(void)
     test_contexts();
     test_exec_plumbing();
     test_recycled_arrays();
+    test_tuning_loops();
     CHECK(SILC_FINALIZE() == 0, "SILC_FINALIZE");
     CHECK(silc_default_context() == NULL, "default context survives SILC_FINALIZE");
     CHECK(SILC_FINALIZE() != 0, "second SILC_FINALIZE succeeded");

@@ -1180,18 +1180,27 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         if (condition(V, s->cond, &truth)) return -1;
         if (truth) return exec_block(V, s->kids[0], flow);
         return s->els ? exec_stmt(V, s->els, flow) : 0;
-    case ST_WHILE:
+    case ST_WHILE: {
+        /* An iteration of the outermost loop is a time step to the tuner
+         * (a script's loop is the program's time loop; tuner_loop_step). */
+        int rc = 0, outer = V->loop_depth++ == 0 && !V->explain;
+        uint64_t key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
         for (;;) {
-            if (condition(V, s->cond, &truth)) return -1;
-            if (!truth) return 0;
-            if (V->E->loop_budget && ++V->loops > V->E->loop_budget)
-                return eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
-                                 (unsigned long long)V->E->loop_budget);
-            if (exec_block(V, s->kids[0], flow)) return -1;
+            double ti = util_now();
+            if ((rc = condition(V, s->cond, &truth)) || !truth) break;
+            if (V->E->loop_budget && ++V->loops > V->E->loop_budget) {
+                rc = eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
+                               (unsigned long long)V->E->loop_budget);
+                break;
+            }
+            if ((rc = exec_block(V, s->kids[0], flow))) break;
+            if (outer) tuner_loop_step(V->E, key, util_now() - ti);
             if (*flow == FLOW_BREAK) break;
         }
-        *flow = FLOW_NEXT;
-        return 0;
+        V->loop_depth--;
+        if (!rc) *flow = FLOW_NEXT;
+        return rc;
+    }
     default:
         return eng_error(V->E, "internal error: expression where a statement was expected");
     }

@@ -105,6 +105,7 @@ typedef struct lang_ev {
     char backends[128];    /* solve backends of the current statement */
     char *bind_text;       /* the statement's text, made before an update in place */
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
+    int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

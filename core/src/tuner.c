@@ -1248,6 +1248,29 @@ void tuner_observe(silc_engine *E, const char *text, double seconds)
     }
 }
 
+/* A script's time loop (`while` in one EXEC, as `silc run` runs it): every
+ * iteration of the outermost loop is a whole step, so the tuner works where
+ * no EXEC texts repeat. */
+void tuner_loop_step(silc_engine *E, uint64_t key, double seconds)
+{
+    tuner *T = E->tuner;
+    const char *cfg = cfg_get(E, "tune.threads");
+    if (!T) {
+        if (!cfg || !(T = tuner_get(E))) return;
+    }
+    if (cfg) follow_config(E, T, cfg);
+    if (!T->enabled) {
+        classes_clear(T->pend, &T->npend);
+        return;
+    }
+    step_open(E, T);
+    T->step_hash = (T->step_hash ^ key) * 1099511628211ull;
+    T->step_acc = seconds;
+    pend_merge(T);
+    T->step_open = 0;
+    step_done(E, T, seconds);
+}
+
 /* ---- reports ------------------------------------------------------------------ */
 
 static const char *phase_name(const tuner *T)

@@ -72,6 +72,9 @@ int tuner_rank(tuner_cand *c, int n, double accuracy, double steps, int per_step
 /* ---- the engine hooks ------------------------------------------------------ */
 /* After each top-level EXEC (lang_exec). */
 void tuner_observe(silc_engine *E, const char *text, double seconds);
+/* After each iteration of a top-level `while` loop (ev): one whole step of
+ * seconds, the loop identified by key. */
+void tuner_loop_step(silc_engine *E, uint64_t key, double seconds);
 /* After each solve that ran (ev_run); retains the operands while needed. */
 void tuner_note_solve(silc_engine *E, const silc_call *call);
 /* `tune WORD [number|"file"]`: on, off, status, step, forget, report, fit.
