@@ -74,8 +74,9 @@ typedef struct lis_options {
     double ilut_drop, ilut_rate;
     double saamg_theta;         /* -saamg_theta: SA-AMG strength threshold */
     int saamg_unsym;            /* -saamg_unsym true: SA-AMG accepts an unsymmetric A */
-    int conv_cond;              /* 0: ||r|| / ||r0||, 1: ||r|| / ||b|| (2-norms) */
-    int initx_zeros;            /* 1: x0 = 0; 0: x0 = in[2] when given */
+    int conv_cond;              /* 0: ||r|| / ||r0||, 1: ||r|| / ||b|| (2-norms); -1 not given:
+                                   ||b|| when starting from an initial guess, else ||r0|| (= ||b||) */
+    int initx_zeros;            /* 1: x0 = 0; 0: x0 = in[2] when given; -1 not given: as 0 */
     int print;                  /* 1: residual history through host->log */
     int quad;                   /* 1: -f quad (double-double) */
     int given;                  /* options the string set */

@@ -63,8 +63,8 @@ void lis_options_init(lis_options *o)
     o->ilut_drop = 0.05;
     o->ilut_rate = 5.0;
     o->saamg_theta = 0.05;
-    o->conv_cond = 0;
-    o->initx_zeros = 1;
+    o->conv_cond = -1;  /* not given: ||r0||, or ||b|| from an initial guess (lis_style.c) */
+    o->initx_zeros = -1; /* not given: start from the host's initial guess when there is one */
 }
 
 /* Levenshtein distance, for "did you mean". */

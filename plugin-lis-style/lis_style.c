@@ -27,9 +27,11 @@
  * restarted from its iterate (as long as that keeps gaining), and only the
  * true residual is reported.  Outcomes: converged -> SILC_OK; iteration limit
  * -> SILC_ENOTCONV; breakdown or NaN -> SILC_EBREAKDOWN, each message naming
- * the method, the iteration and the relative residual.  -initx_zeros false
- * starts from a third operand when one is given (the language's solve() has
- * none today), else from zero, as the note says.
+ * the method, the iteration and the relative residual.  A third operand
+ * (ABI 1.6: the host's initial guess, the previous solution of a time loop
+ * under solve.initial_guess) is the starting point unless -initx_zeros true
+ * says otherwise; the tolerance then applies to ||r|| / ||b|| unless
+ * -conv_cond says otherwise, and `info` says so.
  *
  * Norms are scaled (lk_nrm2), but the methods' inner products (r, r),
  * (p, A p) would under- or overflow once entries leave about 1e+-100: systems
@@ -200,6 +202,7 @@ typedef struct col_result {
     int64_t iterations;
     double resid;
     int restarts;
+    int from_guess;         /* started from the initial guess (it was better than zero) */
 } col_result;
 
 /* Solves column `col` into x (double), driving restarts; returns a SILC status
@@ -225,7 +228,18 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
     c->den = 1;
     r0n = lis_true_resid(c, &x, &work);
     bn = lk_nrm2(c->n, bcol);
-    c->den = c->o->conv_cond == 1 && bn > 0 ? bn : r0n;
+    if (x0 && !(r0n < bn)) {
+        /* A guess no better than zero (another system's solution) would
+         * only cost iterations, or trip a divergence test: start from 0. */
+        lv_zero(c, &x);
+        x0 = NULL;
+        r0n = lis_true_resid(c, &x, &work);
+    }
+    res->from_guess = x0 != NULL;
+    /* From an initial guess (a warm start) the residual is measured against
+     * ||b||, as PETSc does: against ||r0|| a good guess would only demand
+     * more iterations. */
+    c->den = (c->o->conv_cond == 1 || (c->o->conv_cond < 0 && x0)) && bn > 0 ? bn : r0n;
     if (r0n == 0) { /* x0 solves it already (b = 0 from x0 = 0) */
         res->iterations = 0;
         res->resid = 0;
@@ -303,7 +317,7 @@ static int solve_run(silc_call *call)
     char err[320], slabel[32], plabel[48], key[96];
     const char *text = H->option_string(call, "options", "");
     double t0 = H->now(), *bcol = NULL, *x0col = NULL;
-    int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0;
+    int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0, guesses = 0;
     int64_t j, max_iter = 0;
     double max_resid = 0;
 
@@ -380,7 +394,7 @@ static int solve_run(silc_call *call)
 
     /* Right-hand sides, one column at a time. */
     H->view(call->in[1], &B);
-    use_x0 = !opt.initx_zeros && call->nin >= 3 && call->in[2];
+    use_x0 = opt.initx_zeros != 1 && call->nin >= 3 && call->in[2];
     if (use_x0) {
         silc_view X0;
         H->view(call->in[2], &X0);
@@ -408,7 +422,7 @@ static int solve_run(silc_call *call)
     snprintf(c.label, sizeof c.label, "%s", slabel);
     for (j = 0; j < B.n; j++) {
         char tag[32] = "";
-        col_result res = {0, 0, 0};
+        col_result res = {0, 0, 0, 0};
         if (B.n > 1) snprintf(tag, sizeof tag, " (column %lld)", (long long)j + 1);
         column(&B, j, bcol);
         if (use_x0) {
@@ -421,6 +435,7 @@ static int solve_run(silc_call *call)
         if (res.iterations > max_iter) max_iter = res.iterations;
         if (res.resid > max_resid) max_resid = res.resid;
         restarts += res.restarts;
+        guesses += res.from_guess;
     }
 
     /* The report. */
@@ -434,12 +449,14 @@ static int solve_run(silc_call *call)
     }
     rep->iterations = max_iter;
     rep->resid = max_resid;
+    if (guesses && H->abi_minor >= 6) rep->initial_guess = 1;
     rep->reused_factor = reused;
     rep->factor_seconds = pc && !reused ? pc->seconds : 0;
     rep->solve_seconds = H->now() - t0 - rep->factor_seconds;
     {
         int k = snprintf(rep->note, sizeof rep->note, "converged: ||r||/%s = %.2e <= tol %.1e",
-                         opt.conv_cond == 1 ? "||b||" : "||r0||", max_resid, opt.tol);
+                         opt.conv_cond == 1 || (opt.conv_cond < 0 && guesses) ? "||b||" : "||r0||",
+                         max_resid, opt.tol);
         size_t u = k > 0 ? (size_t)k : 0;
         if (pc && u < sizeof rep->note)
             u += (size_t)snprintf(rep->note + u, sizeof rep->note - u, "; preconditioner %s",
@@ -453,7 +470,11 @@ static int solve_run(silc_call *call)
         if (restarts && u < sizeof rep->note)
             u += (size_t)snprintf(rep->note + u, sizeof rep->note - u,
                                   "; restarted %d time(s) on residual drift", restarts);
-        if (!opt.initx_zeros && !use_x0 && u < sizeof rep->note)
+        if (use_x0 && u < sizeof rep->note)
+            u += (size_t)snprintf(rep->note + u, sizeof rep->note - u, guesses
+                                  ? "; started from the initial guess"
+                                  : "; the initial guess was no better than 0: started from 0");
+        if (opt.initx_zeros == 0 && !use_x0 && u < sizeof rep->note)
             snprintf(rep->note + u, sizeof rep->note - u,
                      "; -initx_zeros false but no initial guess given: started from 0");
     }

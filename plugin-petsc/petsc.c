@@ -740,10 +740,13 @@ static int diverged(silc_call *call, const psc_ranks *R, psc_solver *S, KSPConve
 }
 
 /* Solves column by column; fills X and the report.  B and X hold this
- * rank's m of the n rows, column-major.  Collective. */
+ * rank's m of the n rows, column-major.  *guess: in, X holds an initial
+ * guess; out, how many columns started from it (a guess no better than
+ * zero is dropped: it would only trip the divergence test).  Collective. */
 static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double *B, double *X,
-                      int64_t m, int64_t n, int64_t ncols)
+                      int64_t m, int64_t n, int64_t ncols, int *guess)
 {
+    int given = *guess;
     silc_report *r = call->report;
     Vec b = NULL, x = NULL, res = NULL;
     KSPConvergedReason reason = KSP_CONVERGED_ITERATING, first = KSP_CONVERGED_ITERATING;
@@ -756,10 +759,19 @@ static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double
     TRY(vec_wrap(R, m, n, &b), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
     TRY(vec_wrap(R, m, n, &x), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
     TRY(VecDuplicate(b, &res), "VecDuplicate");
+    *guess = 0;
     for (j = 0; j < ncols; j++) {
         double rel;
         TRY(VecPlaceArray(b, B + j * m), "VecPlaceArray");
         TRY(VecPlaceArray(x, X + j * m), "VecPlaceArray");
+        if (given) {
+            TRY(MatMult(S->A, x, res), "MatMult");
+            TRY(VecAYPX(res, -1.0, b), "VecAYPX");
+            TRY(VecNorm(res, NORM_2, &nr), "VecNorm");
+            TRY(VecNorm(b, NORM_2, &nb), "VecNorm");
+            if (nr < nb) (*guess)++;
+            else TRY(VecSet(x, 0.0), "VecSet");
+        }
         TRY(KSPSolve(S->ksp, b, x), "KSPSolve");
         TRY(KSPGetConvergedReason(S->ksp, &reason), "KSPGetConvergedReason");
         TRY(KSPGetIterationNumber(S->ksp, &its), "KSPGetIterationNumber");
@@ -913,8 +925,27 @@ agreed:
         if (rc) goto done;
         r->factor_seconds = S->setup_seconds;
     }
-    t0 = host->now();
-    if ((rc = run_solves(call, &R, S, B, o.val, bv.m, a.n, bv.n))) goto done;
+    {
+        /* A warm start (ABI 1.6: the host's initial guess in in[2]) for a
+         * Krylov method, as KSPSetInitialGuessNonzero; a direct PC gains
+         * nothing from it.  PETSc's default test is relative to ||b||, so a
+         * good guess stops early.  The flag is set every solve: the KSP is
+         * reused across calls with and without a guess. */
+        silc_view g;
+        int guess = host->abi_minor >= 6 && call->nin >= 3 && call->in[2] && !R.dist && !S->direct;
+        if (guess) {
+            host->view(call->in[2], &g);
+            guess = g.format == SILC_FMT_DENSE && g.m == a.n && g.n == bv.n;
+        }
+        if (guess) memcpy(o.val, g.val, (size_t)(g.m * g.n) * sizeof(double));
+        if ((ierr = KSPSetInitialGuessNonzero(S->ksp, guess ? PETSC_TRUE : PETSC_FALSE))) {
+            rc = psc_fail(call, "KSPSetInitialGuessNonzero", ierr);
+            goto done;
+        }
+        t0 = host->now();
+        if ((rc = run_solves(call, &R, S, B, o.val, bv.m, a.n, bv.n, &guess))) goto done;
+        r->initial_guess = guess > 0;
+    }
     r->solve_seconds = host->now() - t0;
     if (!S->checked) {
         if ((rc = psc_options_check_used(call, R.comm, S->opts, text, spd, S->A))) goto done;

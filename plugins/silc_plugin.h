@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 5
+#define SILC_ABI_MINOR 6
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -109,7 +109,10 @@ enum silc_op {
     SILC_OP_EWISE = 3,     /* out = in[0] (sub) in[1] element-wise; sub = enum silc_ewise     */
     SILC_OP_MAP = 4,       /* out = f(in[0]) element-wise; sub = enum silc_map                */
     SILC_OP_TRANSPOSE = 5, /* out = in[0]'                                                    */
-    SILC_OP_SOLVE = 6,     /* out = in[0] \ in[1]; fills call->report; options in call->options */
+    SILC_OP_SOLVE = 6,     /* out = in[0] \ in[1]; fills call->report; options in call->options;
+                              ABI 1.6: nin = 3 gives in[2], an initial guess (dense, the
+                              solution's shape) an iterative method may start from (warm
+                              start; it then sets report->initial_guess); others ignore it */
     SILC_OP_REDUCE = 7,    /* sub = enum silc_reduce; see there                               */
     SILC_OP_CONVERT = 8,   /* out = in[0] stored as format sub (band: kl = ival[0], ku = ival[1]) */
     SILC_OP_DIAG = 9,      /* sub 0: diag(v) -> CSR diagonal matrix; sub 1: diagvec(A) -> column */
@@ -158,6 +161,8 @@ typedef struct silc_report {
                                refines it in double (solve.refine, default 10 steps for these) */
     int refine_steps;       /* host: iterative-refinement steps the core kept */
     double backward_error_unrefined; /* host: backward error before refinement, -1 = none ran */
+    /* ABI 1.6 */
+    int initial_guess;      /* plugin: 1 when it started from the initial guess in[2] */
 } silc_report;
 
 typedef struct silc_call {

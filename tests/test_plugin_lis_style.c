@@ -658,6 +658,20 @@ int main(void)
     test_failures(c);
     test_reuse_and_formats(c);
     test_threads(c);
+    {
+        silc_envelope_t A;
+        double *ones = malloc(900 * sizeof *ones);
+        for (int i = 0; ones && i < 900; i++) ones[i] = 1;
+        grid(&A, 30, 0);
+        if (ones) {
+            put_system(c, &A, ones);
+            printf("lis-style: warm starts\n");
+            tl_check_warm_start(c, "x = solve(A, b, \"lis-style.options = -i cg -p none -tol 1e-10\")", 900,
+                                1e-7, "lis-style CG");
+        }
+        free(ones);
+        silc_envelope_free(&A);
+    }
     printf("lis-style: SPD shared matrices, CG + IC(0) / ILU(0), tol 1e-10\n");
     test_shared_spd(c, ref);
     silc_close(&c);

@@ -427,6 +427,9 @@ int main(void)
         test_options(cp);
         test_multi_rhs(cp, ones, n);
         test_two_contexts(cp, cq, &A, ones, b);
+        CHECK(put_system(cp, &A, ones, b) == 0, "put laplacian again");
+        tl_check_warm_start(cp, "x = solve(A, b, \"petsc.options = -ksp_type cg -pc_type jacobi -ksp_rtol 1e-10\")",
+                            n, 1e-7, "petsc CG");
         silc_envelope_free(&A);
         test_shared(cp, cr, "west0479.mtx",
                     "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps", 0);

@@ -558,6 +558,68 @@ static inline void tl_spd_sweep(silc_context *c, silc_context *ref, const char *
         silc_envelope_free(&A);
     }
 }
+
+/* Warm starts in a time loop (solve.initial_guess, issue 18).  With A and
+ * b = A * ones PUT in c and stmt a solve that assigns x with an iterative
+ * method: stmt run again after b grows by 0.1 % starts from the previous x
+ * (info says so), takes fewer iterations than from zero and still solves
+ * (x = 1.001 * ones to tol); under solve.initial_guess = zero it starts from
+ * zero again; a different statement assigning x does not start from it
+ * (auto), unless solve.initial_guess = previous.  label names the solver. */
+static inline void tl_check_warm_start(silc_context *c, const char *stmt, int64_t n, double tol,
+                                       const char *label)
+{
+    double it0, it1, it2, scale = 1, *x, d = 0;
+    char other[512];
+    const char *in;
+    snprintf(other, sizeof other, "x = 1 * %s", strchr(stmt, '=') + 1);
+    if (silc_exec(c, stmt)) {
+        CHECK(0, "%s: %s: %s", label, stmt, silc_context_errmsg(c));
+        return;
+    }
+    in = tl_out_info(c, "x");
+    it0 = tl_out_number(in, "iterations: ");
+    CHECK(!strstr(in, "initial guess"), "%s: the first solve has no guess:\n%s", label, in);
+    CHECK(silc_exec(c, "b = 1.001 * b") == 0 && silc_exec(c, stmt) == 0, "%s: second step: %s", label,
+          silc_context_errmsg(c));
+    scale *= 1.001;
+    in = tl_out_info(c, "x");
+    it1 = tl_out_number(in, "iterations: ");
+    CHECK(strstr(in, "initial guess: the previous value of x (warm start)") != NULL,
+          "%s: the repeated statement starts from the previous x:\n%s", label, in);
+    CHECK(it1 >= 0 && it1 < it0, "%s: %g iterations from the previous x, %g from zero", label, it1, it0);
+    if ((x = tl_get_dense_checked(c, "x", n, 1))) {
+        for (int64_t i = 0; i < n; i++) d = fmax(d, fabs(x[i] - scale));
+        CHECK(d <= tol, "%s: the warm-started x is off by %g", label, d);
+        free(x);
+    }
+    CHECK(silc_exec(c, "set solve.initial_guess = zero; b = 1.001 * b") == 0 && silc_exec(c, stmt) == 0,
+          "%s: zero: %s", label, silc_context_errmsg(c));
+    in = tl_out_info(c, "x");
+    it2 = tl_out_number(in, "iterations: ");
+    CHECK(!strstr(in, "initial guess") && it2 > it1, "%s: solve.initial_guess = zero starts from 0 (%g "
+          "iterations):\n%s", label, it2, in);
+    CHECK(silc_exec(c, "set solve.initial_guess = auto") == 0 && silc_exec(c, other) == 0, "%s: %s: %s", label,
+          other, silc_context_errmsg(c));
+    CHECK(!strstr(tl_out_info(c, "x"), "initial guess"), "%s: another statement does not start from x", label);
+    CHECK(silc_exec(c, "set solve.initial_guess = previous") == 0 && silc_exec(c, stmt) == 0, "%s: %s", label,
+          silc_context_errmsg(c));
+    CHECK(strstr(tl_out_info(c, "x"), "initial guess: the previous value") != NULL,
+          "%s: solve.initial_guess = previous starts from any previous x:\n%s", label, tl_out());
+    /* A guess worse than zero (b turned round) is dropped, and x is right. */
+    CHECK(silc_exec(c, "b = -1000 * b") == 0 && silc_exec(c, stmt) == 0, "%s: turned: %s", label,
+          silc_context_errmsg(c));
+    scale *= -1000 * 1.001;
+    CHECK(!strstr(tl_out_info(c, "x"), "initial guess: the previous"), "%s: a guess worse than 0 is dropped:\n%s",
+          label, tl_out());
+    if ((x = tl_get_dense_checked(c, "x", n, 1))) {
+        d = 0;
+        for (int64_t i = 0; i < n; i++) d = fmax(d, fabs(x[i] / scale - 1));
+        CHECK(d <= tol, "%s: x after the dropped guess is off by %g", label, d);
+        free(x);
+    }
+    CHECK(silc_exec(c, "set solve.initial_guess = auto") == 0, "restore");
+}
 #endif
 
 #endif

@@ -40,7 +40,7 @@ struct cfg_db {
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
-static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error"};
+static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess"};
 
 /* Longest list a dispatch key may name; more would only repeat names. */
 #define CFG_MAX_LIST 32
@@ -385,8 +385,12 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
                 strcmp(value, "on_request") != 0)
                 return eng_error(E, "solve.backward_error expects 'deferred', 'always' or "
                                     "'on_request', got '%s'", value);
+        } else if (strcmp(name, "initial_guess") == 0) {
+            if (strcmp(value, "auto") != 0 && strcmp(value, "previous") != 0 && strcmp(value, "zero") != 0)
+                return eng_error(E, "solve.initial_guess expects 'auto', 'previous' or 'zero', got '%s'",
+                                 value);
         } else {
-            return unknown_key(E, section, name, solve_keys, 3);
+            return unknown_key(E, section, name, solve_keys, 4);
         }
         return keep_value(E, norm, section, name, value);
     }

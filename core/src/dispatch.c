@@ -352,7 +352,14 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 dist_walk_end(call, &swap);
                 continue;
             }
-            rc = run_one(call, b);
+            {
+                /* An initial guess (in[2]) goes only to plugins that know of it (ABI 1.6). */
+                int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&
+                                 b->plugin->table->abi_minor < 6;
+                if (hide_guess) call->nin = 2;
+                rc = run_one(call, b);
+                if (hide_guess) call->nin = 3;
+            }
             if (rc == SILC_OK && !call->out) {
                 rc = SILC_EINTERNAL;
                 snprintf(ctx.err, sizeof ctx.err, "reported success but returned no result");

@@ -158,6 +158,13 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         rep.cond_est = -1;
         rep.rcond = -1;
         call->report = &rep;
+        /* The statement's initial guess goes to the first solve whose
+         * solution has its shape (exec_assign, solve.initial_guess). */
+        if (V->warm && call->nin == 2 && V->warm->m == call->in[0]->n && V->warm->n == call->in[1]->n) {
+            call->in[2] = V->warm;
+            call->nin = 3;
+            V->warm = NULL;
+        }
     }
     if (V->explain) {
         strbuf d;
@@ -818,6 +825,30 @@ static int self_update_op(const ast_node *s)
     return e->op == TK_PLUS ? TK_PLUSEQ : TK_MINUSEQ;
 }
 
+/* The previous value of the assignment's target, as the initial guess of
+ * its solve (solve.initial_guess): `previous` whenever the target holds a
+ * dense value; `auto` (the default) only when this same statement computed
+ * it -- a time loop, where the last step's solution is close to this one's;
+ * `zero` never.  Iterative backends start from it (direct ones ignore it).
+ * explain and distributed engines start from zero. */
+static silc_value *initial_guess(lang_ev *V, const ast_node *s)
+{
+    const char *mode = cfg_get(V->E, "solve.initial_guess");
+    silc_value *prev;
+    const eng_info *info;
+    size_t len = s->end - s->start;
+    if (V->explain || V->E->dist || (mode && !strcmp(mode, "zero"))) return NULL;
+    prev = store_get(&V->E->store, s->name);
+    if (!prev || prev->format != SILC_FMT_DENSE || prev->dist) return NULL;
+    if (!mode || !strcmp(mode, "auto")) {
+        info = eng_info_get(V->E, s->name);
+        if (!info || !info->statement || strlen(info->statement) != len ||
+            memcmp(info->statement, V->src + s->start, len))
+            return NULL;
+    }
+    return val_retain(prev);
+}
+
 static int exec_assign(lang_ev *V, const ast_node *s, double t0)
 {
     silc_value *v = NULL, *cur = NULL, *r;
@@ -826,7 +857,12 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
     if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
     if (s->kind == ST_ASSIGN && !cur) {
-        if (ev_expr_dist(V, s->kids[0], &v)) return -1;
+        silc_value *guess = initial_guess(V, s);
+        V->warm = guess;
+        rc = ev_expr_dist(V, s->kids[0], &v);
+        V->warm = NULL;
+        val_release(guess);
+        if (rc) return -1;
         return bind(V, s, s->name, v, t0);
     }
     if (!cur) return undefined_name(V, s->name);
@@ -1038,6 +1074,8 @@ static int exec_info(lang_ev *V, const ast_node *s)
                 sb_puts(&b, "  condition estimate: not available\n");
             }
             sb_printf(&b, "  iterations: %lld\n", (long long)r->iterations);
+            if (r->initial_guess)
+                sb_printf(&b, "  initial guess: the previous value of %s (warm start)\n", s->name);
             if (r->iterations > 0) {
                 util_fmt_double(num, sizeof num, r->resid);
                 sb_printf(&b, "  final relative residual: %s\n", num);

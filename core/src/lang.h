@@ -106,6 +106,7 @@ typedef struct lang_ev {
     char *bind_text;       /* the statement's text, made before an update in place */
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
     int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
+    const silc_value *warm; /* initial guess for the statement's solve (solve.initial_guess), or NULL */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

@@ -74,6 +74,7 @@ int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S)
     memset(S, 0, sizeof *S);
     S->A = A;
     S->B = B;
+    S->X0 = call->nin >= 3 ? call->in[2] : NULL;
     S->ea = exponent_for(A);
     S->eb = exponent_for(B);
     if (S->ea) {
@@ -99,6 +100,16 @@ int scale_solve_begin(silc_engine *E, silc_call *call, scale_state *S)
         }
         call->in[1] = S->Bs;
     }
+    if (S->X0 && S->ea != S->eb) {
+        if (!(S->X0s = scaled(S->X0, S->eb - S->ea))) {
+            call->in[0] = A;
+            call->in[1] = B;
+            val_release(S->Bs);
+            S->Bs = NULL;
+            return eng_error(E, "out of memory scaling a system of extreme magnitude");
+        }
+        call->in[2] = S->X0s;
+    }
     return 0;
 }
 
@@ -109,8 +120,10 @@ int scale_solve_end(silc_call *call, scale_state *S)
     int was_finite;
     call->in[0] = S->A;
     call->in[1] = S->B;
+    if (S->X0) call->in[2] = S->X0;
     val_release(S->Bs);
-    S->Bs = NULL;
+    val_release(S->X0s);
+    S->Bs = S->X0s = NULL;
     if (!X || S->ea == S->eb) return 0;
     was_finite = !val_has_nonfinite(X);
     for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);

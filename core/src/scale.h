@@ -6,7 +6,8 @@
  * of moderate size: PETSc's ILU finds "zero pivots" at 1e-300 and CG's inner
  * products underflow.  Multiplying A and B by powers of two rounds nothing
  * (unless an entry would become subnormal, which the exponent avoids), so the
- * dispatcher solves (2^ea A) Y = 2^eb B instead and returns X = 2^(ea-eb) Y.
+ * dispatcher solves (2^ea A) Y = 2^eb B instead and returns X = 2^(ea-eb) Y
+ * (an initial guess X0 goes in as 2^(eb-ea) X0).
  * The backward error is invariant under this scaling, so the report is the
  * original system's.  The scaled A is an attachment of A, so a time loop
  * still factors once.
@@ -17,8 +18,9 @@
 #include "engine.h"
 
 typedef struct scale_state {
-    const silc_value *A, *B;    /* the caller's operands, restored at the end */
+    const silc_value *A, *B, *X0; /* the caller's operands, restored at the end */
     silc_value *Bs;             /* scaled B (owned), NULL if B is not scaled */
+    silc_value *X0s;            /* the initial guess in[2] scaled like the solution (owned) */
     int ea, eb;                 /* exponents applied to A and B */
 } scale_state;
 

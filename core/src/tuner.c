@@ -63,6 +63,7 @@ typedef struct t_point {
 typedef struct t_class {
     char cls[40];
     silc_value *a, *b;      /* retained operands of the latest solve */
+    silc_value *x0;         /* and its initial guess (solve.initial_guess), or NULL */
     uint64_t a_id;
     int count;              /* solves of this class in the step */
     int reuse;              /* the matrix kept its id from the previous step */
@@ -431,7 +432,7 @@ void tuner_set_rule(silc_engine *E, double loo_tol, double rep_tol, int max_repe
 static void classes_clear(t_class *c, int *n)
 {
     int i;
-    for (i = 0; i < *n; i++) val_release(c[i].a), val_release(c[i].b);
+    for (i = 0; i < *n; i++) val_release(c[i].a), val_release(c[i].b), val_release(c[i].x0);
     memset(c, 0, sizeof *c * (size_t)*n);
     *n = 0;
 }
@@ -456,9 +457,9 @@ static void pend_merge(tuner *T)
             snprintf(c->cls, sizeof c->cls, "%s", p->cls);
         }
         if (!c) continue;
-        val_release(c->a), val_release(c->b);
-        c->a = p->a, c->b = p->b, c->a_id = p->a_id;
-        p->a = p->b = NULL;
+        val_release(c->a), val_release(c->b), val_release(c->x0);
+        c->a = p->a, c->b = p->b, c->x0 = p->x0, c->a_id = p->a_id;
+        p->a = p->b = p->x0 = NULL;
         c->count += p->count;
         if (p->own_max > c->own_max) c->own_max = p->own_max;
         snprintf(c->ran, sizeof c->ran, "%s", p->ran);
@@ -496,9 +497,10 @@ void tuner_note_solve(silc_engine *E, const silc_call *call)
         memset(c, 0, sizeof *c);
         snprintf(c->cls, sizeof c->cls, "%s", chain[0]);
     }
-    val_release(c->a), val_release(c->b);
+    val_release(c->a), val_release(c->b), val_release(c->x0);
     c->a = val_retain((silc_value *)call->in[0]);
     c->b = val_retain((silc_value *)call->in[1]);
+    c->x0 = call->nin >= 3 && call->in[2] ? val_retain((silc_value *)call->in[2]) : NULL;
     c->a_id = call->in[0]->id;
     c->count++;
     if (call->report) {
@@ -722,8 +724,8 @@ static silc_value *val_copy(const silc_value *v)
     return c;
 }
 
-static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b, const char *opts,
-                       silc_report *rep)
+static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b, const silc_value *x0,
+                       const char *opts, silc_report *rep)
 {
     silc_call call;
     int rc;
@@ -734,6 +736,7 @@ static int trial_solve(silc_engine *E, const silc_value *a, const silc_value *b,
     call.nin = 2;
     call.in[0] = a;
     call.in[1] = b;
+    if (x0) call.in[2] = x0, call.nin = 3;
     call.options = opts;
     call.report = rep;
     rc = disp_run(E, &call);
@@ -778,7 +781,10 @@ static void trial_one(silc_engine *E, t_class *c, tuner_cand *k)
         snprintf(k->why, sizeof k->why, "out of memory copying the matrix");
         return;
     }
-    if (trial_solve(E, a, c->b, opts, &r1) || trial_solve(E, a, c->b, opts, &r2)) {
+    /* The repeat starts from the program's initial guess when it gave one
+     * (the previous step's solution): what an iterative backend would do in
+     * the loop, against a direct one's back-substitution. */
+    if (trial_solve(E, a, c->b, NULL, opts, &r1) || trial_solve(E, a, c->b, c->x0, opts, &r2)) {
         k->failed = 1;
         snprintf(k->why, sizeof k->why, "failed: %.80s", E->err);
     } else {
@@ -867,7 +873,7 @@ static void judge_class(silc_engine *E, tuner *T, t_class *c)
     }
     if (T->ntab < T_MAXCLS) {
         T->tab[T->ntab] = *c;
-        T->tab[T->ntab].a = T->tab[T->ntab].b = NULL;
+        T->tab[T->ntab].a = T->tab[T->ntab].b = T->tab[T->ntab].x0 = NULL;
         T->ntab++;
     }
 }
@@ -930,8 +936,8 @@ static int run_trials(silc_engine *E, tuner *T)
         if (c->next < c->ncand) done = 0;
         else if (c->a) {
             judge_class(E, T, c);
-            val_release(c->a), val_release(c->b);
-            c->a = c->b = NULL;
+            val_release(c->a), val_release(c->b), val_release(c->x0);
+            c->a = c->b = c->x0 = NULL;
         }
     }
     memcpy(E->err, err, sizeof err);
@@ -1111,6 +1117,7 @@ static void step_done(silc_engine *E, tuner *T, double secs)
             *c = T->cur[i];
             c->a = val_retain(c->a);
             c->b = val_retain(c->b);
+            c->x0 = c->x0 ? val_retain(c->x0) : NULL;
             c->reuse = prev && prev->a_id == c->a_id;
             if (prev && prev->own_max > c->own_max) c->own_max = prev->own_max;
             plan_class(E, c);
