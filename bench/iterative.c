@@ -175,7 +175,8 @@ static void run(silc_context *c, const silc_envelope_t *A, row *r)
     snprintf(cmd, sizeof cmd, "x = solve(A, b, \"%s\")", r->config);
     for (int rep = 0; rep < 2; rep++) {
         double t;
-        if (silc_put(c, "A", A) || silc_exec(c, "b = A * ones(rows(A), 1)")) {
+        /* cleared first: a PUT of what A holds would keep it, preconditioner and all */
+        if (silc_exec(c, "clear A") || silc_put(c, "A", A) || silc_exec(c, "b = A * ones(rows(A), 1)")) {
             snprintf(r->why, sizeof r->why, "%s", silc_context_errmsg(c));
             return;
         }
