@@ -21,14 +21,7 @@ SCENES=(examples/cloth/scenes/hanging.scene examples/cloth/scenes/large.scene)
 echo "cloth bench, $(date +%F), $(getconf _NPROCESSORS_ONLN) cores: bench/cloth.sh $BUILD $STEPS $ROUNDS"
 echo
 "$BENCH" "${SCENES[@]}" --steps "$STEPS" --rounds "$ROUNDS" --label embedded || exit 1
-DIR=$(mktemp -d /tmp/silc-cloth-bench.XXXXXX)
-"$SILCD" --listen "unix:$DIR/s.sock" --ready-file "$DIR/ready" --log-level error 2>"$DIR/silcd.log" &
-PID=$!
-for _ in $(seq 100); do [ -f "$DIR/ready" ] && break; sleep 0.1; done
+. tools/silcd_run.sh
+silcd_start "$SILCD"
 echo
-SILC_SERVER="unix:$DIR/s.sock" "$BENCH" "${SCENES[@]}" --steps "$STEPS" --rounds "$ROUNDS" --label silcd
-rc=$?
-kill -TERM "$PID" 2>/dev/null
-wait "$PID" 2>/dev/null
-rm -rf "$DIR"
-exit $rc
+SILC_SERVER="$SILCD_URL" "$BENCH" "${SCENES[@]}" --steps "$STEPS" --rounds "$ROUNDS" --label silcd

@@ -20,14 +20,7 @@ for f in "$SILCD" "$BUILD/bindings/java/silc.jar" "$BUILD/examples/mps/mps.jar";
 done
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 unset SILC_SERVER SILC_CONFIG
-DIR=$(mktemp -d /tmp/silc-mps-bench.XXXXXX) || exit 1
-PID=
-cleanup() {
-  [ -n "$PID" ] && kill "$PID" 2>/dev/null && wait "$PID" 2>/dev/null
-  rm -rf "$DIR"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
+. tools/silcd_run.sh
 
 # field NAME LINE: the value of NAME=... in a summary line.
 field() { sed -n "s/.*[ ]$1=\([^ ]*\).*/\1/p" <<<"$2"; }
@@ -37,11 +30,7 @@ echo "MPS dam-break bench, $(date +%F), $(getconf _NPROCESSORS_ONLN) cores," \
 rc=0
 for conf in examples/mps/configs/*.conf; do
   name=$(basename "$conf" .conf)
-  rm -f "$DIR/ready"
-  "$SILCD" --listen "unix:$DIR/s.sock" --ready-file "$DIR/ready" --config "$conf" \
-    --log-level error 2>"$DIR/silcd.log" &
-  PID=$!
-  for _ in $(seq 100); do [ -f "$DIR/ready" ] && break; sleep 0.1; done
+  silcd_start "$SILCD" --config "$conf"
   echo
   echo "config \`$conf\`:"
   echo
@@ -49,7 +38,7 @@ for conf in examples/mps/configs/*.conf; do
   echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
   for scene in default large; do
     if [ $scene = large ]; then args=(--large --steps "$LARGE_STEPS"); else args=(--steps "$STEPS"); fi
-    if ! out=$(java -cp "$CP" mps.DamBreak --server "unix:$DIR/s.sock" "${args[@]}" 2>&1); then
+    if ! out=$(java -cp "$CP" mps.DamBreak --server "$SILCD_URL" "${args[@]}" 2>&1); then
       echo "| $scene | failed: $(tail -1 <<<"$out") |"
       rc=1
       continue
@@ -63,8 +52,6 @@ for conf in examples/mps/configs/*.conf; do
       "| $(field transfer_ms "$s") | $(field solve_ms "$s") | $(field solve_share "$s")" \
       "| $(field pressure_share "$s") | $solver |"
   done
-  kill "$PID" 2>/dev/null
-  wait "$PID" 2>/dev/null
-  PID=
+  silcd_stop
 done
 exit $rc

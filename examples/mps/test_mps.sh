@@ -17,31 +17,13 @@ SILCD=$1 CP=$2 SRC=$3 RUNS=$4 MODE=$5
 DATA=$SRC/data/martin_moyce_1952_n2.dat
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 unset SILC_SERVER SILC_CONFIG
-DIR=$(mktemp -d /tmp/silc-mps-test.XXXXXX) || exit 1
-PID=
-cleanup() {
-  [ -n "$PID" ] && kill "$PID" 2>/dev/null && wait "$PID" 2>/dev/null
-  rm -rf "$DIR"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-
-# start_silcd [silcd options...]: a server on $DIR/s.sock, ready or exit 1.
-start_silcd() {
-  "$SILCD" --listen "unix:$DIR/s.sock" --ready-file "$DIR/ready" --log-level error "$@" 2>"$DIR/silcd.log" &
-  PID=$!
-  for _ in $(seq 100); do
-    [ -f "$DIR/ready" ] && return 0
-    kill -0 "$PID" 2>/dev/null || break
-    sleep 0.1
-  done
-  echo "test_mps: silcd did not start:"; cat "$DIR/silcd.log"; exit 1
-}
+. "$(dirname "$0")/../../tools/silcd_run.sh"
+DIR=$SILCD_DIR
 
 case $MODE in
 model)
-  start_silcd
-  java -cp "$CP" mps.ModelTest "unix:$DIR/s.sock"
+  silcd_start "$SILCD"
+  java -cp "$CP" mps.ModelTest "$SILCD_URL"
   ;;
 dambreak)
   CONFIG=$6 PLUGIN=$7
@@ -55,8 +37,8 @@ dambreak)
     petsc-amg) WANT=petsc ;;
     *) echo "test_mps: unknown config $CONFIG"; exit 2 ;;
   esac
-  start_silcd --config "$SRC/configs/$CONFIG.conf"
-  java -cp "$CP" mps.DamBreak --server "unix:$DIR/s.sock" --time 2.8 --csv "$DIR/$CONFIG.csv" \
+  silcd_start "$SILCD" --config "$SRC/configs/$CONFIG.conf"
+  java -cp "$CP" mps.DamBreak --server "$SILCD_URL" --time 2.8 --csv "$DIR/$CONFIG.csv" \
     >"$DIR/out" 2>"$DIR/err"
   rc=$?
   cat "$DIR/out" "$DIR/err"
