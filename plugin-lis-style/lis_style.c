@@ -449,7 +449,10 @@ static int solve_run(silc_call *call)
     }
     rep->iterations = max_iter;
     rep->resid = max_resid;
-    if (guesses && H->abi_minor >= 6) rep->initial_guess = 1;
+    if (H->abi_minor >= 6) {
+        rep->initial_guess = guesses > 0;
+        rep->tol = opt.tol; /* the host verifies the result against it */
+    }
     rep->reused_factor = reused;
     rep->factor_seconds = pc && !reused ? pc->seconds : 0;
     rep->solve_seconds = H->now() - t0 - rep->factor_seconds;

@@ -800,6 +800,7 @@ static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double
         if (rel > worst) worst = rel;
     }
     KSPGetTolerances(S->ksp, &rtol, &atol, &dtol, &maxit);
+    if (!S->direct && host->abi_minor >= 6) r->tol = (double)rtol; /* the host verifies against it */
     r->iterations = max_its;
     r->resid = worst;
     len = snprintf(r->note, sizeof r->note, "KSP_%s; rtol %g, atol %g, dtol %g, max_it %lld",

@@ -163,6 +163,9 @@ typedef struct silc_report {
     double backward_error_unrefined; /* host: backward error before refinement, -1 = none ran */
     /* ABI 1.6 */
     int initial_guess;      /* plugin: 1 when it started from the initial guess in[2] */
+    double tol;             /* plugin: an iterative method's stopping tolerance on the relative
+                               residual (the host verifies the result against it), 0 if none */
+    char attempts[512];     /* host: the backends of the list that failed before this one */
 } silc_report;
 
 typedef struct silc_call {

@@ -225,6 +225,24 @@ static void warn_if_unsolved(silc_engine *E, const char *backend, double be)
                  backend, be);
 }
 
+double acc_verify_limit(silc_engine *E, const silc_report *r)
+{
+    const char *v = cfg_get(E, "solve.verify");
+    double direct = 1e-6, iter;
+    char *end;
+    if (v && !strcmp(v, "off")) return INFINITY;
+    if (v && strcmp(v, "auto")) {
+        double x = strtod(v, &end);
+        if (end != v && !*end && x > 0) direct = x;
+    }
+    if (r->iterations <= 0) return direct;
+    /* The backward error is at most ||r|| / ||b|| (infinity norms), which an
+     * iterative method bounded in its own norm: the factor absorbs the norms'
+     * difference, not a missed tolerance. */
+    iter = r->tol > 0 ? ACC_VERIFY_FACTOR * r->tol : 1e-3;
+    return iter > direct ? iter : direct;
+}
+
 void acc_report(silc_engine *E, silc_call *call, int may_defer)
 {
     silc_report *r = call->report;

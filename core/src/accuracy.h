@@ -54,6 +54,15 @@ double acc_backward_error(const silc_value *A, const silc_value *B, const silc_v
  * "on_request".  Warns when the result does not solve the system. */
 void acc_report(silc_engine *E, silc_call *call, int may_defer);
 
+/* The largest backward error a solve's result may have and still count as
+ * a solution (solve.verify): `auto` (default) 1e-6 for a direct solve, and
+ * for an iterative one ACC_VERIFY_FACTOR x the tolerance it reported (1e-3
+ * when it reported none); a number sets the direct bound and the least
+ * iterative one; `off` gives INFINITY.  A result above it fails the solve
+ * over to the next backend of the list (dispatch.c). */
+#define ACC_VERIFY_FACTOR 10.0
+double acc_verify_limit(silc_engine *E, const silc_report *r);
+
 /* Holds references to the solve's operands and result. */
 void acc_pending_hold(acc_pending *p, const silc_call *call);
 void acc_pending_release(acc_pending *p);

@@ -40,7 +40,8 @@ struct cfg_db {
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
 static const char *const core_keys[] = {"plugin_path", "threads"};
-static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess"};
+static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess",
+                                         "verify"};
 
 /* Longest list a dispatch key may name; more would only repeat names. */
 #define CFG_MAX_LIST 32
@@ -389,8 +390,13 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
             if (strcmp(value, "auto") != 0 && strcmp(value, "previous") != 0 && strcmp(value, "zero") != 0)
                 return eng_error(E, "solve.initial_guess expects 'auto', 'previous' or 'zero', got '%s'",
                                  value);
+        } else if (strcmp(name, "verify") == 0) {
+            if (strcmp(value, "auto") != 0 && strcmp(value, "off") != 0 &&
+                (parse_double(value, &acc) || acc <= 0 || acc >= 1))
+                return eng_error(E, "solve.verify expects 'auto', 'off' or a backward error between 0 and 1, "
+                                    "got '%s'", value);
         } else {
-            return unknown_key(E, section, name, solve_keys, 4);
+            return unknown_key(E, section, name, solve_keys, 5);
         }
         return keep_value(E, norm, section, name, value);
     }

@@ -83,6 +83,7 @@ typedef struct blist {
     const char *names[DISP_MAX_LIST];
     int n;
     int forced;             /* per-call backend = X: no fallback */
+    int nlisted;            /* names the configuration or default listed (then "reference") */
     char source[192];
 } blist;
 
@@ -209,6 +210,7 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
     memset(L, 0, sizeof *L);
     if (forced) {
         split_list(L, forced);
+        L->nlisted = L->n;
         L->forced = 1;
         snprintf(L->source, sizeof L->source, "per-call option backend = %s", forced);
         return;
@@ -228,6 +230,7 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
                  distributed ? ", distributed operands" : "");
     }
     split_list(L, text);
+    L->nlisted = L->n;
     for (c = 0; c < L->n; c++)
         if (strcmp(L->names[c], "reference") == 0) return;
     L->names[L->n++] = "reference";
@@ -312,19 +315,49 @@ static int run_one(silc_call *call, const ld_backend *b)
     return rc;
 }
 
+/* The listed backends after index i that might still take the call: a
+ * failure hands the call on only to those (the reference plugin that
+ * resolve_list appends to every list is a last resort for operations no
+ * listed backend provides, not a fallback for one that failed; a per-call
+ * `backend = X` of one name has nothing to fall back to). */
+static int fallback_left(const blist *L, int i)
+{
+    return i + 1 < L->nlisted;
+}
+
+/* A backend's failure, or a result that failed verification, recorded as
+ * one line of the chain's account; E->err holds the message. */
+static void note_attempt(silc_engine *E, strbuf *attempts, double seconds)
+{
+    sb_printf(attempts, "%s%s (%.3g s)", attempts->len ? "\n  " : "", E->err, seconds);
+}
+
+/* The error of a chain whose every listed backend failed: each attempt's
+ * reason on a line of its own, the last one included. */
+static void chain_error(silc_engine *E, strbuf *attempts)
+{
+    char last[sizeof E->err];
+    if (!attempts->len) return;
+    snprintf(last, sizeof last, "%s", E->err);
+    eng_error(E, "every backend of the list failed:\n  %s\n  %s", sb_str(attempts), last);
+}
+
 static int walk(silc_engine *E, silc_call *call, const char *const *chain, int nchain,
                 const blist *L, int may_defer)
 {
-    strbuf skipped;
+    strbuf skipped, attempts;
     dist_swap swap;
     int ci, i, rc, cholesky_failed = 0;
     sb_init(&skipped);
+    sb_init(&attempts);
     for (ci = 0; ci < nchain; ci++) {
         int next_class = 0;
         for (i = 0; i < L->n && !next_class; i++) {
             const ld_backend *b = ld_find(E, L->names[i]);
             const char *why = NULL;
             host_call_ctx ctx;
+            size_t warned = E->warnings.len;
+            double t0;
             if (ci > 0 && i == 0) sb_printf(&skipped, "[%s] ", chain[ci]);
             if (!b) {
                 sb_printf(&skipped, "%s not installed; ", L->names[i]);
@@ -344,6 +377,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             if (dist_walk_begin(E, call, b, &swap) < 0) {
                 call->host_private = NULL;
                 sb_free(&skipped);
+                sb_free(&attempts);
                 return SILC_ENOMEM;
             }
             ctx.collective = swap.mode == DIST_COLLECTIVE;
@@ -352,6 +386,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 dist_walk_end(call, &swap);
                 continue;
             }
+            t0 = util_now();
             {
                 /* An initial guess (in[2]) goes only to plugins that know of it (ABI 1.6). */
                 int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&
@@ -375,6 +410,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 }
             }
             if (rc == SILC_OK) {
+                double limit;
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report (not
                  * of a distributed solve: refine.c reads whole arrays). */
@@ -390,12 +426,40 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, may_defer);
                 dist_walk_end(call, &swap);
                 call->host_private = NULL;
-                sb_free(&skipped);
                 if (rc) {
                     val_release(call->out);
                     call->out = NULL;
+                    sb_free(&skipped);
+                    sb_free(&attempts);
                     return SILC_ENOMEM;
                 }
+                /* Verification: a result whose backward error says it does
+                 * not solve the system is a failure like any other (a
+                 * deferred one was verified with its factorization). */
+                limit = call->op == SILC_OP_SOLVE ? acc_verify_limit(E, call->report) : INFINITY;
+                if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
+                    !(call->report->backward_error <= limit)) {
+                    eng_error(E, "%s: verification failed: backward error %.2g above %.2g (solve.verify)%s%s",
+                              b->full_name, call->report->backward_error, limit,
+                              call->report->iterations > 0 ? "; " : "",
+                              call->report->iterations > 0 ? call->report->method : "");
+                    val_release(call->out);
+                    call->out = NULL;
+                    E->warnings.len = warned; /* the warnings were the discarded result's */
+                    if (E->warnings.s) E->warnings.s[warned] = 0;
+                    if (fallback_left(L, i)) {
+                        note_attempt(E, &attempts, util_now() - t0);
+                        continue;
+                    }
+                    chain_error(E, &attempts);
+                    sb_free(&skipped);
+                    sb_free(&attempts);
+                    return SILC_ENOTCONV;
+                }
+                if (call->op == SILC_OP_SOLVE)
+                    snprintf(call->report->attempts, sizeof call->report->attempts, "%s", sb_str(&attempts));
+                sb_free(&skipped);
+                sb_free(&attempts);
                 return 0;
             }
             dist_walk_end(call, &swap);
@@ -419,7 +483,17 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 else
                     eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
                 call->host_private = NULL;
+                E->warnings.len = warned;
+                if (E->warnings.s) E->warnings.s[warned] = 0;
+                /* The next listed backend takes over (out of memory is
+                 * not the backend's fault: it stops the chain). */
+                if (rc != SILC_ENOMEM && fallback_left(L, i)) {
+                    note_attempt(E, &attempts, util_now() - t0);
+                    continue;
+                }
+                chain_error(E, &attempts);
                 sb_free(&skipped);
+                sb_free(&attempts);
                 return rc;
             }
         }
@@ -429,7 +503,9 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
     /* Drop the trailing "; " of the last reason. */
     if (skipped.len >= 2) skipped.s[skipped.len -= 2] = '\0';
     eng_error(E, "no backend can run %s (%s): %s", op_names[call->op], chain[0], sb_str(&skipped));
+    chain_error(E, &attempts);
     sb_free(&skipped);
+    sb_free(&attempts);
     return SILC_EUNSUP;
 }
 
@@ -568,6 +644,15 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     else if (n > 1)
         sb_printf(b, "  (if Cholesky finds A not positive definite, the list is tried again "
                      "under %s)\n", chain[1]);
+    if (chosen && fallback_left(&L, i - 1) && call->op == SILC_OP_SOLVE) {
+        const char *v = cfg_get(E, "solve.verify");
+        if (v && !strcmp(v, "off"))
+            sb_puts(b, "  (if it fails, the next listed backend takes over; solve.verify = off)\n");
+        else
+            sb_printf(b, "  (if it fails, or its result's backward error is above %s (solve.verify), the next "
+                         "listed backend takes over)\n",
+                      v && strcmp(v, "auto") ? v : "1e-6, or 10x an iterative method's tolerance");
+    }
     if (call->options) cfg_clear_call_options(E);
     return 0;
 }

@@ -1076,6 +1076,7 @@ static int exec_info(lang_ev *V, const ast_node *s)
             sb_printf(&b, "  iterations: %lld\n", (long long)r->iterations);
             if (r->initial_guess)
                 sb_printf(&b, "  initial guess: the previous value of %s (warm start)\n", s->name);
+            if (r->attempts[0]) sb_printf(&b, "  earlier attempts (failed, the next listed backend took over):\n    %s\n", r->attempts);
             if (r->iterations > 0) {
                 util_fmt_double(num, sizeof num, r->resid);
                 sb_printf(&b, "  final relative residual: %s\n", num);

@@ -1,0 +1,158 @@
+/*
+ * test_fallback.c -- a configured backend list is a verified fallback chain
+ * (issue 21), on real matrices from ../shared/matrices:
+ *
+ *   - west0067 has a zero diagonal entry: PETSc GMRES + ILU fails in
+ *     KSPSetUp, and UMFPACK, listed next, solves it (backward error
+ *     <= 1e-14); `info` lists the failed attempt;
+ *   - bcsstk13 is SPD: PETSc GMRES + ILU reports convergence, but its result
+ *     has a backward error above 10 x its tolerance, so verification fails
+ *     and CHOLMOD, listed next, solves it; under solve.verify = off the
+ *     unverified result stays, as before the chain;
+ *   - a singular matrix fails on every listed backend: the error has one
+ *     line per attempt and x keeps its old value;
+ *   - a per-call `backend = X` has nothing to fall back to: its failed
+ *     verification is the error.
+ *
+ * Skips (with a message) what needs a plugin this build does not have.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "testlib.h"
+
+static silc_context *open_ctx(void)
+{
+    silc_context *c = NULL;
+    if (silc_open(&c, NULL)) {
+        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
+        silc_close(&c);
+        return NULL;
+    }
+    silc_set_output(c, tl_out_fn, NULL);
+    return c;
+}
+
+/* 1 when every named backend is installed in c. */
+static int have(silc_context *c, const char *names)
+{
+    char stmt[256];
+    snprintf(stmt, sizeof stmt, "x0 = solve(1, 1, \"backend = %s\")", names);
+    return silc_exec(c, stmt) == 0 || !tl_contains(silc_context_errmsg(c), "not installed");
+}
+
+/* Puts the shared matrix file as A with b = A * ones; its row count or -1. */
+static int64_t put_system(silc_context *c, const char *file)
+{
+    char err[512];
+    int64_t m = -1;
+    if (tl_put_shared(c, "A", file, &m, NULL, err, sizeof err)) {
+        CHECK(0, "%s: %s", file, err);
+        return -1;
+    }
+    CHECK(silc_exec(c, "b = A * ones(rows(A), 1)") == 0, "b: %s", silc_context_errmsg(c));
+    return m;
+}
+
+/* x = A \ b under the session's list ran on `want` after `failed` failed. */
+static void check_fell_back(silc_context *c, const char *file, const char *failed, const char *why,
+                            const char *want)
+{
+    const char *in;
+    double be;
+    CHECK(silc_exec(c, "x = A \\ b") == 0, "%s: the chain did not solve it: %s", file, silc_context_errmsg(c));
+    in = tl_out_info(c, "x");
+    be = tl_out_number(in, "backward error: ");
+    CHECK(strstr(in, want) != NULL, "%s: solved by %s:\n%s", file, want, in);
+    CHECK(be >= 0 && be <= 1e-14, "%s: backward error %g", file, be);
+    CHECK(strstr(in, "earlier attempts") && strstr(in, failed) && strstr(in, why),
+          "%s: info lists the failed %s (%s):\n%s", file, failed, why, in);
+    printf("  %s: %s failed (%s), %s solved it, backward error %.2g\n", file, failed, why, want, be);
+}
+
+static void test_library_failure(silc_context *c)
+{
+    if (put_system(c, "west0067.mtx") < 0) return;
+    CHECK(silc_exec(c, "set dispatch.solve.sparse = petsc, suitesparse.umfpack; "
+                       "set petsc.options = -ksp_type gmres -pc_type ilu") == 0,
+          "set: %s", silc_context_errmsg(c));
+    CHECK(strstr(tl_out_exec(c, "explain x = A \\ b"), "the next listed backend takes over"),
+          "explain shows the chain:\n%s", tl_out());
+    check_fell_back(c, "west0067", "petsc: KSPSetUp", "missing diagonal entry", "backend: suitesparse.umfpack");
+}
+
+static void test_failed_verification(silc_context *c)
+{
+    const char *in;
+    int rc;
+    if (put_system(c, "bcsstk13.mtx") < 0) return;
+    CHECK(silc_exec(c, "set dispatch.solve.sparse.spd = petsc, suitesparse.cholmod; "
+                       "set petsc.options = -ksp_type gmres -pc_type ilu") == 0,
+          "set: %s", silc_context_errmsg(c));
+    check_fell_back(c, "bcsstk13", "petsc: verification failed: backward error", "above 0.0001 (solve.verify)",
+                    "backend: suitesparse.cholmod");
+    /* solve.verify = off: PETSc's unverified result is kept, as before. */
+    CHECK(silc_exec(c, "set solve.verify = off; y = A \\ b") == 0, "verify off: %s", silc_context_errmsg(c));
+    in = tl_out_info(c, "y");
+    CHECK(strstr(in, "backend: petsc") && !strstr(in, "earlier attempts") &&
+              tl_out_number(in, "backward error: ") > 1e-4,
+          "solve.verify = off keeps PETSc's result:\n%s", in);
+    /* A single per-call backend has nothing to fall back to. */
+    rc = silc_exec(c, "set solve.verify = auto; z = solve(A, b, \"backend = petsc\")");
+    CHECK(rc != 0 &&
+              tl_contains(silc_context_errmsg(c), "petsc: verification failed: backward error") &&
+              !tl_contains(silc_context_errmsg(c), "every backend"),
+          "a forced backend's failed verification is the error: %s", silc_context_errmsg(c));
+    /* A bound of its own: 1e-20 is more than any double solve can show.  A
+     * back-substitution with the factorization x's solve left is verified
+     * when its backward error is computed at once (solve.backward_error =
+     * always); deferred, the factorization's first solve vouches for it. */
+    rc = silc_exec(c, "set solve.verify = 1e-20; set solve.backward_error = always; "
+                      "w = solve(A, b, \"backend = suitesparse.cholmod\")");
+    CHECK(rc != 0 && tl_contains(silc_context_errmsg(c), "suitesparse.cholmod: verification failed") &&
+              tl_contains(silc_context_errmsg(c), "above 1e-20"),
+          "solve.verify = 1e-20 fails CHOLMOD: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(c, "set solve.verify = auto; set solve.backward_error = deferred") == 0, "back to auto: %s",
+          silc_context_errmsg(c));
+    CHECK(silc_exec(c, "set solve.verify = often") != 0 &&
+              tl_contains(silc_context_errmsg(c), "solve.verify expects 'auto', 'off' or a backward error"),
+          "a bad solve.verify: %s", silc_context_errmsg(c));
+}
+
+static void test_all_fail(silc_context *c)
+{
+    const char *e;
+    double *x;
+    /* Structurally singular: row 2 and column 2 empty but for a zero. */
+    CHECK(silc_exec(c, "Zs = sparse([1; 2; 3; 1; 3], [1; 2; 3; 3; 1], [4; 0; 4; 1; 1], 3, 3); "
+                       "bz = [1; 1; 1]; x = [7; 7; 7]; "
+                       "set dispatch.solve.sparse = suitesparse.umfpack, suitesparse.klu") == 0,
+          "setup: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(c, "x = Zs \\ bz") != 0, "a singular matrix is refused");
+    e = silc_context_errmsg(c);
+    CHECK(tl_contains(e, "every backend of the list failed:\n  suitesparse.umfpack: ") &&
+              tl_contains(e, "singular") && tl_contains(e, "\n  suitesparse.klu: "),
+          "one line per attempt: %s", e);
+    printf("  all fail: %s\n", e);
+    x = tl_get_dense_checked(c, "x", 3, 1);
+    CHECK(x && x[0] == 7 && x[1] == 7 && x[2] == 7, "x is unchanged after the chain failed");
+    free(x);
+}
+
+int main(void)
+{
+    silc_context *c = open_ctx();
+    if (!c) return check_done();
+    if (have(c, "petsc") && have(c, "suitesparse.umfpack")) {
+        test_library_failure(c);
+        test_failed_verification(c);
+    } else {
+        printf("test_fallback: petsc or suitesparse not built: the PETSc chains skipped\n");
+    }
+    if (have(c, "suitesparse.umfpack") && have(c, "suitesparse.klu")) test_all_fail(c);
+    silc_close(&c);
+    return check_done();
+}
