@@ -12,7 +12,9 @@
  *   - a singular matrix fails on every listed backend: the error has one
  *     line per attempt and x keeps its old value;
  *   - a per-call `backend = X` has nothing to fall back to: its failed
- *     verification is the error.
+ *     verification is the error;
+ *   - a direct result that misses the bound is refined first (bayer10 with
+ *     KLU), unless solve.refine = 0.
  *
  * Skips (with a message) what needs a plugin this build does not have.
  */
@@ -142,6 +144,28 @@ static void test_all_fail(silc_context *c)
     free(x);
 }
 
+/* A direct result that misses the bound gets refinement from its own
+ * factorization before the next backend is tried: KLU leaves bayer10 at a
+ * backward error of 8e-13, one step brings it to 1e-16.  solve.refine = 0
+ * says no refinement, so the miss is final. */
+static void test_refinement_first(silc_context *c)
+{
+    const char *in;
+    int rc;
+    if (put_system(c, "bayer10.mtx") < 0) return;
+    rc = silc_exec(c, "set solve.verify = 1e-13; x = solve(A, b, \"backend = suitesparse.klu\")");
+    in = tl_out_info(c, "x");
+    CHECK(rc == 0 && strstr(in, "refinement: ") && tl_out_number(in, "backward error: ") <= 1e-14,
+          "bayer10: KLU refined into the bound:\n%s", in);
+    /* (x's factorization is reused: its backward error is computed at once) */
+    rc = silc_exec(c, "set solve.refine = 0; set solve.backward_error = always; "
+                      "y = solve(A, b, \"backend = suitesparse.klu\")");
+    CHECK(rc != 0 && tl_contains(silc_context_errmsg(c), "suitesparse.klu: verification failed"),
+          "bayer10: with solve.refine = 0 KLU's miss is final: %s", rc ? silc_context_errmsg(c) : "solved");
+    CHECK(silc_exec(c, "set solve.verify = auto; set solve.backward_error = deferred") == 0, "reset: %s",
+          silc_context_errmsg(c));
+}
+
 int main(void)
 {
     silc_context *c = open_ctx();
@@ -152,7 +176,10 @@ int main(void)
     } else {
         printf("test_fallback: petsc or suitesparse not built: the PETSc chains skipped\n");
     }
-    if (have(c, "suitesparse.umfpack") && have(c, "suitesparse.klu")) test_all_fail(c);
+    if (have(c, "suitesparse.umfpack") && have(c, "suitesparse.klu")) {
+        test_refinement_first(c);
+        test_all_fail(c);
+    }
     silc_close(&c);
     return check_done();
 }

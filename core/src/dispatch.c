@@ -414,7 +414,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report (not
                  * of a distributed solve: refine.c reads whole arrays). */
-                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine_solve(E, call, b);
+                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine_solve(E, call, b, 0);
                 if (call->op == SILC_OP_SOLVE && ctx.collective) {
                     int rk = dist_size(E);
                     call->report->backward_error_unrefined = -1; /* no refinement ran */
@@ -437,6 +437,26 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                  * not solve the system is a failure like any other (a
                  * deferred one was verified with its factorization). */
                 limit = call->op == SILC_OP_SOLVE ? acc_verify_limit(E, call->report) : INFINITY;
+                if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
+                    !(call->report->backward_error <= limit) && call->report->iterations == 0 &&
+                    call->report->refine_steps == 0 && !ctx.collective && !E->dist &&
+                    isfinite(call->report->backward_error)) {
+                    /* A direct result that missed: refinement first, by the
+                     * same factorization (one triangular solve a step),
+                     * before the next backend factors afresh. */
+                    E->warnings.len = warned;
+                    if (E->warnings.s) E->warnings.s[warned] = 0;
+                    call->host_private = &ctx;
+                    refine_solve(E, call, b, REFINE_RESCUE_STEPS);
+                    call->host_private = NULL;
+                    if (call->report->refine_steps > 0 && finish_solve(E, call, 0, 0)) {
+                        val_release(call->out);
+                        call->out = NULL;
+                        sb_free(&skipped);
+                        sb_free(&attempts);
+                        return SILC_ENOMEM;
+                    }
+                }
                 if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
                     !(call->report->backward_error <= limit)) {
                     eng_error(E, "%s: verification failed: backward error %.2g above %.2g (solve.verify)%s%s",

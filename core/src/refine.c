@@ -112,7 +112,7 @@ static void add_note(silc_report *r, const char *text)
     snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", text);
 }
 
-void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
+void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least)
 {
     silc_report *r = call->report;
     const silc_value *A = call->in[0], *Bv = call->in[1];
@@ -125,6 +125,7 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b)
     r->backward_error_unrefined = -1;
     r->refine_steps = 0;
     want = steps_wanted(E, r, &extended);
+    if (!cfg_get(E, "solve.refine") && want < at_least) want = at_least;
     if (want <= 0 || !call->out) return;
     if (A->m != A->n || n == 0 || k == 0) {
         if (A->m != A->n) add_note(r, "refinement skipped: least-squares solve");

@@ -29,11 +29,16 @@
  * right-hand side and gets val_has_nonfinite's scan. */
 int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const char *name);
 
+/* Steps a direct result that failed verification gets before the next
+ * backend of the list is tried (the fallback chain, dispatch.c), unless
+ * solve.refine is set: then its steps ran already. */
+#define REFINE_RESCUE_STEPS 3
 /* Refines call->out, a solution just computed by backend b, as the
- * configuration and call->report->single_factor ask; replaces call->out when
- * a step was kept and records steps, the backward error before and a note in
- * the report.  Never fails the solve: a correction that cannot be computed
- * ends the refinement with a note. */
-void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b);
+ * configuration and call->report->single_factor ask, and at least at_least
+ * steps when solve.refine is not set; replaces call->out when a step was
+ * kept and records steps, the backward error before and a note in the
+ * report.  Never fails the solve: a correction that cannot be computed ends
+ * the refinement with a note. */
+void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least);
 
 #endif
