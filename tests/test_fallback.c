@@ -4,7 +4,8 @@
  *
  *   - west0067 has a zero diagonal entry: PETSc GMRES + ILU fails in
  *     KSPSetUp, and UMFPACK, listed next, solves it (backward error
- *     <= 1e-14); `info` lists the failed attempt;
+ *     <= 1e-14); `info` lists the failed attempt, and the next solve with
+ *     the same A skips PETSc;
  *   - bcsstk13 is SPD: PETSc GMRES + ILU reports convergence, but its result
  *     has a backward error above 10 x its tolerance, so verification fails
  *     and CHOLMOD, listed next, solves it; under solve.verify = off the
@@ -84,6 +85,11 @@ static void test_library_failure(silc_context *c)
     CHECK(strstr(tl_out_exec(c, "explain x = A \\ b"), "the next listed backend takes over"),
           "explain shows the chain:\n%s", tl_out());
     check_fell_back(c, "west0067", "petsc: KSPSetUp", "missing diagonal entry", "backend: suitesparse.umfpack");
+    /* The next solve with the same A (a time loop) does not try PETSc again. */
+    CHECK(silc_exec(c, "x2 = A \\ (2 * b)") == 0, "second solve: %s", silc_context_errmsg(c));
+    CHECK(strstr(tl_out_info(c, "x2"), "petsc: skipped: it failed on this matrix before") &&
+              strstr(tl_out(), "backend: suitesparse.umfpack"),
+          "the failure is remembered with A:\n%s", tl_out());
 }
 
 static void test_failed_verification(silc_context *c)

@@ -332,6 +332,37 @@ static void note_attempt(silc_engine *E, strbuf *attempts, double seconds)
     sb_printf(attempts, "%s%s (%.3g s)", attempts->len ? "\n  " : "", E->err, seconds);
 }
 
+/* The backends that failed on a matrix, remembered with it (an attachment
+ * of A: it goes when A goes): a time loop that solves with the same A
+ * every step does not pay for the same failure every step.  A solve's
+ * failure can depend on its right-hand side (an iterative method's), but a
+ * backend that failed on A once is a poor first choice for it. */
+#define FAILED_KEY "dispatch.failed"
+
+/* Entries are "name\n", or "name?\n" for a result that failed
+ * verification, which counts only while solve.verify is on. */
+static int failed_before(silc_engine *E, const silc_value *A, const char *name)
+{
+    const char *list = val_attach_get(A, FAILED_KEY), *v = cfg_get(E, "solve.verify");
+    size_t len = strlen(name);
+    int verifying = !(v && !strcmp(v, "off"));
+    for (; list && *list; list += strcspn(list, "\n") + (list[strcspn(list, "\n")] != 0))
+        if (!strncmp(list, name, len) &&
+            (list[len] == '\n' || !list[len] || (verifying && list[len] == '?')))
+            return 1;
+    return 0;
+}
+
+static void remember_failure(const silc_value *A, const char *name, int verification)
+{
+    const char *old = val_attach_get(A, FAILED_KEY);
+    size_t ol = old ? strlen(old) : 0, size = ol + strlen(name) + 3;
+    char *list = malloc(size);
+    if (!list) return; /* only a memory of the failure is lost */
+    snprintf(list, size, "%s%s%s\n", old ? old : "", name, verification ? "?" : "");
+    if (val_attach_set(A, FAILED_KEY, list, free)) free(list);
+}
+
 /* The error of a chain whose every listed backend failed: each attempt's
  * reason on a line of its own, the last one included. */
 static void chain_error(silc_engine *E, strbuf *attempts)
@@ -365,6 +396,11 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             }
             if (!provides(b, call->op)) {
                 sb_printf(&skipped, "%s does not provide %s; ", b->full_name, op_names[call->op]);
+                continue;
+            }
+            if (call->op == SILC_OP_SOLVE && fallback_left(L, i) && failed_before(E, call->in[0], b->full_name)) {
+                sb_printf(&attempts, "%s%s: skipped: it failed on this matrix before", attempts.len ? "\n  " : "",
+                          b->full_name);
                 continue;
             }
             memset(&ctx, 0, sizeof ctx);
@@ -469,6 +505,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                     if (E->warnings.s) E->warnings.s[warned] = 0;
                     if (fallback_left(L, i)) {
                         note_attempt(E, &attempts, util_now() - t0);
+                        if (!E->dist) remember_failure(call->in[0], b->full_name, 1);
                         continue;
                     }
                     chain_error(E, &attempts);
@@ -509,6 +546,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                  * not the backend's fault: it stops the chain). */
                 if (rc != SILC_ENOMEM && fallback_left(L, i)) {
                     note_attempt(E, &attempts, util_now() - t0);
+                    if (!E->dist) remember_failure(call->in[0], b->full_name, 0);
                     continue;
                 }
                 chain_error(E, &attempts);
