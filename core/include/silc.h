@@ -40,7 +40,7 @@
 extern "C" {
 #endif
 
-#define SILC_VERSION "0.1.0"
+#define SILC_VERSION "1.0.0" /* CMakeLists.txt checks it is the project version */
 
 /* Limits of one EXEC text, so that no text can exhaust the stack of the
  * recursive parser and evaluator (they hold in a server as embedded):

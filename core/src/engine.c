@@ -23,6 +23,7 @@
 #ifndef SILC_PLUGIN_INSTALL_DIR
 #define SILC_PLUGIN_INSTALL_DIR "/usr/local/lib/silc"
 #endif
+#include <limits.h>
 
 /* Seed of rand(): fixed so that scripts are reproducible run to run. */
 #define ENG_RAND_SEED 0x9E3779B97F4A7C15ull
@@ -57,9 +58,15 @@ static int eng_setup(silc_engine *E, const char *config_path)
     if (store_init(&E->store)) return eng_error(E, "out of memory creating the store");
     if (cfg_create(E)) return -1;
     if (ld_create(E)) return -1;
-    /* The built-in directories may legitimately be absent (not installed, or
-     * run from elsewhere); a directory the user named must work. */
-    ld_load_path(E, SILC_PLUGIN_BUILD_DIR ":" SILC_PLUGIN_INSTALL_DIR);
+    /* An installed engine loads the plugins of its own install, wherever
+     * `cmake --install --prefix` put it; a build tree's engine those of the
+     * build tree, then of the configured install directory.  These may
+     * legitimately be absent; a directory the user named must work. */
+    {
+        char here[PATH_MAX];
+        if (ld_installed_plugin_dir(here, sizeof here) == 0) ld_load_path(E, here);
+        else ld_load_path(E, SILC_PLUGIN_BUILD_DIR ":" SILC_PLUGIN_INSTALL_DIR);
+    }
     E->err[0] = '\0';
     path = getenv("SILC_PLUGIN_PATH");
     if (path && *path && ld_load_path(E, path)) return -1;

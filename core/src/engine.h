@@ -154,6 +154,10 @@ int ld_load_file(silc_engine *E, const char *path);
 /* Loads every libsilc_plugin_*.so in the directories of a ':'-separated list;
  * refusals are logged as warnings, not errors. */
 int ld_load_path(silc_engine *E, const char *dirs);
+/* The plugin directory of the install this engine runs from (beside
+ * libsilc.so, or beside the bindir of a program that links the engine), if
+ * there is one: 0 and the path in out, else -1 (a build tree). */
+int ld_installed_plugin_dir(char *out, size_t len);
 const ld_backend *ld_find(const silc_engine *E, const char *full_name);
 size_t ld_backend_names(const silc_engine *E, const char ***names); /* malloc'd array */
 const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name);

@@ -17,7 +17,7 @@
  * runtime under MUMPS, OpenMP) keep process-wide state and are not safe to
  * unload or to shut down while another context still uses them.
  */
-#define _XOPEN_SOURCE 700 /* realpath */
+#define _GNU_SOURCE /* realpath, dladdr */
 #include "engine.h"
 
 #include <dirent.h>
@@ -407,6 +407,40 @@ static int load_dir(silc_engine *E, const char *dir)
     free(names);
     E->err[0] = '\0';
     return 0;
+}
+
+#ifndef SILC_PLUGIN_LIBDIR_REL
+#define SILC_PLUGIN_LIBDIR_REL "silc/plugins"
+#endif
+#ifndef SILC_INSTALL_LIBDIR
+#define SILC_INSTALL_LIBDIR "lib"
+#endif
+
+/* An object of the engine's own image, for dladdr to find the file. */
+static const char engine_marker = 0;
+
+int ld_installed_plugin_dir(char *out, size_t len)
+{
+    /* Where this engine's code lives -- libsilc.so in an install's libdir,
+     * or a program linking the engine statically in its bindir -- tells
+     * where the install put the plugins, whatever prefix it was given. */
+    static const char *const beside[] = {"/" SILC_PLUGIN_LIBDIR_REL, "/../" SILC_INSTALL_LIBDIR "/" SILC_PLUGIN_LIBDIR_REL};
+    Dl_info info;
+    char dir[PATH_MAX];
+    struct stat st;
+    size_t i;
+    char *slash;
+    if (!dladdr(&engine_marker, &info) || !info.dli_fname ||
+        !realpath(info.dli_fname, dir))
+        return -1;
+    slash = strrchr(dir, '/');
+    if (!slash) return -1;
+    *slash = '\0';
+    for (i = 0; i < sizeof beside / sizeof beside[0]; i++) {
+        if ((size_t)snprintf(out, len, "%s%s", dir, beside[i]) >= len) continue;
+        if (stat(out, &st) == 0 && S_ISDIR(st.st_mode)) return 0;
+    }
+    return -1;
 }
 
 int ld_load_path(silc_engine *E, const char *dirs)
