@@ -160,5 +160,18 @@ check "--help text" has out "usage: silc"
 run "$SILC" --version
 check "--version" grep -q '^silc [0-9]' out
 
+# Completion (what Tab completes in the REPL): bound names, statements and
+# built-ins, the REPL's own commands; help and help NAME.
+run "$SILC" -e 'alpha = 1; alps = [1; 2]; beta = 3' --complete al
+check "--complete: bound names" [ "$(cat out)" = "$(printf 'alpha\nalps')" ]
+run "$SILC" -e 'x = 1' --complete spa
+check "--complete: built-ins" [ "$(cat out)" = "sparse" ]
+run "$SILC" --complete e
+check "--complete: keywords, built-ins and commands" [ "$(tr '\n' ' ' <out)" = "else explain eye exp eps exit " ]
+run "$SILC" -e 'help solve'
+check "help solve" has out 'solve(A, b, "options")'
+run "$SILC" -e 'help sparce'
+check "help of an unknown word" has err "no statement or built-in 'sparce' (did you mean 'sparse'?)"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -48,6 +48,8 @@ static const char usage_text[] =
     "  --config FILE        configuration file (default: $SILC_CONFIG, else ./silc.conf)\n"
     "  -h, --help           show this text\n"
     "  --version            show the version\n"
+    "  --complete WORD      after running, print the names, statements and built-ins\n"
+    "                       that start with WORD, one a line (what Tab completes)\n"
     "In the interactive session a line that ends inside an unclosed ( [ or { continues\n"
     "on the next line; 'quit', 'exit' or end of input leaves.  Warnings go to standard\n"
     "error as \"warning: ...\"; who, info and explain print to standard output.\n";
@@ -61,6 +63,7 @@ typedef struct {
     const char **get_names;
     int nget;
     char *tune_text;        /* statement built from `tune ...` arguments */
+    const char *complete;   /* --complete WORD */
 } cli_options;
 
 static void fail(const char *fmt, ...)
@@ -136,6 +139,9 @@ static int parse_args(int argc, char **argv, cli_options *o)
         } else if (take_option(argc, argv, &i, "--get", &v)) {
             if (!v || !*v) return fail("--get needs a name"), 2;
             o->get_names[o->nget++] = v;
+        } else if (take_option(argc, argv, &i, "--complete", &v)) {
+            if (!v) return fail("--complete needs a word (it may be empty)"), 2;
+            o->complete = v;
         } else if (take_option(argc, argv, &i, "-e", &v)) {
             if (!v) return fail("-e needs statements"), 2;
             if (o->statements || o->script) return fail("give only one of 'run FILE' and -e"), 2;
@@ -246,6 +252,108 @@ static int print_gets(silc_context *ctx, const cli_options *o)
     return 0;
 }
 
+/* ---- completion ----------------------------------------------------------- */
+
+/* Output of one statement, collected (for completion's `help` and `who`). */
+typedef struct {
+    char *s;
+    size_t len;
+} collected;
+
+static void collect(void *user, const char *text)
+{
+    collected *c = user;
+    size_t add = strlen(text);
+    char *grown = realloc(c->s, c->len + add + 1);
+    if (!grown) return;
+    memcpy(grown + c->len, text, add + 1);
+    c->s = grown;
+    c->len += add;
+}
+
+static char *output_of(silc_context *ctx, const char *stmt)
+{
+    collected c = {NULL, 0};
+    int rc;
+    silc_set_output(ctx, collect, &c);
+    rc = silc_exec(ctx, stmt);
+    silc_set_output(ctx, NULL, NULL);
+    if (rc) {
+        free(c.s);
+        return NULL;
+    }
+    return c.s;
+}
+
+/* Every completion of prefix: the session's names (from `who`), the
+ * statements and built-ins (from `help`), quit and exit; a malloc'd array
+ * of malloc'd strings ending in NULL, in that order, without repeats. */
+static char **completions(silc_context *ctx, const char *prefix)
+{
+    char *who = output_of(ctx, "who"), *help = output_of(ctx, "help"), *p;
+    size_t n = 0, cap = 16, plen = strlen(prefix), k;
+    char **out = malloc(cap * sizeof *out);
+    const char *fixed = "quit exit";
+    for (int src = 0; src < 3 && out; src++) {
+        /* who: the first word of each line after the header; help: every
+         * word after the first line; then the REPL's own commands */
+        p = src == 0 ? who : src == 1 ? help : (char *)fixed;
+        if (!p) continue;
+        if (src < 2) p = strchr(p, '\n');
+        while (p && *p && out) {
+            size_t wl;
+            p += strspn(p, " \t\n");
+            wl = strcspn(p, " \t\n");
+            if (wl && !strncmp(p, prefix, plen)) {
+                for (k = 0; k < n && (strlen(out[k]) != wl || strncmp(out[k], p, wl)); k++) continue;
+                if (k == n) {
+                    if (n + 2 > cap) {
+                        char **grown = realloc(out, (cap *= 2) * sizeof *out);
+                        if (!grown) break;
+                        out = grown;
+                    }
+                    if ((out[n] = malloc(wl + 1))) memcpy(out[n], p, wl), out[n++][wl] = 0;
+                }
+            }
+            p += wl;
+            if (src == 0) p = strchr(p, '\n'); /* the rest of a who line is its shape */
+        }
+    }
+    if (out) out[n] = NULL;
+    free(who);
+    free(help);
+    return out;
+}
+
+static void free_completions(char **c)
+{
+    for (size_t k = 0; c && c[k]; k++) free(c[k]);
+    free(c);
+}
+
+#ifdef SILC_HAVE_READLINE
+static silc_context *completion_ctx;
+
+static char *completion_next(const char *text, int state)
+{
+    static char **list;
+    static size_t at;
+    if (state == 0) {
+        free_completions(list);
+        list = completions(completion_ctx, text);
+        at = 0;
+    }
+    return list && list[at] ? strdup(list[at++]) : NULL;
+}
+
+static char **complete(const char *text, int start, int end)
+{
+    (void)start, (void)end;
+    rl_attempted_completion_over = 1; /* no file names */
+    return rl_completion_matches(text, completion_next);
+}
+#endif
+
 /* ---- the interactive session ------------------------------------------------ */
 
 /* Net number of ( [ { left open in text, ignoring strings and comments: a line
@@ -325,6 +433,8 @@ static int repl(silc_context *ctx)
 #ifdef SILC_HAVE_READLINE
     char *hist = interactive ? history_path() : NULL;
     if (interactive) {
+        completion_ctx = ctx;
+        rl_attempted_completion_function = complete;
         using_history();
         stifle_history(1000);
         if (hist) read_history(hist); /* a missing file is a first session */
@@ -408,10 +518,15 @@ int main(int argc, char **argv)
             free(text);
         } else if (!status && o.statements) {
             status = run_text(ctx, o.statements);
-        } else if (!status) {
+        } else if (!status && !o.complete) {
             status = repl(ctx);
         }
         if (!status) status = print_gets(ctx, &o);
+        if (!status && o.complete) {
+            char **c = completions(ctx, o.complete);
+            for (size_t k = 0; c && c[k]; k++) puts(c[k]);
+            free_completions(c);
+        }
     }
     silc_close(&ctx);
     free(o.put_args), free(o.get_names), free(o.tune_text);

@@ -1207,6 +1207,16 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         return exec_explain(V, s);
     case ST_TUNE:
         return exec_tune(V, s);
+    case ST_HELP: {
+        strbuf b;
+        char err[200];
+        sb_init(&b);
+        if (lang_help(&b, s->name, err, sizeof err)) {
+            sb_free(&b);
+            return eng_error(V->E, "%s", err);
+        }
+        return print_whole(V->E, &b, "help");
+    }
     case ST_BREAK:
         *flow = FLOW_BREAK;
         return 0;

@@ -55,8 +55,9 @@ enum ast_kind {
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
     ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
-    ST_TUNE                /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
+    ST_TUNE,               /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
                               pairs); els unused; an AST_STRING kid names a file */
+    ST_HELP                /* help [NAME]: name is NULL or the word asked about */
 };
 
 typedef struct ast_node ast_node;
@@ -154,5 +155,11 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out);
  * consumers that hand it to ev_run or bind it, never read its arrays.
  * ev_expr gathers such a value to every rank first. */
 int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out);
+
+/* help.c: `help` (every statement and built-in word) or `help NAME` (its
+ * usage and what it does) into out; -1 with err for an unknown name.  The
+ * README's statement (statements = 1) and built-in tables, as markdown. */
+int lang_help(strbuf *out, const char *name, char *err, size_t errlen);
+void lang_help_markdown(strbuf *out, int statements);
 
 #endif

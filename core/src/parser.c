@@ -754,6 +754,18 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
         return node_new(P, tok_is_text(P, kw, "break") ? ST_BREAK : ST_CONTINUE, kw);
     }
     if (tok_is_text(P, kw, "who")) return node_new(P, ST_WHO, kw);
+    if (tok_is_text(P, kw, "help")) {
+        n = node_new(P, ST_HELP, kw);
+        if (n && peek(P)->kind == TK_NAME) {
+            const lx_token *w = next(P);
+            if (!(n->name = tok_text(P, w))) {
+                node_free(n);
+                return fail(P, w, "out of memory while parsing");
+            }
+            n->end = w->start + w->len;
+        }
+        return n;
+    }
     if (tok_is_text(P, kw, "tune")) return parse_tune(P, kw);
     if (tok_is_text(P, kw, "clear")) {
         n = node_new(P, ST_CLEAR, kw);
@@ -811,7 +823,7 @@ static int is_assign_op(int k)
 }
 
 static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
-                                       "info", "set", "explain", "tune"};
+                                       "info", "set", "explain", "tune", "help"};
 
 static ast_node *parse_statement_body(ps_state *P);
 
