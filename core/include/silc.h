@@ -141,6 +141,13 @@ SILC_API void silc_close(silc_context **ctx);
 SILC_API int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
 SILC_API int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
 SILC_API int silc_exec(silc_context *ctx, const char *statements);
+/* The statements `save "path" names` and `load "path" names` (HDF5; README
+ * "Saving and loading"): names is a space-separated list, NULL or "" for
+ * every name (save) or every object of the file (load).  A failed save
+ * leaves the old file, a failed load changes no name.  On a remote context
+ * path is on the server's machine. */
+SILC_API int silc_save(silc_context *ctx, const char *path, const char *names);
+SILC_API int silc_load(silc_context *ctx, const char *path, const char *names);
 SILC_API const char *silc_context_errmsg(const silc_context *ctx);
 /* Warnings of the last silc_exec (one per line, "" if none): results that were
  * computed but deserve distrust, e.g. "matrix is singular to working precision

@@ -410,6 +410,36 @@ int silc_exec(silc_context *ctx, const char *statements)
     return ctx_result(ctx, api_exec(ctx->E, statements, ctx->err, sizeof ctx->err));
 }
 
+/* save / load as a statement, so that embedded and remote contexts do the
+ * same (the engine's h5io.c). */
+static int save_or_load(silc_context *ctx, const char *word, const char *path, const char *names)
+{
+    char *stmt;
+    size_t len;
+    int rc;
+    if (!ctx) return env_error("silc_%s: NULL context", word);
+    if (!path || !*path || strpbrk(path, "\"\n"))
+        return ctx_error(ctx, "silc_%s: the file name must be non-empty, without '\"' or a newline", word);
+    if (names && strpbrk(names, "\";\n"))
+        return ctx_error(ctx, "silc_%s: names must be names separated by spaces", word);
+    len = strlen(word) + strlen(path) + (names ? strlen(names) : 0) + 8;
+    if (!(stmt = malloc(len))) return ctx_error(ctx, "silc_%s: out of memory", word);
+    snprintf(stmt, len, "%s \"%s\" %s", word, path, names ? names : "");
+    rc = silc_exec(ctx, stmt);
+    free(stmt);
+    return rc;
+}
+
+int silc_save(silc_context *ctx, const char *path, const char *names)
+{
+    return save_or_load(ctx, "save", path, names);
+}
+
+int silc_load(silc_context *ctx, const char *path, const char *names)
+{
+    return save_or_load(ctx, "load", path, names);
+}
+
 const char *silc_context_errmsg(const silc_context *ctx)
 {
     if (!ctx) {

@@ -15,6 +15,7 @@
  */
 #include "lang.h"
 #include "tuner.h"
+#include "h5io.h"
 #include "refine.h"
 #include "accuracy.h"
 #include "memo.h"
@@ -1207,6 +1208,14 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         return exec_explain(V, s);
     case ST_TUNE:
         return exec_tune(V, s);
+    case ST_SAVE:
+    case ST_LOAD: {
+        const char *names[256];
+        size_t i;
+        if (s->nkids > 256) return eng_error(V->E, "%s: at most 256 names at once", s->kind == ST_SAVE ? "save" : "load");
+        for (i = 0; i < s->nkids; i++) names[i] = s->kids[i]->name;
+        return (s->kind == ST_SAVE ? h5_save : h5_load)(V->E, s->name, names, s->nkids);
+    }
     case ST_HELP: {
         strbuf b;
         char err[200];

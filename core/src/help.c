@@ -46,6 +46,10 @@ static const help_entry entries[] = {
     {"tune", 1, "`tune on [N]`, `tune off`, `tune status`, `tune step`, `tune report [\"f.svg\"]`, `tune forget`",
      "the tuner: thread count and backend for a time loop (docs/tuner.md)"},
     {"help", 1, "`help`, `help name`", "the statements and built-ins, or one of them"},
+    {"save load", 1, "`save \"f.h5\" [a b ...]`, `load \"f.h5\" [a b ...]`",
+     "values to and from HDF5 (all names, or those given): dense as a 2-D dataset, CSR as a group with "
+     "`data`, `indices`, `indptr` and a `shape` attribute (scipy's and anndata's layout), band as LAPACK "
+     "storage with `kl`, `ku`; a failed save keeps the old file, a failed load changes no name"},
     {"[", 0, "`[1, 2; 3, 4]`, `[A, b; c', d]`",
      "matrix literal / concatenation: `,` side by side, `;` stacks; `[]` is 0×0 and is skipped in "
      "concatenation; CSR if any block is CSR"},

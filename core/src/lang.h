@@ -57,7 +57,8 @@ enum ast_kind {
     ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
     ST_TUNE,               /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
                               pairs); els unused; an AST_STRING kid names a file */
-    ST_HELP                /* help [NAME]: name is NULL or the word asked about */
+    ST_HELP,               /* help [NAME]: name is NULL or the word asked about */
+    ST_SAVE, ST_LOAD       /* save/load "file" [names]: name is the file, kids AST_NAME */
 };
 
 typedef struct ast_node ast_node;

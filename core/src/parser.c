@@ -679,6 +679,39 @@ static ast_node *num_node(ps_state *P)
     return x;
 }
 
+/* The text of a string token, quotes off, malloc'd; NULL after fail(). */
+static char *string_text(ps_state *P, const lx_token *tk)
+{
+    char *s = malloc(tk->len - 1);
+    if (!s) {
+        fail(P, tk, "out of memory while parsing");
+        return NULL;
+    }
+    memcpy(s, P->src + tk->start + 1, tk->len - 2);
+    s[tk->len - 2] = 0;
+    return s;
+}
+
+/* save "file" [names] and load "file" [names]: name is the file, kids the
+ * names (none: all). */
+static ast_node *parse_file_names(ps_state *P, const lx_token *kw, int kind, const char *word)
+{
+    ast_node *n;
+    if (!is(P, TK_STRING))
+        return fail(P, peek(P), "%s needs a file name in quotes, as in %s \"run.h5\" x y", word, word);
+    n = node_new(P, kind, kw);
+    if (n && !(n->name = string_text(P, next(P)))) {
+        node_free(n);
+        return NULL;
+    }
+    while (n && peek(P)->kind == TK_NAME)
+        if (add_kid(P, n, name_node(P, AST_NAME))) {
+            node_free(n);
+            return NULL;
+        }
+    return n;
+}
+
 /* tune [on [STEPS] | off | status | step | forget | report ["file.svg"] |
  * fit P:T P:T ...]; a bare `tune` is `tune status`. */
 static ast_node *parse_tune(ps_state *P, const lx_token *kw)
@@ -727,13 +760,9 @@ static ast_node *parse_tune(ps_state *P, const lx_token *kw)
     } else if (!strcmp(n->name, "report") && is(P, TK_STRING)) {
         const lx_token *tk = next(P);
         ast_node *x = node_new(P, AST_STRING, tk);
-        if (x && !(x->name = malloc(tk->len - 1))) {
+        if (x && !(x->name = string_text(P, tk))) {
             node_free(x);
-            x = fail(P, tk, "out of memory while parsing");
-        }
-        if (x) {
-            memcpy(x->name, P->src + tk->start + 1, tk->len - 2);
-            x->name[tk->len - 2] = 0;
+            x = NULL;
         }
         if (add_kid(P, n, x)) goto bad;
     }
@@ -754,6 +783,8 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
         return node_new(P, tok_is_text(P, kw, "break") ? ST_BREAK : ST_CONTINUE, kw);
     }
     if (tok_is_text(P, kw, "who")) return node_new(P, ST_WHO, kw);
+    if (tok_is_text(P, kw, "save")) return parse_file_names(P, kw, ST_SAVE, "save");
+    if (tok_is_text(P, kw, "load")) return parse_file_names(P, kw, ST_LOAD, "load");
     if (tok_is_text(P, kw, "help")) {
         n = node_new(P, ST_HELP, kw);
         if (n && peek(P)->kind == TK_NAME) {
@@ -823,7 +854,7 @@ static int is_assign_op(int k)
 }
 
 static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
-                                       "info", "set", "explain", "tune", "help"};
+                                       "info", "set", "explain", "tune", "help", "save", "load"};
 
 static ast_node *parse_statement_body(ps_state *P);
 
