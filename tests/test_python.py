@@ -1,7 +1,10 @@
-"""test_python.py -- the pure-Python client (bindings/python/silc.py) against
-the silcd of the test fixture (SILC_SERVER): numpy arrays and CSR in, EXEC,
-values out and compared; errors, output, warnings, LIST/DELETE/INFO/EXPLAIN;
-and the 1-D diffusion example against the exact solution.
+"""test_python.py -- the Python package silc (bindings/python/silc) in both
+of its modes: against the silcd of the test fixture (SILC_SERVER set: the
+pure-Python protocol client) and embedded (no SILC_SERVER: libsilc through
+ctypes, SILC_LIBRARY naming it): numpy arrays and CSR in, EXEC, values out
+and compared; s["x"] indexing; errors, output, warnings, names, delete,
+info as a dict, explain; and the 1-D diffusion example against the exact
+solution.
 
     SILC_SERVER=unix:/path /usr/bin/python3 tests/test_python.py bindings/python
 
@@ -31,13 +34,13 @@ def check(cond, what):
 def expect_error(fn, text, what):
     try:
         fn()
-    except silc.SilcError as e:
+    except silc.Error as e:
         check(text in str(e), "%s: message '%s' lacks '%s'" % (what, e, text))
         return
     check(False, "%s: no error" % what)
 
 
-with silc.connect() as s:
+with silc.Session() as s:
     rng = np.random.default_rng(7)
     M = rng.standard_normal((6, 4))
     v = rng.standard_normal(4)
@@ -72,7 +75,17 @@ with silc.connect() as s:
     text = "".join(out)
     check("M " in text and "Mc" in text, "who output: %r" % text)
     check("would" in s.explain("c = A \\ b"), "explain")
-    check("bytes:" in s.info(), "session info")
+    if s.remote:
+        check(s.info()["bytes"] > 0, "session info: %r" % s.info())
+    else:
+        expect_error(lambda: s.info(), "an embedded session has", "session info is a server's")
+    inf = s.info("x")
+    check(isinstance(inf["backend"], str) and 0 <= inf["backward error"] < 1e-12
+          and inf["value"].startswith("50x1 dense"), "info('x') as a dict: %r" % inf)
+    s["k2"] = np.eye(2)
+    check("k2" in s and np.array_equal(s["k2"], np.eye(2)), "s[name] = ..., s[name], in")
+    del s["k2"]
+    check("k2" not in s, "del s[name]")
     check("x" in s.names() and "M" in s.names(), "LIST")
     s.delete("Mc")
     check("Mc" not in s.names(), "DELETE")
@@ -86,7 +99,7 @@ with silc.connect() as s:
     check(err < 1.5 * bound + 1e-5, "diffusion1d error %.3e vs estimate %.3e" % (err, bound))
 
 # Names never leak between sessions.
-with silc.connect() as s2:
+with silc.Session() as s2:
     check(s2.names() == [], "a new session sees no names")
 
 print("%d passed, %d failed" % (passed, failed))

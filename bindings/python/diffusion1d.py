@@ -1,7 +1,9 @@
 """diffusion1d.py -- the 1-D diffusion example of examples/diffusion1d.c, in
-Python against a silcd server: Crank-Nicolson for u_t = u_xx on [0, pi],
-u(x, 0) = sin x, u = 0 at both ends; exact solution e^{-t} sin x.
+Python, embedded or against a silcd server: Crank-Nicolson for u_t = u_xx
+on [0, pi], u(x, 0) = sin x, u = 0 at both ends; exact solution
+e^{-t} sin x.
 
+    SILC_LIBRARY=build/core/libsilc.so.1 /usr/bin/python3 diffusion1d.py [N [steps [T]]]
     SILC_SERVER=tcp://127.0.0.1:7070 /usr/bin/python3 diffusion1d.py [N [steps [T]]]
 
 The tridiagonal A = I - dt/2 L and B = I + dt/2 L are built here as CSR and
@@ -47,7 +49,7 @@ def main(argv):
     n = int(argv[1]) if len(argv) > 1 else 100
     steps = int(argv[2]) if len(argv) > 2 else 500
     t_end = float(argv[3]) if len(argv) > 3 else 0.5
-    with silc.connect() as s:
+    with silc.Session() as s:
         err, _ = run(s, n, steps, t_end)
     h = math.pi / (n + 1)
     print("N = %d, steps = %d, T = %g: max error %.3e (spatial estimate %.3e)"

@@ -36,4 +36,19 @@ cc -o "$PREFIX/consumer_pc" "$SRC/tests/install/consumer.c" \
   $(PKG_CONFIG_PATH="$PREFIX/lib/pkgconfig" pkg-config --cflags --libs silc) -lm \
   -Wl,-rpath,"$(PKG_CONFIG_PATH="$PREFIX/lib/pkgconfig" pkg-config --variable=libdir silc)" || fail "cc with pkg-config"
 "$PREFIX/consumer_pc" | head -1 || fail "the pkg-config-built C program"
-echo "test_install: find_package(SILC), SILC::silc, SILC::silc_fortran and pkg-config work from $PREFIX"
+# The Python package, embedded, found by the interpreter under the prefix
+# and finding libsilc by itself (no SILC_LIBRARY).
+PYDIR=$(ls -d "$PREFIX"/lib/python3*/dist-packages 2>/dev/null | head -1)
+if [ -n "$PYDIR" ] && [ -x /usr/bin/python3 ]; then
+  PYTHONPATH=$PYDIR /usr/bin/python3 -c '
+import numpy as np, silc
+with silc.Session() as s:
+    s["A"] = np.array([[4.0, 1.0], [1.0, 3.0]]); s["b"] = np.array([5.0, 4.0])
+    s.exec("x = A \\ b")
+    assert np.allclose(s["x"].ravel(), [1, 1], rtol=0, atol=1e-15), s["x"]
+    print("python: embedded session from", silc.__file__)
+' || fail "the installed Python package"
+else
+  echo "test_install: no Python package installed (no /usr/bin/python3 at configure)"
+fi
+echo "test_install: find_package(SILC), SILC::silc, SILC::silc_fortran, pkg-config and Python work from $PREFIX"

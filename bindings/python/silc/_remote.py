@@ -1,21 +1,9 @@
-"""silc.py -- a pure-Python client of the SILC wire protocol (docs/protocol.md).
-
-It speaks to silcd directly, with no C library, to show that any language
-that can open a socket can use SILC:
-
-    import numpy as np, silc
-    with silc.connect("tcp://127.0.0.1:7070") as s:     # or SILC_SERVER
-        s.put("b", np.ones(5))
-        s.exec("x = 2 * b")
-        print(s.get("x"))                                # 5x1 numpy array
-
-Values: numpy arrays go in (1-D -> n x 1 vector, 2-D -> dense matrix, sent
-column-major), scipy.sparse matrices and (indptr, indices, data, shape) tuples
-go in as CSR.  get() returns a 2-D numpy array for dense and band values, and
-a scipy.sparse.csr_matrix for CSR (the tuple if scipy is missing).  Arrays
-travel without extra copies: they are sent from and received into their
-numpy buffers.  Errors raise SilcError with the server's message, the same
-text the C API reports.
+"""silc._remote -- the wire protocol (docs/protocol.md) in pure Python: a
+session on a silcd server, with no C library, so that any machine with
+Python and a socket can use SILC.  Arrays travel without extra copies: they
+are sent from and received into their numpy buffers.  silc/__init__.py is
+the package's front; this is one of its two back ends (_embedded.py the
+other).
 """
 import os
 import socket
@@ -24,10 +12,11 @@ import sys
 
 import numpy as np
 
+from ._values import CSR, SilcError, from_parts, to_parts
+
 PROTOCOL_VERSION = 1
 PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE = range(1, 9)
 OK, ERROR, VALUE, TEXT, WARN = range(128, 133)
-DENSE, CSR, BAND = 0, 1, 2
 _HEADER = struct.Struct("<IIQ")
 _HELLO = struct.Struct("<4sII")
 _DESC = struct.Struct("<IIqqqqq")
@@ -37,8 +26,6 @@ if sys.byteorder != "little":
     raise ImportError("silc.py: the wire protocol needs a little-endian host")
 
 
-class SilcError(Exception):
-    """A request the server refused (its message) or a lost connection."""
 
 
 def _token_from_env():
@@ -52,7 +39,7 @@ def _token_from_env():
     return None
 
 
-class Session:
+class RemoteSession:
     """One session on a silcd server: its own names, closed by close()."""
 
     def __init__(self, url=None, token=None):
@@ -113,28 +100,13 @@ class Session:
             raise SilcError("VALUE reply shorter than its descriptor")
         fmt, _, m, n, nnz, kl, ku = _DESC.unpack(self._recv_exact(_DESC.size))
         if fmt == CSR:
-            indptr = np.empty(m + 1, dtype=np.int64)
-            indices = np.empty(nnz, dtype=np.int64)
-            data = np.empty(nnz, dtype=np.float64)
-            for a in (indptr, indices, data):
-                self._recv_into(a)
-            try:
-                import scipy.sparse
-                return scipy.sparse.csr_matrix((data, indices, indptr), shape=(m, n))
-            except ImportError:
-                return (indptr, indices, data, (m, n))
-        vals = np.empty(nnz, dtype=np.float64)
-        self._recv_into(vals)
-        if fmt == DENSE:
-            return vals.reshape((m, n), order="F")
-        # Band, LAPACK layout: A(i, j) = band[ku + i - j, j].
-        ld = kl + ku + 1
-        band = vals.reshape((ld, n), order="F")
-        a = np.zeros((m, n))
-        for j in range(n):
-            for i in range(max(0, j - ku), min(m, j + kl + 1)):
-                a[i, j] = band[ku + i - j, j]
-        return a
+            arrays = [np.empty(m + 1, dtype=np.int64), np.empty(nnz, dtype=np.int64),
+                      np.empty(nnz, dtype=np.float64)]
+        else:
+            arrays = [np.empty(nnz, dtype=np.float64)]
+        for a in arrays:
+            self._recv_into(a)
+        return from_parts(fmt, m, n, kl, ku, arrays)
 
     def _reply(self, out=None):
         """Reads replies up to the final one; returns its text or value."""
@@ -165,29 +137,8 @@ class Session:
     def put(self, name, value):
         """Deposits value under name."""
         nm = name.encode()
-        if hasattr(value, "tocsr") and hasattr(value, "shape"):
-            c = value.tocsr()
-            c.sort_indices()
-            value = (c.indptr, c.indices, c.data, c.shape)
-        if isinstance(value, tuple):
-            indptr, indices, data, (m, n) = value
-            arrays = [np.ascontiguousarray(indptr, dtype=np.int64),
-                      np.ascontiguousarray(indices, dtype=np.int64),
-                      np.ascontiguousarray(data, dtype=np.float64)]
-            desc = _DESC.pack(CSR, len(nm), m, n, len(arrays[2]), 0, 0)
-        else:
-            a = np.asarray(value, dtype=np.float64)
-            if a.ndim == 0:
-                a = a.reshape(1, 1)
-            elif a.ndim == 1:
-                a = a.reshape(-1, 1)
-            elif a.ndim != 2:
-                raise SilcError("'%s': only vectors and matrices can be stored" % name)
-            m, n = a.shape
-            # Column-major without a copy when it already is.
-            arrays = [a.reshape(-1, order="F") if a.flags.f_contiguous else
-                      np.asfortranarray(a).reshape(-1, order="F")]
-            desc = _DESC.pack(DENSE, len(nm), m, n, m * n, 0, 0)
+        fmt, m, n, arrays = to_parts(name, value)
+        desc = _DESC.pack(fmt, len(nm), m, n, len(arrays[-1]), 0, 0)
         self._send(PUT, desc, nm, *arrays)
         self._reply()
 
@@ -241,8 +192,3 @@ class Session:
 
     def __exit__(self, *exc):
         self.close()
-
-
-def connect(url=None, token=None):
-    """Opens a session: url tcp://host:port or unix:/path (default SILC_SERVER)."""
-    return Session(url, token)

@@ -1,0 +1,156 @@
+"""silc._embedded -- a session inside this process, through libsilc with
+ctypes (no compiler at import): the engine, its plugins and the values live
+here, as for a C program.  libsilc is found by SILC_LIBRARY (a path), else
+the one the package was installed with (_paths.py, written by cmake
+--install), else the system's (ctypes.util.find_library).  One of the
+package's two back ends (_remote.py the other).
+"""
+import ctypes
+import ctypes.util
+import os
+
+import numpy as np
+
+from ._values import CSR, DENSE, SilcError, from_parts, to_parts
+
+
+class _Envelope(ctypes.Structure):
+    """silc_envelope_t (silc.h)."""
+    _fields_ = [("m", ctypes.c_int64), ("n", ctypes.c_int64), ("format", ctypes.c_int),
+                ("values", ctypes.POINTER(ctypes.c_double)), ("rowptr", ctypes.POINTER(ctypes.c_int64)),
+                ("colind", ctypes.POINTER(ctypes.c_int64)), ("nnz", ctypes.c_int64),
+                ("kl", ctypes.c_int64), ("ku", ctypes.c_int64)]
+
+
+_OUTPUT = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
+_lib = None
+
+
+def _library():
+    global _lib
+    if _lib is not None:
+        return _lib
+    path = os.environ.get("SILC_LIBRARY")
+    if not path:
+        try:
+            from . import _paths
+            path = _paths.LIBSILC
+        except ImportError:
+            path = ctypes.util.find_library("silc")
+    if not path:
+        raise SilcError("libsilc not found: set SILC_LIBRARY to its path, or install SILC "
+                        "(cmake --install), or pass a server address for a remote session")
+    try:
+        lib = ctypes.CDLL(path)
+    except OSError as e:
+        raise SilcError("cannot load libsilc from %s: %s" % (path, e))
+    vp, cp, env = ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(_Envelope)
+    for name, res, args in (("silc_open", ctypes.c_int, [ctypes.POINTER(vp), cp]),
+                            ("silc_close", None, [ctypes.POINTER(vp)]),
+                            ("silc_put", ctypes.c_int, [vp, cp, env]),
+                            ("silc_get", ctypes.c_int, [vp, env, cp]),
+                            ("silc_exec", ctypes.c_int, [vp, cp]),
+                            ("silc_context_errmsg", cp, [vp]),
+                            ("silc_context_warnings", cp, [vp]),
+                            ("silc_errmsg", cp, []),
+                            ("silc_envelope_free", None, [env]),
+                            ("silc_set_output", None, [vp, _OUTPUT, vp])):
+        f = getattr(lib, name)
+        f.restype, f.argtypes = res, args
+    _lib = lib
+    return lib
+
+
+def _copy(pointer, count, dtype):
+    if count == 0 or not pointer:
+        return np.empty(count, dtype=dtype)
+    return np.ctypeslib.as_array(pointer, shape=(count,)).astype(dtype, copy=True)
+
+
+class EmbeddedSession:
+    """A SILC context in this process: its own names, closed by close()."""
+
+    def __init__(self, config=None):
+        self._lib = _library()
+        self._ctx = ctypes.c_void_p()
+        self.warnings = ""
+        self._sink = None
+        if self._lib.silc_open(ctypes.byref(self._ctx), config.encode() if config else None):
+            msg = (self._lib.silc_context_errmsg(self._ctx) if self._ctx else self._lib.silc_errmsg()) or b""
+            raise SilcError(msg.decode())
+        # who / info / explain print through this, to sys.stdout or a list
+        self._output = _OUTPUT(self._print)
+        self._lib.silc_set_output(self._ctx, self._output, None)
+
+    def _print(self, _user, text):
+        text = text.decode("utf-8", "replace")
+        if self._sink is not None:
+            self._sink.append(text)
+        else:
+            import sys
+            sys.stdout.write(text)
+
+    def _check(self, rc):
+        if rc:
+            raise SilcError(self._lib.silc_context_errmsg(self._ctx).decode("utf-8", "replace"))
+
+    def put(self, name, value):
+        fmt, m, n, arrays = to_parts(name, value)
+        e = _Envelope(m=m, n=n, format=fmt, nnz=len(arrays[-1]))
+        dbl, i64 = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int64)
+        e.values = arrays[-1].ctypes.data_as(dbl)
+        if fmt == CSR:
+            e.rowptr, e.colind = arrays[0].ctypes.data_as(i64), arrays[1].ctypes.data_as(i64)
+        # silc_put copies: the arrays only need to live through the call
+        self._check(self._lib.silc_put(self._ctx, name.encode(), ctypes.byref(e)))
+
+    def get(self, name):
+        e = _Envelope()
+        self._check(self._lib.silc_get(self._ctx, ctypes.byref(e), name.encode()))
+        try:
+            if e.format == CSR:
+                arrays = [_copy(e.rowptr, e.m + 1, np.int64), _copy(e.colind, e.nnz, np.int64),
+                          _copy(e.values, e.nnz, np.float64)]
+            else:
+                arrays = [_copy(e.values, e.nnz, np.float64)]
+            return from_parts(e.format, e.m, e.n, e.kl, e.ku, arrays)
+        finally:
+            self._lib.silc_envelope_free(ctypes.byref(e))
+
+    def exec(self, statements, out=None):
+        self._sink = out
+        try:
+            rc = self._lib.silc_exec(self._ctx, statements.encode())
+        finally:
+            self._sink = None
+        w = self._lib.silc_context_warnings(self._ctx)
+        self.warnings = w.decode("utf-8", "replace") if w else ""
+        self._check(rc)
+
+    def text_of(self, statement):
+        out = []
+        self.exec(statement, out)
+        return "".join(out)
+
+    def explain(self, statement):
+        return self.text_of("explain " + statement)
+
+    def info(self, name=None):
+        if not name:
+            raise SilcError("info without a name describes a server's session; "
+                            "an embedded session has `who` and `set`")
+        return self.text_of("info " + name)
+
+    def names(self):
+        lines = self.text_of("who").splitlines()
+        return [] if not lines or lines[0].startswith("no variables") else [ln.split()[0] for ln in lines[1:] if ln]
+
+    def delete(self, name):
+        if name not in self.names():
+            raise SilcError("undefined name '%s'" % name)
+        self.exec("clear " + name)
+
+    def close(self):
+        if self._ctx:
+            self._lib.silc_close(ctypes.byref(self._ctx))
+            self._ctx = ctypes.c_void_p()
