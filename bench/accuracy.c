@@ -18,6 +18,8 @@
  * Hilbert rows show that floor).  Configurations a backend cannot run (not
  * built, declines) are left out.
  */
+#define _POSIX_C_SOURCE 200809L
+#include "progress.h"
 #include "testlib.h"
 
 #include <float.h>
@@ -154,11 +156,15 @@ static int run(const problem *p, const char *opts, result *r)
 
 /* Runs one configuration into the next free slot of R, if there is one. */
 #define MAX_RESULTS 64
+static progress bar; /* on stderr while a run is going, when it is a terminal */
+
 static void add_run(const problem *p, const char *opts, const char *label, result *R, int *nr)
 {
     if (*nr >= MAX_RESULTS) return;
     snprintf(R[*nr].label, sizeof R[*nr].label, "%s", label);
+    progress_show(&bar, "accuracy: %s: %s", p->name, label);
     if (run(p, opts, &R[*nr]) == 0) (*nr)++;
+    progress_done(&bar);
 }
 
 static void svg(const char *dir, const problem *p, const result *R, int nr, const int *front)

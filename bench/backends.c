@@ -43,6 +43,7 @@
  * comparison: every tool then runs its BLAS on one thread.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "progress.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -253,6 +254,8 @@ static void flush_pattern_caches(silc_context *c)
     silc_exec(c, "z = solve(Z, zb, \"backend = mumps\")");
 }
 
+static progress bar; /* on stderr while the bench runs, when it is a terminal */
+
 /* One run on a fresh A: nsolve solves with it, timed together; be, the
  * backend that ran and the time of silc_put(A) (copy, checks and shape,
  * which the direct calls do not pay) are filled.  compare() takes the best
@@ -266,6 +269,7 @@ static double silc_time(silc_context *c, tl_capture *cap, const problem *P, cons
     if (!strcmp(backend, "default")) snprintf(stmt, sizeof stmt, "x = A \\ b");
     else snprintf(stmt, sizeof stmt, "x = solve(%s, b, \"backend = %s\")",
                   strcmp(backend, "lapack") ? "A" : "Ad", backend);
+    progress_show(&bar, "backends: %s, %s", P->name, backend);
     flush_pattern_caches(c);
     /* A PUT of exactly what A holds keeps the value, factorization and all
      * (silc_put): clear it first, so this run starts from nothing. */
@@ -293,6 +297,7 @@ static double silc_time(silc_context *c, tl_capture *cap, const problem *P, cons
         if (p) sscanf(p + 11, "%63s", ran);
     }
     silc_exec(c, "clear Ad");
+    progress_done(&bar);
     return t;
 }
 

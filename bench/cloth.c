@@ -27,6 +27,7 @@
  * and with --svg DIR writes DIR/cloth_trade_SCENE.svg.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "progress.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,6 +46,8 @@ static const variant variants[] = {
     {CLOTH_ORIGINAL, "cg"}, {CLOTH_LTD, "cg"}, {CLOTH_CMP, "cg"}, {CLOTH_LTD, "direct"}, {CLOTH_CMP, "direct"},
 };
 enum { NV = sizeof variants / sizeof variants[0] };
+
+static progress bar; /* on stderr while the bench runs, when it is a terminal */
 
 /* One run from the scene's start: per-step times and the final positions
  * (3n, in x).  solver as in variant; tol is also original's CG tolerance.
@@ -318,6 +321,8 @@ int main(int argc, char **argv)
             for (v = 0; v < NV; v++) {
                 cloth_times t;
                 double per;
+                progress_show(&bar, "cloth bench: %s, round %d of %d, %s", s.name, r + 1, rounds,
+                              cloth_mode_name(variants[v].mode));
                 if (run(&s, variants[v].mode, variants[v].solver, tol, steps, &t, v == 0 ? x0 : x, err,
                         sizeof err)) {
                     fprintf(stderr, "cloth_bench: %s %s: %s\n", s.name, cloth_mode_name(variants[v].mode), err);
@@ -330,6 +335,7 @@ int main(int argc, char **argv)
                     split[v][0] = t.assembly / steps, split[v][1] = t.solve / steps, split[v][2] = t.update / steps;
                 }
             }
+        progress_done(&bar);
         for (v = 0; v < NV; v++) {
             char what[128];
             if (!isfinite(best[v])) {

@@ -30,6 +30,7 @@
  * them.  Not run by the test suite.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "progress.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -168,9 +169,12 @@ static double info_number(const char *label)
 
 /* Best of two runs: this machine is shared, and one descheduled OpenMP
  * thread can stretch a run of barrier-heavy iterations many times over. */
+static progress bar; /* on stderr while the bench runs, when it is a terminal */
+
 static void run(silc_context *c, const silc_envelope_t *A, row *r)
 {
     char cmd[320];
+    progress_show(&bar, "iterative: %s", r->config);
     r->ok = 0;
     snprintf(cmd, sizeof cmd, "x = solve(A, b, \"%s\")", r->config);
     for (int rep = 0; rep < 2; rep++) {
@@ -178,11 +182,13 @@ static void run(silc_context *c, const silc_envelope_t *A, row *r)
         /* cleared first: a PUT of what A holds would keep it, preconditioner and all */
         if (silc_exec(c, "clear A") || silc_put(c, "A", A) || silc_exec(c, "b = A * ones(rows(A), 1)")) {
             snprintf(r->why, sizeof r->why, "%s", silc_context_errmsg(c));
+            progress_done(&bar);
             return;
         }
         t = now();
         if (silc_exec(c, cmd)) {
             snprintf(r->why, sizeof r->why, "%s", silc_context_errmsg(c));
+            progress_done(&bar);
             return;
         }
         t = now() - t;
@@ -193,6 +199,7 @@ static void run(silc_context *c, const silc_envelope_t *A, row *r)
         r->iterations = info_number("iterations: ");
         r->ok = 1;
     }
+    progress_done(&bar);
 }
 
 /* ---- the plot ------------------------------------------------------------------------------ */

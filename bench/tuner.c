@@ -28,6 +28,7 @@
  * Uses the public API only.  Not run by the test suite.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "progress.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +39,7 @@
 #include "silc.h"
 
 static const char *backend, *options;
+static progress bar; /* on stderr while the bench runs, when it is a terminal */
 static double budget = 1;
 static char wisdom[128];
 
@@ -173,6 +175,7 @@ int main(int argc, char **argv)
         if (!u) return 1;
         for (p = 1; p <= pmax && p <= 64; p++) {
             double a, b;
+            progress_show(&bar, "tuner bench: n = %lld, p = %d of %d", (long long)n, p, pmax);
             if (setup()) return 1;
             snprintf(cmd, sizeof cmd, "set tune.threads = %d", p);
             if (exec(cmd)) return 1;
@@ -182,6 +185,7 @@ int main(int argc, char **argv)
             if (t[p] < best) best = t[p], pbest = p;
             SILC_FINALIZE();
         }
+        progress_done(&bar);
         if (setup()) return 1;
         snprintf(cmd, sizeof cmd, "set tune.max_threads = %d", pmax);
         if (exec(cmd)) return 1;

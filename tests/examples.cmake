@@ -28,4 +28,8 @@ if(TARGET silc_cloth)
   add_test(NAME example_cloth COMMAND cloth ${PROJECT_SOURCE_DIR}/examples/cloth/scenes/hanging.scene
            --mode cmp --steps 20 --frames ${CMAKE_CURRENT_BINARY_DIR}/cloth-frames)
   set_tests_properties(example_cloth PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
+  # Its progress line: on a terminal only (tools/progress.h, as the benches').
+  add_test(NAME test_progress COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/test_progress.sh $<TARGET_FILE:cloth>
+           ${PROJECT_SOURCE_DIR}/examples/cloth/scenes/hanging.scene)
+  set_tests_properties(test_progress PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 120)
 endif()

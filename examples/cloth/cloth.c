@@ -27,6 +27,7 @@
 #include <sys/stat.h>
 
 #include "cloth.h"
+#include "progress.h"
 
 static const char usage[] =
     "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver NAME|OPTIONS | --tune]\n"
@@ -58,6 +59,7 @@ int main(int argc, char **argv)
     int steps = -1, w = 640, h = 480, a, step, tune = 0;
     double tol = -1, ek0, es0, ek, es, pinned = 0;
     cloth_scene scene;
+    progress bar = {0, 0, 0, 0};
     cloth_model m;
     cloth_driver *d;
     cloth_times t = {0, 0, 0, 0};
@@ -136,12 +138,16 @@ int main(int argc, char **argv)
     }
     cloth_energy(&m, m.x, m.v, &ek0, &es0);
     if (frames && scene.frame_every > 0 && write_frame(frames, &scene, mode, 0, m.x, w, h)) goto fail;
+    progress_start(&bar);
     for (step = 1; step <= scene.steps; step++) {
+        progress_show(&bar, "cloth: step %d of %d", step, scene.steps);
         if (cloth_driver_step(d, &t, err, sizeof err)) {
+            progress_done(&bar);
             fprintf(stderr, "cloth: step %d: %s\n", step, err);
             goto fail;
         }
         if (frames && scene.frame_every > 0 && step % scene.frame_every == 0) {
+            progress_done(&bar); /* a failure's message gets a clean line */
             if (cloth_driver_sync(d, err, sizeof err)) {
                 fprintf(stderr, "cloth: %s\n", err);
                 goto fail;
@@ -149,6 +155,7 @@ int main(int argc, char **argv)
             if (write_frame(frames, &scene, mode, step, m.x, w, h)) goto fail;
         }
     }
+    progress_done(&bar);
     if (cloth_driver_sync(d, err, sizeof err)) {
         fprintf(stderr, "cloth: %s\n", err);
         goto fail;

@@ -126,17 +126,24 @@ public final class DamBreak {
             client.INIT(o.server());
             SilcSolver solver = new SilcSolver(client);
             if (csv != null) csv.println("t,front_x,T,Z_over_L");
-            long stepNanos = 0;
+            long stepNanos = 0, shown = 0;
+            // A progress line on a terminal (System.console(): not when piped), ten a second at most.
+            boolean progress = System.console() != null;
             for (int s = 0; s <= steps; s++) {
                 if (s > 0) {
                     long t0 = System.nanoTime();
                     m.step(solver);
                     stepNanos += System.nanoTime() - t0;
                 }
+                if (progress && System.nanoTime() - shown > 100_000_000L) {
+                    System.err.printf("\rmps: step %d of %d\033[K", s, steps);
+                    shown = System.nanoTime();
+                }
                 double z = m.front();
                 if (csv != null) csv.printf("%.6f,%.6f,%.4f,%.4f%n", m.time, z, m.time * toT, z / L);
                 if (frames != null && s % o.every() == 0) frames.write(m);
             }
+            if (progress) System.err.print("\r\033[K");
             if (csv != null && csv.checkError()) throw new IOException("cannot write " + o.csv());
             String[] solved = solver.lastSolver();
             double ms = 1e-6 / Math.max(steps, 1), step = stepNanos * ms, solve = solver.solveNanos * ms;
