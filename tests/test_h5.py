@@ -18,16 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 silc = sys.argv[1]
-passed = failed = 0
-
-
-def check(cond, what):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL: %s" % what, file=sys.stderr)
+from pychecks import check, done  # noqa: E402 (tests/, beside this file)
 
 
 def run(statements, *gets):
@@ -90,5 +81,4 @@ with tempfile.TemporaryDirectory() as d:
     check(np.array_equal(np.array(v).reshape(2, 3).T, V), "dense from h5py loads exactly")
     check(w == [1.0, 2.0, 3.0], "a 1-D dataset loads as a column vector: %r" % w)
 
-print("%d passed, %d failed" % (passed, failed))
-sys.exit(1 if failed else 0)
+done()

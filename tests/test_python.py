@@ -19,16 +19,7 @@ sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "bindings/python")
 import silc  # noqa: E402
 import diffusion1d  # noqa: E402
 
-passed = failed = 0
-
-
-def check(cond, what):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL: %s" % what, file=sys.stderr)
+from pychecks import check, done  # noqa: E402 (tests/, beside this file)
 
 
 def expect_error(fn, text, what):
@@ -102,5 +93,4 @@ with silc.Session() as s:
 with silc.Session() as s2:
     check(s2.names() == [], "a new session sees no names")
 
-print("%d passed, %d failed" % (passed, failed))
-sys.exit(1 if failed else 0)
+done()
