@@ -60,12 +60,7 @@ static int ctx_error(silc_context *ctx, const char *fmt, ...)
 
 int api_check_name(const char *name, char *err, size_t errlen)
 {
-    const char *s = name;
-    int ok = isalpha((unsigned char)*s) || *s == '_';
-    if (ok)
-        for (s++; *s; s++)
-            if (!(isalnum((unsigned char)*s) || *s == '_')) ok = 0;
-    if (ok) return 0;
+    if (util_is_name(name)) return 0;
     snprintf(err, errlen, "invalid name '%s': names start with a letter or '_' and contain "
                           "only letters, digits and '_'", name);
     return -1;

@@ -343,9 +343,12 @@ static void note_attempt(silc_engine *E, strbuf *attempts, double seconds)
  * verification, which counts only while solve.verify is on. */
 static int failed_before(silc_engine *E, const silc_value *A, const char *name)
 {
-    const char *list = val_attach_get(A, FAILED_KEY), *v = cfg_get(E, "solve.verify");
+    const char *list = val_attach_get(A, FAILED_KEY), *v;
     size_t len = strlen(name);
-    int verifying = !(v && !strcmp(v, "off"));
+    int verifying;
+    if (!list) return 0; /* the usual case: nothing failed on A */
+    v = cfg_get(E, "solve.verify");
+    verifying = !(v && !strcmp(v, "off"));
     for (; list && *list; list += strcspn(list, "\n") + (list[strcspn(list, "\n")] != 0))
         if (!strncmp(list, name, len) &&
             (list[len] == '\n' || !list[len] || (verifying && list[len] == '?')))
@@ -363,6 +366,13 @@ static void remember_failure(const silc_value *A, const char *name, int verifica
     if (val_attach_set(A, FAILED_KEY, list, free)) free(list);
 }
 
+/* Drops the warnings added since mark: they were a discarded result's. */
+static void drop_warnings(silc_engine *E, size_t mark)
+{
+    E->warnings.len = mark;
+    if (E->warnings.s) E->warnings.s[mark] = 0;
+}
+
 /* The error of a chain whose every listed backend failed: each attempt's
  * reason on a line of its own, the last one included. */
 static void chain_error(silc_engine *E, strbuf *attempts)
@@ -371,6 +381,22 @@ static void chain_error(silc_engine *E, strbuf *attempts)
     if (!attempts->len) return;
     snprintf(last, sizeof last, "%s", E->err);
     eng_error(E, "every backend of the list failed:\n  %s\n  %s", sb_str(attempts), last);
+}
+
+/* Backend b, entry i of L, failed (E->err says why; verification: its
+ * result failed verification): 1 when the next listed backend takes over --
+ * the attempt is recorded, and remembered with A -- else 0, E->err then
+ * being the chain's error. */
+static int hand_over(silc_engine *E, const silc_call *call, const blist *L, int i, const ld_backend *b,
+                     strbuf *attempts, double seconds, int verification)
+{
+    if (!fallback_left(L, i)) {
+        chain_error(E, attempts);
+        return 0;
+    }
+    note_attempt(E, attempts, seconds);
+    if (!E->dist) remember_failure(call->in[0], b->full_name, verification);
+    return 1;
 }
 
 static int walk(silc_engine *E, silc_call *call, const char *const *chain, int nchain,
@@ -480,8 +506,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                     /* A direct result that missed: refinement first, by the
                      * same factorization (one triangular solve a step),
                      * before the next backend factors afresh. */
-                    E->warnings.len = warned;
-                    if (E->warnings.s) E->warnings.s[warned] = 0;
+                    drop_warnings(E, warned);
                     call->host_private = &ctx;
                     refine_solve(E, call, b, REFINE_RESCUE_STEPS);
                     call->host_private = NULL;
@@ -501,14 +526,8 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                               call->report->iterations > 0 ? call->report->method : "");
                     val_release(call->out);
                     call->out = NULL;
-                    E->warnings.len = warned; /* the warnings were the discarded result's */
-                    if (E->warnings.s) E->warnings.s[warned] = 0;
-                    if (fallback_left(L, i)) {
-                        note_attempt(E, &attempts, util_now() - t0);
-                        if (!E->dist) remember_failure(call->in[0], b->full_name, 1);
-                        continue;
-                    }
-                    chain_error(E, &attempts);
+                    drop_warnings(E, warned);
+                    if (hand_over(E, call, L, i, b, &attempts, util_now() - t0, 1)) continue;
                     sb_free(&skipped);
                     sb_free(&attempts);
                     return SILC_ENOTCONV;
@@ -540,16 +559,11 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 else
                     eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
                 call->host_private = NULL;
-                E->warnings.len = warned;
-                if (E->warnings.s) E->warnings.s[warned] = 0;
+                drop_warnings(E, warned);
                 /* The next listed backend takes over (out of memory is
                  * not the backend's fault: it stops the chain). */
-                if (rc != SILC_ENOMEM && fallback_left(L, i)) {
-                    note_attempt(E, &attempts, util_now() - t0);
-                    if (!E->dist) remember_failure(call->in[0], b->full_name, 0);
-                    continue;
-                }
-                chain_error(E, &attempts);
+                if (rc == SILC_ENOMEM) chain_error(E, &attempts);
+                else if (hand_over(E, call, L, i, b, &attempts, util_now() - t0, 0)) continue;
                 sb_free(&skipped);
                 sb_free(&attempts);
                 return rc;

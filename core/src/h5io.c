@@ -21,6 +21,7 @@
 #include "engine.h"
 #include "envelope.h"
 #include "h5io.h"
+#include "util.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -219,15 +220,6 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
 
 /* ---- load ---------------------------------------------------------------------- */
 
-static int is_name(const char *s)
-{
-    if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || *s == '_')) return 0;
-    for (s++; *s; s++)
-        if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') || *s == '_'))
-            return 0;
-    return 1;
-}
-
 /* The value of the object name of file, or NULL with E->err naming it. */
 static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const char *name)
 {
@@ -376,7 +368,7 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
         count = all.n;
     }
     for (i = 0; !rc && i < count; i++)
-        if (!is_name(names[i]))
+        if (!util_is_name(names[i]))
             rc = eng_error(E, "load: '%s' in '%s' is not a name SILC can bind (a letter or '_', then letters, "
                               "digits and '_')", names[i], path);
     if (!rc && (!(got = calloc(count ? count : 1, sizeof *got)) || !(olds = calloc(count ? count : 1, sizeof *olds))))

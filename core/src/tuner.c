@@ -68,7 +68,6 @@ typedef struct t_class {
     int count;              /* solves of this class in the step */
     int reuse;              /* the matrix kept its id from the previous step */
     char ran[64];           /* backend the program's solve used */
-    double own_max;         /* the program's slowest solve of this class (a factorization) */
     int next;               /* trials: the next candidate to time */
     tuner_cand cand[T_MAXB];
     int ncand, winner;      /* winner -1: none met the accuracy target */
@@ -461,7 +460,6 @@ static void pend_merge(tuner *T)
         c->a = p->a, c->b = p->b, c->x0 = p->x0, c->a_id = p->a_id;
         p->a = p->b = p->x0 = NULL;
         c->count += p->count;
-        if (p->own_max > c->own_max) c->own_max = p->own_max;
         snprintf(c->ran, sizeof c->ran, "%s", p->ran);
     }
     classes_clear(T->pend, &T->npend);
@@ -503,10 +501,7 @@ void tuner_note_solve(silc_engine *E, const silc_call *call)
     c->x0 = call->nin >= 3 && call->in[2] ? val_retain((silc_value *)call->in[2]) : NULL;
     c->a_id = call->in[0]->id;
     c->count++;
-    if (call->report) {
-        snprintf(c->ran, sizeof c->ran, "%s", call->report->backend);
-        if (call->report->seconds > c->own_max) c->own_max = call->report->seconds;
-    }
+    if (call->report) snprintf(c->ran, sizeof c->ran, "%s", call->report->backend);
 }
 
 /* ---- progress and wisdom ----------------------------------------------------- */
@@ -923,8 +918,7 @@ static int run_trials(silc_engine *E, tuner *T)
         t_class *c = &T->trial[i];
         while (c->next < c->ncand) {
             const double *worst = slowest(T, c->cls);
-            double t0, took, predicted = 2 * (c->own_max > 0 ? c->own_max : 1e-6);
-            if (worst && 2 * *worst > predicted) predicted = 2 * *worst;
+            double t0, took, predicted = 2 * (worst && *worst > 0 ? *worst : 1e-6);
             if (T->trial_max > predicted) predicted = T->trial_max;
             if (spent(T) + predicted > allowance(E, T)) break;
             t0 = now();
@@ -1119,7 +1113,6 @@ static void step_done(silc_engine *E, tuner *T, double secs)
             c->b = val_retain(c->b);
             c->x0 = c->x0 ? val_retain(c->x0) : NULL;
             c->reuse = prev && prev->a_id == c->a_id;
-            if (prev && prev->own_max > c->own_max) c->own_max = prev->own_max;
             plan_class(E, c);
         }
         T->ncands = tuner_candidates(cores(), max_threads(E), T->cands);

@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "util.h"
 
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,6 +113,14 @@ static size_t edit_distance(const char *a, const char *b)
     d = prev[lb];
     free(heap);
     return d;
+}
+
+int util_is_name(const char *s)
+{
+    if (!(isalpha((unsigned char)*s) || *s == '_')) return 0;
+    for (s++; *s; s++)
+        if (!(isalnum((unsigned char)*s) || *s == '_')) return 0;
+    return 1;
 }
 
 const char *util_closest(const char *name, const char *const *cands, size_t ncands)

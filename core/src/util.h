@@ -31,6 +31,10 @@ const char *sb_str(const strbuf *b);   /* "" when empty */
  * at most max(1, strlen(name)/3)). */
 const char *util_closest(const char *name, const char *const *cands, size_t ncands);
 
+/* 1 when s is a name the language binds: a letter or '_', then letters,
+ * digits and '_' (what PUT, load and the lexer accept). */
+int util_is_name(const char *s);
+
 /* Marks a helper of a recursive function that holds large buffers, so the
  * compiler does not inline them into each level of the recursion (the
  * evaluator walks expression trees SILC_MAX_EXPR_HEIGHT deep). */

@@ -110,5 +110,3 @@ def connect(url=None, token=None):
     """A Session (kept for the remote-only client's callers)."""
     return Session(url, token)
 
-
-SilcError = SilcError
