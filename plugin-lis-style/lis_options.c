@@ -264,8 +264,9 @@ static int set_option(lis_options *o, const char *opt, const char *val, char *er
         if (!real_in(opt, val, 0, 1, 0, &x, err, errlen)) return -1;
         o->saamg_theta = x;
     } else if (!strcmp(opt, "-conv_cond")) {
-        static const char *const n[] = {"nrm2_r", "0", "nrm2_b", "1", NULL};
-        static const int v[] = {0, 0, 1, 1};
+        /* "backward" is SILC's own (Lis has no such criterion): lis.h. */
+        static const char *const n[] = {"nrm2_r", "0", "nrm2_b", "1", "backward", NULL};
+        static const int v[] = {0, 0, 1, 1, LIS_CONV_BACKWARD};
         if (!choice(opt, val, n, v, &o->conv_cond, err, errlen)) return -1;
     } else if (!strcmp(opt, "-initx_zeros")) {
         if (!boolean(opt, val, &o->initx_zeros, err, errlen)) return -1;
@@ -336,8 +337,18 @@ int lis_options_parse(const char *text, lis_options *o, char *err, size_t errlen
     }
 }
 
-void lis_options_finish(lis_options *o, int spd_class)
+void lis_options_finish(lis_options *o, int spd_class, int mmatrix_class)
 {
+    if (!o->given && mmatrix_class) {
+        /* The first solve with a large symmetric M-matrix (core's
+         * solve.sparse.mmatrix.spd): cheaper than a factorization when it
+         * converges in few iterations, and soon handed to one when not. */
+        o->solver = LIS_CG;
+        o->precon = LIS_PC_SAAMG;
+        o->conv_cond = LIS_CONV_BACKWARD;
+        o->maxiter = LIS_MMATRIX_MAXITER;
+        return;
+    }
     if (!o->given) {
         o->solver = spd_class ? LIS_CG : LIS_BICGSTAB;
         o->precon = spd_class ? LIS_PC_IC : LIS_PC_ILU;

@@ -203,7 +203,22 @@ typedef struct col_result {
     double resid;
     int restarts;
     int from_guess;         /* started from the initial guess (it was better than zero) */
+    double backward;        /* -conv_cond backward: the accepted backward error */
 } col_result;
+
+/* ||r||inf / (||A||inf ||x||inf + ||b||inf), r = b - A x: the normwise
+ * backward error that -conv_cond backward stops on (lis.h). */
+static double backward_error(const lis_ctx *c, const lis_vec *x, const lis_vec *r, const double *b)
+{
+    double rn = 0, xn = 0, bn = 0;
+    int64_t i;
+    for (i = 0; i < c->n; i++) {
+        if (fabs(r->h[i]) > rn) rn = fabs(r->h[i]);
+        if (fabs(x->h[i]) > xn) xn = fabs(x->h[i]);
+        if (fabs(b[i]) > bn) bn = fabs(b[i]);
+    }
+    return rn / (c->anorm * xn + bn);
+}
 
 /* Solves column `col` into x (double), driving restarts; returns a SILC status
  * after host->error on failure.  tag is "" or " (column 3)". */
@@ -239,7 +254,10 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
     /* From an initial guess (a warm start) the residual is measured against
      * ||b||, as PETSc does: against ||r0|| a good guess would only demand
      * more iterations. */
-    c->den = (c->o->conv_cond == 1 || (c->o->conv_cond < 0 && x0)) && bn > 0 ? bn : r0n;
+    c->den = (c->o->conv_cond == 1 || c->o->conv_cond == LIS_CONV_BACKWARD || (c->o->conv_cond < 0 && x0)) &&
+                     bn > 0
+                 ? bn
+                 : r0n;
     if (r0n == 0) { /* x0 solves it already (b = 0 from x0 = 0) */
         res->iterations = 0;
         res->resid = 0;
@@ -261,9 +279,14 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
                                  c->label, tag, (long long)c->iter);
             goto done;
         }
-        tr = lis_true_resid(c, &x, &work);
+        tr = lis_true_resid(c, &x, &work); /* work = b - A x */
         c->resid = tr;
-        if (tr <= c->o->tol) break;
+        if (c->o->conv_cond == LIS_CONV_BACKWARD) {
+            res->backward = backward_error(c, &x, &work, bcol);
+            if (res->backward <= c->o->tol) break;
+        } else if (tr <= c->o->tol) {
+            break;
+        }
         if (st == LIS_BREAKDOWN) {
             rc = lis_host->error(call, SILC_EBREAKDOWN,
                                  "lis-style %s%s: breakdown at iteration %lld (%s); relative "
@@ -319,12 +342,13 @@ static int solve_run(silc_call *call)
     double t0 = H->now(), *bcol = NULL, *x0col = NULL;
     int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0, guesses = 0;
     int64_t j, max_iter = 0;
-    double max_resid = 0;
+    double max_resid = 0, max_backward = 0;
 
     lis_options_init(&opt);
     if (lis_options_parse(text, &opt, err, sizeof err))
         return H->error(call, SILC_EARG, "lis-style options: %s (in '%s')", err, text);
-    lis_options_finish(&opt, ends_with(call->op_class, ".spd"));
+    lis_options_finish(&opt, ends_with(call->op_class, ".spd"),
+                       call->op_class && !strcmp(call->op_class, "solve.sparse.mmatrix.spd"));
     lis_solver_label(&opt, slabel, sizeof slabel);
     lis_precon_label(&opt, plabel, sizeof plabel);
     if ((opt.solver == LIS_JACOBI || opt.solver == LIS_GS || opt.solver == LIS_SOR) &&
@@ -418,11 +442,18 @@ static int solve_run(silc_call *call)
     c.pc = pc;
     c.o = &opt;
     c.n = a.n;
+    if (opt.conv_cond == LIS_CONV_BACKWARD)
+        for (j = 0; j < A.m; j++) {
+            double row = 0;
+            int64_t k;
+            for (k = A.rp[j]; k < A.rp[j + 1]; k++) row += fabs(A.v[k]);
+            if (row > c.anorm) c.anorm = row;
+        }
     c.quad = opt.quad;
     snprintf(c.label, sizeof c.label, "%s", slabel);
     for (j = 0; j < B.n; j++) {
         char tag[32] = "";
-        col_result res = {0, 0, 0, 0};
+        col_result res = {0, 0, 0, 0, 0};
         if (B.n > 1) snprintf(tag, sizeof tag, " (column %lld)", (long long)j + 1);
         column(&B, j, bcol);
         if (use_x0) {
@@ -434,6 +465,7 @@ static int solve_run(silc_call *call)
         if (rc) goto done;
         if (res.iterations > max_iter) max_iter = res.iterations;
         if (res.resid > max_resid) max_resid = res.resid;
+        if (res.backward > max_backward) max_backward = res.backward;
         restarts += res.restarts;
         guesses += res.from_guess;
     }
@@ -457,9 +489,12 @@ static int solve_run(silc_call *call)
     rep->factor_seconds = pc && !reused ? pc->seconds : 0;
     rep->solve_seconds = H->now() - t0 - rep->factor_seconds;
     {
-        int k = snprintf(rep->note, sizeof rep->note, "converged: ||r||/%s = %.2e <= tol %.1e",
-                         opt.conv_cond == 1 || (opt.conv_cond < 0 && guesses) ? "||b||" : "||r0||",
-                         max_resid, opt.tol);
+        int k = opt.conv_cond == LIS_CONV_BACKWARD
+                    ? snprintf(rep->note, sizeof rep->note, "converged: backward error %.2e <= tol %.1e",
+                               max_backward, opt.tol)
+                    : snprintf(rep->note, sizeof rep->note, "converged: ||r||/%s = %.2e <= tol %.1e",
+                               opt.conv_cond == 1 || (opt.conv_cond < 0 && guesses) ? "||b||" : "||r0||",
+                               max_resid, opt.tol);
         size_t u = k > 0 ? (size_t)k : 0;
         if (pc && u < sizeof rep->note)
             u += (size_t)snprintf(rep->note + u, sizeof rep->note - u, "; preconditioner %s",
