@@ -39,6 +39,16 @@
  * triangular solves) through SILC, directly (factor once, N solves), with
  * SciPy's splu + N solves, and Octave's loop of A\b (which factors every time).
  *
+ * The diffusion loop (--only diffusion): the main example's Crank-Nicolson
+ * loop, u = A \ (B u) with A = I + s L, B = I - s L, L the 5-point
+ * Laplacian on a K x K grid (K = 200 unless --grid says), s = dt / (2 h^2),
+ * dt = 1e-3, N steps (--loop, default 100) from the example's initial block:
+ * SILC with the default config, SILC with `tune on N` and tune.accuracy =
+ * 1e-8 (a fresh session and wisdom file: the first run's whole cost), SciPy
+ * with splu(A) once and N solves, Octave's loop of A \ (B*u).  Each row
+ * prints sum(u) at the end (the tools agree to about 1e-10 relative) and
+ * the last step's backward error.
+ *
  * Set OPENBLAS_NUM_THREADS=1 (done here if unset) for a single-thread
  * comparison: every tool then runs its BLAS on one thread.
  */
@@ -69,7 +79,7 @@ typedef struct problem {
 
 typedef struct opts {
     int scipy, octave, install, reps, loop;
-    int64_t grid;
+    int64_t grid, grid_given;
     const char *only;
     char tmpdir[256];
 } opts;
@@ -543,6 +553,158 @@ static void bench_problem(silc_context *c, tl_capture *cap, problem *P, const op
     free(x);
 }
 
+/* ---- the diffusion loop -------------------------------------------------------- */
+
+#define DIFF_DT 1e-3
+
+static const char scipy_diffusion[] =
+    "import sys, time, numpy as np, scipy.sparse as sp, scipy.sparse.linalg as sl\n"
+    "k, nloop, dt = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3])\n"
+    "h = 1.0 / (k + 1); s = dt / (2 * h * h)\n"
+    "T = sp.diags([-1, 2, -1], [-1, 0, 1], shape=(k, k)); I = sp.identity(k)\n"
+    "L = sp.kron(I, T) + sp.kron(T, I); E = sp.identity(k * k)\n"
+    "A = (E + s * L).tocsc(); B = (E - s * L).tocsr()\n"
+    "g = (np.arange(1, k + 1) * h); blk = ((g > 0.4) & (g < 0.6)).astype(float)\n"
+    "u = np.kron(blk, blk)\n"
+    "t = time.perf_counter(); f = sl.splu(A)\n"
+    "for i in range(nloop): v = B @ u; u = f.solve(v)\n"
+    "t = time.perf_counter() - t\n"
+    "nA = abs(A).sum(axis=1).max()\n"
+    "be = np.abs(v - A @ u).max() / (nA * np.abs(u).max() + np.abs(v).max())\n"
+    "print('diffusion %.6g %.3g %.12g' % (t, be, u.sum()))\n";
+
+static const char octave_diffusion[] =
+    "args = argv(); k = str2num(args{1}); nloop = str2num(args{2}); dt = str2num(args{3});\n"
+    "h = 1 / (k + 1); s = dt / (2 * h * h); e = ones(k, 1);\n"
+    "T = spdiags([-e, 2 * e, -e], -1:1, k, k); I = speye(k); L = kron(I, T) + kron(T, I);\n"
+    "A = speye(k * k) + s * L; B = speye(k * k) - s * L;\n"
+    "g = (1:k)' * h; blk = double(g > 0.4 & g < 0.6); u = kron(blk, blk);\n"
+    "tic; for i = 1:nloop, v = B * u; u = A \\ v; end; t = toc;\n"
+    "be = norm(v - A * u, inf) / (norm(A, inf) * norm(u, inf) + norm(v, inf));\n"
+    "printf('diffusion %.6g %.3g %.12g\\n', t, be, sum(u));\n";
+
+/* Runs a tool's diffusion script: time, backward error, sum(u). */
+static int run_diffusion_tool(const char *cmd, double out[3])
+{
+    char line[256];
+    FILE *p = popen(cmd, "r");
+    int got = 0;
+    if (!p) return -1;
+    while (fgets(line, sizeof line, p))
+        if (sscanf(line, "diffusion %lf %lf %lf", &out[0], &out[1], &out[2]) == 3) got = 1;
+    return pclose(p) == 0 && got ? 0 : -1;
+}
+
+/* The k x k 5-point grid operator c0 I + c1 L (L: 4 on the diagonal, -1 to
+ * each neighbour), from tl_grid2d's diag I - L' scaled. */
+static int grid_operator(silc_envelope_t *e, int64_t k, double c0, double c1)
+{
+    int64_t i;
+    if (tl_grid2d(e, k, 0, 4 + c0 / c1)) return -1; /* (c0/c1 + 4) I - neighbours */
+    for (i = 0; i < e->nnz; i++) e->values[i] *= c1;
+    return 0;
+}
+
+/* One SILC run of the loop in a fresh session (setup: statements run
+ * before it, e.g. the tuner's); time of the loop, last step's backward
+ * error and sum(u) into out, what ran the last solve into ran. */
+static int silc_diffusion(int64_t k, int steps, const char *setup, double out[3], char *ran, size_t ranlen)
+{
+    double h = 1.0 / (double)(k + 1), s = DIFF_DT / (2 * h * h), t0, *u, *sum;
+    silc_envelope_t A, B, U;
+    silc_context *c = NULL;
+    tl_capture cap = {0};
+    int64_t i, j, m, n;
+    int step, rc = -1;
+    char stmt[64];
+    if (!(u = calloc((size_t)(k * k), sizeof *u))) return -1;
+    for (j = 0; j < k; j++)
+        for (i = 0; i < k; i++) {
+            double x = (double)(i + 1) * h, y = (double)(j + 1) * h;
+            u[j * k + i] = x > 0.4 && x < 0.6 && y > 0.4 && y < 0.6;
+        }
+    if (grid_operator(&A, k, 1, s) || grid_operator(&B, k, 1, -s) || silc_envelope_dense(&U, k * k, 1, u) ||
+        silc_open(&c, NULL)) {
+        free(u);
+        return -1;
+    }
+    free(u);
+    tl_capture_attach(c, &cap);
+    if (silc_put(c, "A", &A) || silc_put(c, "B", &B) || silc_put(c, "u", &U) || (setup && silc_exec(c, setup)))
+        goto done;
+    snprintf(stmt, sizeof stmt, "u = A \\ (B * u)");
+    t0 = tl_now();
+    for (step = 0; step < steps; step++)
+        if (silc_exec(c, stmt)) goto done;
+    out[0] = tl_now() - t0;
+    {
+        const char *info = tl_info(c, &cap, "u");
+        const char *p = strstr(info, "  backend: ");
+        out[1] = tl_field(info, "backward error");
+        if (p) sscanf(p + 11, "%63s", ran);
+        (void)ranlen;
+    }
+    if (silc_exec(c, "s = sum(u)") || !(sum = tl_get_dense(c, "s", &m, &n))) goto done;
+    out[2] = sum[0];
+    free(sum);
+    rc = 0;
+done:
+    if (rc) fprintf(stderr, "backends: diffusion: %s\n", silc_context_errmsg(c));
+    silc_close(&c);
+    tl_capture_free(&cap);
+    silc_envelope_free(&A);
+    silc_envelope_free(&B);
+    silc_envelope_free(&U);
+    return rc;
+}
+
+static void diffusion_row(const char *who, const char *ran, const double r[3], double silc_t)
+{
+    printf("  %-40s %-22s %9.4f %9.1e %17.12g %8.2f\n", who, ran, r[0], r[1], r[2],
+           silc_t > 0 ? r[0] / silc_t : NAN);
+}
+
+static void bench_diffusion(const opts *o)
+{
+    int64_t k = o->grid_given ? o->grid : 200;
+    int r, reps = o->reps > 0 ? o->reps : 3;
+    char setup[320], cmd[1024], script[512], wisdom[64], ran[2][64] = {"", ""};
+    double best[2][3] = {{-1, 0, 0}, {-1, 0, 0}}, res[3];
+    printf("\ndiffusion loop: %lld x %lld grid (%lld unknowns), Crank-Nicolson, dt = %g, %d steps\n",
+           (long long)k, (long long)k, (long long)(k * k), DIFF_DT, o->loop);
+    printf("  %-40s %-22s %9s %9s %17s %8s\n", "", "last solve by", "seconds", "bwd err", "sum(u)",
+           "/ SILC");
+    snprintf(wisdom, sizeof wisdom, "/tmp/silc-bench-diffusion-wisdom-%ld", (long)getpid());
+    /* Best of reps; the tuned run starts from no wisdom every time. */
+    for (r = 0; r < reps; r++) {
+        char rn[64] = "";
+        remove(wisdom);
+        snprintf(setup, sizeof setup,
+                 "set tune.wisdom = %s; set tune.threads = auto; set tune.accuracy = 1e-8; tune on %d", wisdom,
+                 o->loop);
+        if (silc_diffusion(k, o->loop, NULL, res, rn, sizeof rn) == 0 && (best[0][0] < 0 || res[0] < best[0][0]))
+            memcpy(best[0], res, sizeof res), snprintf(ran[0], sizeof ran[0], "%s", rn);
+        if (silc_diffusion(k, o->loop, setup, res, rn, sizeof rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
+            memcpy(best[1], res, sizeof res), snprintf(ran[1], sizeof ran[1], "%s", rn);
+    }
+    remove(wisdom);
+    diffusion_row("SILC, default config", ran[0], best[0], best[0][0]);
+    diffusion_row("SILC, tune on, tune.accuracy = 1e-8", ran[1], best[1], best[0][0]);
+    if (o->scipy) {
+        write_file(o->tmpdir, "diffusion.py", scipy_diffusion, script, sizeof script);
+        snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %lld %d %g", script, (long long)k, o->loop, DIFF_DT);
+        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("SciPy splu once + loop", "SuperLU (COLAMD)", res, best[0][0]);
+        else printf("  SciPy: failed\n");
+    }
+    if (o->octave) {
+        write_file(o->tmpdir, "diffusion.m", octave_diffusion, script, sizeof script);
+        snprintf(cmd, sizeof cmd, "octave-cli -q %s %lld %d %g 2>/dev/null", script, (long long)k, o->loop, DIFF_DT);
+        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("Octave loop of A \\ (B*u)", "Octave", res, best[0][0]);
+        else printf("  Octave: failed\n");
+    }
+    printf("  (last column: seconds / SILC default's; below 1 is faster than SILC)\n");
+}
+
 static int usage(void)
 {
     fprintf(stderr, "usage: backends [--scipy] [--octave] [--install] [--reps R] [--loop N] [--grid K] "
@@ -582,7 +744,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--install")) o.install = 1;
         else if (!strcmp(argv[a], "--reps") && a + 1 < argc) o.reps = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--loop") && a + 1 < argc) o.loop = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--grid") && a + 1 < argc) o.grid = atoll(argv[++a]);
+        else if (!strcmp(argv[a], "--grid") && a + 1 < argc) o.grid = atoll(argv[++a]), o.grid_given = 1;
         else if (!strcmp(argv[a], "--only") && a + 1 < argc) o.only = argv[++a];
         else return usage();
     }
@@ -619,12 +781,13 @@ int main(int argc, char **argv)
         free(P->b);
         free(P->x0);
     }
+    if (!o.only || !strcmp(o.only, "diffusion")) bench_diffusion(&o);
     silc_close(&c);
     tl_capture_free(&cap);
     if (o.scipy || o.octave) {
         char path[512];
-        const char *const files[] = {"bench.py", "bench.m", "A.txt"};
-        for (i = 0; i < 3; i++) {
+        const char *const files[] = {"bench.py", "bench.m", "A.txt", "diffusion.py", "diffusion.m"};
+        for (i = 0; i < sizeof files / sizeof files[0]; i++) {
             snprintf(path, sizeof path, "%s/%s", o.tmpdir, files[i]);
             remove(path);
         }

@@ -304,15 +304,21 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
             res->restarts++;
             continue;
         }
-        if (st == LIS_CONVERGED)
-            rc = lis_host->error(call, SILC_ENOTCONV,
-                                 "lis-style %s%s: not converged: the recursive residual met the "
-                                 "tolerance but the true relative residual stalled at %.1e "
-                                 "after %lld iterations", c->label, tag, tr, (long long)c->iter);
-        else
-            rc = lis_host->error(call, SILC_ENOTCONV,
-                                 "lis-style %s%s: not converged after %lld iterations (relative "
-                                 "residual %.1e)", c->label, tag, (long long)c->iter, tr);
+        {
+            /* Under -conv_cond backward the number that missed is the backward error. */
+            char also[48] = "";
+            if (c->o->conv_cond == LIS_CONV_BACKWARD)
+                snprintf(also, sizeof also, ", backward error %.1e", res->backward);
+            if (st == LIS_CONVERGED)
+                rc = lis_host->error(call, SILC_ENOTCONV,
+                                     "lis-style %s%s: not converged: the recursive residual met the "
+                                     "tolerance but the true relative residual stalled at %.1e%s "
+                                     "after %lld iterations", c->label, tag, tr, also, (long long)c->iter);
+            else
+                rc = lis_host->error(call, SILC_ENOTCONV,
+                                     "lis-style %s%s: not converged after %lld iterations (relative "
+                                     "residual %.1e%s)", c->label, tag, (long long)c->iter, tr, also);
+        }
         goto done;
     }
     res->iterations = c->iter;
