@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "engine.h"
 #include "lang.h"
 
 /* The README's text between the marker line that contains tag and the

@@ -34,6 +34,7 @@
 #include <string.h>
 
 #include "accuracy.h"
+#include "dispatch.h"
 #include "engine.h"
 #include "envelope.h"
 #include "value.h"

@@ -22,6 +22,7 @@
 #include "check.h"
 #include "lang.h"
 #include "tuner.h"
+#include "engine.h"
 
 static strbuf captured;
 

@@ -260,26 +260,10 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer)
     warn_if_unsolved(E, r->backend, r->backward_error);
 }
 
-void acc_pending_hold(acc_pending *p, const silc_call *call)
-{
-    acc_pending_release(p);
-    p->A = val_retain((silc_value *)call->in[0]);
-    p->B = val_retain((silc_value *)call->in[1]);
-    p->X = val_retain(call->out);
-}
-
-void acc_pending_release(acc_pending *p)
-{
-    val_release(p->A);
-    val_release(p->B);
-    val_release(p->X);
-    memset(p, 0, sizeof *p);
-}
-
-double acc_pending_resolve(silc_engine *E, acc_pending *p, const char *backend)
+double acc_pending_resolve(silc_engine *E, eng_pending *p, const char *backend)
 {
     double be = p->A && p->B && p->X ? acc_backward_error(p->A, p->B, p->X) : -1;
     warn_if_unsolved(E, backend, be);
-    acc_pending_release(p);
+    eng_pending_release(p);
     return be;
 }

@@ -27,7 +27,7 @@
 #ifndef SILC_ACCURACY_H
 #define SILC_ACCURACY_H
 
-#include "engine.h"
+#include "context.h"
 
 /* report->backward_error of a solve whose backward error is deferred. */
 #define ACC_DEFERRED (-2.0)
@@ -63,11 +63,8 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer);
 #define ACC_VERIFY_FACTOR 10.0
 double acc_verify_limit(silc_engine *E, const silc_report *r);
 
-/* Holds references to the solve's operands and result. */
-void acc_pending_hold(acc_pending *p, const silc_call *call);
-void acc_pending_release(acc_pending *p);
-/* The deferred backward error, computed now (with the warning a bad one
- * deserves); releases p. */
-double acc_pending_resolve(silc_engine *E, acc_pending *p, const char *backend);
+/* The deferred backward error held by p (context.h: eng_pending_hold),
+ * computed now (with the warning a bad one deserves); releases p. */
+double acc_pending_resolve(silc_engine *E, eng_pending *p, const char *backend);
 
 #endif

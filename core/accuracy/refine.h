@@ -14,7 +14,7 @@
 #ifndef SILC_REFINE_H
 #define SILC_REFINE_H
 
-#include "engine.h"
+#include "dispatch.h"
 
 #define REFINE_SINGLE_DEFAULT 10
 /* Backward error a refined single-precision solve must reach, else a warning

@@ -15,7 +15,7 @@
 #ifndef SILC_SCALE_H
 #define SILC_SCALE_H
 
-#include "engine.h"
+#include "context.h"
 
 typedef struct scale_state {
     const silc_value *A, *B, *X0; /* the caller's operands, restored at the end */

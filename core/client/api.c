@@ -25,6 +25,7 @@
 #include "dist.h"
 #include "silc_comm.h"
 #include "engine.h"
+#include "lang.h"
 #include "envelope.h"
 #include "pool.h"
 #include "remote.h"

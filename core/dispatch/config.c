@@ -17,7 +17,7 @@
  * config file serves every machine.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "engine.h"
+#include "dispatch.h"
 
 #include <ctype.h>
 #include <errno.h>

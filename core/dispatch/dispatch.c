@@ -18,7 +18,7 @@
  * comes from accuracy.c, so backends are judged by one yardstick.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "engine.h"
+#include "dispatch.h"
 #include "accuracy.h"
 #include "dist.h"
 #include "refine.h"

@@ -9,7 +9,7 @@
  * host_call_ctx for every attempt.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "engine.h"
+#include "dispatch.h"
 #include "dist.h"
 
 #include <errno.h>

@@ -18,7 +18,7 @@
  * unload or to shut down while another context still uses them.
  */
 #define _GNU_SOURCE /* realpath, dladdr */
-#include "engine.h"
+#include "dispatch.h"
 
 #include <dirent.h>
 #include <sys/stat.h>

@@ -31,7 +31,7 @@
 #ifndef SILC_DIST_H
 #define SILC_DIST_H
 
-#include "engine.h"
+#include "dispatch.h"
 #include "silc_comm.h"
 
 typedef struct dist_ctx {

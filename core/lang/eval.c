@@ -213,8 +213,8 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     if (call->op == SILC_OP_SOLVE) {
         V->has_solve = 1;
         V->report = rep;
-        if (rep.backward_error == ACC_DEFERRED) acc_pending_hold(&V->pending, call);
-        else acc_pending_release(&V->pending);
+        if (rep.backward_error == ACC_DEFERRED) eng_pending_hold(&V->pending, call);
+        else eng_pending_release(&V->pending);
         add_backend(V, rep.backend);
         if (!E->dist) tuner_note_solve(E, call); /* the tuner times one process (issue 18) */
     }
@@ -1177,7 +1177,7 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         V->moved0[0] = V->E->dist->moved_matrix;
         V->moved0[1] = V->E->dist->moved_vector;
     }
-    acc_pending_release(&V->pending);
+    eng_pending_release(&V->pending);
     switch (s->kind) {
     case ST_EXPR: {
         silc_value *v;
@@ -1280,7 +1280,7 @@ int lang_exec(silc_engine *E, const char *text)
         int flow;
         E->err[0] = 0;
         if (exec_stmt(&V, prog->stmts[i], &flow)) {
-            acc_pending_release(&V.pending);
+            eng_pending_release(&V.pending);
             free(V.bind_text);
             if (prog->nstmts > 1) {
                 char msg[sizeof E->err];
@@ -1290,7 +1290,7 @@ int lang_exec(silc_engine *E, const char *text)
             return -1;
         }
     }
-    acc_pending_release(&V.pending);
+    eng_pending_release(&V.pending);
     free(V.bind_text);
     tuner_observe(E, text, util_now() - t0);
     return 0;

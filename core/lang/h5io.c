@@ -18,7 +18,7 @@
  * with HDF5 (SILC_HAVE_HDF5); without it both statements say so.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "engine.h"
+#include "context.h"
 #include "envelope.h"
 #include "h5io.h"
 #include "util.h"

@@ -5,7 +5,7 @@
 #ifndef SILC_H5IO_H
 #define SILC_H5IO_H
 
-#include "engine.h"
+#include "context.h"
 
 /* names[0..n) (n = 0: every name) to path, replacing the file.  0, or -1
  * with E->err. */

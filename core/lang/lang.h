@@ -12,7 +12,13 @@
 #ifndef SILC_LANG_H
 #define SILC_LANG_H
 
-#include "engine.h"
+#include "dispatch.h"
+
+/* ---- running a text (eval.c) ------------------------------------------------- */
+/* Executes a statement list.  Statements run in order; the first failing one
+ * stops the run, leaves the store as the earlier statements left it, and sets
+ * E->err to "statement N: <message>" (N only when the text has several). */
+int lang_exec(silc_engine *E, const char *text);
 
 /* ---- tokens ----------------------------------------------------------------- */
 enum lx_kind {
@@ -103,7 +109,7 @@ typedef struct lang_ev {
     int has_solve;         /* the current statement ran a solve */
     uint64_t moved0[2];    /* dist.h's byte counters (matrices, vectors) when the statement began */
     silc_report report;    /* its last solve report */
-    acc_pending pending;   /* its operands when its backward error is deferred */
+    eng_pending pending;   /* its operands when its backward error is deferred */
     char backends[128];    /* solve backends of the current statement */
     char *bind_text;       /* the statement's text, made before an update in place */
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */

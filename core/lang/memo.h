@@ -5,7 +5,7 @@
 #ifndef SILC_MEMO_H
 #define SILC_MEMO_H
 
-#include "engine.h"
+#include "context.h"
 
 /* The value call gave the last time it ran on these operands (retained), or NULL. */
 silc_value *memo_lookup(silc_engine *E, const silc_call *call);

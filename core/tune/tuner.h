@@ -20,7 +20,7 @@
 
 #include <stdint.h>
 
-#include "engine.h"
+#include "dispatch.h"
 
 /* ---- the model ------------------------------------------------------------- */
 typedef struct tuner_model {

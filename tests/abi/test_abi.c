@@ -9,6 +9,7 @@
  * after checking that the public context opens and closes.
  */
 #include "check.h"
+#include "dispatch.h"
 #include "engine.h"
 
 #include <stdio.h>
