@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "api.h"
+#include "dispatch.h"
 #include "dist.h"
 #include "engine.h"
 #include "protocol.h"

@@ -225,9 +225,8 @@ static void warn_if_unsolved(silc_engine *E, const char *backend, double be)
                  backend, be);
 }
 
-double acc_verify_limit(silc_engine *E, const silc_report *r)
+double acc_verify_limit(const char *v, const silc_report *r)
 {
-    const char *v = cfg_get(E, "solve.verify");
     double direct = 1e-6, iter;
     char *end;
     if (v && !strcmp(v, "off")) return INFINITY;
@@ -243,11 +242,10 @@ double acc_verify_limit(silc_engine *E, const silc_report *r)
     return iter > direct ? iter : direct;
 }
 
-void acc_report(silc_engine *E, silc_call *call, int may_defer)
+void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when)
 {
     silc_report *r = call->report;
     if (may_defer && r->iterations == 0 && r->backward_error_unrefined < 0) {
-        const char *when = cfg_get(E, "solve.backward_error");
         int defer;
         if (when && strcmp(when, "on_request") == 0) defer = 1;
         else defer = r->reused_factor && !(when && strcmp(when, "always") == 0);

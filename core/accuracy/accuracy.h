@@ -51,17 +51,20 @@ double acc_backward_error(const silc_value *A, const silc_value *B, const silc_v
  * ACC_DEFERRED when the caller allows deferral (may_defer), the solve
  * neither iterated nor refined, and either it only reused a factorization
  * and solve.backward_error is not "always", or solve.backward_error is
- * "on_request".  Warns when the result does not solve the system. */
-void acc_report(silc_engine *E, silc_call *call, int may_defer);
+ * "on_request".  Warns when the result does not solve the system.  when is
+ * solve.backward_error (NULL when not set): the dispatcher reads the
+ * options, this layer below it is told them. */
+void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when);
 
 /* The largest backward error a solve's result may have and still count as
  * a solution (solve.verify): `auto` (default) 1e-6 for a direct solve, and
  * for an iterative one ACC_VERIFY_FACTOR x the tolerance it reported (1e-3
  * when it reported none); a number sets the direct bound and the least
- * iterative one; `off` gives INFINITY.  A result above it fails the solve
+ * iterative one; `off` gives INFINITY.  verify is solve.verify's value
+ * (NULL when not set).  A result above it fails the solve
  * over to the next backend of the list (dispatch.c). */
 #define ACC_VERIFY_FACTOR 10.0
-double acc_verify_limit(silc_engine *E, const silc_report *r);
+double acc_verify_limit(const char *verify, const silc_report *r);
 
 /* The deferred backward error held by p (context.h: eng_pending_hold),
  * computed now (with the warning a bad one deserves); releases p. */

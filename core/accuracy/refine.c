@@ -22,7 +22,10 @@
  *
  * The correction solve goes straight to the backend that made x (not through
  * the dispatcher again), with the same class and per-call options, so it
- * finds the factorization that backend attached to A.  Least-squares and
+ * finds the factorization that backend attached to A.  Only the dispatcher
+ * can run a backend, and it sits above this layer, so it hands the
+ * correction solve down as a callback (refine_how), with the settings of
+ * solve.refine and solve.refine_residual it read.  Least-squares and
  * iterative solves are left alone with a note: the first has no square
  * residual equation, the second is better served by a tighter tolerance.
  */
@@ -70,39 +73,12 @@ int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const c
 
 /* ---- the loop -------------------------------------------------------------- */
 
-/* The correction D = A \ R by backend b with the call's class and options;
- * NULL (and why in err) when it fails. */
-static silc_value *correction(silc_engine *E, const silc_call *call, const ld_backend *b,
-                              const silc_value *R, char *err, size_t errlen)
-{
-    silc_call c = *call;
-    silc_report rep;
-    host_call_ctx ctx;
-    int rc;
-    memset(&rep, 0, sizeof rep);
-    rep.cond_est = rep.rcond = -1;
-    memset(&ctx, 0, sizeof ctx);
-    ctx.E = E;
-    ctx.backend = b;
-    c.in[1] = R;
-    c.out = NULL;
-    c.report = &rep;
-    c.host_private = &ctx;
-    rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
-    if (rc == SILC_OK && c.out && c.out->m == call->out->m && c.out->n == call->out->n)
-        return c.out;
-    val_release(c.out);
-    snprintf(err, errlen, "%s", ctx.err[0] ? ctx.err : "the correction solve failed");
-    return NULL;
-}
-
 /* Steps asked for: solve.refine, else the default of single-precision
  * factorizations, else none. */
-static int64_t steps_wanted(const silc_engine *E, const silc_report *r, int *extended)
+static int64_t steps_wanted(const refine_how *how, const silc_report *r, int *extended)
 {
-    const char *v = cfg_get(E, "solve.refine"), *res = cfg_get(E, "solve.refine_residual");
-    *extended = res && strcmp(res, "extended") == 0;
-    if (v) return strtoll(v, NULL, 10);
+    *extended = how->residual && strcmp(how->residual, "extended") == 0;
+    if (how->steps) return strtoll(how->steps, NULL, 10);
     return r->single_factor ? REFINE_SINGLE_DEFAULT : 0;
 }
 
@@ -112,7 +88,7 @@ static void add_note(silc_report *r, const char *text)
     snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", text);
 }
 
-void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least)
+void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_t at_least)
 {
     silc_report *r = call->report;
     const silc_value *A = call->in[0], *Bv = call->in[1];
@@ -120,12 +96,12 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t 
     double t0 = util_now();
     int64_t want, step, kept = 0, n = A->n, k = Bv->n;
     int extended;
-    char note[200], why[sizeof(((host_call_ctx *)0)->err)];
+    char note[200], why[REFINE_WHY_MAX];
     const char *stop = "step limit";
     r->backward_error_unrefined = -1;
     r->refine_steps = 0;
-    want = steps_wanted(E, r, &extended);
-    if (!cfg_get(E, "solve.refine") && want < at_least) want = at_least;
+    want = steps_wanted(how, r, &extended);
+    if (!how->steps && want < at_least) want = at_least;
     if (want <= 0 || !call->out) return;
     if (A->m != A->n || n == 0 || k == 0) {
         if (A->m != A->n) add_note(r, "refinement skipped: least-squares solve");
@@ -165,7 +141,7 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t 
             break;
         }
         memcpy(Rv->val, R, (size_t)(n * k) * sizeof *R);
-        D = correction(E, call, b, Rv, why, sizeof why);
+        D = how->correct(how->ctx, E, call, Rv, why, sizeof why);
         val_release(Rv);
         if (!D) {
             stop = why;
@@ -225,7 +201,7 @@ void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t 
                  "'\\': refinement of %s's single-precision factorization stopped at backward "
                  "error %.2g (%s): too ill-conditioned for a single-precision factor, use a "
                  "double one",
-                 b->full_name, kept ? be : be0, stop);
+                 how->backend, kept ? be : be0, stop);
 done:
     r->seconds += util_now() - t0;
     free(B);

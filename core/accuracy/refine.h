@@ -14,7 +14,7 @@
 #ifndef SILC_REFINE_H
 #define SILC_REFINE_H
 
-#include "dispatch.h"
+#include "context.h"
 
 #define REFINE_SINGLE_DEFAULT 10
 /* Backward error a refined single-precision solve must reach, else a warning
@@ -33,12 +33,27 @@ int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const c
  * backend of the list is tried (the fallback chain, dispatch.c), unless
  * solve.refine is set: then its steps ran already. */
 #define REFINE_RESCUE_STEPS 3
-/* Refines call->out, a solution just computed by backend b, as the
- * configuration and call->report->single_factor ask, and at least at_least
+/* Longest message a failed correction solve leaves in err. */
+#define REFINE_WHY_MAX 1024
+/* What the dispatcher tells refine_solve: the settings it read, and how to
+ * solve the correction A D = R by the backend that made call->out, with the
+ * call's class and options (call->out's shape; NULL, and why in err, when
+ * it fails).  A callback because this layer sits below the dispatcher: the
+ * call goes up once, like the host API's. */
+typedef struct refine_how {
+    const char *steps;          /* solve.refine, NULL when not set */
+    const char *residual;       /* solve.refine_residual, NULL when not set */
+    const char *backend;        /* the backend's full name, for the warning */
+    silc_value *(*correct)(const void *ctx, silc_engine *E, const silc_call *call, const silc_value *R,
+                           char *err, size_t errlen);
+    const void *ctx;            /* the dispatcher's, for correct */
+} refine_how;
+/* Refines call->out, a solution just computed by how's backend, as how's
+ * settings and call->report->single_factor ask, and at least at_least
  * steps when solve.refine is not set; replaces call->out when a step was
  * kept and records steps, the backward error before and a note in the
  * report.  Never fails the solve: a correction that cannot be computed ends
  * the refinement with a note. */
-void refine_solve(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least);
+void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_t at_least);
 
 #endif

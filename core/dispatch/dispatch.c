@@ -280,12 +280,54 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
     else if (r->cond_est > 0 && eps_cond > 1e-4)
         eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
                  r->cond_est);
-    acc_report(E, call, may_defer);
+    acc_report(E, call, may_defer, cfg_get(E, "solve.backward_error"));
     if (r->backward_error < 0 && r->backward_error != ACC_DEFERRED)
         return eng_error(E, "out of memory computing the backward error of '\\'");
     if (val_has_nonfinite(call->out))
         eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
     return 0;
+}
+
+/* ---- refinement (refine.c) -------------------------------------------------- */
+
+/* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
+ * with the call's class and options; NULL (and why in err) when it fails. */
+static silc_value *correction(const void *be, silc_engine *E, const silc_call *call, const silc_value *R,
+                              char *err, size_t errlen)
+{
+    const ld_backend *b = be;
+    silc_call c = *call;
+    silc_report rep;
+    host_call_ctx ctx;
+    int rc;
+    memset(&rep, 0, sizeof rep);
+    rep.cond_est = rep.rcond = -1;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.E = E;
+    ctx.backend = b;
+    c.in[1] = R;
+    c.out = NULL;
+    c.report = &rep;
+    c.host_private = &ctx;
+    rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
+    if (rc == SILC_OK && c.out && c.out->m == call->out->m && c.out->n == call->out->n)
+        return c.out;
+    val_release(c.out);
+    snprintf(err, errlen, "%s", ctx.err[0] ? ctx.err : "the correction solve failed");
+    return NULL;
+}
+
+/* Iterative refinement of call->out by backend b, at least at_least steps
+ * (refine_solve), with the settings of this call. */
+static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least)
+{
+    refine_how how;
+    how.steps = cfg_get(E, "solve.refine");
+    how.residual = cfg_get(E, "solve.refine_residual");
+    how.backend = b->full_name;
+    how.correct = correction;
+    how.ctx = b;
+    refine_solve(E, call, &how, at_least);
 }
 
 /* ---- running --------------------------------------------------------------- */
@@ -436,7 +478,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             call->op_class = chain[ci];
             /* Distributed operands (dist.h): a collective backend runs on the
              * row blocks on every rank; any other gets whole copies. */
-            if (dist_walk_begin(E, call, b, &swap) < 0) {
+            if (dist_walk_begin(E, call, ld_backend_collective(b, call->op), &swap) < 0) {
                 call->host_private = NULL;
                 sb_free(&skipped);
                 sb_free(&attempts);
@@ -476,7 +518,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report (not
                  * of a distributed solve: refine.c reads whole arrays). */
-                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine_solve(E, call, b, 0);
+                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine(E, call, b, 0);
                 if (call->op == SILC_OP_SOLVE && ctx.collective) {
                     int rk = dist_size(E);
                     call->report->backward_error_unrefined = -1; /* no refinement ran */
@@ -498,7 +540,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 /* Verification: a result whose backward error says it does
                  * not solve the system is a failure like any other (a
                  * deferred one was verified with its factorization). */
-                limit = call->op == SILC_OP_SOLVE ? acc_verify_limit(E, call->report) : INFINITY;
+                limit = call->op == SILC_OP_SOLVE ? acc_verify_limit(cfg_get(E, "solve.verify"), call->report) : INFINITY;
                 if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
                     !(call->report->backward_error <= limit) && call->report->iterations == 0 &&
                     call->report->refine_steps == 0 && !ctx.collective && !E->dist &&
@@ -508,7 +550,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                      * before the next backend factors afresh. */
                     drop_warnings(E, warned);
                     call->host_private = &ctx;
-                    refine_solve(E, call, b, REFINE_RESCUE_STEPS);
+                    refine(E, call, b, REFINE_RESCUE_STEPS);
                     call->host_private = NULL;
                     if (call->report->refine_steps > 0 && finish_solve(E, call, 0, 0)) {
                         val_release(call->out);
@@ -694,7 +736,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         c.host_private = &ctx;
         /* As walk: a backend judges the operands it would get (gathered
          * copies, kept with the values, when it is not collective). */
-        if (dist_walk_begin(E, &c, be, &swap) < 0) {
+        if (dist_walk_begin(E, &c, ld_backend_collective(be, c.op), &swap) < 0) {
             if (call->options) cfg_clear_call_options(E);
             return -1;
         }
@@ -707,7 +749,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         dist_walk_end(&c, &swap);
         sb_printf(b, "  %s -> would run%s\n", be->full_name,
                   !E->dist || !dist_call_has(call) ? ""
-                  : dist_backend_collective(be, call->op) && call->op == SILC_OP_SOLVE
+                  : ld_backend_collective(be, call->op) && call->op == SILC_OP_SOLVE
                       ? " (collective, on the row blocks of every rank)"
                       : " (sequential, on operands gathered to every rank)");
         chosen = 1;

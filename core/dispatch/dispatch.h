@@ -71,6 +71,9 @@ const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name);
 size_t ld_plugin_count(const silc_engine *E);
 const ld_plugin *ld_plugin_at(const silc_engine *E, size_t i);
 void ld_set_threads(silc_engine *E, int nthreads); /* every plugin's set_threads */
+/* 1 when b's plugin lists op among b's collective_ops (ABI 1.5): b runs it
+ * on the row blocks of every rank of an SPMD engine (dist.h). */
+int ld_backend_collective(const ld_backend *b, int op);
 /* Names every backend may be configured with, loaded or not (for suggestions
  * and for telling "not installed" from "unknown"). */
 extern const char *const ld_known_backends[];

@@ -26,6 +26,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <pthread.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -467,6 +468,18 @@ int ld_load_path(silc_engine *E, const char *dirs)
     /* Every directory is tried; the first that could not be read is reported. */
     if (rc) memcpy(E->err, bad, sizeof bad);
     return rc;
+}
+
+int ld_backend_collective(const ld_backend *b, int op)
+{
+    const silc_plugin *pl = b->plugin->table;
+    int i;
+    if (pl->abi_minor < 5 || pl->struct_size < offsetof(silc_plugin, collective_ops) + sizeof(void *) ||
+        !pl->collective_ops)
+        return 0;
+    for (i = 0; i < pl->n_backends; i++)
+        if (&pl->backends[i] == b->backend) return (pl->collective_ops[i] & SILC_COLLECTIVE(op)) != 0;
+    return 0;
 }
 
 const ld_backend *ld_find(const silc_engine *E, const char *full_name)

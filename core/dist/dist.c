@@ -67,7 +67,7 @@ static int any_rank(dist_ctx *D, int flag)
     return f != 0;
 }
 
-int dist_attach(silc_engine *E, silc_comm_ops *ops)
+int dist_attach(silc_engine *E, silc_comm_ops *ops, dist_run_fn run)
 {
     static const val_dist_hooks hooks = {dist_props_hook, dist_scan_hook};
     dist_ctx *D;
@@ -77,6 +77,7 @@ int dist_attach(silc_engine *E, silc_comm_ops *ops)
                          SILC_COMM_VERSION);
     if (!(D = calloc(1, sizeof *D))) return eng_oom(E);
     D->ops = ops;
+    D->run = run;
     D->rank = ops->rank;
     D->size = ops->size;
     E->dist = D;
@@ -892,18 +893,6 @@ int dist_call_has(const silc_call *call)
     return 0;
 }
 
-int dist_backend_collective(const ld_backend *b, int op)
-{
-    const silc_plugin *pl = b->plugin->table;
-    int i;
-    if (pl->abi_minor < 5 || pl->struct_size < offsetof(silc_plugin, collective_ops) + sizeof(void *) ||
-        !pl->collective_ops)
-        return 0;
-    for (i = 0; i < pl->n_backends; i++)
-        if (&pl->backends[i] == b->backend) return (pl->collective_ops[i] & SILC_COLLECTIVE(op)) != 0;
-    return 0;
-}
-
 /* The partition of the first distributed operand. */
 static dist_part *call_part(const silc_call *call)
 {
@@ -920,7 +909,7 @@ static int run_on_blocks(silc_engine *E, silc_call *call, dist_part *P, int64_t 
 {
     dist_ctx *D = E->dist;
     silc_value *out;
-    int rc = disp_run(E, call);
+    int rc = D->run(E, call);
     if (rc) return rc;
     if (!(out = val_dist_new(m, n, call->out->format, D, P, call->out))) {
         call->out = NULL;
@@ -1218,7 +1207,7 @@ static int reduction(silc_engine *E, silc_call *call, int *rc)
         a.sub = SILC_MAP_ABS;
         a.nin = 1;
         a.out = NULL;
-        *rc = dist_agree(E, disp_run(E, &a));
+        *rc = dist_agree(E, E->dist->run(E, &a));
         if (*rc) {
             val_release(tmp);
             return 0;
@@ -1226,12 +1215,12 @@ static int reduction(silc_engine *E, silc_call *call, int *rc)
         ab = a.out;
         c.in[0] = ab;
         c.out = NULL;
-        *rc = dist_agree(E, disp_run(E, &c));
+        *rc = dist_agree(E, E->dist->run(E, &c));
         val_release(ab);
     } else {
         /* A block of zero rows reduces to the neutral element the kernels give it. */
         c.out = NULL;
-        *rc = dist_agree(E, disp_run(E, &c));
+        *rc = dist_agree(E, E->dist->run(E, &c));
     }
     val_release(tmp);
     if (*rc) return 0;
@@ -1279,11 +1268,10 @@ static int reduction(silc_engine *E, silc_call *call, int *rc)
 int dist_run(silc_engine *E, silc_call *call)
 {
     int rc = 0, declined = 1;
-    if (!E->dist) return disp_run(E, call);
     if (!dist_call_has(call)) {
         /* Whole operands: every rank computes the same, unless one rank
          * alone ran out of memory; agreeing keeps all on the same path. */
-        rc = dist_agree(E, disp_run(E, call));
+        rc = dist_agree(E, E->dist->run(E, call));
         if (rc) val_release(call->out), call->out = NULL;
         return rc;
     }
@@ -1304,16 +1292,16 @@ int dist_run(silc_engine *E, silc_call *call)
     if (!declined) return rc;
     /* Solves (collective or gathered, per backend: dist_walk_begin) and the
      * rest (gathered). */
-    return disp_run(E, call);
+    return E->dist->run(E, call);
 }
 
-int dist_walk_begin(silc_engine *E, silc_call *call, const ld_backend *b, dist_swap *s)
+int dist_walk_begin(silc_engine *E, silc_call *call, int collective, dist_swap *s)
 {
     int i;
     memset(s, 0, sizeof *s);
     if (!E->dist || !dist_call_has(call)) return s->mode = DIST_LOCAL;
     for (i = 0; i < call->nin; i++) s->in[i] = call->in[i];
-    if (dist_backend_collective(b, call->op) && call->op == SILC_OP_SOLVE) {
+    if (collective && call->op == SILC_OP_SOLVE) {
         const silc_value *A = call->in[0], *B = call->in[1];
         dist_part *P = call_part(call);
         int ok = A->m == A->n && A->format == SILC_FMT_CSR && B->format == SILC_FMT_DENSE &&

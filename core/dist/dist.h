@@ -31,11 +31,18 @@
 #ifndef SILC_DIST_H
 #define SILC_DIST_H
 
-#include "dispatch.h"
+#include "context.h"
 #include "silc_comm.h"
+
+/* The dispatcher's disp_run, which dist_run hands every operation it cannot
+ * run on the blocks itself (and runs on the blocks): this layer sits below
+ * the dispatcher, which calls it on every walk, so the call up goes through
+ * the pointer the engine registers with dist_attach. */
+typedef int (*dist_run_fn)(silc_engine *E, silc_call *call);
 
 typedef struct dist_ctx {
     silc_comm_ops *ops;
+    dist_run_fn run;
     int rank, size;
     /* Bytes received from other ranks, summed over all ranks (so every rank
      * counts the same), split by what moved: CSR values are matrices, dense
@@ -45,8 +52,8 @@ typedef struct dist_ctx {
 } dist_ctx;
 
 /* The engine runs on ops's ranks from now on (taken over: destroyed with
- * the engine).  Before any value exists. */
-int dist_attach(silc_engine *E, silc_comm_ops *ops);
+ * the engine), dispatching through run.  Before any value exists. */
+int dist_attach(silc_engine *E, silc_comm_ops *ops, dist_run_fn run);
 void dist_detach(silc_engine *E);
 /* Rank and size; 0 and 1 without a communicator. */
 int dist_rank(const silc_engine *E);
@@ -80,10 +87,12 @@ int dist_rows_of(silc_engine *E, const silc_value *v, silc_value **block, int64_
  * one per rank), else copied whole.  Collective; *out retained. */
 int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out);
 
-/* The dispatcher's entry for an evaluated operation (eval.c calls this
- * instead of disp_run): runs call as the header comment says. */
+/* The dispatcher's entry for an evaluated operation on an SPMD engine
+ * (eval.c calls this instead of disp_run when E->dist is set): runs call
+ * as the header comment says. */
 int dist_run(silc_engine *E, silc_call *call);
-/* For the dispatcher's walk: how backend b is to run call.
+/* For the dispatcher's walk: how a backend is to run call; collective: it
+ * runs call->op collectively (dispatch.h: ld_backend_collective).
  * DIST_LOCAL: no distributed operand, run as always.
  * DIST_COLLECTIVE: b runs on every rank on the row blocks.
  * DIST_GATHERED: the operands were replaced by whole copies.
@@ -94,9 +103,8 @@ typedef struct dist_swap {
     silc_value *tmp[3];
     int mode;
 } dist_swap;
-int dist_walk_begin(silc_engine *E, silc_call *call, const ld_backend *b, dist_swap *s);
+int dist_walk_begin(silc_engine *E, silc_call *call, int collective, dist_swap *s);
 void dist_walk_end(silc_call *call, dist_swap *s);
-int dist_backend_collective(const ld_backend *b, int op);
 /* Any distributed operand in call. */
 int dist_call_has(const silc_call *call);
 

@@ -99,7 +99,7 @@ int eng_create_comm(silc_engine **out, const char *config_path, silc_comm_ops *c
     E->threads = 1;
     E->rand_state = ENG_RAND_SEED;
     /* The communicator first: the loader picks MPI builds of plugins for it. */
-    if ((comm && dist_attach(E, comm)) || eng_setup(E, config_path)) {
+    if ((comm && dist_attach(E, comm, disp_run)) || eng_setup(E, config_path)) {
         if (comm && !E->dist && comm->destroy) comm->destroy(comm->impl);
         if (err && errlen)
             snprintf(err, errlen, "%s", E->err[0] ? E->err : "engine initialisation failed");

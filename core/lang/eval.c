@@ -202,7 +202,7 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
-    rc = dist_run(E, call);
+    rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
