@@ -17,7 +17,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE   /* MAP_ANONYMOUS */
 #include "server.h"
-#include "pool.h"
+#include "client.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -40,7 +40,6 @@
 #include <unistd.h>
 
 #include "engine.h"
-#include "protocol.h"
 #include "silc.h"
 
 srv_config srv_cfg = {

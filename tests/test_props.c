@@ -36,8 +36,7 @@
 #include "accuracy.h"
 #include "dispatch.h"
 #include "engine.h"
-#include "envelope.h"
-#include "value.h"
+#include "store.h"
 #include "silc.h"
 #include "testlib.h"
 

@@ -9,8 +9,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "envelope.h"
-#include "protocol.h"
+#include "store.h"
+#include "client.h"
 
 typedef struct buf {
     uint8_t p[1 << 16];

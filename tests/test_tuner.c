@@ -21,7 +21,7 @@
 
 #include "check.h"
 #include "lang.h"
-#include "tuner.h"
+#include "tune.h"
 #include "engine.h"
 
 static strbuf captured;

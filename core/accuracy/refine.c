@@ -30,7 +30,6 @@
  * residual equation, the second is better served by a tighter tolerance.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "refine.h"
 #include "accuracy.h"
 
 #include <float.h>

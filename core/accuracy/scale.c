@@ -1,8 +1,8 @@
 /*
  * scale.c -- power-of-two scaling of solves far from 1 in magnitude; see
- * scale.h for why it exists and why it is exact.
+ * accuracy.h for why it exists and why it is exact.
  */
-#include "scale.h"
+#include "accuracy.h"
 
 #include <float.h>
 #include <math.h>

@@ -5,7 +5,7 @@
  * A context is embedded (an engine in this process) or remote (a connection
  * to silcd, remote.c); every call checks its arguments here, once for both,
  * and then goes to one or the other.  The embedded operations themselves are
- * the api_* functions of api.h, which silcd runs for its sessions, so both
+ * the api_* functions of client.h, which silcd runs for its sessions, so both
  * modes produce the same results and the same messages.  Each failure leaves
  * its message on the context (ctx->err); failures that have no context (a
  * call before SILC_INIT, a NULL context, an envelope constructor) leave it in
@@ -21,14 +21,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "api.h"
+#include "client.h"
 #include "dist.h"
 #include "silc_comm.h"
 #include "engine.h"
 #include "lang.h"
-#include "envelope.h"
-#include "pool.h"
-#include "remote.h"
+#include "store.h"
 
 struct silc_context {
     silc_engine *E;          /* embedded, or NULL */
@@ -57,7 +55,7 @@ static int ctx_error(silc_context *ctx, const char *fmt, ...)
     return -1;
 }
 
-/* ---- embedded operations (api.h) ---------------------------------------- */
+/* ---- embedded operations (client.h) ------------------------------------- */
 
 int api_check_name(const char *name, char *err, size_t errlen)
 {

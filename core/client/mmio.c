@@ -21,8 +21,7 @@
 #include <string.h>
 #include <strings.h>
 
-#include "envelope.h"
-#include "value.h"
+#include "store.h"
 
 enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN };
 enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW };

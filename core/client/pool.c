@@ -18,7 +18,7 @@
  * POOL_IDLE_SECONDS is freed at the next pool call.
  */
 #define _GNU_SOURCE 1 /* malloc_usable_size */
-#include "pool.h"
+#include "client.h"
 
 #include <pthread.h>
 
@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "value.h"
+#include "store.h"
 
 enum { POOL_SLOTS = 8, POOL_IDLE_SECONDS = 30 };
 #define POOL_MIN_BYTES ((size_t)1 << 20)

@@ -1,6 +1,6 @@
 /*
  * protocol.c -- frame encoding, decoding and validation of the wire protocol
- * (protocol.h, docs/protocol.md), shared by the client, the server and the
+ * (client.h, docs/protocol.md), shared by the client, the server and the
  * fuzz harness so that there is one decoder to get right.
  *
  * Every decoder follows the same order: read a fixed-size part, check each
@@ -12,7 +12,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE 1   /* madvise */
-#include "protocol.h"
+#include "client.h"
 #include "util.h"
 
 #include <errno.h>
@@ -26,7 +26,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "envelope.h"
+#include "store.h"
 
 /* Bytes of a frame body skipped rather than ending the session: a refused
  * message up to this size costs a read, a larger one a reconnect. */

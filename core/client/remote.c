@@ -1,5 +1,5 @@
 /*
- * remote.c -- the client transport of remote contexts (remote.h): connect and
+ * remote.c -- the client transport of remote contexts (client.h): connect and
  * handshake, then one request frame per call and its replies.
  *
  * Arrays travel without being copied: a PUT sends the envelope's own arrays
@@ -12,7 +12,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE   /* TCP_KEEPIDLE and friends */
-#include "remote.h"
+#include "client.h"
 
 #include <errno.h>
 #include <netdb.h>
@@ -25,8 +25,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include "envelope.h"
-#include "protocol.h"
+#include "store.h"
 
 /* A reply may take hours, so waiting for it has no timeout; a server whose
  * host dies or drops off the network is detected by the kernel instead:

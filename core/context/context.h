@@ -15,7 +15,7 @@
 #include "silc.h"
 #include "silc_plugin.h"
 #include "util.h"
-#include "value.h"
+#include "store.h"
 
 typedef struct silc_engine silc_engine;
 typedef struct cfg_db cfg_db;
@@ -64,7 +64,7 @@ struct silc_engine {
                                            the fuzzers set so `while 1 {}` ends; no option */
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     struct dist_ctx *dist;              /* the communicator of an SPMD engine (dist.h), NULL = one process */
-    struct eng_memo *memo;              /* repeated operations' results (memo.h), NULL until needed */
+    struct eng_memo *memo;              /* repeated operations' results (lang.h: memo_lookup), NULL until needed */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
 };

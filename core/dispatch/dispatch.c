@@ -21,8 +21,6 @@
 #include "dispatch.h"
 #include "accuracy.h"
 #include "dist.h"
-#include "refine.h"
-#include "scale.h"
 
 #include <float.h>
 #include <math.h>

@@ -640,7 +640,7 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
     dist_part_unref(P);
     props_set(w, &pw);
     /* Rank 0 keeps the whole value it was given, so a GET moves nothing.
-     * `where` must read the same on every rank (value.h): dist_whole decides
+     * `where` must read the same on every rank (store.h): dist_whole decides
      * from it whether to enter a gather, and a rank that gathered alone
      * would wait there for ever. */
     if (D->rank == 0) w->dist->whole = val_retain(v);

@@ -8,9 +8,9 @@
 #define _POSIX_C_SOURCE 200809L
 #include "engine.h"
 #include "dispatch.h"
-#include "memo.h"
+#include "lang.h"
 #include "dist.h"
-#include "tuner.h"
+#include "tune.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -14,11 +14,8 @@
  * "'x + y'"), else called "the left operand" / "the right operand".
  */
 #include "lang.h"
-#include "tuner.h"
-#include "h5io.h"
-#include "refine.h"
+#include "tune.h"
 #include "accuracy.h"
-#include "memo.h"
 #include "dist.h"
 
 #include <math.h>

@@ -19,8 +19,8 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "context.h"
-#include "envelope.h"
-#include "h5io.h"
+#include "store.h"
+#include "lang.h"
 #include "util.h"
 
 #include <stdio.h>

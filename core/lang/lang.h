@@ -1,8 +1,11 @@
 /*
- * lang.h -- internal interface of the command language: tokens (lexer.c), the
+ * lang.h -- the command language (core/lang/): tokens (lexer.c), the
  * syntax tree (parser.c), the evaluator's state shared with the built-in
- * functions (builtins.c) and subscripts (index.c), all driven by lang_exec()
- * in eval.c.
+ * functions (builtins.c), subscripts (index.c) and matrix literals
+ * (concat.c), `help` (help.c), save/load (h5io.c) and the memo of repeated
+ * operations (memo.c), all driven by lang_exec() in eval.c.  The language
+ * calls down into the tuner, the dispatcher, the accuracy machinery and the
+ * distributed layer; only the engine and the client call it.
  *
  * A text is lexed and parsed whole before anything runs, so a syntax error
  * anywhere refuses the text.  The parsed program keeps its own copy of the
@@ -168,5 +171,30 @@ int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out);
  * README's statement (statements = 1) and built-in tables, as markdown. */
 int lang_help(strbuf *out, const char *name, char *err, size_t errlen);
 void lang_help_markdown(strbuf *out, int statements);
+
+/*
+ * ---- save and load (h5io.c): a session's values in HDF5 (h5io.c says the
+ * layouts, and why a failed save or load changes nothing).
+ */
+
+/* names[0..n) (n = 0: every name) to path, replacing the file.  0, or -1
+ * with E->err. */
+int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n);
+/* names[0..n) (n = 0: every object at the file's root) from path, bound
+ * all or none.  0, or -1 with E->err naming the object. */
+int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n);
+
+/*
+ * ---- the memo (memo.c): repeated operations on unchanged operands return
+ * the value they gave before (memo.c says when and why).
+ */
+
+/* The value call gave the last time it ran on these operands (retained), or NULL. */
+silc_value *memo_lookup(silc_engine *E, const silc_call *call);
+/* After call ran and gave result: remember it (warned: the call warned, so
+ * it is never handed out).  Failing to remember loses nothing. */
+void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int warned);
+/* At the engine's end. */
+void memo_free(silc_engine *E);
 
 #endif

@@ -23,7 +23,7 @@
  * in-place update of it (x += ...) copies first, as for any shared value.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "memo.h"
+#include "lang.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -3,11 +3,11 @@
  *
  * Constructors copy the caller's arrays and normalise them (CSR columns sorted
  * within rows), so that everything past this file can rely on the value
- * invariants of value.h.  Envelopes filled by hand are checked again when they
+ * invariants of store.h.  Envelopes filled by hand are checked again when they
  * are turned into values (env_to_value).  Failures here have no context to
  * report to; their messages go to a per-thread buffer that silc_errmsg() shows.
  */
-#include "envelope.h"
+#include "store.h"
 
 #include <stdarg.h>
 #include <stdio.h>

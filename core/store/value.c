@@ -2,14 +2,14 @@
  * value.c -- values and the store.
  *
  * A value is created mutable by one of the constructors, filled by its
- * creator, and frozen from then on (see value.h).  What lives here is the
+ * creator, and frozen from then on (see store.h).  What lives here is the
  * bookkeeping around that: unique ids, reference counts, attachments, the
  * structural properties the dispatcher asks about (computed once, on demand,
  * with scaled norms so that entries near the overflow threshold give finite
  * answers), and the per-context store mapping names to values.
  */
 #define _DEFAULT_SOURCE   /* sysconf(_SC_PHYS_PAGES) */
-#include "value.h"
+#include "store.h"
 
 #include <float.h>
 #include <math.h>
@@ -920,7 +920,7 @@ const silc_props *val_props(const silc_value *v)
     return val_props_part(v, SILC_PROPS_ALL);
 }
 
-/* What val_scan has cached (value.h's scan_ready). */
+/* What val_scan has cached (store.h's scan_ready). */
 enum { SCAN_FINITE = 1, SCAN_MAXABS = 2 };
 
 /* Non-zero when an entry of x is NaN or Inf: x - x is +0 for every finite x

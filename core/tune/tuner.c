@@ -1,6 +1,6 @@
 /*
  * tuner.c -- automatic performance tuning: thread count by the seeds' model,
- * solver backend under an accuracy target, and wisdom (see tuner.h).
+ * solver backend under an accuracy target, and wisdom (see tune.h).
  *
  * The tuner watches the stream of top-level EXEC texts.  A time-stepping
  * program repeats the same texts every step, so the smallest k for which the
@@ -32,7 +32,7 @@
  * count can change, without the program's work between EXECs.
  */
 #define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
-#include "tuner.h"
+#include "tune.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,5 +1,5 @@
 /*
- * tuner.h -- automatic performance tuning (issue 6): the seeds' thread-count
+ * tune.h -- the tuner (core/tune/, tuner.c): automatic performance tuning (issue 6): the seeds' thread-count
  * model f(p) = a/p + b*p + c, the choice of a solver backend under an
  * accuracy target, and the wisdom file that lets the next run start tuned.
  *
@@ -15,8 +15,8 @@
  * backend ranking, wisdom file) are exposed so tests can drive them with
  * synthetic timings; nothing here asserts anything about real clocks.
  */
-#ifndef SILC_TUNER_H
-#define SILC_TUNER_H
+#ifndef SILC_TUNE_H
+#define SILC_TUNE_H
 
 #include <stdint.h>
 

@@ -1,8 +1,59 @@
 /*
- * protocol.h -- the SILC wire protocol: one implementation of frame encoding,
+ * client.h -- the client side of the engine (core/client/): what silc.h
+ * promises, embedded (api.c: contexts over an engine of their own) or
+ * remote (remote.c over the wire protocol, protocol.c, which silcd shares),
+ * the array pool (pool.c) and Matrix Market files (mmio.c).  It sits on
+ * top: it calls the engine, the language and the store, and nothing below
+ * calls it.
+ *
+ * ---- the embedded operations (api.c) behind silc_put, silc_get and silc_exec,
+ * shared by api.c (embedded contexts) and silcd (one engine per session), so
+ * that a remote caller gets exactly the messages an embedded one gets.
+ * Each returns 0 or -1 with the message in err.
+ */
+#ifndef SILC_CLIENT_H
+#define SILC_CLIENT_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <sys/uio.h>
+
+#include "engine.h"
+#include "silc.h"
+#include "store.h"
+#include "util.h"
+
+/* Names follow the language's identifiers, so every put value can be used. */
+int api_check_name(const char *name, char *err, size_t errlen);
+/* Binds v (retained) to name as data from the program. */
+int api_bind(silc_engine *E, const char *name, silc_value *v, char *err, size_t errlen);
+/* The value bound to name (borrowed), or NULL with "undefined name 'u' (did
+ * you mean 'v'?)" in err. */
+const silc_value *api_lookup(silc_engine *E, const char *name, char *err, size_t errlen);
+/* Runs statements, warnings collected in E->warnings (cleared first). */
+int api_exec(silc_engine *E, const char *statements, char *err, size_t errlen);
+
+/*
+ * ---- the pool (pool.c): the process's pool of recently freed large arrays (pool.c says
+ * why).  silcd installs it with its --array-pool cap; a program using libsilc
+ * gets it at its first silc_open / silc_open_remote with the cap
+ * $SILC_ARRAY_POOL (MiB; 0 turns it off), else POOL_DEFAULT_MIB.
+ */
+
+#define POOL_DEFAULT_MIB 256
+
+/* Makes value and envelope arrays recycle through the pool, which keeps at
+ * most cap bytes; 0 leaves arrays to malloc and free.  Call before the
+ * threads that use values start. */
+void pool_install(size_t cap);
+/* pool_install with the library's default cap, once per process. */
+void pool_install_default(void);
+
+/*
+ * ---- the wire protocol (protocol.c): one implementation of frame encoding,
  * decoding and validation shared by the remote client (remote.c), the server
  * (server/) and the fuzz harness (tests/fuzz/).  docs/protocol.md is the
- * normative description; this header is its C form.
+ * normative description; this section is its C form.
  *
  * A connection opens with a 12-byte hello each way ("SILC", u32 version,
  * u32 token length, then the token from the client), then carries frames:
@@ -18,15 +69,6 @@
  * Reading goes through a proto_stream, a socket with a timeout or a memory
  * buffer, so the fuzz harness drives exactly the code the server runs.
  */
-#ifndef SILC_PROTOCOL_H
-#define SILC_PROTOCOL_H
-
-#include <stddef.h>
-#include <stdint.h>
-#include <sys/uio.h>
-
-#include "silc.h"
-#include "value.h"
 
 #define PROTO_MAGIC "SILC"
 #define PROTO_VERSION 1u
@@ -164,5 +206,29 @@ void proto_request_free(proto_request *r);
 int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, char *err,
                      size_t errlen);
 void proto_reply_free(proto_reply *r);
+
+/*
+ * ---- remote contexts (remote.c): the client transport: a connection to silcd
+ * carrying the calls of silc.h as protocol frames (above).  Used only by
+ * api.c, which keeps the context-level state (output callback, warnings,
+ * message) and calls these for the wire.
+ *
+ * Each call returns 0, or -1 with the message in err: the server's own text
+ * for a refused request (identical to the embedded message), or a transport
+ * failure naming the server.  After a transport failure the connection is
+ * dead and every later call says so.
+ */
+
+typedef struct rem_conn rem_conn;
+
+/* url: tcp://host:port or unix:/path.  token may be NULL (none). */
+int rem_open(rem_conn **out, const char *url, const char *token, char *err, size_t errlen);
+void rem_close(rem_conn **c);               /* says BYE, then closes */
+int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, size_t errlen);
+int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, char *err, size_t errlen);
+/* EXEC: TEXT replies go to fn (stdout when NULL) as they come,
+ * WARN replies are appended to warnings. */
+int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
+             strbuf *warnings, char *err, size_t errlen);
 
 #endif
