@@ -16,6 +16,7 @@
 # refine_how's correct) are pointers, which neither check sees: that is the
 # point of them.  Exits 1 naming every violation.
 set -eu
+export LC_ALL=C # sort and join must agree on the order
 core=$1
 shift
 

@@ -50,7 +50,7 @@ struct silc_engine {
     silc_store store;
     cfg_db *cfg;
     ld_set *plugins;
-    void *lang_cache;                   /* owned by lang.c */
+    void *lang_cache;                   /* the parse cache, owned by lang/ (eval.c) */
     void (*lang_cache_free)(void *);
     eng_info_entry *infos;
     silc_output_fn output;              /* NULL = stdout */
