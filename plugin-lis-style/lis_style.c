@@ -36,7 +36,7 @@
  * Norms are scaled (lk_nrm2), but the methods' inner products (r, r),
  * (p, A p) would under- or overflow once entries leave about 1e+-100: systems
  * that far from 1 arrive here already scaled by powers of two by the core
- * (core/src/scale.c), which does it once for every backend.
+ * (core/accuracy/scale.c), which does it once for every backend.
  */
 #include "lis.h"
 

@@ -3,7 +3,7 @@
  *
  * Rank 0 owns the listening socket and every connection, in one process
  * (MPI ranks cannot fork per session), and serves one request at a time
- * from a poll loop; each session's engine runs on every rank (core/src/
+ * from a poll loop; each session's engine runs on every rank (core/dist/
  * dist.h), on a communicator of its own.  Before rank 0's engine takes a
  * step the others must share (a session opening or closing, a PUT, a GET of
  * a distributed value, an EXEC, a DELETE), it broadcasts the step on a

@@ -27,10 +27,10 @@
 #include <sys/time.h>
 #include <unistd.h>
 
-#include "api.h"
+#include "client.h"
+#include "dispatch.h"
 #include "dist.h"
 #include "engine.h"
-#include "protocol.h"
 
 /* Frames an EXEC produces (who, info, explain), sent with its reply. */
 typedef struct outbuf {

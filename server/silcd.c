@@ -17,7 +17,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE   /* MAP_ANONYMOUS */
 #include "server.h"
-#include "pool.h"
+#include "client.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -40,7 +40,6 @@
 #include <unistd.h>
 
 #include "engine.h"
-#include "protocol.h"
 #include "silc.h"
 
 srv_config srv_cfg = {
@@ -726,7 +725,7 @@ int main(int argc, char **argv)
     val_set_max_bytes(srv_cfg.max_value_bytes, "silcd --max-value-bytes");
     if (preload_plugins()) return 1;
     if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
-    pool_install((size_t)srv_cfg.pool_bytes); /* core/src/pool.c: each session's own */
+    pool_install((size_t)srv_cfg.pool_bytes); /* core/client/pool.c: each session's own */
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,
             (unsigned long long)srv_cfg.max_value_bytes,
             (unsigned long long)srv_cfg.max_session_bytes, srv_cfg.token ? ", token required" : "");

@@ -42,8 +42,9 @@ endif()
 # The whole engine, compiled by clang with the fuzzer's instrumentation: the
 # sources and definitions silc_objects has (core/CMakeLists.txt), linked
 # straight into each harness.
-file(GLOB _fz_engine CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/core/src/*.c
-     ${PROJECT_SOURCE_DIR}/plugin-reference/*.c)
+file(GLOB _fz_engine CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/plugin-reference/*.c)
+list(PREPEND _fz_engine ${SILC_CORE_SOURCES})
+list(TRANSFORM SILC_CORE_DIRS PREPEND -I OUTPUT_VARIABLE _core_inc)
 set(_fz_inih_flags)
 foreach(d ${INIH_INCLUDE_DIRS})
   list(APPEND _fz_inih_flags -I${d})
@@ -55,7 +56,7 @@ foreach(h lang config)
             -fno-sanitize-recover=undefined
             -DSILC_REFERENCE_BUILTIN=1 -DSILC_PLUGIN_BUILD_DIR="${SILC_PLUGIN_BUILD_DIR}"
             -DSILC_PLUGIN_INSTALL_DIR="${SILC_PLUGIN_INSTALL_DIR}"
-            -I${PROJECT_SOURCE_DIR}/core/include -I${PROJECT_SOURCE_DIR}/core/src
+            -I${PROJECT_SOURCE_DIR}/core/include ${_core_inc}
             -I${PROJECT_SOURCE_DIR}/plugins -I${PROJECT_SOURCE_DIR}/plugin-reference ${_fz_inih_flags}
             ${_fz_dir}/fuzz_${h}.c ${_fz_engine} ${INIH_LDFLAGS} -ldl -lm -lpthread -o ${_fz}
     DEPENDS ${_fz_dir}/fuzz_${h}.c ${_fz_engine} VERBATIM)

@@ -44,12 +44,13 @@ if(SILC_CLANG AND NOT SILC_SANITIZE)
                   RESULT_VARIABLE SILC_LIBFUZZER_RC OUTPUT_QUIET ERROR_QUIET)
   if(SILC_LIBFUZZER_RC EQUAL 0)
     set(_fz ${CMAKE_CURRENT_BINARY_DIR}/fuzz_frame_libfuzzer)
-    set(_src ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c ${PROJECT_SOURCE_DIR}/core/src/protocol.c
-             ${PROJECT_SOURCE_DIR}/core/src/envelope.c ${PROJECT_SOURCE_DIR}/core/src/value.c
-             ${PROJECT_SOURCE_DIR}/core/src/util.c)
+    set(_src ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c ${PROJECT_SOURCE_DIR}/core/client/protocol.c
+             ${PROJECT_SOURCE_DIR}/core/store/envelope.c ${PROJECT_SOURCE_DIR}/core/store/value.c
+             ${PROJECT_SOURCE_DIR}/core/util/util.c)
+    list(TRANSFORM SILC_CORE_DIRS PREPEND -I OUTPUT_VARIABLE _core_inc)
     add_custom_command(OUTPUT ${_fz}
       COMMAND ${SILC_CLANG} -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined
-              -I${PROJECT_SOURCE_DIR}/core/include -I${PROJECT_SOURCE_DIR}/core/src
+              -I${PROJECT_SOURCE_DIR}/core/include ${_core_inc}
               -I${PROJECT_SOURCE_DIR}/plugins ${_src} -lm -o ${_fz}
       DEPENDS ${_src} VERBATIM)
     add_custom_target(fuzz_frame_libfuzzer ALL DEPENDS ${_fz})

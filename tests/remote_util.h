@@ -18,7 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "protocol.h"
+#include "client.h"
 
 typedef struct test_server {
     pid_t pid;

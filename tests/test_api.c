@@ -576,7 +576,7 @@ static void test_exec_plumbing(void)
     silc_envelope_free(&e);
 }
 
-/* Large arrays recycle through the process's pool (core/src/pool.c): one
+/* Large arrays recycle through the process's pool (core/client/pool.c): one
  * asked for zeroed must be zero even when it last held other numbers, and
  * one about to be overwritten must hold exactly what was written. */
 static void test_recycled_arrays(void)

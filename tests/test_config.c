@@ -9,6 +9,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
+#include "dispatch.h"
 #include "engine.h"
 
 #include <stdio.h>

@@ -25,9 +25,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "api.h"
+#include "client.h"
 #include "engine.h"
-#include "value.h"
+#include "store.h"
 
 static silc_engine *E;
 static char err[1024];

@@ -268,7 +268,7 @@ static void test_matrix(double *A, int spd)
 
 /* x = A \\ b for a scaled system must be x1 * f, with a small backward error
  * and the same condition estimate, from every backend: the core solves
- * systems near 1e+-300 scaled by powers of two (core/src/scale.c), so even
+ * systems near 1e+-300 scaled by powers of two (core/accuracy/scale.c), so even
  * backends whose norms or pivot tests assume moderate data (PETSc's ILU,
  * CG's inner products) see moderate data. */
 static void check_scaled(const backend *B, double sc, const char *what, const double *x1, double f)

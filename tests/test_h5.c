@@ -1,5 +1,5 @@
 /*
- * test_h5.c -- save / load in HDF5 (core/src/h5io.c) through the API
+ * test_h5.c -- save / load in HDF5 (core/lang/h5io.c) through the API
  * (silc_save, silc_load) and the statements: every value kind comes back
  * bit for bit (dense, vector, scalar, empty, CSR, band); names choose what
  * is saved and loaded; and every failure is a message that names what is

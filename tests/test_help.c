@@ -1,5 +1,5 @@
 /*
- * test_help.c -- `help` and its table (core/src/help.c): the README's two
+ * test_help.c -- `help` and its table (core/lang/help.c): the README's two
  * tables are exactly the table's markdown (one table serves both), every
  * word `help` lists answers `help WORD` with its usage, and an unknown word
  * is an error with a suggestion.  Also the parse: `help` is a keyword, and a
@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "engine.h"
 #include "lang.h"
 
 /* The README's text between the marker line that contains tag and the
@@ -52,7 +53,7 @@ int main(void)
         char *t = readme_table(readme, statements ? "help table: statements" : "help table: built-ins");
         sb_init(&b);
         lang_help_markdown(&b, statements);
-        CHECK(t && !strcmp(t, sb_str(&b)), "README's %s table is not core/src/help.c's; it should read:\n%s",
+        CHECK(t && !strcmp(t, sb_str(&b)), "README's %s table is not core/lang/help.c's; it should read:\n%s",
               statements ? "statement" : "built-in", sb_str(&b));
         free(t);
         sb_free(&b);

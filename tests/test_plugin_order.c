@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "dispatch.h"
 #include "engine.h"
 #include "testlib.h"
 

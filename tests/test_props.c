@@ -34,9 +34,9 @@
 #include <string.h>
 
 #include "accuracy.h"
+#include "dispatch.h"
 #include "engine.h"
-#include "envelope.h"
-#include "value.h"
+#include "store.h"
 #include "silc.h"
 #include "testlib.h"
 

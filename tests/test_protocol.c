@@ -1,6 +1,6 @@
 /*
  * test_protocol.c -- unit tests of the wire protocol's encoder and decoders
- * (core/src/protocol.c) on memory streams: round trips of every message,
+ * (core/client/protocol.c) on memory streams: round trips of every message,
  * and each kind of malformed input answered with the right outcome
  * (PROTO_REFUSED: consumed, session goes on; PROTO_FATAL: close) and a
  * message naming the problem.
@@ -9,8 +9,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "envelope.h"
-#include "protocol.h"
+#include "store.h"
+#include "client.h"
 
 typedef struct buf {
     uint8_t p[1 << 16];

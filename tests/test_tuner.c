@@ -1,5 +1,5 @@
 /*
- * test_tuner.c -- the tuner (core/src/tuner.c): the seeds' published fits,
+ * test_tuner.c -- the tuner (core/tune/tuner.c): the seeds' published fits,
  * the guards, period detection, the leave-one-out stopping rule, the budget,
  * wisdom round trips, the SVG report and backend choice on a real matrix
  * (mixed-precision variants among the candidates: mumps single, lapack mixed).
@@ -21,7 +21,8 @@
 
 #include "check.h"
 #include "lang.h"
-#include "tuner.h"
+#include "tune.h"
+#include "engine.h"
 
 static strbuf captured;
 

@@ -5,10 +5,11 @@
  * The purpose-made modules (wrong_major.c, wrong_index.c, no_symbol.c,
  * init_fails.c, no_ops.c, good.c) are built next to this test; their
  * directory comes in as ABI_PLUGIN_DIR and the template plugin's file as
- * TEMPLATE_PLUGIN.  The test drives the internal engine (engine.h) directly,
+ * TEMPLATE_PLUGIN.  The test drives the internal engine (engine.h, dispatch.h) directly,
  * after checking that the public context opens and closes.
  */
 #include "check.h"
+#include "dispatch.h"
 #include "engine.h"
 
 #include <stdio.h>

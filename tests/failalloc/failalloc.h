@@ -3,7 +3,7 @@
  *
  * tests/CMakeLists.txt compiles the engine a second time, into the static
  * library silc_failalloc, with `-include failalloc.h`: every malloc, calloc,
- * realloc and strdup written in the engine's own sources (core/src,
+ * realloc and strdup written in the engine's own sources (the folders of core/,
  * plugin-reference) then goes through the counting wrappers of failalloc.c,
  * which can be told to fail the n-th allocation from now.  Production builds
  * never see this header.  free is left alone: the wrappers hand out blocks of

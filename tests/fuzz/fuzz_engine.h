@@ -15,6 +15,7 @@
 
 #include <stdlib.h>
 
+#include "dispatch.h"
 #include "engine.h"
 
 static void fuzz_discard(void *user, const char *text)

@@ -19,8 +19,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "envelope.h"
-#include "protocol.h"
+#include "store.h"
+#include "client.h"
 
 static int violations;
 

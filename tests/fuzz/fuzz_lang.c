@@ -22,7 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "api.h"
+#include "client.h"
 #include "engine.h"
 #include "fuzz_engine.h"
 

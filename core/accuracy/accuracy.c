@@ -1,0 +1,267 @@
+/*
+ * accuracy.c -- residuals and the backward error of a solve, computed here
+ * for every backend alike (so backends are judged by one yardstick), and the
+ * deferral of that number for back-substitutions that reuse a factorization
+ * (accuracy.h says why that is safe).  refine.c forms its residuals with the
+ * same kernel.
+ */
+#include "accuracy.h"
+#include "dist.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* (r[i] + l[i]) -= a * x.  l NULL: plain r[i] -= a x.  Otherwise the product
+ * is split exactly (a x = p + e by fma) and added with TwoSum, so r + l
+ * carries the sum to about twice the working precision. */
+static void sub_product(double *r, double *l, int64_t i, double a, double x)
+{
+    double p = a * x, s, bb, err, e;
+    if (!l) {
+        r[i] -= p;
+        return;
+    }
+    e = fma(a, x, -p);
+    s = r[i] - p;
+    bb = s - r[i];
+    err = (r[i] - (s - bb)) + (-p - bb);
+    r[i] = s;
+    l[i] += err - e;
+}
+
+void acc_residual(const silc_value *A, const double *B, const double *X, int64_t k, int extended,
+                  double *R, double *lo)
+{
+    silc_view a;
+    int64_t i, j, c, p;
+    val_view(A, &a);
+    memcpy(R, B, (size_t)(a.m * k) * sizeof *R);
+    if (extended) memset(lo, 0, (size_t)(a.m * k) * sizeof *lo);
+    for (c = 0; c < k; c++) {
+        double *r = R + c * a.m, *l = extended ? lo + c * a.m : NULL;
+        const double *x = X + c * a.n;
+        if (a.format == SILC_FMT_CSR) {
+            for (i = 0; i < a.m; i++)
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++)
+                    sub_product(r, l, i, a.val[p], x[a.colind[p]]);
+        } else if (a.format == SILC_FMT_BAND) {
+            for (j = 0; j < a.n; j++) {
+                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
+                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
+                for (i = lo_i; i < hi_i; i++)
+                    sub_product(r, l, i, a.val[(a.ku + i - j) + j * a.ld], x[j]);
+            }
+        } else {
+            for (j = 0; j < a.n; j++)
+                for (i = 0; i < a.m; i++) sub_product(r, l, i, a.val[i + j * a.m], x[j]);
+        }
+        if (l)
+            for (i = 0; i < a.m; i++) r[i] += l[i];
+    }
+}
+
+/* The larger of best and s, where a NaN wins and stays. */
+static double max_nan(double best, double s)
+{
+    return s > best || s != s ? s : best;
+}
+
+double acc_norm_inf(const double *x, int64_t m, int64_t k)
+{
+    double best = 0;
+    int64_t i, c;
+    for (i = 0; i < m; i++) {
+        double s = 0;
+        for (c = 0; c < k; c++) s += fabs(x[i + c * m]);
+        best = max_nan(best, s);
+        if (isnan(best)) break;
+    }
+    return best;
+}
+
+double *acc_dense_copy(const silc_value *v)
+{
+    double *x = malloc((size_t)(v->m * v->n > 0 ? v->m * v->n : 1) * sizeof *x);
+    int64_t i, j;
+    if (!x) return NULL;
+    if (v->format == SILC_FMT_DENSE) {
+        if (v->m * v->n > 0) memcpy(x, v->val, (size_t)(v->m * v->n) * sizeof *x);
+        return x;
+    }
+    for (j = 0; j < v->n; j++)
+        for (i = 0; i < v->m; i++) x[i + j * v->m] = val_get(v, i, j);
+    return x;
+}
+
+/* ||B - A X||_inf for CSR A and dense B, X in one pass, nothing allocated:
+ * the common case, whose cost is one sparse product.  With norm_a, also
+ * ||A||_inf, summed unscaled while the entries pass by (the properties'
+ * norms would cost a pass of their own); +Inf when that sum overflowed, and
+ * not complete when the residual is NaN. */
+static double residual_norm_csr(const silc_value *A, const double *B, const double *X, int64_t k,
+                                double *norm_a)
+{
+    silc_view a;
+    double best = 0, best_a = 0;
+    int64_t i, c, p;
+    val_view(A, &a);
+    for (i = 0; i < a.m; i++) {
+        double s = 0;
+        for (c = 0; c < k; c++) {
+            const double *x = X + c * a.n;
+            double r = B[i + c * a.m], row_a = 0;
+            /* row_a costs an add beside each gather: not worth a second loop */
+            for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) {
+                r -= a.val[p] * x[a.colind[p]];
+                row_a += fabs(a.val[p]);
+            }
+            if (c == 0) best_a = row_a > best_a ? row_a : best_a;
+            s += fabs(r);
+        }
+        best = max_nan(best, s);
+        if (isnan(best)) break;
+    }
+    if (norm_a) *norm_a = best_a;
+    return best;
+}
+
+/* G = A' R (A m x n, R m x k, G n x k zeroed by the caller). */
+static void transpose_times(const silc_value *A, const double *R, int64_t k, double *G)
+{
+    silc_view a;
+    int64_t i, j, c, p;
+    val_view(A, &a);
+    for (c = 0; c < k; c++) {
+        const double *r = R + c * a.m;
+        double *g = G + c * a.n;
+        if (a.format == SILC_FMT_CSR) {
+            for (i = 0; i < a.m; i++)
+                for (p = a.rowptr[i]; p < a.rowptr[i + 1]; p++) g[a.colind[p]] += a.val[p] * r[i];
+        } else if (a.format == SILC_FMT_BAND) {
+            for (j = 0; j < a.n; j++) {
+                int64_t lo_i = j - a.ku > 0 ? j - a.ku : 0;
+                int64_t hi_i = j + a.kl + 1 < a.m ? j + a.kl + 1 : a.m;
+                for (i = lo_i; i < hi_i; i++) g[j] += a.val[(a.ku + i - j) + j * a.ld] * r[i];
+            }
+        } else {
+            for (j = 0; j < a.n; j++)
+                for (i = 0; i < a.m; i++) g[j] += a.val[i + j * a.m] * r[i];
+        }
+    }
+}
+
+/*
+ * Normwise backward error of X as a solution of A X = B, in the infinity norm:
+ *
+ *   square A:        ||B - A X|| / (||A|| ||X|| + ||B||)
+ *   rectangular A:   ||A'(B - A X)|| / (||A|| (||A|| ||X|| + ||B||))
+ *
+ * The first is the Rigal-Gaches backward error of a linear system.  A least
+ * squares solution does not make B - A X small, only orthogonal to the range
+ * of A, so the second measures the normal equations' residual A'R, scaled so
+ * that it is invariant under scaling A and B, as the first is.
+ */
+static double backward_error_whole(const silc_value *A, const silc_value *B, const silc_value *X)
+{
+    /* A one-column B's infinity norm is its largest entry: the scan the
+     * solve already made of it (val_max_abs), not a properties pass.  A's
+     * comes from its properties when they hold it, else from the residual's
+     * pass over A. */
+    double nA = (A->props_have & SILC_PROPS_NORMS) ? A->props.norminf : -1;
+    double nB = B->n == 1 ? val_max_abs(B) : val_props(B)->norminf;
+    double nX, nR, be = -1;
+    const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
+    const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
+    double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL;
+    int64_t k = X->n;
+    if (!b) b = bc = acc_dense_copy(B);
+    if (!x) x = xc = acc_dense_copy(X);
+    if (!b || !x) goto out;
+    nX = acc_norm_inf(x, X->m, k);
+    if (A->m == A->n && A->format == SILC_FMT_CSR) {
+        nR = residual_norm_csr(A, b, x, k, nA < 0 ? &nA : NULL);
+        if (!isfinite(nA)) nA = -1; /* overflowed: the scaled sums below */
+    } else {
+        R = malloc((size_t)(A->m * k > 0 ? A->m * k : 1) * sizeof *R);
+        if (!R) goto out;
+        acc_residual(A, b, x, k, 0, R, NULL);
+        if (A->m == A->n) {
+            nR = acc_norm_inf(R, A->m, k);
+        } else {
+            G = calloc((size_t)(A->n * k > 0 ? A->n * k : 1), sizeof *G);
+            if (!G) goto out;
+            transpose_times(A, R, k, G);
+            nR = acc_norm_inf(G, A->n, k);
+        }
+    }
+    if (nA < 0) nA = val_props(A)->norminf;
+    if (isnan(nR) || isnan(nX)) be = NAN;
+    else if (nR == 0) be = 0; /* also 0/0: X = 0 solves B = 0 exactly */
+    else if (A->m == A->n) be = nR / (nA * nX + nB);
+    else be = nR / (nA * (nA * nX + nB));
+out:
+    free(bc);
+    free(xc);
+    free(R);
+    free(G);
+    return be;
+}
+
+double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
+{
+    if (A->dist || B->dist || X->dist) return dist_backward_error(A, B, X);
+    return backward_error_whole(A, B, X);
+}
+
+/* ---- when -------------------------------------------------------------------- */
+
+static void warn_if_unsolved(silc_engine *E, const char *backend, double be)
+{
+    /* A result that does not solve the system is never returned silently,
+     * whatever the backend claimed. */
+    if (be > 1e-3)
+        eng_warn(E, "'\\': the result of %s has backward error %.2g: it does not solve the system",
+                 backend, be);
+}
+
+double acc_verify_limit(const char *v, const silc_report *r)
+{
+    double direct = 1e-6, iter;
+    char *end;
+    if (v && !strcmp(v, "off")) return INFINITY;
+    if (v && strcmp(v, "auto")) {
+        double x = strtod(v, &end);
+        if (end != v && !*end && x > 0) direct = x;
+    }
+    if (r->iterations <= 0) return direct;
+    /* The backward error is at most ||r|| / ||b|| (infinity norms), which an
+     * iterative method bounded in its own norm: the factor absorbs the norms'
+     * difference, not a missed tolerance. */
+    iter = r->tol > 0 ? ACC_VERIFY_FACTOR * r->tol : 1e-3;
+    return iter > direct ? iter : direct;
+}
+
+void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when)
+{
+    silc_report *r = call->report;
+    if (may_defer && r->iterations == 0 && r->backward_error_unrefined < 0) {
+        int defer;
+        if (when && strcmp(when, "on_request") == 0) defer = 1;
+        else defer = r->reused_factor && !(when && strcmp(when, "always") == 0);
+        if (defer) {
+            r->backward_error = ACC_DEFERRED;
+            return;
+        }
+    }
+    r->backward_error = acc_backward_error(call->in[0], call->in[1], call->out);
+    warn_if_unsolved(E, r->backend, r->backward_error);
+}
+
+double acc_pending_resolve(silc_engine *E, eng_pending *p, const char *backend)
+{
+    double be = p->A && p->B && p->X ? acc_backward_error(p->A, p->B, p->X) : -1;
+    warn_if_unsolved(E, backend, be);
+    eng_pending_release(p);
+    return be;
+}

@@ -1,0 +1,108 @@
+/*
+ * context.h -- the state of one engine that every layer reads and writes:
+ * struct silc_engine (its store, and the opaque state of the layers above,
+ * each owned by its folder), the error message, warnings and output of the
+ * running exec, and the per-name records that `info` shows.
+ *
+ * This is the lowest layer that knows an engine (docs/architecture.md): the
+ * dispatcher, the accuracy machinery, the distributed layer and the language
+ * all report through eng_error / eng_warn, so these cannot live with the
+ * engine's creation (engine/), which calls all of them.
+ */
+#ifndef SILC_CONTEXT_H
+#define SILC_CONTEXT_H
+
+#include "silc.h"
+#include "silc_plugin.h"
+#include "util.h"
+#include "store.h"
+
+typedef struct silc_engine silc_engine;
+typedef struct cfg_db cfg_db;
+typedef struct ld_set ld_set;
+typedef struct eng_memo eng_memo;
+
+/* The operands and result of a solve whose backward error is deferred
+ * (accuracy.h: acc_pending_resolve computes it); all NULL when none is. */
+typedef struct eng_pending {
+    silc_value *A, *B, *X;
+} eng_pending;
+
+/* How a value bound to a name was last computed (`info x`). */
+typedef struct eng_info {
+    char *statement;        /* text of the statement that bound it */
+    int has_solve;          /* the statement ran a solve: report is meaningful */
+    silc_report report;     /* of the last solve in the statement */
+    double seconds;         /* wall time of the whole statement */
+    char backends[128];     /* backends that ran, comma separated, deduplicated */
+    int ranks;              /* of an SPMD engine (dist.h), else 0 */
+    uint64_t moved_matrix, moved_vector; /* bytes moved between ranks by the statement */
+    eng_pending pending;    /* report.backward_error == ACC_DEFERRED: owned refs */
+} eng_info;
+
+typedef struct eng_info_entry {
+    char *name;
+    eng_info info;
+    struct eng_info_entry *next;
+} eng_info_entry;
+
+struct silc_engine {
+    silc_store store;
+    cfg_db *cfg;
+    ld_set *plugins;
+    void *lang_cache;                   /* the parse cache, owned by lang/ (eval.c) */
+    void (*lang_cache_free)(void *);
+    eng_info_entry *infos;
+    silc_output_fn output;              /* NULL = stdout */
+    void *output_user;
+    int threads;                        /* thread budget granted to plugins */
+    int accuracy_defer;                 /* solves may defer their backward error
+                                           (accuracy.h); set by the evaluator */
+    uint64_t rand_state;                /* rand() seed state */
+    uint64_t loop_budget;               /* most `while` iterations one exec may run, 0 =
+                                           unlimited (the default): an internal guard that
+                                           the fuzzers set so `while 1 {}` ends; no option */
+    void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
+    struct dist_ctx *dist;              /* the communicator of an SPMD engine (dist.h), NULL = one process */
+    struct eng_memo *memo;              /* repeated operations' results (lang.h: memo_lookup), NULL until needed */
+    char err[4096];
+    strbuf warnings;                    /* warnings of the current/last exec */
+};
+
+int eng_error(silc_engine *E, const char *fmt, ...)   /* sets E->err, returns -1 */
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* A constructor returned NULL: reports the size refusal it left
+ * (val_refusal) or "out of memory", and returns -1. */
+int eng_oom(silc_engine *E);
+void eng_print(silc_engine *E, const char *text);     /* to the output callback or stdout */
+/* Records a warning of the running exec ("matrix is singular to working
+ * precision ..."); the API clears them at each exec start and the CLI prints them
+ * to stderr as "warning: ...". */
+void eng_warn(silc_engine *E, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Copies info; takes over its pending references (also on failure). */
+int eng_info_set(silc_engine *E, const char *name, eng_info *info);
+/* As eng_info_set, but takes over info->statement (malloc'd) too; allocates
+ * nothing when name already has a record (see eng_info_reserve). */
+int eng_info_take(silc_engine *E, const char *name, eng_info *info);
+/* Makes sure name has a record, so that the next eng_info_take of name
+ * cannot fail: for a change that cannot be undone (an update in place). */
+int eng_info_reserve(silc_engine *E, const char *name);
+eng_info *eng_info_get(const silc_engine *E, const char *name);
+void eng_info_remove(silc_engine *E, const char *name);
+/* Every record, at the engine's end. */
+void eng_info_free_all(silc_engine *E);
+
+/* Holds call's operands and result (retained) as the deferred backward error
+ * of the statement's solve; releases what p held before. */
+void eng_pending_hold(eng_pending *p, const silc_call *call);
+/* Releases what p holds and empties it. */
+void eng_pending_release(eng_pending *p);
+
+#endif

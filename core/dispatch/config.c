@@ -1,0 +1,651 @@
+/*
+ * config.c -- the options database: every key SILC understands, in three
+ * scopes that shadow each other (config file < session `set` < per-call
+ * options of solve(A, b, "...")).
+ *
+ * A key is "section.name": dispatch.<class> (an ordered list of backends),
+ * tune.threads / tune.accuracy / tune.budget / tune.wisdom / tune.max_threads, core.plugin_path / core.threads,
+ * solve.refine / solve.refine_residual (iterative refinement, refine.c) and
+ * solve.backward_error (deferred | always | on_request, accuracy.h) -- per call these may be
+ * written without the section: "refine = 2" --, and
+ * <plugin>.<option> for the typed options a loaded plugin lists.  The INI file
+ * (read with inih) spells the same keys as [section] name = value.  Every key
+ * and value is checked when it is set, not when it is used, so a typo is
+ * reported with its file and line and the closest valid spelling instead of
+ * being silently ignored.  Names that SILC knows but that are not installed
+ * here (a [mumps] section on a machine without MUMPS) are accepted, so one
+ * config file serves every machine.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "dispatch.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct cfg_entry {
+    char *key;
+    char *value;
+    struct cfg_entry *next;
+} cfg_entry;
+
+struct cfg_db {
+    cfg_entry *scope[3]; /* indexed by enum cfg_scope, each in insertion order */
+};
+
+static const char *const scope_names[3] = {"file", "session", "call"};
+static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
+static const char *const core_keys[] = {"plugin_path", "threads"};
+static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess",
+                                         "verify"};
+
+/* Longest list a dispatch key may name; more would only repeat names. */
+#define CFG_MAX_LIST 32
+
+/* ---- small text helpers --------------------------------------------------- */
+
+static int in_list(const char *s, const char *const *list, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (strcmp(s, list[i]) == 0) return 1;
+    return 0;
+}
+
+static size_t count_names(const char *const *list)
+{
+    size_t n = 0;
+    while (list[n]) n++;
+    return n;
+}
+
+/* Copies s[0..len) trimmed of surrounding white space into out (outlen > 0). */
+static void trim_copy(char *out, size_t outlen, const char *s, size_t len)
+{
+    while (len && isspace((unsigned char)*s)) s++, len--;
+    while (len && isspace((unsigned char)s[len - 1])) len--;
+    if (len >= outlen) len = outlen - 1;
+    memcpy(out, s, len);
+    out[len] = '\0';
+}
+
+static int parse_int(const char *s, int64_t *out)
+{
+    char *end;
+    long long v;
+    errno = 0;
+    v = strtoll(s, &end, 10);
+    if (end == s || *end != '\0' || errno == ERANGE) return -1;
+    *out = (int64_t)v;
+    return 0;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    double v;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_bool(const char *s, int64_t *out)
+{
+    static const char *const yes[] = {"1", "true", "yes", "on"};
+    static const char *const no[] = {"0", "false", "no", "off"};
+    size_t i;
+    for (i = 0; i < 4; i++) {
+        if (strcmp(s, yes[i]) == 0) return *out = 1, 0;
+        if (strcmp(s, no[i]) == 0) return *out = 0, 0;
+    }
+    return -1;
+}
+
+/* ---- names: sections, plugins, backends ----------------------------------- */
+
+/* A backend name SILC knows: one of ld_known_backends or one a loaded plugin
+ * provides (third-party plugins are configurable too). */
+static int backend_known(const silc_engine *E, const char *name)
+{
+    size_t i;
+    for (i = 0; ld_known_backends[i]; i++)
+        if (strcmp(ld_known_backends[i], name) == 0) return 1;
+    return ld_find(E, name) != NULL;
+}
+
+/* Every configurable backend name, for suggestions; *out is malloc'd. */
+static size_t backend_candidates(const silc_engine *E, const char ***out)
+{
+    const char **loaded = NULL, **all;
+    size_t nl = ld_backend_names(E, &loaded), nk = count_names(ld_known_backends), i;
+    all = malloc((nk + nl + 1) * sizeof *all);
+    if (!all) {
+        free(loaded);
+        *out = NULL;
+        return 0;
+    }
+    for (i = 0; i < nk; i++) all[i] = ld_known_backends[i];
+    for (i = 0; i < nl; i++) all[nk + i] = loaded[i];
+    free(loaded);
+    *out = all;
+    return nk + nl;
+}
+
+/* A name like "umfpack" is far (by edit distance) from "suitesparse.umfpack"
+ * yet plainly meant it: the part after the dot is compared too, exactly and
+ * then by edit distance, after the full names. */
+static const char *suggest_backend(const silc_engine *E, const char *name)
+{
+    const char **cands, **tails;
+    const char *best = NULL, *tail;
+    size_t n = backend_candidates(E, &cands), i;
+    tails = malloc((n + 1) * sizeof *tails);
+    for (i = 0; i < n; i++) {
+        const char *dot = strchr(cands[i], '.');
+        if (tails) tails[i] = dot ? dot + 1 : NULL;
+        if (dot && strcmp(dot + 1, name) == 0 && !best) best = cands[i];
+    }
+    if (!best) best = util_closest(name, cands, n);
+    if (!best && tails && (tail = util_closest(name, tails, n)) != NULL)
+        for (i = 0; i < n && !best; i++)
+            if (tails[i] == tail) best = cands[i];
+    free(tails);
+    free(cands);
+    return best;
+}
+
+/* Reports an unknown backend; `where` says which key named it. */
+static int unknown_backend(silc_engine *E, const char *name, const char *where)
+{
+    const char *best = suggest_backend(E, name);
+    if (best)
+        return eng_error(E, "unknown backend '%s' in %s; did you mean '%s'?", name, where, best);
+    return eng_error(E, "unknown backend '%s' in %s (known: reference, lapack, "
+                        "suitesparse.umfpack, suitesparse.cholmod, suitesparse.klu, "
+                        "suitesparse.spqr, mumps, petsc, lis-style)", name, where);
+}
+
+/* Plugin part ("suitesparse") of a known backend name, into out. */
+static void plugin_part(const char *backend, char *out, size_t outlen)
+{
+    const char *dot = strchr(backend, '.');
+    trim_copy(out, outlen, backend, dot ? (size_t)(dot - backend) : strlen(backend));
+}
+
+/* 1 if section names a plugin SILC knows of (installed or not). */
+static int plugin_known(const char *section)
+{
+    char buf[64];
+    size_t i;
+    for (i = 0; ld_known_backends[i]; i++) {
+        plugin_part(ld_known_backends[i], buf, sizeof buf);
+        if (strcmp(buf, section) == 0) return 1;
+    }
+    return 0;
+}
+
+static int unknown_section(silc_engine *E, const char *section)
+{
+    /* Fixed sections, known plugins, loaded plugins: all valid section names. */
+    char known[16][64];
+    const char *cands[16 + 64];
+    size_t n = 0, nk = 0, i, np = ld_plugin_count(E);
+    const char *best;
+    cands[n++] = "dispatch";
+    cands[n++] = "tune";
+    cands[n++] = "core";
+    cands[n++] = "solve";
+    for (i = 0; ld_known_backends[i] && nk < 16; i++) {
+        plugin_part(ld_known_backends[i], known[nk], sizeof known[nk]);
+        cands[n++] = known[nk++];
+    }
+    for (i = 0; i < np && n < sizeof cands / sizeof cands[0]; i++)
+        cands[n++] = ld_plugin_at(E, i)->table->name;
+    best = util_closest(section, cands, n);
+    if (best) return eng_error(E, "unknown section [%s]; did you mean [%s]?", section, best);
+    return eng_error(E, "unknown section [%s] (sections: dispatch, tune, core, solve, or a plugin name)",
+                     section);
+}
+
+static int unknown_key(silc_engine *E, const char *section, const char *name,
+                       const char *const *keys, size_t nkeys)
+{
+    const char *best = util_closest(name, keys, nkeys);
+    if (best) return eng_error(E, "unknown key '%s.%s'; did you mean '%s.%s'?", section, name,
+                               section, best);
+    return eng_error(E, "unknown key '%s.%s'", section, name);
+}
+
+/* ---- value checks ---------------------------------------------------------- */
+
+/* A comma list of backend names; writes the normalised list "a, b, c" to norm. */
+static int check_backend_list(silc_engine *E, const char *key, const char *value, strbuf *norm)
+{
+    const char *p = value;
+    int count = 0;
+    for (;;) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        char name[128];
+        trim_copy(name, sizeof name, p, len);
+        if (!name[0])
+            return eng_error(E, "%s: empty backend name in list '%s'", key, value);
+        if (!backend_known(E, name)) return unknown_backend(E, name, key);
+        if (++count > CFG_MAX_LIST)
+            return eng_error(E, "%s: more than %d backends listed", key, CFG_MAX_LIST);
+        if ((count > 1 && sb_puts(norm, ", ")) || sb_puts(norm, name))
+            return eng_error(E, "out of memory setting '%s'", key);
+        if (!comma) break;
+        p = comma + 1;
+    }
+    return 0;
+}
+
+static int check_threads(silc_engine *E, const char *key, const char *value)
+{
+    int64_t n;
+    if (strcmp(value, "auto") == 0) return 0;
+    if (parse_int(value, &n) || n < 1 || n > 4096)
+        return eng_error(E, "%s expects 'auto' or a thread count from 1 to 4096, got '%s'", key,
+                         value);
+    return 0;
+}
+
+static int check_option(silc_engine *E, const silc_plugin *pl, const char *name,
+                        const char *value)
+{
+    const char **keys;
+    int i;
+    int64_t iv;
+    double dv;
+    const silc_option_spec *spec = NULL;
+    for (i = 0; i < pl->n_options; i++)
+        if (strcmp(pl->options[i].key, name) == 0) spec = &pl->options[i];
+    if (!spec) {
+        const char *best = NULL;
+        keys = malloc((size_t)(pl->n_options + 1) * sizeof *keys);
+        if (keys) {
+            for (i = 0; i < pl->n_options; i++) keys[i] = pl->options[i].key;
+            best = util_closest(name, keys, (size_t)pl->n_options);
+        }
+        if (best)
+            eng_error(E, "plugin '%s' has no option '%s'; did you mean '%s'?", pl->name, name, best);
+        else if (pl->n_options == 0)
+            eng_error(E, "plugin '%s' has no option '%s' (it takes no options)", pl->name, name);
+        else
+            eng_error(E, "plugin '%s' has no option '%s'", pl->name, name);
+        free(keys);
+        return -1;
+    }
+    switch (spec->type) {
+    case SILC_OPT_INT:
+        if (parse_int(value, &iv))
+            return eng_error(E, "option '%s.%s' expects an integer, got '%s'", pl->name, name, value);
+        break;
+    case SILC_OPT_DOUBLE:
+        if (parse_double(value, &dv))
+            return eng_error(E, "option '%s.%s' expects a number, got '%s'", pl->name, name, value);
+        break;
+    case SILC_OPT_BOOL:
+        if (parse_bool(value, &iv))
+            return eng_error(E, "option '%s.%s' expects true or false, got '%s'", pl->name, name,
+                             value);
+        break;
+    default:
+        break;
+    }
+    return 0;
+}
+
+/* value as the one to store (norm), or "out of memory" (a short value
+ * stored silently would be another setting). */
+static int keep_value(silc_engine *E, strbuf *norm, const char *section, const char *name,
+                      const char *value)
+{
+    if (sb_puts(norm, value) == 0) return 0;
+    return eng_error(E, "out of memory setting '%s%s%s'", section, section[0] ? "." : "", name);
+}
+
+/* Validates section.name = value; on success norm holds the value to store. */
+static int check_key(silc_engine *E, int scope, const char *section, const char *name,
+                     const char *value, strbuf *norm)
+{
+    const ld_plugin *pl;
+    double acc;
+    if (!section[0]) {
+        if (strcmp(name, "backend") == 0) {
+            if (scope != CFG_SCOPE_CALL)
+                return eng_error(E, "'backend' forces a backend for one call only; use "
+                                    "dispatch.<class> to change the default");
+            if (!backend_known(E, value)) return unknown_backend(E, value, "option 'backend'");
+            return keep_value(E, norm, section, name, value);
+        }
+        return eng_error(E, "key '%s' has no section (write section.key, e.g. tune.threads)",
+                         name);
+    }
+    if (!name[0]) return eng_error(E, "key '%s.' names no option", section);
+    if (!value[0]) return eng_error(E, "%s.%s: empty value", section, name);
+    if (strcmp(section, "dispatch") == 0) {
+        char key[160];
+        size_t nc = count_names(disp_class_names), i;
+        for (i = 0; i < nc; i++)
+            if (strcmp(disp_class_names[i], name) == 0) break;
+        if (i == nc) {
+            const char *best = util_closest(name, disp_class_names, nc);
+            if (best)
+                return eng_error(E, "unknown dispatch class '%s'; did you mean '%s'?", name, best);
+            return eng_error(E, "unknown dispatch class '%s'", name);
+        }
+        snprintf(key, sizeof key, "dispatch.%s", name);
+        return check_backend_list(E, key, value, norm);
+    }
+    if (strcmp(section, "tune") == 0) {
+        if (strcmp(name, "threads") == 0) {
+            if (check_threads(E, "tune.threads", value)) return -1;
+        } else if (strcmp(name, "accuracy") == 0) {
+            if (parse_double(value, &acc) || acc <= 0 || acc >= 1)
+                return eng_error(E, "tune.accuracy expects a number between 0 and 1, got '%s'",
+                                 value);
+        } else if (strcmp(name, "budget") == 0) {
+            if (parse_double(value, &acc) || acc <= 0 || acc > 1)
+                return eng_error(E, "tune.budget expects a share of the run above 0 and at most 1, "
+                                    "got '%s'", value);
+        } else if (strcmp(name, "max_threads") == 0) {
+            if (check_threads(E, "tune.max_threads", value)) return -1;
+        } else if (strcmp(name, "wisdom") != 0) {
+            return unknown_key(E, section, name, tune_keys, 5);
+        }
+        return keep_value(E, norm, section, name, value);
+    }
+    if (strcmp(section, "core") == 0) {
+        if (strcmp(name, "threads") == 0) {
+            if (check_threads(E, "core.threads", value)) return -1;
+        } else if (strcmp(name, "plugin_path") != 0) {
+            return unknown_key(E, section, name, core_keys, 2);
+        }
+        return keep_value(E, norm, section, name, value);
+    }
+    if (strcmp(section, "solve") == 0) {
+        int64_t steps;
+        if (strcmp(name, "refine") == 0) {
+            if (parse_int(value, &steps) || steps < 0 || steps > 100)
+                return eng_error(E, "solve.refine expects a number of refinement steps from 0 to "
+                                    "100, got '%s'", value);
+        } else if (strcmp(name, "refine_residual") == 0) {
+            if (strcmp(value, "double") != 0 && strcmp(value, "extended") != 0)
+                return eng_error(E, "solve.refine_residual expects 'double' or 'extended', got '%s'",
+                                 value);
+        } else if (strcmp(name, "backward_error") == 0) {
+            if (strcmp(value, "always") != 0 && strcmp(value, "deferred") != 0 &&
+                strcmp(value, "on_request") != 0)
+                return eng_error(E, "solve.backward_error expects 'deferred', 'always' or "
+                                    "'on_request', got '%s'", value);
+        } else if (strcmp(name, "initial_guess") == 0) {
+            if (strcmp(value, "auto") != 0 && strcmp(value, "previous") != 0 && strcmp(value, "zero") != 0)
+                return eng_error(E, "solve.initial_guess expects 'auto', 'previous' or 'zero', got '%s'",
+                                 value);
+        } else if (strcmp(name, "verify") == 0) {
+            if (strcmp(value, "auto") != 0 && strcmp(value, "off") != 0 &&
+                (parse_double(value, &acc) || acc <= 0 || acc >= 1))
+                return eng_error(E, "solve.verify expects 'auto', 'off' or a backward error between 0 and 1, "
+                                    "got '%s'", value);
+        } else {
+            return unknown_key(E, section, name, solve_keys, 5);
+        }
+        return keep_value(E, norm, section, name, value);
+    }
+    pl = ld_find_plugin(E, section);
+    if (pl) {
+        if (check_option(E, pl->table, name, value)) return -1;
+        return keep_value(E, norm, section, name, value);
+    }
+    if (plugin_known(section)) return keep_value(E, norm, section, name, value);
+    return unknown_section(E, section);
+}
+
+/* ---- the database ---------------------------------------------------------- */
+
+static void free_list(cfg_entry *e)
+{
+    while (e) {
+        cfg_entry *next = e->next;
+        free(e->key);
+        free(e->value);
+        free(e);
+        e = next;
+    }
+}
+
+static cfg_entry **find_slot(cfg_db *db, int scope, const char *key)
+{
+    cfg_entry **pe;
+    for (pe = &db->scope[scope]; *pe; pe = &(*pe)->next)
+        if (strcmp((*pe)->key, key) == 0) break;
+    return pe;
+}
+
+/* Stores key = value in scope (replacing an earlier value of that key). */
+static int store_value(silc_engine *E, int scope, const char *key, const char *value)
+{
+    cfg_entry **pe = find_slot(E->cfg, scope, key), *e;
+    char *v = util_strdup(value);
+    if (!v) return eng_error(E, "out of memory setting '%s'", key);
+    if (*pe) {
+        free((*pe)->value);
+        (*pe)->value = v;
+        return 0;
+    }
+    e = calloc(1, sizeof *e);
+    if (!e || !(e->key = util_strdup(key))) {
+        free(e);
+        free(v);
+        return eng_error(E, "out of memory setting '%s'", key);
+    }
+    e->value = v;
+    *pe = e;
+    return 0;
+}
+
+int cfg_create(silc_engine *E)
+{
+    E->cfg = calloc(1, sizeof *E->cfg);
+    if (!E->cfg) return eng_error(E, "out of memory creating the options database");
+    return 0;
+}
+
+void cfg_destroy(silc_engine *E)
+{
+    int s;
+    if (!E || !E->cfg) return;
+    for (s = 0; s < 3; s++) free_list(E->cfg->scope[s]);
+    free(E->cfg);
+    E->cfg = NULL;
+}
+
+/* Checks and stores section.name = value.  Loading plugins named by
+ * core.plugin_path right away lets the rest of the same file configure them. */
+static int set_parts(silc_engine *E, int scope, const char *section, const char *name,
+                     const char *value)
+{
+    strbuf norm, key;
+    int rc;
+    if (scope < CFG_SCOPE_FILE || scope > CFG_SCOPE_CALL)
+        return eng_error(E, "invalid option scope %d", scope);
+    sb_init(&norm);
+    sb_init(&key);
+    rc = check_key(E, scope, section, name, value, &norm);
+    if (rc == 0 && (section[0] ? sb_printf(&key, "%s.%s", section, name) : sb_puts(&key, name)))
+        rc = eng_error(E, "out of memory setting '%s%s%s'", section, section[0] ? "." : "", name);
+    else if (rc == 0)
+        rc = store_value(E, scope, sb_str(&key), sb_str(&norm));
+    if (rc == 0 && strcmp(section, "core") == 0 && strcmp(name, "plugin_path") == 0)
+        rc = ld_load_path(E, value);
+    sb_free(&norm);
+    sb_free(&key);
+    return rc ? -1 : 0;
+}
+
+int cfg_set(silc_engine *E, int scope, const char *key, const char *value)
+{
+    char k[256], v[4096], section[128];
+    const char *dot;
+    if (!E || !key || !value) return -1;
+    trim_copy(k, sizeof k, key, strlen(key));
+    trim_copy(v, sizeof v, value, strlen(value));
+    if (!k[0]) return eng_error(E, "empty option key");
+    dot = strchr(k, '.');
+    /* The solve knobs read naturally without their section:
+     * solve(A, b, "refine = 2"). */
+    if (!dot && in_list(k, solve_keys, sizeof solve_keys / sizeof solve_keys[0]))
+        return set_parts(E, scope, "solve", k, v);
+    if (!dot) return set_parts(E, scope, "", k, v);
+    trim_copy(section, sizeof section, k, (size_t)(dot - k));
+    return set_parts(E, scope, section, dot + 1, v);
+}
+
+int cfg_set_call_options(silc_engine *E, const char *text)
+{
+    const char *p = text;
+    cfg_clear_call_options(E);
+    if (!text) return 0;
+    while (*p) {
+        size_t len = strcspn(p, ";\n");
+        char item[4096], *eq;
+        trim_copy(item, sizeof item, p, len);
+        p += len;
+        if (*p) p++;
+        if (!item[0]) continue;
+        eq = strchr(item, '=');
+        if (!eq) {
+            cfg_clear_call_options(E);
+            return eng_error(E, "option '%s' needs the form key = value", item);
+        }
+        *eq = '\0';
+        if (cfg_set(E, CFG_SCOPE_CALL, item, eq + 1)) {
+            cfg_clear_call_options(E);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void cfg_clear_call_options(silc_engine *E)
+{
+    if (!E || !E->cfg) return;
+    free_list(E->cfg->scope[CFG_SCOPE_CALL]);
+    E->cfg->scope[CFG_SCOPE_CALL] = NULL;
+}
+
+const char *cfg_get(const silc_engine *E, const char *key)
+{
+    int s;
+    if (!E || !E->cfg || !key) return NULL;
+    for (s = CFG_SCOPE_CALL; s >= CFG_SCOPE_FILE; s--) {
+        cfg_entry *e = *find_slot(E->cfg, s, key);
+        if (e) return e->value;
+    }
+    return NULL;
+}
+
+void cfg_list(const silc_engine *E, strbuf *b)
+{
+    int s;
+    if (!E || !E->cfg) return;
+    for (s = CFG_SCOPE_FILE; s <= CFG_SCOPE_CALL; s++) {
+        const cfg_entry *e;
+        for (e = E->cfg->scope[s]; e; e = e->next) {
+            /* A key shadowed by a narrower scope is shown but marked. */
+            int t, shadowed = 0;
+            for (t = s + 1; t <= CFG_SCOPE_CALL; t++)
+                if (*find_slot(E->cfg, t, e->key)) shadowed = 1;
+            sb_printf(b, "%s = %s  (%s%s)\n", e->key, e->value, scope_names[s],
+                      shadowed ? ", overridden" : "");
+        }
+    }
+}
+
+/* ---- the INI file ---------------------------------------------------------- */
+
+/* inih (as packaged) does not pass line numbers to the handler, so the reader
+ * counts them. */
+typedef struct file_ctx {
+    silc_engine *E;
+    FILE *fp;
+    const char *path;
+    int line;
+    int err_line;          /* line of the first rejected key or line, 0 if none */
+    char err[sizeof ((silc_engine *)0)->err];
+} file_ctx;
+
+/* Hands inih one whole line.  inih reads into a buffer of its build's
+ * INI_MAX_LINE bytes (num) and would silently cut a longer line, or take its
+ * rest as the next line; and a NUL byte would hide the rest of its line.
+ * Either ends the file here with an error naming the line. */
+static char *file_reader(char *str, int num, void *stream)
+{
+    file_ctx *c = stream;
+    int len = 0, ch = 0;
+    if (c->err_line) return NULL;          /* nothing after the first error */
+    while (len < num - 1 && (ch = getc(c->fp)) != EOF) {
+        if (ch == 0) {
+            c->err_line = c->line + 1;
+            snprintf(c->err, sizeof c->err, "a NUL byte: not a text file");
+            return NULL;
+        }
+        str[len++] = (char)ch;
+        if (ch == '\n') break;
+    }
+    if (len == 0) return NULL;
+    str[len] = 0;
+    c->line++;
+    if (ch != '\n' && len == num - 1) {
+        ch = getc(c->fp);                  /* a line of exactly num - 1 characters? */
+        if (ch != EOF && ch != '\n') {
+            c->err_line = c->line;
+            snprintf(c->err, sizeof c->err, "line longer than %d characters (the INI reader's limit)", num - 1);
+            return NULL;
+        }
+    }
+    return str;
+}
+
+static int file_handler(void *user, const char *section, const char *name, const char *value)
+{
+    file_ctx *c = user;
+    if (c->err_line) return 0; /* keep the first error; apply nothing after it */
+    if (!name) return 1;
+    /* Before any [section] the flat form "tune.threads = 4" is allowed. */
+    if (section && section[0]) {
+        if (set_parts(c->E, CFG_SCOPE_FILE, section, name, value ? value : "") == 0) return 1;
+    } else if (cfg_set(c->E, CFG_SCOPE_FILE, name, value ? value : "") == 0) {
+        return 1;
+    }
+    c->err_line = c->line;
+    memcpy(c->err, c->E->err, sizeof c->err);
+    return 0;
+}
+
+int cfg_load_file(silc_engine *E, const char *path)
+{
+    file_ctx c;
+    int rc;
+    memset(&c, 0, sizeof c);
+    c.E = E;
+    c.path = path;
+    c.fp = fopen(path, "r");
+    if (!c.fp) return eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
+    rc = ini_parse_stream(file_reader, &c, file_handler, &c);
+    fclose(c.fp);
+    if (rc < 0) return eng_error(E, "%s: out of memory reading the config file", path);
+    /* the first error wins: inih's syntax errors are numbered as ours */
+    if (c.err_line && (rc == 0 || rc == c.err_line))
+        return eng_error(E, "%s:%d: %s", path, c.err_line, c.err);
+    if (rc == 0) return 0;
+    return eng_error(E, "%s:%d: syntax error (expected '[section]' or 'key = value')", path, rc);
+}

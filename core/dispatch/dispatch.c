@@ -1,0 +1,824 @@
+/*
+ * dispatch.c -- from an operation to the backend that runs it.
+ *
+ * Every call gets a chain of operation classes, most specific first (a solve
+ * with a symmetric, positive-diagonal sparse matrix is "solve.sparse.spd",
+ * then "solve.sparse").  The class chain picks an ordered list of backends:
+ * a per-call "backend = X", else the first class of the chain that the
+ * configuration names (so a config that only sets solve.sparse governs SPD
+ * systems too), else the built-in default, which follows the structure rules
+ * users know from MATLAB's `\`.  The list is walked: a backend that is not
+ * installed, does not provide the operation, or declines the operands is
+ * skipped; a Cholesky that finds the matrix not positive definite sends the
+ * same list round again under the general class (LU); any other failure stops
+ * with the backend's message.  The reference plugin ends every list, so an
+ * operation always has somewhere to go.
+ *
+ * Every solve gets the same accuracy report whoever ran it: the backward error
+ * comes from accuracy.c, so backends are judged by one yardstick.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "dispatch.h"
+#include "accuracy.h"
+#include "dist.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const disp_class_names[] = {
+    "solve.diag", "solve.triangular", "solve.band", "solve.dense", "solve.dense.spd",
+    "solve.sparse", "solve.sparse.spd", "solve.sparse.mmatrix.spd", "solve.rect", "matmul.sparse_sparse",
+    "matmul.sparse_dense", "matmul.dense", "add", "elementwise", "transpose", "reduce",
+    "convert", "diag", NULL};
+
+static const char *const op_names[SILC_OP_COUNT] = {
+    "add", "scale", "matmul", "elementwise", "map", "transpose", "solve", "reduce", "convert",
+    "diag"};
+
+/* Built-in backend lists; a class not listed uses the reference alone.
+ * The sparse lists follow bench/backends on this machine (docs/backends.md,
+ * one thread): CHOLMOD was fastest on the largest SPD problem (the 2-D
+ * Laplacian, 250000 unknowns: 1.3 s against UMFPACK 1.9, MUMPS 2.4, KLU 3.0),
+ * UMFPACK fastest of the LU libraries on grid-like systems and on bayer10;
+ * KLU wins memplus (circuit) but fills badly on grids and missed the 1e-12
+ * backward error on bayer10, so it is not a default.  MUMPS follows UMFPACK
+ * for solve.sparse. */
+static const struct {
+    const char *cls;
+    const char *list;
+} default_lists[] = {
+    {"solve.diag", "reference"},
+    {"solve.triangular", "lapack, reference"},
+    {"solve.band", "lapack, reference"},
+    {"solve.dense", "lapack, reference"},
+    {"solve.dense.spd", "lapack, reference"},
+    {"solve.sparse", "suitesparse.umfpack, mumps, reference"},
+    {"solve.sparse.spd", "suitesparse.cholmod, suitesparse.umfpack, reference"},
+    {"solve.sparse.mmatrix.spd", "lis-style, suitesparse.cholmod, suitesparse.umfpack, reference"},
+    {"solve.rect", "suitesparse.spqr, lapack, reference"},
+};
+
+/* For a solve whose operands are distributed (dist.h), the built-in lists
+ * start with the backends that solve on the row blocks where they lie --
+ * MUMPS (AMF ordering, the fastest of PETSc's direct packages here:
+ * docs/distributed.md), then PETSc -- before the sequential ones, which
+ * would gather the matrix to every rank. */
+static const struct {
+    const char *cls;
+    const char *list;
+} distributed_lists[] = {
+    {"solve.sparse", "mumps, petsc, suitesparse.umfpack, reference"},
+    {"solve.sparse.spd", "mumps, petsc, suitesparse.cholmod, suitesparse.umfpack, reference"},
+};
+
+#define DISP_MAX_LIST 33 /* the config's 32 plus the appended reference */
+
+/* The backends to try for one call, and where the list came from. */
+typedef struct blist {
+    char buf[1024];
+    const char *names[DISP_MAX_LIST];
+    int n;
+    int forced;             /* per-call backend = X: no fallback */
+    int nlisted;            /* names the configuration or default listed (then "reference") */
+    char source[192];
+} blist;
+
+/* ---- classes --------------------------------------------------------------- */
+
+/* solve.sparse.mmatrix.spd is the first solve with a large symmetric
+ * M-matrix (a Stieltjes matrix: positive diagonal, off-diagonal entries
+ * <= 0, like every diffusion stencil).  Its default sends it to lis-style's
+ * CG + SA-AMG, stopped at a backward error of 1e-12, before CHOLMOD: on the
+ * 2-D Laplacian that is 4-5x cheaper than a Cholesky factorization from
+ * 10 000 unknowns up (docs/backends.md), and algebraic multigrid is built
+ * for exactly these matrices.  A second solve with the same A is
+ * solve.sparse.spd, where a factorization reused for every later solve is
+ * what pays: a time loop pays for one AMG solve more than it would have. */
+#define MMATRIX_MIN_N 10000
+#define SOLVED_KEY "dispatch.solved" /* attached to A by its first sparse solve */
+
+static int mmatrix_first_solve(const silc_value *A)
+{
+    silc_view v;
+    int64_t i, k;
+    if (A->format != SILC_FMT_CSR || A->n < MMATRIX_MIN_N || val_attach_get(A, SOLVED_KEY)) return 0;
+    val_view(A, &v);
+    for (i = 0; i < v.m; i++)
+        for (k = v.rowptr[i]; k < v.rowptr[i + 1]; k++)
+            if (v.colind[k] != i && !(v.val[k] <= 0)) return 0;
+    return 1;
+}
+
+/* After a sparse solve with A succeeded: A's next solve is a repeat. */
+static void note_solved(const silc_call *call)
+{
+    static char solved; /* a marker: the attachment's presence is the fact */
+    const silc_value *A = call->in[0];
+    if (call->op == SILC_OP_SOLVE && A->format == SILC_FMT_CSR && !val_attach_get(A, SOLVED_KEY))
+        val_attach_set(A, SOLVED_KEY, &solved, NULL); /* out of memory: the next solve is a "first" again */
+}
+
+/* 1 for a class whose backends try Cholesky first (silc_plugin.h). */
+static int spd_class(const char *cls)
+{
+    size_t n = strlen(cls);
+    return n >= 4 && !strcmp(cls + n - 4, ".spd");
+}
+
+/* 1 when the configuration (or the call's options) names a backend list
+ * for a sparse solve class and none for solve.band: then a banded CSR
+ * matrix is the user's sparse system, not LAPACK's band one (a config that
+ * says `solve.sparse = lis-style` means every sparse solve). */
+static int sparse_governs_band(const silc_engine *E)
+{
+    return E && !cfg_get(E, "dispatch.solve.band") &&
+           (cfg_get(E, "dispatch.solve.sparse") || cfg_get(E, "dispatch.solve.sparse.spd"));
+}
+
+/* The class chain of call, with a readable reason in why (may be NULL). */
+static int classify(const silc_engine *E, const silc_call *call, const char *out[4], char *why, size_t whylen)
+{
+    const silc_value *A, *B;
+    const silc_props *p;
+    const char *reason;
+    char band_reason[160];
+    int sparse, banded = 0, n = 0;
+    if (why && whylen) why[0] = '\0';
+    if (!call || call->op < 0 || call->op >= SILC_OP_COUNT || call->nin < 1 || !call->in[0])
+        return 0;
+    A = call->in[0];
+    B = call->nin > 1 ? call->in[1] : NULL;
+    switch (call->op) {
+    case SILC_OP_SOLVE:
+        p = val_props_part(A, SILC_PROPS_SHAPE); /* symmetry only if the shape leaves it open */
+        if (!p) return 0;
+        sparse = A->format == SILC_FMT_CSR;
+        if (A->m != A->n) {
+            out[n++] = "solve.rect";
+            reason = "not square (least squares)";
+        } else if (p->diagonal) {
+            out[n++] = "solve.diag";
+            reason = "diagonal";
+        } else if (p->lower || p->upper) {
+            out[n++] = "solve.triangular";
+            reason = p->lower ? "lower triangular" : "upper triangular";
+        } else if ((banded = A->format == SILC_FMT_BAND ||
+                             ((double)p->nnz >= 0.5 * (double)(p->kl + p->ku + 1) * (double)A->n &&
+                              2 * (p->kl + p->ku + 1) < A->n)) &&
+                   !(sparse && sparse_governs_band(E))) {
+            out[n++] = "solve.band";
+            snprintf(band_reason, sizeof band_reason, "banded (kl=%lld, ku=%lld)",
+                     (long long)p->kl, (long long)p->ku);
+            reason = band_reason;
+        } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric) {
+            /* (Not on an MPI engine: its lists start with the distributed solvers.) */
+            int mm = sparse && E && !E->dist && mmatrix_first_solve(A);
+            if (mm) out[n++] = "solve.sparse.mmatrix.spd";
+            out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
+            out[n++] = sparse ? "solve.sparse" : "solve.dense";
+            reason = mm ? (banded ? "banded, but a sparse class is configured and solve.band is not; symmetric "
+                                    "M-matrix (positive diagonal, off-diagonal entries <= 0), first solve with it"
+                                  : "symmetric M-matrix (positive diagonal, off-diagonal entries <= 0), first "
+                                    "solve with it")
+                 : banded ? "banded, but a sparse class is configured and solve.band is not; symmetric with "
+                            "positive diagonal"
+                          : "symmetric with positive diagonal";
+        } else if (banded) {
+            out[n++] = "solve.sparse";
+            reason = "banded, but a sparse class is configured and solve.band is not";
+        } else {
+            out[n++] = sparse ? "solve.sparse" : "solve.dense";
+            reason = why && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric
+                         ? "symmetric, some diagonal entry <= 0"
+                         : "general";
+        }
+        if (why && whylen) {
+            int k = snprintf(why, whylen, "A is %lldx%lld %s, %s -> %s", (long long)A->m,
+                             (long long)A->n, val_format_name(A->format), reason, out[0]);
+            for (int c = 1; c < n && k > 0 && (size_t)k < whylen; c++) {
+                int more = snprintf(why + k, whylen - (size_t)k, ", then %s", out[c]);
+                k = more > 0 ? k + more : -1;
+            }
+        }
+        return n;
+    case SILC_OP_MATMUL:
+        if (!B) return 0;
+        if (A->format == SILC_FMT_CSR && B->format == SILC_FMT_CSR) out[n++] = "matmul.sparse_sparse";
+        else if (A->format == SILC_FMT_CSR || B->format == SILC_FMT_CSR) out[n++] = "matmul.sparse_dense";
+        else out[n++] = "matmul.dense";
+        break;
+    case SILC_OP_ADD:
+    case SILC_OP_SCALE: out[n++] = "add"; break;
+    case SILC_OP_EWISE:
+    case SILC_OP_MAP: out[n++] = "elementwise"; break;
+    case SILC_OP_TRANSPOSE: out[n++] = "transpose"; break;
+    case SILC_OP_REDUCE: out[n++] = "reduce"; break;
+    case SILC_OP_CONVERT: out[n++] = "convert"; break;
+    case SILC_OP_DIAG: out[n++] = "diag"; break;
+    default: return 0;
+    }
+    if (why && whylen) snprintf(why, whylen, "%s -> %s", op_names[call->op], out[0]);
+    return n;
+}
+
+int disp_classes(silc_engine *E, const silc_call *call, const char *out[4])
+{
+    return classify(E, call, out, NULL, 0);
+}
+
+/* ---- backend lists --------------------------------------------------------- */
+
+static void split_list(blist *L, const char *text)
+{
+    char *p;
+    snprintf(L->buf, sizeof L->buf, "%s", text);
+    L->n = 0;
+    for (p = L->buf; p && L->n < DISP_MAX_LIST - 1;) {
+        char *comma = strchr(p, ','), *end;
+        if (comma) *comma = '\0';
+        while (*p == ' ' || *p == '\t') p++;
+        end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t')) *--end = '\0';
+        if (*p) L->names[L->n++] = p;
+        p = comma ? comma + 1 : NULL;
+    }
+}
+
+static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
+                         blist *L)
+{
+    int distributed = E->dist && dist_call_has(call);
+    const char *forced = cfg_get(E, "backend"), *text = NULL;
+    char key[160];
+    size_t i;
+    int c;
+    memset(L, 0, sizeof *L);
+    if (forced) {
+        split_list(L, forced);
+        L->nlisted = L->n;
+        L->forced = 1;
+        snprintf(L->source, sizeof L->source, "per-call option backend = %s", forced);
+        return;
+    }
+    for (c = 0; c < nchain && !text; c++) {
+        snprintf(key, sizeof key, "dispatch.%s", chain[c]);
+        text = cfg_get(E, key);
+        if (text) snprintf(L->source, sizeof L->source, "config key %s", key);
+    }
+    if (!text) {
+        text = "reference";
+        for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
+            if (strcmp(default_lists[i].cls, chain[0]) == 0) text = default_lists[i].list;
+        for (i = 0; distributed && i < sizeof distributed_lists / sizeof distributed_lists[0]; i++)
+            if (strcmp(distributed_lists[i].cls, chain[0]) == 0) text = distributed_lists[i].list;
+        snprintf(L->source, sizeof L->source, "built-in default for %s%s", chain[0],
+                 distributed ? ", distributed operands" : "");
+    }
+    split_list(L, text);
+    L->nlisted = L->n;
+    for (c = 0; c < L->n; c++)
+        if (strcmp(L->names[c], "reference") == 0) return;
+    L->names[L->n++] = "reference";
+}
+
+static int provides(const ld_backend *b, int op)
+{
+    return op < b->backend->n_ops && b->backend->ops[op].run != NULL;
+}
+
+static const char *status_text(int status)
+{
+    switch (status) {
+    case SILC_EARG: return "invalid operands";
+    case SILC_ENOMEM: return "out of memory";
+    case SILC_ESINGULAR: return "singular matrix";
+    case SILC_ENOTSPD: return "not positive definite";
+    case SILC_ENOTCONV: return "did not converge";
+    case SILC_EBREAKDOWN: return "iterative method broke down";
+    case SILC_EDECLINE: return "declined";
+    case SILC_ELIB: return "library failure";
+    case SILC_EUNSUP: return "not supported";
+    case SILC_EINTERNAL: return "internal error";
+    default: return "failed";
+    }
+}
+
+/* ---- the accuracy report --------------------------------------------------- */
+
+/* Completes the report of a solve that succeeded and warns about a result that
+ * deserves distrust.  -1 when the backward error could not be computed (out
+ * of memory): a result returned without it could hide an unsolved system. */
+static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
+{
+    silc_report *r = call->report;
+    double eps_cond;
+    if (cholesky_failed) {
+        char note[sizeof r->note];
+        snprintf(note, sizeof note, "Cholesky failed (not positive definite); used LU%s%.200s",
+                 r->note[0] ? "; " : "", r->note);
+        memcpy(r->note, note, sizeof note);
+    }
+    eps_cond = r->cond_est * DBL_EPSILON;
+    if (r->cond_est > 0 && eps_cond >= 1)
+        eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
+                 r->cond_est);
+    else if (r->cond_est > 0 && eps_cond > 1e-4)
+        eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
+                 r->cond_est);
+    acc_report(E, call, may_defer, cfg_get(E, "solve.backward_error"));
+    if (r->backward_error < 0 && r->backward_error != ACC_DEFERRED)
+        return eng_error(E, "out of memory computing the backward error of '\\'");
+    if (val_has_nonfinite(call->out))
+        eng_warn(E, "'\\': the result contains NaN or Inf (backend %s)", r->backend);
+    return 0;
+}
+
+/* ---- refinement (refine.c) -------------------------------------------------- */
+
+/* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
+ * with the call's class and options; NULL (and why in err) when it fails. */
+static silc_value *correction(const void *be, silc_engine *E, const silc_call *call, const silc_value *R,
+                              char *err, size_t errlen)
+{
+    const ld_backend *b = be;
+    silc_call c = *call;
+    silc_report rep;
+    host_call_ctx ctx;
+    int rc;
+    memset(&rep, 0, sizeof rep);
+    rep.cond_est = rep.rcond = -1;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.E = E;
+    ctx.backend = b;
+    c.in[1] = R;
+    c.out = NULL;
+    c.report = &rep;
+    c.host_private = &ctx;
+    rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
+    if (rc == SILC_OK && c.out && c.out->m == call->out->m && c.out->n == call->out->n)
+        return c.out;
+    val_release(c.out);
+    snprintf(err, errlen, "%s", ctx.err[0] ? ctx.err : "the correction solve failed");
+    return NULL;
+}
+
+/* Iterative refinement of call->out by backend b, at least at_least steps
+ * (refine_solve), with the settings of this call. */
+static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least)
+{
+    refine_how how;
+    how.steps = cfg_get(E, "solve.refine");
+    how.residual = cfg_get(E, "solve.refine_residual");
+    how.backend = b->full_name;
+    how.correct = correction;
+    how.ctx = b;
+    refine_solve(E, call, &how, at_least);
+}
+
+/* ---- running --------------------------------------------------------------- */
+
+/* One attempt of backend b; the report is reset for every attempt so nothing
+ * of a failed backend leaks into the one that succeeds. */
+static int run_one(silc_call *call, const ld_backend *b)
+{
+    double t0;
+    int rc;
+    call->out = NULL;
+    if (call->op == SILC_OP_SOLVE) {
+        memset(call->report, 0, sizeof *call->report);
+        call->report->cond_est = -1;
+        call->report->rcond = -1;
+    }
+    t0 = util_now();
+    rc = b->backend->ops[call->op].run(call);
+    if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
+        call->report->seconds = util_now() - t0;
+        snprintf(call->report->backend, sizeof call->report->backend, "%s", b->full_name);
+    }
+    if (rc != SILC_OK) {
+        val_release(call->out);
+        call->out = NULL;
+    }
+    return rc;
+}
+
+/* The listed backends after index i that might still take the call: a
+ * failure hands the call on only to those (the reference plugin that
+ * resolve_list appends to every list is a last resort for operations no
+ * listed backend provides, not a fallback for one that failed; a per-call
+ * `backend = X` of one name has nothing to fall back to). */
+static int fallback_left(const blist *L, int i)
+{
+    return i + 1 < L->nlisted;
+}
+
+/* A backend's failure, or a result that failed verification, recorded as
+ * one line of the chain's account; E->err holds the message. */
+static void note_attempt(silc_engine *E, strbuf *attempts, double seconds)
+{
+    sb_printf(attempts, "%s%s (%.3g s)", attempts->len ? "\n  " : "", E->err, seconds);
+}
+
+/* The backends that failed on a matrix, remembered with it (an attachment
+ * of A: it goes when A goes): a time loop that solves with the same A
+ * every step does not pay for the same failure every step.  A solve's
+ * failure can depend on its right-hand side (an iterative method's), but a
+ * backend that failed on A once is a poor first choice for it. */
+#define FAILED_KEY "dispatch.failed"
+
+/* Entries are "name\n", or "name?\n" for a result that failed
+ * verification, which counts only while solve.verify is on. */
+static int failed_before(silc_engine *E, const silc_value *A, const char *name)
+{
+    const char *list = val_attach_get(A, FAILED_KEY), *v;
+    size_t len = strlen(name);
+    int verifying;
+    if (!list) return 0; /* the usual case: nothing failed on A */
+    v = cfg_get(E, "solve.verify");
+    verifying = !(v && !strcmp(v, "off"));
+    for (; list && *list; list += strcspn(list, "\n") + (list[strcspn(list, "\n")] != 0))
+        if (!strncmp(list, name, len) &&
+            (list[len] == '\n' || !list[len] || (verifying && list[len] == '?')))
+            return 1;
+    return 0;
+}
+
+static void remember_failure(const silc_value *A, const char *name, int verification)
+{
+    const char *old = val_attach_get(A, FAILED_KEY);
+    size_t ol = old ? strlen(old) : 0, size = ol + strlen(name) + 3;
+    char *list = malloc(size);
+    if (!list) return; /* only a memory of the failure is lost */
+    snprintf(list, size, "%s%s%s\n", old ? old : "", name, verification ? "?" : "");
+    if (val_attach_set(A, FAILED_KEY, list, free)) free(list);
+}
+
+/* Drops the warnings added since mark: they were a discarded result's. */
+static void drop_warnings(silc_engine *E, size_t mark)
+{
+    E->warnings.len = mark;
+    if (E->warnings.s) E->warnings.s[mark] = 0;
+}
+
+/* The error of a chain whose every listed backend failed: each attempt's
+ * reason on a line of its own, the last one included. */
+static void chain_error(silc_engine *E, strbuf *attempts)
+{
+    char last[sizeof E->err];
+    if (!attempts->len) return;
+    snprintf(last, sizeof last, "%s", E->err);
+    eng_error(E, "every backend of the list failed:\n  %s\n  %s", sb_str(attempts), last);
+}
+
+/* Backend b, entry i of L, failed (E->err says why; verification: its
+ * result failed verification): 1 when the next listed backend takes over --
+ * the attempt is recorded, and remembered with A -- else 0, E->err then
+ * being the chain's error. */
+static int hand_over(silc_engine *E, const silc_call *call, const blist *L, int i, const ld_backend *b,
+                     strbuf *attempts, double seconds, int verification)
+{
+    if (!fallback_left(L, i)) {
+        chain_error(E, attempts);
+        return 0;
+    }
+    note_attempt(E, attempts, seconds);
+    if (!E->dist) remember_failure(call->in[0], b->full_name, verification);
+    return 1;
+}
+
+static int walk(silc_engine *E, silc_call *call, const char *const *chain, int nchain,
+                const blist *L, int may_defer)
+{
+    strbuf skipped, attempts;
+    dist_swap swap;
+    int ci, i, rc, cholesky_failed = 0;
+    sb_init(&skipped);
+    sb_init(&attempts);
+    for (ci = 0; ci < nchain; ci++) {
+        int next_class = 0;
+        for (i = 0; i < L->n && !next_class; i++) {
+            const ld_backend *b = ld_find(E, L->names[i]);
+            const char *why = NULL;
+            host_call_ctx ctx;
+            size_t warned = E->warnings.len;
+            double t0;
+            if (ci > 0 && i == 0) sb_printf(&skipped, "[%s] ", chain[ci]);
+            if (!b) {
+                sb_printf(&skipped, "%s not installed; ", L->names[i]);
+                continue;
+            }
+            if (!provides(b, call->op)) {
+                sb_printf(&skipped, "%s does not provide %s; ", b->full_name, op_names[call->op]);
+                continue;
+            }
+            if (call->op == SILC_OP_SOLVE && fallback_left(L, i) && failed_before(E, call->in[0], b->full_name)) {
+                sb_printf(&attempts, "%s%s: skipped: it failed on this matrix before", attempts.len ? "\n  " : "",
+                          b->full_name);
+                continue;
+            }
+            memset(&ctx, 0, sizeof ctx);
+            ctx.E = E;
+            ctx.backend = b;
+            call->host_private = &ctx;
+            call->op_class = chain[ci];
+            /* Distributed operands (dist.h): a collective backend runs on the
+             * row blocks on every rank; any other gets whole copies. */
+            if (dist_walk_begin(E, call, ld_backend_collective(b, call->op), &swap) < 0) {
+                call->host_private = NULL;
+                sb_free(&skipped);
+                sb_free(&attempts);
+                return SILC_ENOMEM;
+            }
+            ctx.collective = swap.mode == DIST_COLLECTIVE;
+            if (b->backend->ops[call->op].accepts && !b->backend->ops[call->op].accepts(call, &why)) {
+                sb_printf(&skipped, "%s declines: %s; ", b->full_name, why ? why : "no reason given");
+                dist_walk_end(call, &swap);
+                continue;
+            }
+            t0 = util_now();
+            {
+                /* An initial guess (in[2]) goes only to plugins that know of it (ABI 1.6). */
+                int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&
+                                 b->plugin->table->abi_minor < 6;
+                if (hide_guess) call->nin = 2;
+                rc = run_one(call, b);
+                if (hide_guess) call->nin = 3;
+            }
+            if (rc == SILC_OK && !call->out) {
+                rc = SILC_EINTERNAL;
+                snprintf(ctx.err, sizeof ctx.err, "reported success but returned no result");
+            }
+            if (ctx.collective) { /* every rank learns how every rank did */
+                if (rc != SILC_OK) eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
+                else E->err[0] = 0;
+                rc = dist_agree(E, rc);
+                if (rc != SILC_OK) {
+                    val_release(call->out);
+                    call->out = NULL;
+                    snprintf(ctx.err, sizeof ctx.err, "%.1000s", E->err);
+                }
+            }
+            if (rc == SILC_OK) {
+                double limit;
+                /* Hook (refine.c): iterative refinement as solve.refine asks,
+                 * by the backend that just solved, before the report (not
+                 * of a distributed solve: refine.c reads whole arrays). */
+                if (call->op == SILC_OP_SOLVE && !ctx.collective) refine(E, call, b, 0);
+                if (call->op == SILC_OP_SOLVE && ctx.collective) {
+                    int rk = dist_size(E);
+                    call->report->backward_error_unrefined = -1; /* no refinement ran */
+                    size_t l = strlen(call->report->note);
+                    if (!strstr(call->report->note, "ranks"))
+                        snprintf(call->report->note + l, sizeof call->report->note - l, "%son %d ranks",
+                                 l ? "; " : "", rk);
+                }
+                rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, may_defer);
+                dist_walk_end(call, &swap);
+                call->host_private = NULL;
+                if (rc) {
+                    val_release(call->out);
+                    call->out = NULL;
+                    sb_free(&skipped);
+                    sb_free(&attempts);
+                    return SILC_ENOMEM;
+                }
+                /* Verification: a result whose backward error says it does
+                 * not solve the system is a failure like any other (a
+                 * deferred one was verified with its factorization). */
+                limit = call->op == SILC_OP_SOLVE ? acc_verify_limit(cfg_get(E, "solve.verify"), call->report) : INFINITY;
+                if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
+                    !(call->report->backward_error <= limit) && call->report->iterations == 0 &&
+                    call->report->refine_steps == 0 && !ctx.collective && !E->dist &&
+                    isfinite(call->report->backward_error)) {
+                    /* A direct result that missed: refinement first, by the
+                     * same factorization (one triangular solve a step),
+                     * before the next backend factors afresh. */
+                    drop_warnings(E, warned);
+                    call->host_private = &ctx;
+                    refine(E, call, b, REFINE_RESCUE_STEPS);
+                    call->host_private = NULL;
+                    if (call->report->refine_steps > 0 && finish_solve(E, call, 0, 0)) {
+                        val_release(call->out);
+                        call->out = NULL;
+                        sb_free(&skipped);
+                        sb_free(&attempts);
+                        return SILC_ENOMEM;
+                    }
+                }
+                if (call->op == SILC_OP_SOLVE && call->report->backward_error != ACC_DEFERRED &&
+                    !(call->report->backward_error <= limit)) {
+                    eng_error(E, "%s: verification failed: backward error %.2g above %.2g (solve.verify)%s%s",
+                              b->full_name, call->report->backward_error, limit,
+                              call->report->iterations > 0 ? "; " : "",
+                              call->report->iterations > 0 ? call->report->method : "");
+                    val_release(call->out);
+                    call->out = NULL;
+                    drop_warnings(E, warned);
+                    if (hand_over(E, call, L, i, b, &attempts, util_now() - t0, 1)) continue;
+                    sb_free(&skipped);
+                    sb_free(&attempts);
+                    return SILC_ENOTCONV;
+                }
+                if (call->op == SILC_OP_SOLVE)
+                    snprintf(call->report->attempts, sizeof call->report->attempts, "%s", sb_str(&attempts));
+                sb_free(&skipped);
+                sb_free(&attempts);
+                return 0;
+            }
+            dist_walk_end(call, &swap);
+            if (rc == SILC_ENOTSPD && ci + 1 < nchain) {
+                /* The list again under the first class that is not SPD's
+                 * (the loop's ci++ moves to it). */
+                cholesky_failed = 1;
+                next_class = 1;
+                while (ci + 2 < nchain && spd_class(chain[ci + 1])) ci++;
+            } else if (rc == SILC_EDECLINE) {
+                sb_printf(&skipped, "%s declines: %s; ", b->full_name,
+                          ctx.err[0] ? ctx.err : "no reason given");
+            } else {
+                /* The message is prefixed with the backend, unless the
+                 * plugin already named itself ("lis-style BiCG: ..."). */
+                size_t bl = strlen(b->full_name);
+                if (rc == SILC_ENOMEM && *val_refusal())
+                    /* A value constructor that refused a size said how
+                     * large: that beats the plugin's "out of memory". */
+                    eng_error(E, "%s: %s", b->full_name, val_refusal());
+                else if ((strncmp(ctx.err, b->full_name, bl) == 0 && (ctx.err[bl] == ':' || ctx.err[bl] == ' ')) ||
+                         (ctx.collective && strncmp(ctx.err, "rank ", 5) == 0))
+                    eng_error(E, "%s", ctx.err);
+                else
+                    eng_error(E, "%s: %s", b->full_name, ctx.err[0] ? ctx.err : status_text(rc));
+                call->host_private = NULL;
+                drop_warnings(E, warned);
+                /* The next listed backend takes over (out of memory is
+                 * not the backend's fault: it stops the chain). */
+                if (rc == SILC_ENOMEM) chain_error(E, &attempts);
+                else if (hand_over(E, call, L, i, b, &attempts, util_now() - t0, 0)) continue;
+                sb_free(&skipped);
+                sb_free(&attempts);
+                return rc;
+            }
+        }
+        if (!next_class) break;
+    }
+    call->host_private = NULL;
+    /* Drop the trailing "; " of the last reason. */
+    if (skipped.len >= 2) skipped.s[skipped.len -= 2] = '\0';
+    eng_error(E, "no backend can run %s (%s): %s", op_names[call->op], chain[0], sb_str(&skipped));
+    chain_error(E, &attempts);
+    sb_free(&skipped);
+    sb_free(&attempts);
+    return SILC_EUNSUP;
+}
+
+/* 1 when classify asked whether a solve's A is symmetric and could not tell
+ * (out of memory), so chose a general class: going on with a general method
+ * instead of Cholesky would give other bits, or another explanation, than
+ * with memory to spare.  (With a `why`, classify asks twice, and the second
+ * time may have found A symmetric after all.) */
+static int symmetry_unknown(const silc_call *call, const char *const chain[4])
+{
+    const silc_value *A = call->in[0];
+    return call->op == SILC_OP_SOLVE && A->props.pos_diag &&
+           (!(A->props_have & SILC_PROPS_SYMMETRY) || A->props.symmetric) &&
+           !strcmp(chain[0], A->format == SILC_FMT_CSR ? "solve.sparse" : "solve.dense");
+}
+
+int disp_run(silc_engine *E, silc_call *call)
+{
+    const char *chain[4];
+    silc_report local;
+    blist L;
+    int n, rc, own_options;
+    if (!E || !call) return SILC_EARG;
+    call->out = NULL;
+    own_options = call->options != NULL;
+    if (own_options && cfg_set_call_options(E, call->options)) return SILC_EARG;
+    n = classify(E, call, chain, NULL, 0);
+    if (n == 0) {
+        eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
+        rc = SILC_EARG;
+    } else if (call->op == SILC_OP_SOLVE && (call->nin < 2 || !call->in[1])) {
+        eng_error(E, "solve needs a right-hand side");
+        rc = SILC_EARG;
+    } else if (symmetry_unknown(call, chain)) {
+        eng_error(E, "out of memory classifying the matrix of '\\'");
+        rc = SILC_ENOMEM;
+    } else if (call->op == SILC_OP_SOLVE &&
+               (refine_check_finite(E, call->in[0], 1, "the matrix") ||
+                refine_check_finite(E, call->in[1], 0, "the right-hand side"))) {
+        /* Hook (refine.c): NaN/Inf operands are an error before any backend runs. */
+        rc = SILC_EARG;
+    } else {
+        silc_report *saved = call->report;
+        scale_state S;
+        /* Read below whether or not scaling ran: unset, a distributed
+         * solve's ranks would disagree on deferring its backward error. */
+        memset(&S, 0, sizeof S);
+        /* A distributed system is not rescaled (scale.c copies whole arrays). */
+        int scaling = call->op == SILC_OP_SOLVE && !dist_call_has(call);
+        if (scaling && !call->report) call->report = &local;
+        /* Hook (scale.c): systems near 1e+-300 are solved scaled by 2^k. */
+        if (scaling && scale_solve_begin(E, call, &S)) {
+            rc = SILC_ENOMEM;
+        } else {
+            resolve_list(E, call, chain, n, &L);
+            /* A scaled solve's deferred residual would be formed unscaled,
+             * where it may overflow: no deferral then. */
+            rc = walk(E, call, chain, n, &L, E->accuracy_defer && !S.ea && !S.eb);
+            if (rc == SILC_OK && !E->dist) note_solved(call);
+            if (scaling && scale_solve_end(call, &S))
+                eng_warn(E, "'\\': the solution has entries beyond the largest double (returned as Inf); "
+                            "the backward error was measured before the final scaling by 2^%d",
+                         S.ea - S.eb);
+        }
+        call->report = saved;
+    }
+    if (own_options) cfg_clear_call_options(E);
+    return rc;
+}
+
+/* ---- explain --------------------------------------------------------------- */
+
+int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
+{
+    const char *chain[4];
+    char why[384];
+    silc_call c;
+    dist_swap swap;
+    blist L;
+    int n, i, chosen = 0;
+    if (!E || !call || !b) return -1;
+    if (call->options && cfg_set_call_options(E, call->options)) return -1;
+    n = classify(E, call, chain, why, sizeof why);
+    if (n == 0) {
+        if (call->options) cfg_clear_call_options(E);
+        return eng_error(E, "invalid call: operation %d with %d operand(s)", call->op, call->nin);
+    }
+    if (symmetry_unknown(call, chain)) {
+        if (call->options) cfg_clear_call_options(E);
+        return eng_error(E, "out of memory classifying the matrix of '\\'");
+    }
+    resolve_list(E, call, chain, n, &L);
+    sb_printf(b, "%s\n", why);
+    sb_printf(b, "backends (%s):", L.source);
+    for (i = 0; i < L.n; i++) sb_printf(b, "%s %s", i ? "," : "", L.names[i]);
+    sb_puts(b, "\n");
+    c = *call;
+    c.op_class = chain[0];
+    c.out = NULL;
+    for (i = 0; i < L.n && !chosen; i++) {
+        const ld_backend *be = ld_find(E, L.names[i]);
+        const char *reason = NULL;
+        host_call_ctx ctx;
+        if (!be) {
+            sb_printf(b, "  %s: not installed\n", L.names[i]);
+            continue;
+        }
+        if (!provides(be, call->op)) {
+            sb_printf(b, "  %s: does not provide %s\n", be->full_name, op_names[call->op]);
+            continue;
+        }
+        memset(&ctx, 0, sizeof ctx);
+        ctx.E = E;
+        ctx.backend = be;
+        c.host_private = &ctx;
+        /* As walk: a backend judges the operands it would get (gathered
+         * copies, kept with the values, when it is not collective). */
+        if (dist_walk_begin(E, &c, ld_backend_collective(be, c.op), &swap) < 0) {
+            if (call->options) cfg_clear_call_options(E);
+            return -1;
+        }
+        ctx.collective = swap.mode == DIST_COLLECTIVE;
+        if (be->backend->ops[call->op].accepts && !be->backend->ops[call->op].accepts(&c, &reason)) {
+            dist_walk_end(&c, &swap);
+            sb_printf(b, "  %s: declines: %s\n", be->full_name, reason ? reason : "no reason given");
+            continue;
+        }
+        dist_walk_end(&c, &swap);
+        sb_printf(b, "  %s -> would run%s\n", be->full_name,
+                  !E->dist || !dist_call_has(call) ? ""
+                  : ld_backend_collective(be, call->op) && call->op == SILC_OP_SOLVE
+                      ? " (collective, on the row blocks of every rank)"
+                      : " (sequential, on operands gathered to every rank)");
+        chosen = 1;
+    }
+    if (!chosen) sb_printf(b, "  no backend can run this\n");
+    else if (n > 1)
+        sb_printf(b, "  (if Cholesky finds A not positive definite, the list is tried again "
+                     "under %s)\n", chain[n - 1]);
+    if (chosen && fallback_left(&L, i - 1) && call->op == SILC_OP_SOLVE) {
+        const char *v = cfg_get(E, "solve.verify");
+        if (v && !strcmp(v, "off"))
+            sb_puts(b, "  (if it fails, the next listed backend takes over; solve.verify = off)\n");
+        else
+            sb_printf(b, "  (if it fails, or its result's backward error is above %s (solve.verify), the next "
+                         "listed backend takes over)\n",
+                      v && strcmp(v, "auto") ? v : "1e-6, or 10x an iterative method's tolerance");
+    }
+    if (call->options) cfg_clear_call_options(E);
+    return 0;
+}

@@ -1,0 +1,109 @@
+/*
+ * dispatch.h -- from an operation to the backend that runs it: the options
+ * database, the plugins, the host API handed to them and the dispatcher.
+ *
+ *   config.c    options database: config file (inih), `set`, per-call options;
+ *               key validation with "did you mean"
+ *   loader.c    plugins: built-in reference, dlopen(RTLD_NOW|RTLD_LOCAL) of the
+ *               rest, ABI checks, backend look-up by full name
+ *   host.c      the silc_host_api table handed to plugins
+ *   dispatch.c  operation class -> ordered backend list -> first that accepts;
+ *               fallbacks; accuracy report of every solve; `explain` text
+ *
+ * Below it are the accuracy machinery (accuracy.h) and the distributed layer
+ * (dist.h), which it calls; the plugins call back up only through the host
+ * API table.
+ */
+#ifndef SILC_DISPATCH_H
+#define SILC_DISPATCH_H
+
+#include "context.h"
+
+/* ---- config.c -------------------------------------------------------------- */
+enum cfg_scope { CFG_SCOPE_FILE = 0, CFG_SCOPE_SESSION = 1, CFG_SCOPE_CALL = 2 };
+/* Keys: dispatch.<class> (comma list of backend names), <plugin>.<option>
+ * (options the plugin lists), tune.threads, tune.accuracy, core.plugin_path,
+ * core.threads.  Unknown keys, unknown backends and ill-typed values are
+ * errors naming the closest valid key/backend. */
+int cfg_create(silc_engine *E);
+void cfg_destroy(silc_engine *E);
+int cfg_load_file(silc_engine *E, const char *path);
+int cfg_set(silc_engine *E, int scope, const char *key, const char *value);
+/* Parses "key = value; key = value" (newlines or ';' separate) into the call
+ * scope, replacing what was there.  "backend = NAME" is shorthand for forcing a
+ * backend for this call. */
+int cfg_set_call_options(silc_engine *E, const char *text);
+void cfg_clear_call_options(silc_engine *E);
+/* Value of key, the narrowest scope first; NULL if unset anywhere. */
+const char *cfg_get(const silc_engine *E, const char *key);
+/* Appends every set key with its value and scope to b (for `set` with no args). */
+void cfg_list(const silc_engine *E, strbuf *b);
+
+/* ---- loader.c -------------------------------------------------------------- */
+typedef struct ld_backend {
+    char *full_name;                /* "suitesparse.umfpack" */
+    const silc_backend *backend;
+    const struct ld_plugin *plugin;
+} ld_backend;
+
+typedef struct ld_plugin {
+    const silc_plugin *table;
+    void *handle;                   /* dlopen handle, NULL for built-in */
+    char *path;
+} ld_plugin;
+
+int ld_create(silc_engine *E);                 /* registers the built-in reference plugin */
+void ld_destroy(silc_engine *E);
+/* Loads one plugin file.  On refusal returns non-zero with E->err naming the
+ * file and the reason (wrong ABI major "plugin 2, host 1", index width, missing
+ * symbol, init failure with the plugin's message, no ops at all). */
+int ld_load_file(silc_engine *E, const char *path);
+/* Loads every libsilc_plugin_*.so in the directories of a ':'-separated list;
+ * refusals are logged as warnings, not errors. */
+int ld_load_path(silc_engine *E, const char *dirs);
+/* The plugin directory of the install this engine runs from (beside
+ * libsilc.so, or beside the bindir of a program that links the engine), if
+ * there is one: 0 and the path in out, else -1 (a build tree). */
+int ld_installed_plugin_dir(char *out, size_t len);
+const ld_backend *ld_find(const silc_engine *E, const char *full_name);
+size_t ld_backend_names(const silc_engine *E, const char ***names); /* malloc'd array */
+const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name);
+size_t ld_plugin_count(const silc_engine *E);
+const ld_plugin *ld_plugin_at(const silc_engine *E, size_t i);
+void ld_set_threads(silc_engine *E, int nthreads); /* every plugin's set_threads */
+/* 1 when b's plugin lists op among b's collective_ops (ABI 1.5): b runs it
+ * on the row blocks of every rank of an SPMD engine (dist.h). */
+int ld_backend_collective(const ld_backend *b, int op);
+/* Names every backend may be configured with, loaded or not (for suggestions
+ * and for telling "not installed" from "unknown"). */
+extern const char *const ld_known_backends[];
+
+/* ---- host.c ---------------------------------------------------------------- */
+const silc_host_api *host_api(void);
+/* The thread budget host->threads() reports; set by ld_set_threads. */
+void host_set_threads(int nthreads);
+/* Per-call bookkeeping behind call->host_private. */
+typedef struct host_call_ctx {
+    silc_engine *E;
+    const ld_backend *backend;      /* backend running the call (options prefix) */
+    char err[1024];
+    int status;
+    int collective;                 /* runs on the row blocks of every rank (dist.h) */
+} host_call_ctx;
+
+/* ---- dispatch.c ------------------------------------------------------------ */
+/* Runs call: picks the backend by class and configuration, falls back on
+ * SILC_EDECLINE / SILC_ENOTSPD, and for SOLVE fills call->report (backend, wall
+ * time, backward error computed by the core).  On failure E->err holds
+ * "<backend>: <message>" and call->out is NULL.  call->report may be NULL for
+ * non-solve ops.  Returns 0 or the failing silc_status. */
+int disp_run(silc_engine *E, silc_call *call);
+/* Appends to b what disp_run would do for call and why, without running it. */
+int disp_explain(silc_engine *E, const silc_call *call, strbuf *b);
+/* Class chain of a call, most specific first, e.g. {"solve.sparse.spd",
+ * "solve.sparse"}; returns the count (<= 4). */
+int disp_classes(silc_engine *E, const silc_call *call, const char *out[4]);
+/* Every class name that may appear in [dispatch] (for key validation). */
+extern const char *const disp_class_names[];
+
+#endif

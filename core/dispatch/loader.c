@@ -1,0 +1,536 @@
+/*
+ * loader.c -- the plugins of one engine: the built-in reference plugin, and
+ * shared objects found in configured directories.
+ *
+ * A plugin file is opened with dlopen(RTLD_NOW | RTLD_LOCAL) and nothing else:
+ * RTLD_GLOBAL would put every library a plugin pulls in (Debian's sequential
+ * MUMPS, PETSc's own MUMPS) into one global namespace where same-named symbols
+ * cross-bind and crash.  RTLD_NOW makes a missing dependency a load-time error
+ * with dlerror()'s text instead of a crash at first use.  Every table is
+ * checked before the plugin is accepted (ABI major, index width, table size,
+ * at least one operation) and a refused plugin is closed again, so nothing of
+ * it stays in the process.
+ *
+ * An accepted plugin belongs to the process, not to the engine that loaded it:
+ * it is opened and initialised once, shared by every context, and shut down at
+ * exit, never dlclose'd.  Libraries behind plugins (MPI, PETSc, the Fortran
+ * runtime under MUMPS, OpenMP) keep process-wide state and are not safe to
+ * unload or to shut down while another context still uses them.
+ */
+#define _GNU_SOURCE /* realpath, dladdr */
+#include "dispatch.h"
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <dlfcn.h>
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/lsan_interface.h>
+#endif
+
+/* The reference plugin is compiled into libsilc (plugin-reference/). */
+extern int silc_reference_plugin_init(const silc_host_api *host, const silc_plugin **out,
+                                      const char **errmsg);
+
+const char *const ld_known_backends[] = {
+    "reference", "lapack", "suitesparse.umfpack", "suitesparse.cholmod", "suitesparse.klu",
+    "suitesparse.spqr", "mumps", "petsc", "lis-style", "template", NULL};
+
+/* Every plugin the process has accepted, in load order. */
+static struct {
+    ld_plugin **items;
+    size_t n;
+    int exit_hook;
+} g_loaded;
+static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
+
+struct ld_set {
+    ld_plugin **plugins;        /* borrowed from g_loaded: backends point into them */
+    size_t nplugins;
+    ld_backend **backends;
+    size_t nbackends;
+};
+
+#define LD_FILE_PREFIX "libsilc_plugin_"
+#define LD_FILE_SUFFIX ".so"
+#define LD_REFERENCE_FILE "libsilc_plugin_reference.so"
+
+/* A table smaller than ABI 1.0's cannot be read safely; one absurdly large is
+ * not a table at all. */
+#define LD_MAX_STRUCT_SIZE ((size_t)1 << 16)
+
+static char *full_name(const silc_plugin *pl, const silc_backend *b)
+{
+    size_t len = strlen(pl->name) + (b->name ? strlen(b->name) + 1 : 0) + 1;
+    char *s = malloc(len);
+    if (!s) return NULL;
+    if (b->name) snprintf(s, len, "%s.%s", pl->name, b->name);
+    else snprintf(s, len, "%s", pl->name);
+    return s;
+}
+
+static int backend_has_ops(const silc_backend *b)
+{
+    int i;
+    if (!b->ops || b->n_ops <= 0) return 0;
+    for (i = 0; i < b->n_ops && i < SILC_OP_COUNT; i++)
+        if (b->ops[i].run) return 1;
+    return 0;
+}
+
+/* Checks a plugin's table; path is only for messages. */
+static int check_table(silc_engine *E, const silc_plugin *pl, const char *path)
+{
+    const char *name;
+    int i, any = 0;
+    if (!pl) return eng_error(E, "plugin %s: silc_plugin_init returned no table", path);
+    name = pl->name ? pl->name : "?";
+    if (pl->abi_major != SILC_ABI_MAJOR)
+        return eng_error(E, "plugin '%s' (%s) was built for ABI major %d, this host has %d", name,
+                         path, pl->abi_major, SILC_ABI_MAJOR);
+    if (pl->index_bytes != (int)sizeof(silc_index))
+        return eng_error(E, "plugin '%s' (%s) uses %d-byte indices, host uses %d", name, path,
+                         pl->index_bytes, (int)sizeof(silc_index));
+    /* A 1.0 table ends at shutdown; later fields are read only when present. */
+    if (pl->struct_size < offsetof(silc_plugin, collective_ops) || pl->struct_size > LD_MAX_STRUCT_SIZE)
+        return eng_error(E, "plugin '%s' (%s) has a table of %zu bytes, ABI %d.0 needs at least %zu",
+                         name, path, pl->struct_size, SILC_ABI_MAJOR, sizeof(silc_plugin));
+    if (!pl->name || !pl->name[0] || strchr(pl->name, '.'))
+        return eng_error(E, "plugin at %s has no valid name (non-empty, without '.')", path);
+    if (pl->n_options < 0 || (pl->n_options > 0 && !pl->options))
+        return eng_error(E, "plugin '%s' (%s) has an invalid option list", name, path);
+    for (i = 0; i < pl->n_options; i++)
+        if (!pl->options[i].key)
+            return eng_error(E, "plugin '%s' (%s) lists an option without a name", name, path);
+    if (pl->n_backends < 0 || (pl->n_backends > 0 && !pl->backends))
+        return eng_error(E, "plugin '%s' (%s) has an invalid backend list", name, path);
+    for (i = 0; i < pl->n_backends; i++)
+        if (backend_has_ops(&pl->backends[i])) any = 1;
+    if (!any) return eng_error(E, "plugin '%s' (%s) provides no operations", name, path);
+    return 0;
+}
+
+/* Shuts every plugin down at exit, last loaded first, like destructors. */
+static void shutdown_all(void)
+{
+    size_t i;
+    pthread_mutex_lock(&g_lock);
+    for (i = g_loaded.n; i-- > 0;) {
+        ld_plugin *p = g_loaded.items[i];
+        if (p->table->shutdown) p->table->shutdown();
+        free(p->path);
+        free(p);
+    }
+    free(g_loaded.items);
+    g_loaded.items = NULL;
+    g_loaded.n = 0;
+    pthread_mutex_unlock(&g_lock);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+/* AddressSanitizer builds check for leaks here, at the plugins' shutdown,
+ * instead of at the very end of the process.  The libraries the plugins pull
+ * in register exit handlers of their own when they are loaded (libstdc++'s
+ * stream flush, GnuTLS under OpenMPI), and once those have touched their
+ * thread-local storage, gcc 12's LeakSanitizer can misread the dynamic TLS
+ * vector and crash in its tracer ("Tracer caught signal 11"), depending only
+ * on how many TLS modules are loaded.  Registered after every new plugin, so
+ * the last registration (which runs first) follows the last dlopen: the
+ * check sees the process before any library's exit handler runs. */
+static void shutdown_then_check_leaks(void)
+{
+    static int done;
+    if (done) return;
+    done = 1;
+    shutdown_all();
+    __lsan_do_leak_check();
+}
+#endif
+
+/* The process-wide entry of an accepted plugin (caller holds g_lock). */
+static ld_plugin *register_plugin(const silc_plugin *pl, void *handle, const char *path)
+{
+    ld_plugin *p, **np = realloc(g_loaded.items, (g_loaded.n + 1) * sizeof *np);
+    if (!np) return NULL;
+    g_loaded.items = np;
+    p = calloc(1, sizeof *p);
+    if (!p || !(p->path = util_strdup(path))) {
+        free(p);
+        return NULL;
+    }
+    p->table = pl;
+    p->handle = handle;
+    g_loaded.items[g_loaded.n++] = p;
+    if (!g_loaded.exit_hook) g_loaded.exit_hook = atexit(shutdown_all) == 0;
+    return p;
+}
+
+/* The accepted plugin loaded from this file or, for path NULL, the built-in
+ * one (caller holds g_lock). */
+static ld_plugin *registered(const char *path)
+{
+    size_t i;
+    for (i = 0; i < g_loaded.n; i++) {
+        ld_plugin *p = g_loaded.items[i];
+        char other[PATH_MAX];
+        if (!path ? !p->handle : p->handle && realpath(p->path, other) && strcmp(path, other) == 0)
+            return p;
+    }
+    return NULL;
+}
+
+/* Makes an accepted plugin and its backends usable by this engine. */
+static int add_plugin(silc_engine *E, ld_plugin *p)
+{
+    ld_set *S = E->plugins;
+    const silc_plugin *pl = p->table;
+    ld_plugin **np;
+    ld_backend **nb;
+    int i, added = 0;
+    np = realloc(S->plugins, (S->nplugins + 1) * sizeof *np);
+    if (!np) return eng_error(E, "out of memory loading plugin %s", p->path);
+    S->plugins = np;
+    nb = realloc(S->backends, (S->nbackends + (size_t)pl->n_backends) * sizeof *nb);
+    if (!nb && pl->n_backends > 0) return eng_error(E, "out of memory loading plugin %s", p->path);
+    if (nb) S->backends = nb;
+    for (i = 0; i < pl->n_backends; i++) {
+        ld_backend *b;
+        if (!backend_has_ops(&pl->backends[i])) continue;
+        b = calloc(1, sizeof *b);
+        if (!b || !(b->full_name = full_name(pl, &pl->backends[i]))) {
+            free(b);
+            while (added-- > 0) {
+                ld_backend *last = S->backends[--S->nbackends];
+                free(last->full_name);
+                free(last);
+            }
+            return eng_error(E, "out of memory loading plugin %s", p->path);
+        }
+        b->backend = &pl->backends[i];
+        b->plugin = p;
+        S->backends[S->nbackends++] = b;
+        added++;
+    }
+    S->plugins[S->nplugins++] = p;
+    if (pl->set_threads && E->threads > 0) pl->set_threads(E->threads);
+    return 0;
+}
+
+int ld_create(silc_engine *E)
+{
+    const silc_plugin *pl = NULL;
+    const char *msg = NULL;
+    ld_plugin *p;
+    E->plugins = calloc(1, sizeof *E->plugins);
+    if (!E->plugins) return eng_error(E, "out of memory creating the plugin set");
+    pthread_mutex_lock(&g_lock);
+    p = registered(NULL);
+    if (!p) {
+        if (silc_reference_plugin_init(host_api(), &pl, &msg)) {
+            pthread_mutex_unlock(&g_lock);
+            return eng_error(E, "built-in reference plugin failed to start: %s",
+                             msg ? msg : "no reason given");
+        }
+        if (check_table(E, pl, "built-in") || !(p = register_plugin(pl, NULL, "built-in"))) {
+            pthread_mutex_unlock(&g_lock);
+            return E->err[0] ? -1 : eng_error(E, "out of memory registering the reference plugin");
+        }
+    }
+    pthread_mutex_unlock(&g_lock);
+    return add_plugin(E, p);
+}
+
+/* Frees this engine's view of the plugins; the plugins stay loaded (see top). */
+void ld_destroy(silc_engine *E)
+{
+    ld_set *S;
+    size_t i;
+    if (!E || !E->plugins) return;
+    S = E->plugins;
+    for (i = 0; i < S->nbackends; i++) {
+        free(S->backends[i]->full_name);
+        free(S->backends[i]);
+    }
+    free(S->plugins);
+    free(S->backends);
+    free(S);
+    E->plugins = NULL;
+}
+
+/* Opens, initialises and checks a plugin file not loaded before (caller holds
+ * g_lock); real is its canonical path. */
+static ld_plugin *open_plugin(silc_engine *E, const char *path, const char *real)
+{
+    void *handle, *sym;
+    silc_plugin_init_fn init;
+    const silc_plugin *pl = NULL;
+    const char *msg = NULL;
+    ld_plugin *p;
+    dlerror();
+    handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+        const char *why = dlerror();
+        eng_error(E, "cannot load plugin %s: %s", path, why ? why : "dlopen failed");
+        return NULL;
+    }
+    dlerror();
+    sym = dlsym(handle, SILC_PLUGIN_INIT_SYMBOL);
+    if (!sym) {
+        const char *why = dlerror();
+        eng_error(E, "cannot load plugin %s: no %s symbol (%s)", path, SILC_PLUGIN_INIT_SYMBOL,
+                  why ? why : "not exported");
+        dlclose(handle);
+        return NULL;
+    }
+    /* POSIX guarantees a dlsym'd function pointer round-trips through void *;
+     * memcpy keeps -Wpedantic quiet about the object-to-function conversion. */
+    memcpy(&init, &sym, sizeof init);
+    if (init(host_api(), &pl, &msg)) {
+        eng_error(E, "cannot load plugin %s: %s failed: %s", path, SILC_PLUGIN_INIT_SYMBOL,
+                  msg ? msg : "no reason given");
+        dlclose(handle);
+        return NULL;
+    }
+    if (check_table(E, pl, path)) {
+        if (pl && pl->abi_major == SILC_ABI_MAJOR && pl->shutdown) pl->shutdown();
+        dlclose(handle);
+        return NULL;
+    }
+#if defined(__SANITIZE_ADDRESS__)
+    atexit(shutdown_then_check_leaks);
+#endif
+    if (!(p = register_plugin(pl, handle, real))) {
+        eng_error(E, "out of memory loading plugin %s", path);
+        if (pl->shutdown) pl->shutdown();
+        dlclose(handle);
+    }
+    return p;
+}
+
+int ld_load_file(silc_engine *E, const char *path)
+{
+    ld_plugin *p;
+    const ld_plugin *other;
+    char real[PATH_MAX];
+    size_t i;
+    if (!E || !E->plugins || !path) return -1;
+    if (!realpath(path, real))
+        return eng_error(E, "cannot load plugin %s: %s", path, strerror(errno));
+    /* The same file reached twice (a directory listed twice, a config naming
+     * the build directory again) is not a conflict. */
+    for (i = 0; i < E->plugins->nplugins; i++) {
+        char other_real[PATH_MAX];
+        const ld_plugin *q = E->plugins->plugins[i];
+        if (q->handle && realpath(q->path, other_real) && strcmp(real, other_real) == 0) return 0;
+    }
+    pthread_mutex_lock(&g_lock);
+    p = registered(real);
+    if (!p) p = open_plugin(E, path, real);
+    pthread_mutex_unlock(&g_lock);
+    if (!p) return -1;
+    other = ld_find_plugin(E, p->table->name);
+    if (other)
+        return eng_error(E,
+                         "plugin '%s' (%s) not loaded: a plugin of that name is already loaded from %s",
+                         p->table->name, path, other->path);
+    return add_plugin(E, p);
+}
+
+static int plugin_file_name(const char *name)
+{
+    size_t n = strlen(name), np = strlen(LD_FILE_PREFIX), ns = strlen(LD_FILE_SUFFIX);
+    if (n <= np + ns) return 0;
+    if (strncmp(name, LD_FILE_PREFIX, np) != 0) return 0;
+    if (strcmp(name + n - ns, LD_FILE_SUFFIX) != 0) return 0;
+    /* The reference is built in: its module copy would only duplicate the name. */
+    return strcmp(name, LD_REFERENCE_FILE) != 0;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* Loads the plugins of one directory in name order (so which of two
+ * same-named plugins wins does not depend on readdir order). */
+/* 1 if dir/sub/name exists. */
+static int exists_in(const char *dir, const char *sub, const char *name)
+{
+    char path[PATH_MAX];
+    struct stat st;
+    int len = snprintf(path, sizeof path, "%s/%s/%s", dir, sub, name);
+    return len > 0 && (size_t)len < sizeof path && stat(path, &st) == 0;
+}
+
+static int load_dir(silc_engine *E, const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *ent;
+    char **names = NULL;
+    size_t n = 0, cap = 0, i;
+    if (!d) return eng_error(E, "cannot read plugin directory %s: %s", dir, strerror(errno));
+    /* An engine on a communicator (dist.h) takes the MPI builds of plugins
+     * from dir/mpi first, and then not the sequential build of the same
+     * file: Debian's sequential MUMPS and the MPI one must never share a
+     * process (docs/distributed.md). */
+    if (E->dist && exists_in(dir, "mpi", ".")) {
+        char sub[PATH_MAX];
+        if ((size_t)snprintf(sub, sizeof sub, "%s/mpi", dir) < sizeof sub) load_dir(E, sub);
+    }
+    while ((ent = readdir(d)) != NULL) {
+        if (!plugin_file_name(ent->d_name)) continue;
+        if (E->dist && exists_in(dir, "mpi", ent->d_name)) continue;
+        if (n == cap) {
+            char **nn = realloc(names, (cap = cap ? 2 * cap : 16) * sizeof *nn);
+            if (!nn) break;
+            names = nn;
+        }
+        if (!(names[n] = util_strdup(ent->d_name))) break;
+        n++;
+    }
+    closedir(d);
+    if (n) qsort(names, n, sizeof *names, cmp_str);
+    for (i = 0; i < n; i++) {
+        strbuf path;
+        sb_init(&path);
+        sb_printf(&path, "%s/%s", dir, names[i]);
+        if (ld_load_file(E, sb_str(&path))) fprintf(stderr, "silc: warning: %s\n", E->err);
+        sb_free(&path);
+        free(names[i]);
+    }
+    free(names);
+    E->err[0] = '\0';
+    return 0;
+}
+
+#ifndef SILC_PLUGIN_LIBDIR_REL
+#define SILC_PLUGIN_LIBDIR_REL "silc/plugins"
+#endif
+#ifndef SILC_INSTALL_LIBDIR
+#define SILC_INSTALL_LIBDIR "lib"
+#endif
+
+/* An object of the engine's own image, for dladdr to find the file. */
+static const char engine_marker = 0;
+
+int ld_installed_plugin_dir(char *out, size_t len)
+{
+    /* Where this engine's code lives -- libsilc.so in an install's libdir,
+     * or a program linking the engine statically in its bindir -- tells
+     * where the install put the plugins, whatever prefix it was given. */
+    static const char *const beside[] = {"/" SILC_PLUGIN_LIBDIR_REL, "/../" SILC_INSTALL_LIBDIR "/" SILC_PLUGIN_LIBDIR_REL};
+    Dl_info info;
+    char dir[PATH_MAX];
+    struct stat st;
+    size_t i;
+    char *slash;
+    if (!dladdr(&engine_marker, &info) || !info.dli_fname ||
+        !realpath(info.dli_fname, dir))
+        return -1;
+    slash = strrchr(dir, '/');
+    if (!slash) return -1;
+    *slash = '\0';
+    for (i = 0; i < sizeof beside / sizeof beside[0]; i++) {
+        if ((size_t)snprintf(out, len, "%s%s", dir, beside[i]) >= len) continue;
+        if (stat(out, &st) == 0 && S_ISDIR(st.st_mode)) return 0;
+    }
+    return -1;
+}
+
+int ld_load_path(silc_engine *E, const char *dirs)
+{
+    const char *p = dirs;
+    int rc = 0;
+    char bad[sizeof E->err];
+    if (!E || !dirs) return -1;
+    while (*p) {
+        size_t len = strcspn(p, ":");
+        if (len > 0) {
+            char dir[PATH_MAX];
+            if (len >= sizeof dir) len = sizeof dir - 1;
+            memcpy(dir, p, len);
+            dir[len] = '\0';
+            if (load_dir(E, dir) && !rc) {
+                rc = -1;
+                memcpy(bad, E->err, sizeof bad);
+            }
+        }
+        p += len;
+        if (*p) p++;
+    }
+    /* Every directory is tried; the first that could not be read is reported. */
+    if (rc) memcpy(E->err, bad, sizeof bad);
+    return rc;
+}
+
+int ld_backend_collective(const ld_backend *b, int op)
+{
+    const silc_plugin *pl = b->plugin->table;
+    int i;
+    if (pl->abi_minor < 5 || pl->struct_size < offsetof(silc_plugin, collective_ops) + sizeof(void *) ||
+        !pl->collective_ops)
+        return 0;
+    for (i = 0; i < pl->n_backends; i++)
+        if (&pl->backends[i] == b->backend) return (pl->collective_ops[i] & SILC_COLLECTIVE(op)) != 0;
+    return 0;
+}
+
+const ld_backend *ld_find(const silc_engine *E, const char *full_name)
+{
+    size_t i;
+    if (!E || !E->plugins || !full_name) return NULL;
+    for (i = 0; i < E->plugins->nbackends; i++)
+        if (strcmp(E->plugins->backends[i]->full_name, full_name) == 0)
+            return E->plugins->backends[i];
+    return NULL;
+}
+
+size_t ld_backend_names(const silc_engine *E, const char ***names)
+{
+    size_t i, n;
+    *names = NULL;
+    if (!E || !E->plugins || E->plugins->nbackends == 0) return 0;
+    n = E->plugins->nbackends;
+    *names = malloc(n * sizeof **names);
+    if (!*names) return 0;
+    for (i = 0; i < n; i++) (*names)[i] = E->plugins->backends[i]->full_name;
+    return n;
+}
+
+const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name)
+{
+    size_t i;
+    if (!E || !E->plugins || !plugin_name) return NULL;
+    for (i = 0; i < E->plugins->nplugins; i++)
+        if (strcmp(E->plugins->plugins[i]->table->name, plugin_name) == 0)
+            return E->plugins->plugins[i];
+    return NULL;
+}
+
+size_t ld_plugin_count(const silc_engine *E)
+{
+    return E && E->plugins ? E->plugins->nplugins : 0;
+}
+
+const ld_plugin *ld_plugin_at(const silc_engine *E, size_t i)
+{
+    return i < ld_plugin_count(E) ? E->plugins->plugins[i] : NULL;
+}
+
+void ld_set_threads(silc_engine *E, int nthreads)
+{
+    size_t i;
+    if (!E || nthreads < 1) return;
+    E->threads = nthreads;
+    host_set_threads(nthreads);
+    for (i = 0; i < ld_plugin_count(E); i++)
+        if (E->plugins->plugins[i]->table->set_threads)
+            E->plugins->plugins[i]->table->set_threads(nthreads);
+}

@@ -1,0 +1,1294 @@
+/*
+ * eval.c -- runs parsed statements: the AST cache, expression evaluation,
+ * assignment, control flow and the keyword statements (clear, who, set, info,
+ * explain, tune).  It also feeds the tuner (tuner.c): each top-level EXEC's
+ * text and time, and each solve that ran.
+ *
+ * Every arithmetic operation becomes a silc_call handed to disp_run(); the
+ * core only builds values that are pure structure (literals, zeros, sparse
+ * triplets, subscripts).  A statement computes its new value completely
+ * before binding it, so a failing statement leaves the store untouched while
+ * the earlier statements of the same text stay done.
+ *
+ * Operands in messages are quoted as the user wrote them when short ("'A'",
+ * "'x + y'"), else called "the left operand" / "the right operand".
+ */
+#include "lang.h"
+#include "tune.h"
+#include "accuracy.h"
+#include "dist.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- AST cache ------------------------------------------------------------ */
+/* Keyed by the exact text, so a time loop EXECing the same strings parses each
+ * once.  Bounded: when full it is emptied and refills with what is in use. */
+#define CACHE_BUCKETS 1024
+#define CACHE_MAX 512
+
+typedef struct cache_entry {
+    lang_program *prog;
+    struct cache_entry *next;
+} cache_entry;
+
+typedef struct lang_cache {
+    cache_entry *b[CACHE_BUCKETS];
+    size_t count;
+} lang_cache;
+
+static size_t text_hash(const char *s)
+{
+    size_t h = 2166136261u;
+    while (*s) h = (h ^ (unsigned char)*s++) * 16777619u;
+    return h % CACHE_BUCKETS;
+}
+
+static void cache_empty(lang_cache *c)
+{
+    size_t i;
+    for (i = 0; i < CACHE_BUCKETS; i++) {
+        while (c->b[i]) {
+            cache_entry *e = c->b[i];
+            c->b[i] = e->next;
+            ps_free(e->prog);
+            free(e);
+        }
+    }
+    c->count = 0;
+}
+
+static void cache_free(void *p)
+{
+    if (!p) return;
+    cache_empty(p);
+    free(p);
+}
+
+/* Parsed program for text, from the cache or freshly parsed (and cached). */
+static int program_for(silc_engine *E, const char *text, lang_program **out)
+{
+    lang_cache *c = E->lang_cache;
+    cache_entry *e;
+    size_t h = text_hash(text);
+    char err[512];
+    if (!c) {
+        c = calloc(1, sizeof *c);
+        if (!c) return eng_oom(E);
+        E->lang_cache = c;
+        E->lang_cache_free = cache_free;
+    }
+    for (e = c->b[h]; e; e = e->next) {
+        if (!strcmp(e->prog->text, text)) {
+            *out = e->prog;
+            return 0;
+        }
+    }
+    if (ps_parse(text, out, err, sizeof err)) return eng_error(E, "%s", err);
+    if (c->count >= CACHE_MAX) cache_empty(c);
+    e = malloc(sizeof *e);
+    if (!e) {
+        ps_free(*out);
+        *out = NULL;
+        return eng_oom(E);
+    }
+    e->prog = *out;
+    e->next = c->b[h];
+    c->b[h] = e;
+    c->count++;
+    return 0;
+}
+
+/* ---- helpers shared with builtins.c and index.c ---------------------------- */
+
+void ev_shape(const silc_value *v, char *out, size_t outlen)
+{
+    snprintf(out, outlen, "%lldx%lld", (long long)v->m, (long long)v->n);
+}
+
+void ev_operand_name(const lang_ev *V, const ast_node *n, int side, char *out, size_t outlen)
+{
+    size_t len = n->end - n->start;
+    if (len < 24)
+        snprintf(out, outlen, "'%.*s'", (int)len, V->src + n->start);
+    else
+        snprintf(out, outlen, "%s", side == 0 ? "the left operand" : side == 1 ? "the right operand"
+                                                                                : "the argument");
+}
+
+static void add_backend(lang_ev *V, const char *name)
+{
+    size_t len = strlen(name), have = strlen(V->backends);
+    const char *p = V->backends;
+    if (!name[0]) return;
+    while ((p = strstr(p, name)) != NULL) {
+        if ((p == V->backends || p[-1] == ' ') && (p[len] == ',' || p[len] == 0)) return;
+        p += len;
+    }
+    if (have + len + 3 > sizeof V->backends) return;
+    if (have) strcat(V->backends, ", ");
+    strcat(V->backends, name);
+}
+
+/* Appends text indented under an explain step. */
+static void indent_into(strbuf *b, const char *text)
+{
+    while (*text) {
+        const char *nl = strchr(text, '\n');
+        size_t len = nl ? (size_t)(nl - text) : strlen(text);
+        sb_printf(b, "     %.*s\n", (int)len, text);
+        text += len + (nl ? 1 : 0);
+    }
+}
+
+int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
+{
+    silc_engine *E = V->E;
+    silc_report rep;
+    size_t warned;
+    int i, rc;
+    *out = NULL;
+    call->out = NULL;
+    if (call->op == SILC_OP_SOLVE) {
+        memset(&rep, 0, sizeof rep);
+        rep.cond_est = -1;
+        rep.rcond = -1;
+        call->report = &rep;
+        /* The statement's initial guess goes to the first solve whose
+         * solution has its shape (exec_assign, solve.initial_guess). */
+        if (V->warm && call->nin == 2 && V->warm->m == call->in[0]->n && V->warm->n == call->in[1]->n) {
+            call->in[2] = V->warm;
+            call->nin = 3;
+            V->warm = NULL;
+        }
+    }
+    if (V->explain) {
+        strbuf d;
+        char shape[48];
+        sb_printf(V->explain_out, "  %d. %s:", ++V->explain_step, what);
+        for (i = 0; i < call->nin; i++) {
+            ev_shape(call->in[i], shape, sizeof shape);
+            sb_printf(V->explain_out, "%s %s %s", i ? "," : "", shape,
+                      val_format_name(call->in[i]->format));
+        }
+        sb_puts(V->explain_out, "\n");
+        sb_init(&d);
+        dist_explain(E, call, &d);
+        rc = disp_explain(E, call, &d);
+        if (rc && strstr(E->err, "out of memory")) { /* not a reason to show, a failure */
+            sb_free(&d);
+            return -1;
+        }
+        if (!rc) tuner_explain(E, call, &d);
+        indent_into(V->explain_out, rc ? E->err : sb_str(&d));
+        if (d.failed) V->explain_out->failed = 1;   /* explain says out of memory */
+        sb_free(&d);
+        if (call->op == SILC_OP_SOLVE) {
+            /* explain runs no solve: later steps see a placeholder of the right shape */
+            *out = val_dense_new(call->in[0]->n, call->in[1]->n); /* whole: explain moves nothing */
+            return *out ? 0 : eng_oom(E);
+        }
+    }
+    /* The same operation on the same operands as before (memo.c): its value. */
+    if ((call->out = memo_lookup(E, call))) {
+        *out = call->out;
+        return 0;
+    }
+    warned = E->warnings.len;
+    /* The evaluator records what a deferred backward error needs (bind). */
+    E->accuracy_defer = 1;
+    rc = E->dist ? dist_run(E, call) : disp_run(E, call);
+    E->accuracy_defer = 0;
+    if (rc || !call->out) {
+        if (call->out) val_release(call->out);
+        call->out = NULL;
+        if (!E->err[0]) eng_error(E, "%s failed (status %d)", what, rc);
+        return -1;
+    }
+    if (call->op == SILC_OP_SOLVE) {
+        V->has_solve = 1;
+        V->report = rep;
+        if (rep.backward_error == ACC_DEFERRED) eng_pending_hold(&V->pending, call);
+        else eng_pending_release(&V->pending);
+        add_backend(V, rep.backend);
+        if (!E->dist) tuner_note_solve(E, call); /* the tuner times one process (issue 18) */
+    }
+    call->report = NULL;
+    memo_note(E, call, call->out, E->warnings.len != warned);
+    *out = call->out;
+    return 0;
+}
+
+int ev_run_op(lang_ev *V, int op, int sub, const silc_value *a, const silc_value *b,
+              double alpha, double beta, const char *what, silc_value **out)
+{
+    silc_call c;
+    memset(&c, 0, sizeof c);
+    c.op = op;
+    c.sub = sub;
+    c.nin = b ? 2 : 1;
+    c.in[0] = a;
+    c.in[1] = b;
+    c.alpha = alpha;
+    c.beta = beta;
+    return ev_run(V, &c, what, out);
+}
+
+/* ---- names ------------------------------------------------------------------ */
+
+static int undefined_name(lang_ev *V, const char *name)
+{
+    const char **names = NULL, **cands;
+    size_t n = store_names(&V->E->store, &names), nb = 0, i;
+    const char *best;
+    while (bi_names[nb]) nb++;
+    cands = (n || !V->E->store.count) ? malloc((n + nb + 1) * sizeof *cands) : NULL;
+    if (!cands) {
+        /* no suggestion: say why there is none */
+        free(names);
+        return eng_error(V->E, "undefined name '%s' (out of memory looking for a similar name)", name);
+    }
+    for (i = 0; i < n; i++) cands[i] = names[i];
+    for (i = 0; i < nb; i++) cands[n + i] = bi_names[i];
+    best = util_closest(name, cands, n + nb);
+    if (best)
+        eng_error(V->E, "undefined name '%s' (did you mean '%s'?)", name, best);
+    else
+        eng_error(V->E, "undefined name '%s'", name);
+    free(cands);
+    free(names);
+    return -1;
+}
+
+static int eval_name(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *v = store_get(&V->E->store, n->name);
+    double x;
+    if (v) {
+        *out = val_retain(v);
+        return 0;
+    }
+    if (bi_constant(n->name, &x)) {
+        *out = val_scalar_new(x);
+        return *out ? 0 : eng_oom(V->E);
+    }
+    return undefined_name(V, n->name);
+}
+
+/* ---- operators ---------------------------------------------------------------- */
+
+static const char *op_text(int op)
+{
+    switch (op) {
+    case TK_PLUS: case TK_PLUSEQ: return "+";
+    case TK_MINUS: case TK_MINUSEQ: return "-";
+    case TK_STAR: case TK_STAREQ: return "*";
+    case TK_SLASH: case TK_SLASHEQ: return "/";
+    case TK_BACKSLASH: return "\\";
+    case TK_EMUL: return "*@";
+    case TK_EDIV: return "/@";
+    case TK_CARET: return "^";
+    case TK_EPOW: return "^@";
+    case TK_EQ: return "==";
+    case TK_NE: return "!=";
+    case TK_LT: return "<";
+    case TK_LE: return "<=";
+    case TK_GT: return ">";
+    case TK_GE: return ">=";
+    case TK_AND: return "&&";
+    case TK_OR: return "||";
+    default: return "?";
+    }
+}
+
+static int ewise_sub(int op)
+{
+    switch (op) {
+    case TK_EMUL: return SILC_EW_MUL;
+    case TK_EDIV: return SILC_EW_DIV;
+    case TK_EPOW: case TK_CARET: return SILC_EW_POW;
+    case TK_EQ: return SILC_EW_EQ;
+    case TK_NE: return SILC_EW_NE;
+    case TK_LT: return SILC_EW_LT;
+    case TK_LE: return SILC_EW_LE;
+    case TK_GT: return SILC_EW_GT;
+    case TK_GE: return SILC_EW_GE;
+    case TK_AND: return SILC_EW_AND;
+    default: return SILC_EW_OR;
+    }
+}
+
+typedef struct operands {
+    const char *lname, *rname;   /* as quoted in messages */
+    const char *what;            /* the operation's source text, for explain */
+} operands;
+
+static int shape_error(lang_ev *V, const char *fmt_head, int op, const operands *o,
+                       const silc_value *a, const silc_value *b)
+{
+    char sa[48], sb[48];
+    ev_shape(a, sa, sizeof sa);
+    ev_shape(b, sb, sizeof sb);
+    return eng_error(V->E, "'%s' %s: %s is %s, %s is %s", op_text(op), fmt_head, o->lname, sa,
+                     o->rname, sb);
+}
+
+static int same_or_scalar(const silc_value *a, const silc_value *b)
+{
+    return val_is_scalar(a) || val_is_scalar(b) || (a->m == b->m && a->n == b->n);
+}
+
+static silc_value *identity_like(const silc_value *a)
+{
+    int64_t i, n = a->m;
+    silc_value *r;
+    if (a->format == SILC_FMT_DENSE) {
+        r = val_dense_new(n, n);
+        if (r)
+            for (i = 0; i < n; i++) r->val[i + i * n] = 1.0;
+        return r;
+    }
+    r = val_csr_new(n, n, n);
+    if (!r) return NULL;
+    for (i = 0; i < n; i++) {
+        r->rowptr[i] = i;
+        r->colind[i] = i;
+        r->val[i] = 1.0;
+    }
+    r->rowptr[n] = n;
+    val_csr_set_nnz(r, n);
+    return r;
+}
+
+/* A^k for square A and integer k >= 0 by repeated squaring. */
+static int matrix_power(lang_ev *V, const silc_value *a, double k, const char *what,
+                        silc_value **out)
+{
+    silc_value *result = NULL, *base = val_retain((silc_value *)a), *t;
+    unsigned long long e = (unsigned long long)k;
+    if (e == 0) {
+        val_release(base);
+        *out = identity_like(a);
+        return *out ? 0 : eng_oom(V->E);
+    }
+    while (e) {
+        if (e & 1) {
+            if (!result) {
+                result = val_retain(base);
+            } else {
+                if (ev_run_op(V, SILC_OP_MATMUL, 0, result, base, 1, 0, what, &t)) goto fail;
+                val_release(result);
+                result = t;
+            }
+        }
+        e >>= 1;
+        if (e) {
+            if (ev_run_op(V, SILC_OP_MATMUL, 0, base, base, 1, 0, what, &t)) goto fail;
+            val_release(base);
+            base = t;
+        }
+    }
+    val_release(base);
+    *out = result;
+    return 0;
+fail:
+    val_release(base);
+    val_release(result);
+    return -1;
+}
+
+/* a op b for every binary operator. */
+static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value *a,
+                        const silc_value *b, silc_value **out)
+{
+    silc_engine *E = V->E;
+    char sa[48];
+    switch (op) {
+    case TK_PLUS: case TK_PLUSEQ: case TK_MINUS: case TK_MINUSEQ:
+        if (!same_or_scalar(a, b))
+            return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
+        return ev_run_op(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
+                         o->what, out);
+    case TK_STAR: case TK_STAREQ:
+        if (val_is_scalar(a)) return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
+        if (val_is_scalar(b)) return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
+        if (a->n != b->m) return shape_error(V, "inner dimensions differ", op, o, a, b);
+        return ev_run_op(V, SILC_OP_MATMUL, 0, a, b, 1, 0, o->what, out);
+    case TK_SLASH: case TK_SLASHEQ: {
+        silc_value *at, *bt, *x;
+        int rc;
+        if (val_is_scalar(b))
+            return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, 1.0 / val_scalar(b), 0, o->what, out);
+        if (a->n != b->n)
+            return shape_error(V, "needs operands with the same number of columns", op, o, a, b);
+        /* a / B = (B' \ a')' */
+        if (ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, o->what, &at)) return -1;
+        if (ev_run_op(V, SILC_OP_TRANSPOSE, 0, b, NULL, 0, 0, o->what, &bt)) {
+            val_release(at);
+            return -1;
+        }
+        rc = ev_run_op(V, SILC_OP_SOLVE, 0, bt, at, 0, 0, o->what, &x);
+        val_release(at);
+        val_release(bt);
+        if (rc) return -1;
+        rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, x, NULL, 0, 0, o->what, out);
+        val_release(x);
+        return rc;
+    }
+    case TK_BACKSLASH:
+        if (val_is_scalar(a))
+            return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
+        if (a->m != b->m)
+            return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
+        /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
+         * repeats the check with role names for every other route). */
+        if (refine_check_finite(V->E, a, 1, o->lname) || refine_check_finite(V->E, b, 0, o->rname))
+            return -1;
+        return ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
+    case TK_CARET:
+        if (val_is_scalar(a) && val_is_scalar(b))
+            return ev_run_op(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);
+        if (a->m != a->n) {
+            ev_shape(a, sa, sizeof sa);
+            return eng_error(E, "%s is %s but '^' needs a square matrix", o->lname, sa);
+        }
+        if (!val_is_scalar(b)) {
+            ev_shape(b, sa, sizeof sa);
+            return eng_error(E, "'^' needs a scalar exponent: %s is %s (use '^@' for element-wise powers)",
+                             o->rname, sa);
+        }
+        {
+            double k = val_scalar(b);
+            if (!(k >= 0 && k == floor(k) && k < 9.0e15)) {
+                char kt[40];
+                util_fmt_double(kt, sizeof kt, k);
+                return eng_error(E, "'^' of a matrix needs a nonnegative integer exponent, got %s "
+                                    "(use '^@' for element-wise powers)", kt);
+            }
+            return matrix_power(V, a, k, o->what, out);
+        }
+    default:
+        if (!same_or_scalar(a, b))
+            return shape_error(V, "needs operands of the same shape or a scalar", op, o, a, b);
+        return ev_run_op(V, SILC_OP_EWISE, ewise_sub(op), a, b, 0, 0, o->what, out);
+    }
+}
+
+static void node_text(const lang_ev *V, const ast_node *n, char *out, size_t outlen)
+{
+    size_t len = n->end - n->start;
+    if (len >= outlen) len = outlen - 1;
+    memcpy(out, V->src + n->start, len);
+    out[len] = 0;
+}
+
+/* Binary node n applied to its operands a and b, already evaluated (and
+ * released here). */
+UTIL_NOINLINE static int binary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value *b, silc_value **out)
+{
+    char ln[64], rn[64], what[256];
+    operands o;
+    int rc;
+    ev_operand_name(V, n->kids[0], 0, ln, sizeof ln);
+    ev_operand_name(V, n->kids[1], 1, rn, sizeof rn);
+    node_text(V, n, what, sizeof what);
+    o.lname = ln;
+    o.rname = rn;
+    o.what = what;
+    rc = apply_binary(V, n->op, &o, a, b, out);
+    val_release(a);
+    val_release(b);
+    return rc;
+}
+
+static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a, *b;
+    if (ev_expr_dist(V, n->kids[0], &a)) return -1;
+    /* && and || short-circuit on a scalar left side, so `k <= n && v[k] > 0` is safe */
+    if ((n->op == TK_AND || n->op == TK_OR) && val_is_scalar(a)) {
+        int truth = val_scalar(a) != 0;
+        if (truth == (n->op == TK_OR)) {
+            val_release(a);
+            *out = val_scalar_new(truth ? 1.0 : 0.0);
+            return *out ? 0 : eng_oom(V->E);
+        }
+    }
+    if (ev_expr_dist(V, n->kids[1], &b)) {
+        val_release(a);
+        return -1;
+    }
+    return binary_of(V, n, a, b, out);
+}
+
+/* Unary node n applied to its operand a, already evaluated (and released
+ * here).  Apart from eval_unary so that the text buffer is not on the stack
+ * once per level of the recursion. */
+UTIL_NOINLINE static int unary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value **out)
+{
+    char what[256];
+    int rc;
+    node_text(V, n, what, sizeof what);
+    if (n->kind == AST_TRANSPOSE)
+        rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
+    else
+        rc = ev_run_op(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
+                       what, out);
+    val_release(a);
+    return rc;
+}
+
+static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *a;
+    if (ev_expr_dist(V, n->kids[0], &a)) return -1;
+    if (n->op == TK_PLUS) {
+        *out = a;
+        return 0;
+    }
+    return unary_of(V, n, a, out);
+}
+
+/* base[subscripts]: the subscripts are evaluated by ix_extract. */
+static UTIL_NOINLINE int eval_index(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *base;
+    char what[64];
+    int rc;
+    if (ev_expr(V, n->kids[0], &base)) return -1;
+    ev_operand_name(V, n->kids[0], 2, what, sizeof what);
+    rc = ix_extract(V, n->kids + 1, n->nkids - 1, what, base, out);
+    val_release(base);
+    return rc;
+}
+
+int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    if (ev_expr_dist(V, n, out)) return -1;
+    if (dist_make_whole(V->E, out)) {
+        val_release(*out);
+        *out = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+/* A distributed 1x1 (a row block of one row, np = 1) is made whole: every
+ * consumer of a scalar reads its entry. */
+static int scalar_whole(lang_ev *V, int rc, silc_value **out)
+{
+    if (rc == 0 && dist_is(*out) && val_is_scalar(*out) && dist_make_whole(V->E, out)) {
+        val_release(*out);
+        *out = NULL;
+        return -1;
+    }
+    return rc;
+}
+
+static int expr_any(lang_ev *V, const ast_node *n, silc_value **out);
+
+int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    return scalar_whole(V, expr_any(V, n, out), out);
+}
+
+static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_engine *E = V->E;
+    *out = NULL;
+    switch (n->kind) {
+    case AST_NUM:
+        *out = val_scalar_new(n->num);
+        return *out ? 0 : eng_oom(E);
+    case AST_NAME:
+        return eval_name(V, n, out);
+    case AST_END:
+        *out = val_scalar_new((double)V->end_value);
+        return *out ? 0 : eng_oom(E);
+    case AST_STRING:
+        return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
+    case AST_COLON_ALL:
+    case AST_RANGE:
+        return eng_error(E, "a range is only allowed inside a subscript");
+    case AST_BINARY:
+        return eval_binary(V, n, out);
+    case AST_UNARY:
+    case AST_TRANSPOSE:
+        return eval_unary(V, n, out);
+    case AST_INDEX:
+        return eval_index(V, n, out);
+    case AST_CALL:
+        return bi_call(V, n, out);
+    case AST_MATRIX:
+        return cc_matrix(V, n, out);
+    default:
+        return eng_error(E, "internal error: statement where an expression was expected");
+    }
+}
+
+/* ---- statements ---------------------------------------------------------------- */
+
+enum { FLOW_NEXT = 0, FLOW_BREAK, FLOW_CONTINUE };
+
+static char *stmt_text(const lang_ev *V, const ast_node *n)
+{
+    size_t len = n->end - n->start;
+    char *s = malloc(len + 1);
+    if (s) {
+        memcpy(s, V->src + n->start, len);
+        s[len] = 0;
+    }
+    return s;
+}
+
+/* Binds name to v (taking over the caller's reference) and records how it was computed. */
+static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *v, double t0)
+{
+    eng_info info;
+    int rc;
+    if (V->explain) {
+        char shape[48];
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(V->explain_out, "  result: %s would be bound to a %s %s value (not run)\n", name,
+                  shape, val_format_name(v->format));
+        val_release(v);
+        return 0;
+    }
+    /* The record `info` shows is made first, so that running out of memory
+     * leaves neither a binding without its record nor a record without
+     * its binding: rebinding a name never allocates, and a new name has no
+     * record to restore.  (An update in place made both beforehand,
+     * bind_reserve, since it cannot be undone.) */
+    if (V->E->warnings.failed) {   /* a result without its warning would be trusted */
+        val_release(v);
+        return eng_error(V->E, "out of memory recording a warning of '%s'", name);
+    }
+    memset(&info, 0, sizeof info);
+    info.statement = V->bind_text ? V->bind_text : stmt_text(V, stmt);
+    V->bind_text = NULL;
+    if (!info.statement) {
+        val_release(v);
+        return eng_error(V->E, "out of memory binding '%s'", name);
+    }
+    info.has_solve = V->has_solve;
+    if (V->has_solve) info.report = V->report;
+    info.pending = V->pending; /* handed over */
+    memset(&V->pending, 0, sizeof V->pending);
+    info.seconds = util_now() - t0;
+    snprintf(info.backends, sizeof info.backends, "%s", V->backends);
+    if (V->E->dist) {
+        info.ranks = V->E->dist->size;
+        info.moved_matrix = V->E->dist->moved_matrix - V->moved0[0];
+        info.moved_vector = V->E->dist->moved_vector - V->moved0[1];
+    }
+    rc = eng_info_take(V->E, name, &info);
+    if (rc) {
+        val_release(v);
+        return -1;   /* "out of memory recording info for 'x'" */
+    }
+    rc = store_set(&V->E->store, name, v);
+    val_release(v);
+    if (rc) {
+        eng_info_remove(V->E, name);
+        return eng_error(V->E, "out of memory binding '%s'", name);
+    }
+    return 0;
+}
+
+/* Makes what bind() allocates for stmt before x changes in place, which
+ * cannot be undone: then running out of memory stops the statement while x
+ * is still as it was. */
+static int bind_reserve(lang_ev *V, const ast_node *stmt)
+{
+    if (!V->bind_text && !(V->bind_text = stmt_text(V, stmt)))
+        return eng_error(V->E, "out of memory binding '%s'", stmt->name);
+    return eng_info_reserve(V->E, stmt->name);
+}
+
+static int opassign_token(int op)
+{
+    switch (op) {
+    case TK_PLUSEQ: return TK_PLUS;
+    case TK_MINUSEQ: return TK_MINUS;
+    case TK_STAREQ: return TK_STAR;
+    default: return TK_SLASH;
+    }
+}
+
+/* Copy-on-write for `x += r`, `x -= r`, `x *= c`, `x /= c` (DESIGN 5): when
+ * x's dense value is held by the store's binding alone (two references: the
+ * binding's and the caller's) and carries no attachments, nobody else can see it
+ * change, so the result is written over it instead of into a new array.  r
+ * is a dense array of x's shape or a scalar, c a scalar.  The arithmetic is
+ * what SILC_OP_ADD / SCALE compute (1*x + (+-1)*r is x +- r exactly; x / c
+ * is a scale by 1/c), so the numbers do not depend on which path ran.
+ *
+ * With a scale s (a scalar value), `x += s * r` and `x -= s * r` for a
+ * dense r of x's shape: the time-stepping update (`u += dt * v`) without
+ * the temporary s * r.  Each s * r_i is rounded before it is added, as
+ * SILC_OP_SCALE then SILC_OP_ADD round it (no contraction to a fused
+ * multiply-add: the build targets x86-64 without FMA, and GCC does not
+ * contract across statements in ISO C mode).  Returns 1 when done; under
+ * explain, 1 when it would be done, after saying so (stmt: the statement);
+ * -1 when out of memory before anything changed. */
+static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *r,
+                           const silc_value *s, const ast_node *stmt)
+{
+    int64_t i, n = x->m * x->n;
+    int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
+    double c = scalar ? val_scalar(r) : 0;
+    /* Distributed values are never updated in place: their arrays are blocks (dist.h). */
+    if (x->dist || r->dist || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
+        !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
+        return 0;
+    if ((op == TK_STAREQ || op == TK_SLASHEQ) && (!scalar || s)) return 0;
+    if (V->explain) {
+        char xs[48], rs[48], what[256];
+        node_text(V, stmt, what, sizeof what);
+        ev_shape(x, xs, sizeof xs);
+        ev_shape(r, rs, sizeof rs);
+        sb_printf(V->explain_out, "  %d. %s: %s dense, %s %s%s\n", ++V->explain_step, what, xs, rs,
+                  val_format_name(r->format), s ? ", 1x1 scale" : "");
+        indent_into(V->explain_out, "in place: nothing else holds the value, so the core writes the "
+                                    "result over its array (no backend, no new array)");
+        return 1;
+    }
+    if (bind_reserve(V, stmt)) return -1;
+    {
+        /* r is another value (x += x leaves x shared, so never comes here). */
+        double *restrict xv = x->val;
+        const double *restrict rv = scalar ? NULL : r->val;
+        if (s) {
+            double k = val_scalar(s);
+            if (op == TK_PLUSEQ) for (i = 0; i < n; i++) xv[i] += k * rv[i];
+            else for (i = 0; i < n; i++) xv[i] -= k * rv[i];
+        } else if (op == TK_PLUSEQ || op == TK_MINUSEQ) {
+            double sign = op == TK_PLUSEQ ? 1 : -1; /* x + (-r) is x - r, bit for bit */
+            if (scalar) for (i = 0, c *= sign; i < n; i++) xv[i] += c;
+            else if (sign > 0) for (i = 0; i < n; i++) xv[i] += rv[i];
+            else for (i = 0; i < n; i++) xv[i] -= rv[i];
+        } else {
+            c = op == TK_STAREQ ? c : 1.0 / c; /* as apply_binary: x / c is a scale by 1/c */
+            for (i = 0; i < n; i++) xv[i] *= c;
+        }
+    }
+    val_mutated(x);
+    return 1;
+}
+
+/* The operand e of an update of x by op (+= -= *= /=): applied to x in
+ * place when update_in_place allows it (returns 1), else its value in *out
+ * (returns 0), or -1 on error.  e = s * y with a scalar s is scaled into x
+ * without the temporary s * y. */
+static int update_operand(lang_ev *V, int op, silc_value *x, const ast_node *stmt, const ast_node *e,
+                          silc_value **out)
+{
+    int rc;
+    *out = NULL;
+    if ((op == TK_PLUSEQ || op == TK_MINUSEQ) && e->kind == AST_BINARY && e->op == TK_STAR) {
+        const silc_value *k;
+        silc_value *a, *b;
+        if (ev_expr_dist(V, e->kids[0], &a)) return -1;
+        if (ev_expr_dist(V, e->kids[1], &b)) {
+            val_release(a);
+            return -1;
+        }
+        k = val_is_scalar(a) ? a : val_is_scalar(b) ? b : NULL;
+        if (k && (rc = update_in_place(V, op, x, k == a ? b : a, k, stmt)) != 0) {
+            val_release(a);
+            val_release(b);
+            return rc;
+        }
+        if (binary_of(V, e, a, b, out)) return -1;
+    } else if (ev_expr_dist(V, e, out)) {
+        return -1;
+    }
+    if (!(rc = update_in_place(V, op, x, *out, NULL, stmt))) return 0;
+    val_release(*out);
+    *out = NULL;
+    return rc;
+}
+
+/* `x = x + e` and `x = x - e` are the updates `x += e` and `x -= e`: the
+ * same arithmetic (so the same bits), in place under the same conditions.
+ * Returns TK_PLUSEQ / TK_MINUSEQ for such a statement, else 0. */
+static int self_update_op(const ast_node *s)
+{
+    const ast_node *e = s->kids[0];
+    if (s->kind != ST_ASSIGN || e->kind != AST_BINARY || (e->op != TK_PLUS && e->op != TK_MINUS) ||
+        e->kids[0]->kind != AST_NAME || strcmp(e->kids[0]->name, s->name) != 0)
+        return 0;
+    return e->op == TK_PLUS ? TK_PLUSEQ : TK_MINUSEQ;
+}
+
+/* The previous value of the assignment's target, as the initial guess of
+ * its solve (solve.initial_guess): `previous` whenever the target holds a
+ * dense value; `auto` (the default) only when this same statement computed
+ * it -- a time loop, where the last step's solution is close to this one's;
+ * `zero` never.  Iterative backends start from it (direct ones ignore it).
+ * explain and distributed engines start from zero. */
+static silc_value *initial_guess(lang_ev *V, const ast_node *s)
+{
+    const char *mode = cfg_get(V->E, "solve.initial_guess");
+    silc_value *prev;
+    const eng_info *info;
+    size_t len = s->end - s->start;
+    if (V->explain || V->E->dist || (mode && !strcmp(mode, "zero"))) return NULL;
+    prev = store_get(&V->E->store, s->name);
+    if (!prev || prev->format != SILC_FMT_DENSE || prev->dist) return NULL;
+    if (!mode || !strcmp(mode, "auto")) {
+        info = eng_info_get(V->E, s->name);
+        if (!info || !info->statement || strlen(info->statement) != len ||
+            memcmp(info->statement, V->src + s->start, len))
+            return NULL;
+    }
+    return val_retain(prev);
+}
+
+static int exec_assign(lang_ev *V, const ast_node *s, double t0)
+{
+    silc_value *v = NULL, *cur = NULL, *r;
+    char ln[64], rn[64], what[256];
+    operands o;
+    int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
+    if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
+    if (s->kind == ST_ASSIGN && !cur) {
+        silc_value *guess = initial_guess(V, s);
+        V->warm = guess;
+        rc = ev_expr_dist(V, s->kids[0], &v);
+        V->warm = NULL;
+        val_release(guess);
+        if (rc) return -1;
+        return bind(V, s, s->name, v, t0);
+    }
+    if (!cur) return undefined_name(V, s->name);
+    val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
+    if (op) {
+        rc = update_operand(V, op, cur, s, s->kind == ST_OPASSIGN ? s->kids[0] : s->kids[0]->kids[1], &r);
+        if (rc < 0) {
+            val_release(cur);
+            return -1;
+        }
+        if (rc > 0) return bind(V, s, s->name, cur, t0); /* hands over the reference taken above */
+        if (s->kind == ST_ASSIGN) { /* x = x + e, with that expression's wording */
+            if (binary_of(V, s->kids[0], cur, r, &v)) return -1;
+            return bind(V, s, s->name, v, t0);
+        }
+    } else if ((s->kind == ST_INDEX_ASSIGN ? ev_expr : ev_expr_dist)(V, s->kids[0], &r)) {
+        val_release(cur);
+        return -1;
+    }
+    /* x[i] = r reads and writes x's entries: a whole copy of a distributed x. */
+    if (s->kind == ST_INDEX_ASSIGN && dist_make_whole(V->E, &cur)) {
+        val_release(cur);
+        val_release(r);
+        return -1;
+    }
+    snprintf(ln, sizeof ln, "'%s'", s->name);
+    ev_operand_name(V, s->kids[0], 1, rn, sizeof rn);
+    node_text(V, s, what, sizeof what);
+    o.lname = ln;
+    o.rname = rn;
+    o.what = what;
+    if (s->kind == ST_OPASSIGN)
+        rc = apply_binary(V, opassign_token(s->op), &o, cur, r, &v);
+    else
+        rc = ix_assign(V, s->kids + 1, s->nkids - 1, ln, cur, r, &v);
+    val_release(cur);
+    val_release(r);
+    if (rc) return -1;
+    return bind(V, s, s->name, v, t0);
+}
+
+/* Prints b and frees it, or, when an append to it ran out of memory, prints
+ * nothing: a listing cut short would pass for a complete one. */
+static int print_whole(silc_engine *E, strbuf *b, const char *what)
+{
+    int failed = b->failed;
+    if (!failed) eng_print(E, sb_str(b));
+    sb_free(b);
+    return failed ? eng_error(E, "out of memory printing the output of %s", what) : 0;
+}
+
+static int exec_who(lang_ev *V)
+{
+    const char **names = NULL;
+    size_t n = store_names(&V->E->store, &names), i, w = 4, sw = 4;
+    strbuf b;
+    char shape[48];
+    sb_init(&b);
+    if (n == 0 && V->E->store.count) return eng_error(V->E, "out of memory listing the names");
+    if (n == 0) {
+        eng_print(V->E, "no variables\n");
+        free(names);
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        silc_value *v = store_get(&V->E->store, names[i]);
+        ev_shape(v, shape, sizeof shape);
+        if (strlen(names[i]) > w) w = strlen(names[i]);
+        if (strlen(shape) > sw) sw = strlen(shape);
+    }
+    sb_printf(&b, "%-*s  %-*s  %-6s  %s\n", (int)w, "name", (int)sw, "size", "format", "nnz");
+    for (i = 0; i < n; i++) {
+        silc_value *v = store_get(&V->E->store, names[i]);
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(&b, "%-*s  %-*s  %-6s  nnz %lld\n", (int)w, names[i], (int)sw, shape,
+                  val_format_name(v->format), (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
+    }
+    free(names);
+    return print_whole(V->E, &b, "who");
+}
+
+static void clear_name(silc_engine *E, const char *name)
+{
+    store_remove(&E->store, name);
+    eng_info_remove(E, name);
+}
+
+static int exec_clear(lang_ev *V, const ast_node *s)
+{
+    size_t i;
+    if (s->nkids == 0) {
+        const char **names = NULL;
+        size_t n = store_names(&V->E->store, &names);
+        for (i = 0; i < n; i++) eng_info_remove(V->E, names[i]);
+        free(names);
+        store_clear(&V->E->store);
+        return 0;
+    }
+    for (i = 0; i < s->nkids; i++) clear_name(V->E, s->kids[i]->name);
+    return 0;
+}
+
+static char *trimmed(const char *s, size_t len)
+{
+    char *r;
+    while (len && (*s == ' ' || *s == '\t')) s++, len--;
+    while (len && (s[len - 1] == ' ' || s[len - 1] == '\t' || s[len - 1] == '\r')) len--;
+    r = malloc(len + 1);
+    if (r) {
+        memcpy(r, s, len);
+        r[len] = 0;
+    }
+    return r;
+}
+
+static int exec_set(lang_ev *V, const ast_node *s)
+{
+    silc_engine *E = V->E;
+    const char *eq;
+    char *key, *value;
+    int rc;
+    if (!s->name) {
+        strbuf b;
+        sb_init(&b);
+        cfg_list(E, &b);
+        if (!b.len && !b.failed) sb_puts(&b, "no settings\n");
+        return print_whole(E, &b, "set");
+    }
+    eq = strchr(s->name, '=');
+    key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
+    if (!key) return eng_oom(E);
+    if (!eq) {
+        const char *v = cfg_get(E, key);
+        strbuf b;
+        sb_init(&b);
+        if (v) sb_printf(&b, "%s = %s\n", key, v);
+        else sb_printf(&b, "%s is not set\n", key);
+        free(key);
+        return print_whole(E, &b, "set");
+    }
+    value = trimmed(eq + 1, strlen(eq + 1));
+    if (!value) {
+        free(key);
+        return eng_oom(E);
+    }
+    if (!key[0]) rc = eng_error(E, "set needs a key before '=', as in 'set dispatch.solve.dense = lapack'");
+    else rc = cfg_set(E, CFG_SCOPE_SESSION, key, value);
+    free(key);
+    free(value);
+    return rc ? -1 : 0;
+}
+
+static int exec_info(lang_ev *V, const ast_node *s)
+{
+    silc_engine *E = V->E;
+    silc_value *v = store_get(&E->store, s->name);
+    eng_info *in;
+    strbuf b;
+    char shape[48], num[40];
+    if (!v) return undefined_name(V, s->name);
+    in = eng_info_get(E, s->name);
+    sb_init(&b);
+    ev_shape(v, shape, sizeof shape);
+    sb_printf(&b, "%s: %s %s, nnz %lld\n", s->name, shape, val_format_name(v->format),
+              (long long)val_props_part(v, SILC_PROPS_SHAPE)->nnz);
+    if (dist_is(v)) {
+        const dist_part *P = v->dist->part;
+        sb_printf(&b, "  distributed: rows in %d blocks (rank 0: %lld rows", P->size,
+                  (long long)(P->starts[1] - P->starts[0]));
+        if (P->size > 1)
+            sb_printf(&b, ", rank %d: %lld rows", P->size - 1,
+                      (long long)(P->starts[P->size] - P->starts[P->size - 1]));
+        sb_puts(&b, ")\n");
+    } else if (E->dist) {
+        sb_printf(&b, "  whole on each of the %d ranks\n", E->dist->size);
+    }
+    if (!in) {
+        sb_puts(&b, "  deposited by PUT (no statement of this session computed it)\n");
+    } else {
+        const silc_report *r = &in->report;
+        int deferred = in->has_solve && r->backward_error == ACC_DEFERRED;
+        if (deferred)
+            in->report.backward_error = acc_pending_resolve(E, &in->pending, r->backend);
+        sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
+        sb_printf(&b, "  wall time: %.3g s\n", in->seconds);
+        if (in->ranks)
+            sb_printf(&b, "  ranks: %d; moved between ranks by the statement: %llu bytes of matrices, "
+                          "%llu bytes of vectors\n", in->ranks, (unsigned long long)in->moved_matrix,
+                      (unsigned long long)in->moved_vector);
+        if (!in->has_solve) {
+            sb_puts(&b, "  no solve in this statement\n");
+        } else {
+            sb_printf(&b, "  solve: %s\n", r->method[0] ? r->method : "(method not reported)");
+            sb_printf(&b, "  backend: %s\n", in->backends[0] ? in->backends : r->backend);
+            sb_printf(&b, "  backward error: %.3g%s\n", r->backward_error,
+                      !deferred          ? ""
+                      : r->reused_factor ? " (computed now: the solve reused a factorization)"
+                                         : " (computed now: solve.backward_error = on_request)");
+            if (r->backward_error_unrefined >= 0)
+                sb_printf(&b, "  refinement: %d step%s, backward error before: %.3g\n",
+                          r->refine_steps, r->refine_steps == 1 ? "" : "s",
+                          r->backward_error_unrefined);
+            if (r->cond_est >= 0) {
+                sb_printf(&b, "  condition estimate: %.3g\n", r->cond_est);
+                /* First-order bound on the relative forward error (Higham, 7.2). */
+                sb_printf(&b, "  forward error bound: cond x backward error = %.3g\n",
+                          r->cond_est * r->backward_error);
+            } else {
+                sb_puts(&b, "  condition estimate: not available\n");
+            }
+            sb_printf(&b, "  iterations: %lld\n", (long long)r->iterations);
+            if (r->initial_guess)
+                sb_printf(&b, "  initial guess: the previous value of %s (warm start)\n", s->name);
+            if (r->attempts[0]) sb_printf(&b, "  earlier attempts (failed, the next listed backend took over):\n    %s\n", r->attempts);
+            if (r->iterations > 0) {
+                util_fmt_double(num, sizeof num, r->resid);
+                sb_printf(&b, "  final relative residual: %s\n", num);
+            }
+            sb_printf(&b, "  reused factorization: %s\n", r->reused_factor ? "yes" : "no");
+            sb_printf(&b, "  solve time: %.3g s\n", r->seconds);
+            if (r->note[0]) sb_printf(&b, "  note: %s\n", r->note);
+        }
+    }
+    return print_whole(E, &b, "info");
+}
+
+static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
+
+static int exec_tune(lang_ev *V, const ast_node *s)
+{
+    double xs[128];
+    const char *file = NULL;
+    size_t i;
+    int nx = 0;
+    for (i = 0; i < s->nkids; i++) {
+        if (s->kids[i]->kind == AST_STRING) file = s->kids[i]->name;
+        else if (nx < 128) xs[nx++] = s->kids[i]->num;
+        else return eng_error(V->E, "tune %s: too many numbers (at most 64 points)", s->name);
+    }
+    return tuner_command(V->E, s->name, xs, nx, file);
+}
+
+static int exec_explain(lang_ev *V, const ast_node *s)
+{
+    strbuf b;
+    int flow = FLOW_NEXT, rc;
+    char *text = stmt_text(V, s->kids[0]);
+    if (!text) return eng_error(V->E, "out of memory printing the output of explain");
+    sb_init(&b);
+    sb_printf(&b, "explain: %s\n", text);
+    free(text);
+    V->explain = 1;
+    V->explain_out = &b;
+    V->explain_step = 0;
+    rc = exec_stmt(V, s->kids[0], &flow);
+    V->explain = 0;
+    V->explain_out = NULL;
+    if (rc) {
+        sb_free(&b);
+        return rc;
+    }
+    if (V->explain_step == 0) sb_puts(&b, "  no operation runs: values are built by the core\n");
+    return print_whole(V->E, &b, "explain");
+}
+
+static int condition(lang_ev *V, const ast_node *c, int *truth)
+{
+    silc_value *v;
+    char shape[48];
+    if (ev_expr(V, c, &v)) return -1;
+    if (!val_is_scalar(v)) {
+        ev_shape(v, shape, sizeof shape);
+        val_release(v);
+        return eng_error(V->E, "condition must be a scalar, got %s", shape);
+    }
+    *truth = val_scalar(v) != 0;
+    val_release(v);
+    return 0;
+}
+
+static int exec_block(lang_ev *V, const ast_node *b, int *flow)
+{
+    size_t i;
+    for (i = 0; i < b->nkids; i++) {
+        if (exec_stmt(V, b->kids[i], flow)) return -1;
+        if (*flow != FLOW_NEXT) return 0;
+    }
+    return 0;
+}
+
+static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
+
+/* One statement; on a communicator every rank learns whether every rank
+ * ran it (dist.h): a statement that failed on one rank alone (out of
+ * memory) stops all, instead of leaving that rank out of the next
+ * collective. */
+static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
+{
+    int rc = exec_stmt_here(V, s, flow);
+    return V->E->dist && !V->explain ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+}
+
+static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
+{
+    double t0 = util_now();
+    int truth;
+    *flow = FLOW_NEXT;
+    V->has_solve = 0;
+    V->backends[0] = 0;
+    if (V->E->dist) {
+        V->moved0[0] = V->E->dist->moved_matrix;
+        V->moved0[1] = V->E->dist->moved_vector;
+    }
+    eng_pending_release(&V->pending);
+    switch (s->kind) {
+    case ST_EXPR: {
+        silc_value *v;
+        if (ev_expr(V, s->kids[0], &v)) return -1;
+        if (V->explain) {
+            char shape[48];
+            ev_shape(v, shape, sizeof shape);
+            sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
+                      val_format_name(v->format));
+        }
+        val_release(v);
+        if (V->E->warnings.failed) return eng_error(V->E, "out of memory recording a warning");
+        return 0;
+    }
+    case ST_ASSIGN:
+    case ST_OPASSIGN:
+    case ST_INDEX_ASSIGN:
+        return exec_assign(V, s, t0);
+    case ST_CLEAR:
+        return exec_clear(V, s);
+    case ST_WHO:
+        return exec_who(V);
+    case ST_SET:
+        return exec_set(V, s);
+    case ST_INFO:
+        return exec_info(V, s);
+    case ST_EXPLAIN:
+        return exec_explain(V, s);
+    case ST_TUNE:
+        return exec_tune(V, s);
+    case ST_SAVE:
+    case ST_LOAD: {
+        const char *names[256];
+        size_t i;
+        if (s->nkids > 256) return eng_error(V->E, "%s: at most 256 names at once", s->kind == ST_SAVE ? "save" : "load");
+        for (i = 0; i < s->nkids; i++) names[i] = s->kids[i]->name;
+        return (s->kind == ST_SAVE ? h5_save : h5_load)(V->E, s->name, names, s->nkids);
+    }
+    case ST_HELP: {
+        strbuf b;
+        char err[200];
+        sb_init(&b);
+        if (lang_help(&b, s->name, err, sizeof err)) {
+            sb_free(&b);
+            return eng_error(V->E, "%s", err);
+        }
+        return print_whole(V->E, &b, "help");
+    }
+    case ST_BREAK:
+        *flow = FLOW_BREAK;
+        return 0;
+    case ST_CONTINUE:
+        *flow = FLOW_CONTINUE;
+        return 0;
+    case ST_BLOCK:
+        return exec_block(V, s, flow);
+    case ST_IF:
+        if (condition(V, s->cond, &truth)) return -1;
+        if (truth) return exec_block(V, s->kids[0], flow);
+        return s->els ? exec_stmt(V, s->els, flow) : 0;
+    case ST_WHILE: {
+        /* An iteration of the outermost loop is a time step to the tuner
+         * (a script's loop is the program's time loop; tuner_loop_step). */
+        int rc = 0, outer = V->loop_depth++ == 0 && !V->explain;
+        uint64_t key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
+        for (;;) {
+            double ti = util_now();
+            if ((rc = condition(V, s->cond, &truth)) || !truth) break;
+            if (V->E->loop_budget && ++V->loops > V->E->loop_budget) {
+                rc = eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
+                               (unsigned long long)V->E->loop_budget);
+                break;
+            }
+            if ((rc = exec_block(V, s->kids[0], flow))) break;
+            if (outer) tuner_loop_step(V->E, key, util_now() - ti);
+            if (*flow == FLOW_BREAK) break;
+        }
+        V->loop_depth--;
+        if (!rc) *flow = FLOW_NEXT;
+        return rc;
+    }
+    default:
+        return eng_error(V->E, "internal error: expression where a statement was expected");
+    }
+}
+
+int lang_exec(silc_engine *E, const char *text)
+{
+    lang_program *prog;
+    lang_ev V;
+    size_t i;
+    double t0 = util_now();
+    if (!text) return eng_error(E, "no statement text");
+    E->err[0] = 0;
+    if (program_for(E, text, &prog)) return -1;
+    memset(&V, 0, sizeof V);
+    V.E = E;
+    V.src = prog->text;
+    for (i = 0; i < prog->nstmts; i++) {
+        int flow;
+        E->err[0] = 0;
+        if (exec_stmt(&V, prog->stmts[i], &flow)) {
+            eng_pending_release(&V.pending);
+            free(V.bind_text);
+            if (prog->nstmts > 1) {
+                char msg[sizeof E->err];
+                memcpy(msg, E->err, sizeof msg);
+                eng_error(E, "statement %zu: %s", i + 1, msg);
+            }
+            return -1;
+        }
+    }
+    eng_pending_release(&V.pending);
+    free(V.bind_text);
+    tuner_observe(E, text, util_now() - t0);
+    return 0;
+}

@@ -1,0 +1,167 @@
+/*
+ * memo.c -- results of operations that a time loop repeats on the same
+ * operands, kept and handed out again.
+ *
+ * Values never change without a new id (value.c), so an operation (its op,
+ * selector, coefficients and the ids of its operands) always gives the same
+ * result.  A loop such as the seeds' cloth step recomputes, every step,
+ * quantities built only from values that never change -- C1 =
+ * diag(X * sqrt(K_stiff)), A1, T1 = -A1 * A1', A = M - dt^2 DfDx - dt DfDv --
+ * and pays the sparse products each time; worse, A comes out as a new value
+ * every step, so a direct solver factors it again.  Here such a result is
+ * returned as the value it was the first time: the products run once, and
+ * A keeps its id, so its factorization is reused.
+ *
+ * A key is remembered (without its result) the first time it is seen, and
+ * its result is kept only when the same key comes again: most operations of
+ * a loop have an operand that changes every step and would only fill the
+ * table.  The table is small and bounded (MEMO_SLOTS entries, MEMO_BYTES of
+ * results), least recently used first out.  Not used: for solves (their
+ * report and warnings belong to each statement), in explain, for calls
+ * that warned, on SPMD engines (ranks number values differently, and every
+ * rank must take the same path).  A result handed out is shared, so an
+ * in-place update of it (x += ...) copies first, as for any shared value.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "lang.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define MEMO_SLOTS 64
+#define MEMO_BYTES ((uint64_t)128 << 20)
+
+typedef struct memo_key {
+    int op, sub, nin;
+    uint64_t ids[3];
+    double alpha, beta;
+    int64_t ival[2];
+} memo_key;
+
+typedef struct memo_slot {
+    memo_key key;
+    silc_value *result;   /* NULL: seen once, no result kept */
+    uint64_t used;        /* for least-recently-used eviction */
+} memo_slot;
+
+struct eng_memo {
+    memo_slot slot[MEMO_SLOTS];
+    int n;
+    uint64_t clock, bytes;
+};
+
+/* The call's key; -1 for a call never kept: a solve (its report and
+ * warnings belong to each statement), one with per-call options, or one on
+ * an SPMD engine (ranks number values differently, and every rank must
+ * take the same path). */
+static int key_of(const silc_engine *E, const silc_call *call, memo_key *k)
+{
+    int i;
+    if (E->dist || call->op == SILC_OP_SOLVE || call->options || call->nin < 1 || call->nin > 3) return -1;
+    memset(k, 0, sizeof *k);
+    k->op = call->op;
+    k->sub = call->sub;
+    k->nin = call->nin;
+    for (i = 0; i < call->nin; i++) {
+        if (!call->in[i]) return -1;
+        k->ids[i] = call->in[i]->id;
+    }
+    k->alpha = call->alpha;
+    k->beta = call->beta;
+    k->ival[0] = call->ival[0];
+    k->ival[1] = call->ival[1];
+    return 0;
+}
+
+static int same_key(const memo_key *a, const memo_key *b)
+{
+    /* Coefficients compare by bits: -0.0 and 0.0 scale differently. */
+    return a->op == b->op && a->sub == b->sub && a->nin == b->nin && !memcmp(a->ids, b->ids, sizeof a->ids) &&
+           !memcmp(&a->alpha, &b->alpha, sizeof a->alpha) && !memcmp(&a->beta, &b->beta, sizeof a->beta) &&
+           a->ival[0] == b->ival[0] && a->ival[1] == b->ival[1];
+}
+
+static memo_slot *find(eng_memo *M, const memo_key *k)
+{
+    int i;
+    for (i = 0; i < M->n; i++)
+        if (same_key(&M->slot[i].key, k)) return &M->slot[i];
+    return NULL;
+}
+
+static void drop(eng_memo *M, memo_slot *s)
+{
+    if (s->result) {
+        M->bytes -= val_bytes(s->result);
+        val_release(s->result);
+    }
+    *s = M->slot[--M->n];
+}
+
+/* A free slot, evicting the least recently used when the table is full. */
+static memo_slot *make_room(eng_memo *M)
+{
+    int i, old = 0;
+    if (M->n < MEMO_SLOTS) return &M->slot[M->n++];
+    for (i = 1; i < M->n; i++)
+        if (M->slot[i].used < M->slot[old].used) old = i;
+    drop(M, &M->slot[old]);
+    return &M->slot[M->n++];
+}
+
+silc_value *memo_lookup(silc_engine *E, const silc_call *call)
+{
+    memo_key k;
+    memo_slot *s;
+    if (!E->memo || key_of(E, call, &k)) return NULL;
+    s = find(E->memo, &k);
+    if (!s || !s->result) return NULL;
+    s->used = ++E->memo->clock;
+    return val_retain(s->result);
+}
+
+void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int warned)
+{
+    eng_memo *M;
+    memo_key k;
+    memo_slot *s;
+    uint64_t bytes;
+    if (key_of(E, call, &k)) return;
+    if (!E->memo && !(E->memo = calloc(1, sizeof *E->memo))) return; /* no table: nothing kept, nothing lost */
+    M = E->memo;
+    s = find(M, &k);
+    if (warned) { /* its warnings belong to each run: never hand it out */
+        if (s) drop(M, s);
+        return;
+    }
+    if (!s) { /* the first sighting: remember the key only */
+        s = make_room(M);
+        memset(s, 0, sizeof *s);
+        s->key = k;
+        s->used = ++M->clock;
+        return;
+    }
+    s->used = ++M->clock;
+    if (s->result) return;
+    bytes = val_bytes(result);
+    while (M->bytes + bytes > MEMO_BYTES) {
+        int i, old = -1;
+        for (i = 0; i < M->n; i++)
+            if (M->slot[i].result && &M->slot[i] != s && (old < 0 || M->slot[i].used < M->slot[old].used)) old = i;
+        if (old < 0) return; /* larger than the whole table: not kept */
+        /* drop() moves the last slot into the freed one: keep s pointing at our key. */
+        if (s == &M->slot[M->n - 1]) s = &M->slot[old];
+        drop(M, &M->slot[old]);
+    }
+    s->result = val_retain(result);
+    M->bytes += bytes;
+}
+
+void memo_free(silc_engine *E)
+{
+    eng_memo *M = E->memo;
+    if (!M) return;
+    while (M->n) drop(M, &M->slot[M->n - 1]);
+    free(M);
+    E->memo = NULL;
+}

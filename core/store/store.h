@@ -1,0 +1,236 @@
+/*
+ * store.h -- the engine's data model (core/store/), the lowest layer that
+ * knows a matrix: values and the store (value.c), and envelopes, their
+ * public form (envelope.c).  Nothing here knows an engine.
+ *
+ * ---- values and the store (value.c)
+ *
+ * A value is an immutable m x n real matrix in one storage format (dense
+ * column-major, sorted 0-based CSR, LAPACK band), reference counted, with a
+ * process-unique id, lazily computed structural properties, and attachments
+ * (derived data with a destructor: factorizations, converted copies) that die
+ * with it.  Immutability is what makes attachments safe: `A` keeps its id and
+ * its factorization until the name is rebound.  Values are built mutable by the
+ * constructors below, filled, and then frozen by being handed to the store or
+ * returned from an operation; nothing writes to a value after that, with one
+ * exception that no one can observe: `x += ...` updates x's dense value in
+ * place when the store's binding is its only reference and it has no
+ * attachments (copy-on-write, eval.c), and then gives it a new id.
+ *
+ * The store maps names to values for one context.  Binding retains, rebinding
+ * or clearing releases.
+ */
+#ifndef SILC_STORE_H
+#define SILC_STORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "silc_plugin.h"
+#include "silc.h"
+
+typedef struct val_attachment {
+    char *key;
+    void *data;
+    void (*destroy)(void *);
+    struct val_attachment *next;
+} val_attachment;
+
+/* A row partition: rank r holds rows [starts[r], starts[r+1]).  Shared,
+ * reference counted, by the values distributed the same way, so "same
+ * layout" is one comparison (dist.h). */
+typedef struct dist_part {
+    int64_t refcount;
+    int size;
+    int64_t starts[];           /* size + 1 */
+} dist_part;
+
+/* Where a distributed value's whole copy is: the same on every rank. */
+enum { DIST_WHOLE_NONE = 0, DIST_WHOLE_ROOT = 1, DIST_WHOLE_ALL = 2 };
+
+/* What makes a value distributed (dist.c builds and reads it; value.c only
+ * frees it).  The value itself then has no arrays: its m, n and format are
+ * the whole value's, block holds this rank's rows (an ordinary value,
+ * global column indices), and whole the gathered copy once one was needed,
+ * on rank 0 (DIST_WHOLE_ROOT) or on every rank (DIST_WHOLE_ALL). */
+typedef struct val_dist {
+    struct dist_ctx *ctx;       /* the engine's communicator and counters */
+    dist_part *part;
+    struct silc_value *block;
+    struct silc_value *whole;
+    int where;
+} val_dist;
+
+struct silc_value {
+    int64_t refcount;
+    uint64_t id;
+    int64_t m, n;
+    int format;              /* enum silc_format */
+    double *val;
+    silc_index *rowptr, *colind;
+    int64_t nnz;             /* csr: entries in use; dense m*n; band ld*n */
+    int64_t cap;             /* csr: capacity of colind/val */
+    int64_t kl, ku, ld;
+    int props_have;          /* SILC_PROPS_* bits: the parts of props that are valid */
+    silc_props props;
+    int scan_ready;          /* SCAN_FINITE: scan_nonfinite is known; SCAN_MAXABS: both */
+    int scan_nonfinite;
+    double scan_maxabs;
+    val_attachment *attach;
+    val_dist *dist;          /* NULL: the value is whole here (val_dist, below) */
+};
+
+/* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
+silc_value *val_dense_new(int64_t m, int64_t n);
+silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity);
+silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku);
+silc_value *val_scalar_new(double x);
+int val_csr_set_nnz(silc_value *v, int64_t nnz);
+/* Fills a CSR value made for rowptr[m] entries from rowptr/colind/values
+ * (which may be its own arrays: data received in place), checking that each
+ * row's columns lie in [0, n) and strictly increase, and computing the
+ * shape part of the properties in the same pass, while each row is in
+ * cache.  rowptr must be valid (0 first, never decreasing).  -1 at the first
+ * row that fails: the value is then partly filled, to be dropped, and
+ * env_check says what was wrong. */
+int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_index *colind,
+                         const double *values);
+/* As the constructors, elements left unset: for a caller that writes them all. */
+silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
+/* Recycling of value arrays, process-wide (silcd installs a pool): take(bytes)
+ * returns an array of at least bytes with any contents, or NULL; give(p) gets
+ * every freed array and returns 1 when it kept it (then no longer to free).
+ * Install before any thread uses values; NULL hooks mean plain malloc/free. */
+void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p));
+/* An array of count elements of size bytes, zero-filled when zero is set,
+ * from the pool when it has one; never asks for zero bytes, so NULL always
+ * means failure.  Value and envelope arrays are made and freed with these. */
+void *val_array_alloc(int64_t count, size_t size, int zero);
+/* The largest value (its arrays' bytes) the constructors make in this
+ * process; source names the setting in refusals ("silcd --max-value-bytes").
+ * Unset: the machine's physical memory.  Set once, before values are made. */
+void val_set_max_bytes(uint64_t bytes, const char *source);
+uint64_t val_max_bytes(void);
+/* Why this thread's last constructor returned NULL if a size limit refused
+ * it ("a 10000000000x10000000000 csr value needs ... exceeds the limit ...
+ * by ..."), or "" if it was malloc: callers report it instead of "out of
+ * memory" (eng_oom). */
+const char *val_refusal(void);
+/* 0 if bytes fit the limit; else -1 and val_refusal() says "<what> needs N
+ * bytes (..), over the limit of .. by ..: the most one value may hold (..)".
+ * For sizes claimed before any value exists (a Matrix Market size line). */
+int val_claim(double bytes, const char *what);
+void val_array_free(void *p);
+
+silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
+void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */
+
+void val_view(const silc_value *v, silc_view *out);
+const silc_props *val_props(const silc_value *v); /* computes and caches on first call */
+/* Only some parts of the properties (SILC_PROPS_*, silc_plugin.h), each
+ * computed and cached when first asked for (value.c says why). */
+const silc_props *val_props_part(const silc_value *v, int parts);
+/* Any NaN or Inf among the stored entries, and the largest |entry| (NaN if
+ * any is NaN), from one cached scan: what a solve needs of its right-hand
+ * side, without computing the properties. */
+int val_has_nonfinite(const silc_value *v);
+double val_max_abs(const silc_value *v);
+/* After changing a value's entries in place (only before it is shared):
+ * forget what the caches said. */
+void val_forget_caches(silc_value *v);
+/* After updating an unshared value in place (copy-on-write, eval.c): forget
+ * the caches and take a new id, so that nothing keyed by the old id can
+ * mistake the new contents for the old. */
+void val_mutated(silc_value *v);
+int val_is_scalar(const silc_value *v);   /* 1x1 */
+double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
+double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
+/* 1 when a and b hold the same format, shape, pattern and value bits (whole
+ * values only). */
+int val_same_contents(const silc_value *a, const silc_value *b);
+/* The same for two views (val_same_contents and env_same_as_value). */
+int view_same_contents(const silc_view *x, const silc_view *y);
+size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
+const char *val_format_name(int format);  /* "dense", "csr", "band" */
+
+/* Distributed values (dist.c).  val_dist_new makes an array-less value of
+ * the whole shape that takes over block and retains part.  The hooks let
+ * the properties and scans of such a value be computed collectively by
+ * dist.c (which installs them) when someone asks: value.c sits below the
+ * communicator. */
+silc_value *val_dist_new(int64_t m, int64_t n, int format, struct dist_ctx *ctx, dist_part *part,
+                         silc_value *block);
+dist_part *dist_part_ref(dist_part *p);
+void dist_part_unref(dist_part *p);
+typedef struct val_dist_hooks {
+    void (*props)(silc_value *v, int parts);     /* fill v->props for parts, set props_have */
+    void (*scan)(silc_value *v);                 /* fill scan_nonfinite, scan_maxabs, SCAN_MAXABS */
+} val_dist_hooks;
+void val_set_dist_hooks(const val_dist_hooks *h);
+
+void *val_attach_get(const silc_value *v, const char *key);
+int val_attach_set(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
+
+/* ---- the store ------------------------------------------------------------- */
+typedef struct store_entry {
+    char *name;
+    silc_value *value;
+    struct store_entry *next;
+} store_entry;
+
+typedef struct silc_store {
+    store_entry **buckets;
+    size_t nbuckets, count;
+} silc_store;
+
+int store_init(silc_store *s);
+void store_free(silc_store *s);
+silc_value *store_get(const silc_store *s, const char *name);     /* borrowed, NULL if absent */
+int store_set(silc_store *s, const char *name, silc_value *v);    /* retains v; releases the old */
+int store_remove(silc_store *s, const char *name);                /* 0 removed, 1 absent */
+void store_clear(silc_store *s);
+/* Names in sorted order; *names is malloc'd array of borrowed strings. */
+size_t store_names(const silc_store *s, const char ***names);
+
+/*
+ * ---- envelopes (envelope.c): the bridge between public envelopes (silc.h)
+ * and engine values (above), and the message buffer of calls that have no context.
+ *
+ * Envelope constructors and silc_mm_read/write run without a context, so
+ * their failure messages go to a per-thread buffer.  silc_errmsg() shows that
+ * message until a later failure on the default context supersedes it (the API
+ * calls env_error_forget() when it records one).
+ */
+
+/* Validates an envelope without copying it (the checks env_to_value makes):
+ * used by the remote client before sending and by silcd on what it received,
+ * so both report exactly the embedded messages. */
+int env_check(const silc_envelope_t *e, char *err, size_t errlen);
+/* Copies an envelope into a new value (refcount 1), validating it first:
+ * shapes, array presence, CSR rowptr/colind consistency and sorted,
+ * duplicate-free rows.  On failure writes the reason to err. */
+int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen);
+/* The CSR part of env_to_value for a value made for e's rowptr[m] entries:
+ * checks and fills it from e's arrays (which may be the value's own), with
+ * the value's shape computed on the way (val_csr_fill_checked).  0, or -1
+ * with the reason in err. */
+int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen);
+/* 1 when e holds exactly v's format, shape, pattern and value bits: then a
+ * PUT of e to the name holding v need copy nothing (silc_put).  Reads no
+ * array of e beyond what v's shape says a valid e has; 0 for anything that
+ * is not such an e. */
+int env_same_as_value(const silc_envelope_t *e, const silc_value *v);
+/* Copies a value into a freshly built envelope of the same format. */
+int env_from_value(const silc_value *v, silc_envelope_t *e);
+
+/* Records a context-free failure message; returns -1. */
+int env_error(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+/* The context-free message of this thread if it is the latest failure, else NULL. */
+const char *env_error_last(void);
+void env_error_forget(void);
+
+#endif
