@@ -1,6 +1,6 @@
 /*
  * test_mmatrix.c -- the first solve with a large symmetric M-matrix goes to
- * algebraic multigrid (issue 18, core/src/dispatch.c's
+ * algebraic multigrid (issue 18, core/dispatch/dispatch.c's
  * solve.sparse.mmatrix.spd), checked against the exact solution:
  *
  *   - the 120 x 120 Laplacian (14 400 unknowns), b = A xt: the first
