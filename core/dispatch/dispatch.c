@@ -100,11 +100,13 @@ typedef struct blist {
 #define MMATRIX_MIN_N 10000
 #define SOLVED_KEY "dispatch.solved" /* attached to A by its first sparse solve */
 
-static int mmatrix_first_solve(const silc_value *A)
+/* A is CSR with at least MMATRIX_MIN_N rows and no positive off-diagonal
+ * entry (the caller knows it symmetric with a positive diagonal). */
+static int large_mmatrix(const silc_value *A)
 {
     silc_view v;
     int64_t i, k;
-    if (A->format != SILC_FMT_CSR || A->n < MMATRIX_MIN_N || val_attach_get(A, SOLVED_KEY)) return 0;
+    if (A->format != SILC_FMT_CSR || A->n < MMATRIX_MIN_N) return 0;
     val_view(A, &v);
     for (i = 0; i < v.m; i++)
         for (k = v.rowptr[i]; k < v.rowptr[i + 1]; k++)
@@ -144,7 +146,7 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
     const silc_value *A, *B;
     const silc_props *p;
     const char *reason;
-    char band_reason[160];
+    char band_reason[160], spd_reason[192];
     int sparse, banded = 0, n = 0;
     if (why && whylen) why[0] = '\0';
     if (!call || call->op < 0 || call->op >= SILC_OP_COUNT || call->nin < 1 || !call->in[0])
@@ -174,18 +176,21 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
                      (long long)p->kl, (long long)p->ku);
             reason = band_reason;
         } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric) {
-            /* (Not on an MPI engine: its lists start with the distributed solvers.) */
-            int mm = sparse && E && !E->dist && mmatrix_first_solve(A);
-            if (mm) out[n++] = "solve.sparse.mmatrix.spd";
+            /* (Not on an MPI engine: its lists start with the distributed
+             * solvers.)  A repeat is scanned only to explain itself. */
+            int repeat = sparse && val_attach_get(A, SOLVED_KEY) != NULL;
+            int mm = sparse && E && !E->dist && (!repeat || why) && large_mmatrix(A);
+            if (mm && !repeat) out[n++] = "solve.sparse.mmatrix.spd";
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
-            reason = mm ? (banded ? "banded, but a sparse class is configured and solve.band is not; symmetric "
-                                    "M-matrix (positive diagonal, off-diagonal entries <= 0), first solve with it"
-                                  : "symmetric M-matrix (positive diagonal, off-diagonal entries <= 0), first "
-                                    "solve with it")
-                 : banded ? "banded, but a sparse class is configured and solve.band is not; symmetric with "
-                            "positive diagonal"
-                          : "symmetric with positive diagonal";
+            snprintf(spd_reason, sizeof spd_reason, "%s%s",
+                     banded ? "banded, but a sparse class is configured and solve.band is not; " : "",
+                     !mm ? "symmetric with positive diagonal"
+                     : repeat ? "symmetric M-matrix solved before (a factorization kept for the later solves "
+                                "pays from here)"
+                              : "symmetric M-matrix (positive diagonal, off-diagonal entries <= 0), first "
+                                "solve with it");
+            reason = spd_reason;
         } else if (banded) {
             out[n++] = "solve.sparse";
             reason = "banded, but a sparse class is configured and solve.band is not";
