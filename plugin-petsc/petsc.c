@@ -643,7 +643,7 @@ static int solve_accepts(const silc_call *call, const char **why)
         return 0;
     }
     if (!call->op_class || strncmp(call->op_class, "solve.sparse", 12) != 0 ||
-        (call->op_class[12] && strcmp(call->op_class + 12, ".spd") != 0)) {
+        (call->op_class[12] && !ends_with_spd(call->op_class))) { /* also solve.sparse.mmatrix.spd */
         *why = "PETSc KSP here serves solve.sparse and solve.sparse.spd only (dense and band "
                "systems are better left to LAPACK)";
         return 0;

@@ -135,6 +135,20 @@ static void test_configured(silc_context *c)
     CHECK(silc_exec(c, "set dispatch.solve.sparse.spd = suitesparse.cholmod, reference") == 0, "set: %s",
           silc_context_errmsg(c));
     solved_by(c, "solve.sparse.spd configured", "suitesparse.cholmod", NULL, 1e-14);
+    /* A configured or forced PETSc runs under solve.sparse.spd, the class it knows. */
+    if (put_laplacian(c, 120)) return;
+    if (silc_exec(c, "x0 = solve(eye(2), ones(2, 1), \"backend = petsc\")") &&
+        tl_contains(silc_context_errmsg(c), "not installed")) {
+        printf("  (petsc not built: its checks skipped)\n");
+        return;
+    }
+    CHECK(silc_exec(c, "set dispatch.solve.sparse.spd = petsc, suitesparse.cholmod") == 0, "set: %s",
+          silc_context_errmsg(c));
+    solved_by(c, "solve.sparse.spd = petsc, ...", "petsc", NULL, 1e-9);
+    if (put_laplacian(c, 120)) return;
+    CHECK(silc_exec(c, "x = solve(A, b, \"backend = petsc\")") == 0 &&
+              tl_contains(tl_out_info(c, "x"), "backend: petsc"),
+          "forced petsc on a first M-matrix solve: %s", silc_context_errmsg(c));
 }
 
 static void test_fallback(silc_context *c)

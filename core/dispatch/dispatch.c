@@ -114,6 +114,17 @@ static int large_mmatrix(const silc_value *A)
     return 1;
 }
 
+/* The class is there for its built-in list: a configuration that names
+ * solve.sparse.spd or solve.sparse (and not this class) governs the solve
+ * under the class it named, and a per-call `backend = X` runs under the
+ * class X knows. */
+static int mmatrix_class_applies(const silc_engine *E)
+{
+    return !cfg_get(E, "backend") &&
+           (cfg_get(E, "dispatch.solve.sparse.mmatrix.spd") ||
+            !(cfg_get(E, "dispatch.solve.sparse.spd") || cfg_get(E, "dispatch.solve.sparse")));
+}
+
 /* After a sparse solve with A succeeded: A's next solve is a repeat. */
 static void note_solved(const silc_call *call)
 {
@@ -179,7 +190,8 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
             /* (Not on an MPI engine: its lists start with the distributed
              * solvers.)  A repeat is scanned only to explain itself. */
             int repeat = sparse && val_attach_get(A, SOLVED_KEY) != NULL;
-            int mm = sparse && E && !E->dist && (!repeat || why) && large_mmatrix(A);
+            int mm = sparse && E && !E->dist && (!repeat || why) && mmatrix_class_applies(E) &&
+                     large_mmatrix(A);
             if (mm && !repeat) out[n++] = "solve.sparse.mmatrix.spd";
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
