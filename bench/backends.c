@@ -66,6 +66,7 @@
 #include <klu.h>
 #include <umfpack.h>
 
+#include "diffusion_common.h"
 #include "silc.h"
 #include "testlib.h"
 
@@ -595,54 +596,41 @@ static int run_diffusion_tool(const char *cmd, double out[3])
     return pclose(p) == 0 && got ? 0 : -1;
 }
 
-/* The k x k 5-point grid operator c0 I + c1 L (L: 4 on the diagonal, -1 to
- * each neighbour), from tl_grid2d's diag I - L' scaled. */
-static int grid_operator(silc_envelope_t *e, int64_t k, double c0, double c1)
-{
-    int64_t i;
-    if (tl_grid2d(e, k, 0, 4 + c0 / c1)) return -1; /* (c0/c1 + 4) I - neighbours */
-    for (i = 0; i < e->nnz; i++) e->values[i] *= c1;
-    return 0;
-}
-
 /* One SILC run of the loop in a fresh session (setup: statements run
- * before it, e.g. the tuner's); time of the loop, last step's backward
- * error and sum(u) into out, what ran the last solve into ran. */
-static int silc_diffusion(int64_t k, int steps, const char *setup, double out[3], char *ran, size_t ranlen)
+ * before it, e.g. the tuner's), with the example's matrices and initial
+ * field (diffusion_common.h); time of the loop, last step's backward error
+ * and sum(u) into out, what ran the last solve into ran[64]. */
+static int silc_diffusion(int64_t k, int steps, const char *setup, double out[3], char ran[64])
 {
-    double h = 1.0 / (double)(k + 1), s = DIFF_DT / (2 * h * h), t0, *u, *sum;
-    silc_envelope_t A, B, U;
+    double h = diff2d_h(k), t0, *u, *sum;
+    silc_envelope_t A = {0}, B = {0}, U = {0};
     silc_context *c = NULL;
     tl_capture cap = {0};
-    int64_t i, j, m, n;
+    int64_t m, n;
     int step, rc = -1;
-    char stmt[64];
-    if (!(u = calloc((size_t)(k * k), sizeof *u))) return -1;
-    for (j = 0; j < k; j++)
-        for (i = 0; i < k; i++) {
-            double x = (double)(i + 1) * h, y = (double)(j + 1) * h;
-            u[j * k + i] = x > 0.4 && x < 0.6 && y > 0.4 && y < 0.6;
-        }
-    if (grid_operator(&A, k, 1, s) || grid_operator(&B, k, 1, -s) || silc_envelope_dense(&U, k * k, 1, u) ||
-        silc_open(&c, NULL)) {
+    if (!(u = malloc((size_t)(k * k) * sizeof *u))) return -1;
+    diff2d_initial(k, u);
+    if (diff_shifted_laplacian(2, k, h, -DIFF_DT / 2, &A) || diff_shifted_laplacian(2, k, h, DIFF_DT / 2, &B) ||
+        silc_envelope_dense(&U, k * k, 1, u) || silc_open(&c, NULL)) {
         free(u);
+        silc_envelope_free(&A);
+        silc_envelope_free(&B);
+        silc_envelope_free(&U);
         return -1;
     }
     free(u);
     tl_capture_attach(c, &cap);
     if (silc_put(c, "A", &A) || silc_put(c, "B", &B) || silc_put(c, "u", &U) || (setup && silc_exec(c, setup)))
         goto done;
-    snprintf(stmt, sizeof stmt, "u = A \\ (B * u)");
     t0 = tl_now();
     for (step = 0; step < steps; step++)
-        if (silc_exec(c, stmt)) goto done;
+        if (silc_exec(c, "u = A \\ (B * u)")) goto done;
     out[0] = tl_now() - t0;
     {
         const char *info = tl_info(c, &cap, "u");
         const char *p = strstr(info, "  backend: ");
         out[1] = tl_field(info, "backward error");
         if (p) sscanf(p + 11, "%63s", ran);
-        (void)ranlen;
     }
     if (silc_exec(c, "s = sum(u)") || !(sum = tl_get_dense(c, "s", &m, &n))) goto done;
     out[2] = sum[0];
@@ -682,9 +670,9 @@ static void bench_diffusion(const opts *o)
         snprintf(setup, sizeof setup,
                  "set tune.wisdom = %s; set tune.threads = auto; set tune.accuracy = 1e-8; tune on %d", wisdom,
                  o->loop);
-        if (silc_diffusion(k, o->loop, NULL, res, rn, sizeof rn) == 0 && (best[0][0] < 0 || res[0] < best[0][0]))
+        if (silc_diffusion(k, o->loop, NULL, res, rn) == 0 && (best[0][0] < 0 || res[0] < best[0][0]))
             memcpy(best[0], res, sizeof res), snprintf(ran[0], sizeof ran[0], "%s", rn);
-        if (silc_diffusion(k, o->loop, setup, res, rn, sizeof rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
+        if (silc_diffusion(k, o->loop, setup, res, rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
             memcpy(best[1], res, sizeof res), snprintf(ran[1], sizeof ran[1], "%s", rn);
     }
     remove(wisdom);

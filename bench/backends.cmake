@@ -22,5 +22,6 @@ else()
     ${BENCH_SS_INCLUDE} ${BENCH_MUMPS_INCLUDE})
   get_filename_component(_bench_matrices ${PROJECT_SOURCE_DIR}/../shared/matrices ABSOLUTE)
   target_compile_definitions(backends PRIVATE SILC_SHARED_MATRICES="${_bench_matrices}")
-  target_link_libraries(backends PRIVATE silc ${_bench_libs} ${MATH_LIB})
+  # silc_diffusion: the main example's matrices and field for --only diffusion.
+  target_link_libraries(backends PRIVATE silc silc_diffusion ${_bench_libs} ${MATH_LIB})
 endif()

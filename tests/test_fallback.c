@@ -27,18 +27,6 @@
 #include "check.h"
 #include "testlib.h"
 
-static silc_context *open_ctx(void)
-{
-    silc_context *c = NULL;
-    if (silc_open(&c, NULL)) {
-        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        return NULL;
-    }
-    silc_set_output(c, tl_out_fn, NULL);
-    return c;
-}
-
 /* 1 when every named backend is installed in c. */
 static int have(silc_context *c, const char *names)
 {
@@ -174,7 +162,7 @@ static void test_refinement_first(silc_context *c)
 
 int main(void)
 {
-    silc_context *c = open_ctx();
+    silc_context *c = tl_open_printing();
     if (!c) return check_done();
     if (have(c, "petsc") && have(c, "suitesparse.umfpack")) {
         test_library_failure(c);

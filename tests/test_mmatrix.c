@@ -29,18 +29,6 @@
 #include "check.h"
 #include "testlib.h"
 
-static silc_context *open_ctx(void)
-{
-    silc_context *c = NULL;
-    if (silc_open(&c, NULL)) {
-        CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
-        silc_close(&c);
-        return NULL;
-    }
-    silc_set_output(c, tl_out_fn, NULL);
-    return c;
-}
-
 /* The 1x1 value `name` (NaN if there is none). */
 static double scalar(silc_context *c, const char *name)
 {
@@ -189,7 +177,7 @@ static void test_backward_criterion(silc_context *c)
 
 int main(void)
 {
-    silc_context *c = open_ctx();
+    silc_context *c = tl_open_printing();
     if (!c) return check_done();
     if (silc_exec(c, "I = eye(2); x0 = solve(I, ones(2, 1), \"backend = lis-style\"); "
                      "x0 = solve(I, ones(2, 1), \"backend = suitesparse.cholmod\")") &&
@@ -203,9 +191,9 @@ int main(void)
     test_backward_criterion(c);
     silc_close(&c);
     /* Sessions of their own: each sets an option for the rest of its session. */
-    if ((c = open_ctx())) test_configured(c);
+    if ((c = tl_open_printing())) test_configured(c);
     silc_close(&c);
-    if ((c = open_ctx())) test_fallback(c);
+    if ((c = tl_open_printing())) test_fallback(c);
     silc_close(&c);
     return check_done();
 }

@@ -432,18 +432,27 @@ static inline int tl_index_next(FILE *f, tl_index_row *r)
     return 0;
 }
 
-/* A context printing into tl_out() whose sparse solve classes (solve.sparse
- * and solve.sparse.spd) are forced to backend; NULL with a failed check. */
-static inline silc_context *tl_open_forced(const char *backend)
+/* A context with the default config, printing into tl_out(); NULL with a
+ * failed check. */
+static inline silc_context *tl_open_printing(void)
 {
     silc_context *c = NULL;
-    char stmt[160];
     if (silc_open(&c, NULL)) {
         CHECK(0, "silc_open: %s", c ? silc_context_errmsg(c) : silc_errmsg());
         silc_close(&c);
         return NULL;
     }
     silc_set_output(c, tl_out_fn, NULL);
+    return c;
+}
+
+/* A context printing into tl_out() whose sparse solve classes (solve.sparse
+ * and solve.sparse.spd) are forced to backend; NULL with a failed check. */
+static inline silc_context *tl_open_forced(const char *backend)
+{
+    silc_context *c = tl_open_printing();
+    char stmt[160];
+    if (!c) return NULL;
     snprintf(stmt, sizeof stmt, "set dispatch.solve.sparse = %s; set dispatch.solve.sparse.spd = %s",
              backend, backend);
     CHECK(silc_exec(c, stmt) == 0, "%s: %s", stmt, silc_context_errmsg(c));

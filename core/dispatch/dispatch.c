@@ -92,7 +92,7 @@ typedef struct blist {
  * M-matrix (a Stieltjes matrix: positive diagonal, off-diagonal entries
  * <= 0, like every diffusion stencil).  Its default sends it to lis-style's
  * CG + SA-AMG, stopped at a backward error of 1e-12, before CHOLMOD: on the
- * 2-D Laplacian that is 4-5x cheaper than a Cholesky factorization from
+ * 2-D Laplacian that is 5-8x cheaper than a Cholesky factorization from
  * 10 000 unknowns up (docs/backends.md), and algebraic multigrid is built
  * for exactly these matrices.  A second solve with the same A is
  * solve.sparse.spd, where a factorization reused for every later solve is
