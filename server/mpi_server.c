@@ -174,6 +174,7 @@ int srv_mpi_serve(int lfd, int is_tcp)
         }
         if (p[0].revents & POLLIN) {
             int fd = accept(lfd, NULL, NULL), one = 1;
+            char peer[64];
             session *S;
             if (fd < 0) continue;
             if (n == srv_cfg.max_clients) {
@@ -183,7 +184,12 @@ int srv_mpi_serve(int lfd, int is_tcp)
                 continue;
             }
             if (is_tcp) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+            /* The handshake runs to its end here, so the peer's entry of
+             * the authentication backoff is needed only meanwhile. */
+            srv_peer_of(fd, peer, sizeof peer);
+            srv_auth_hold(peer);
             if ((S = srv_session_open(fd, next_id++, NULL))) open[n++] = S;
+            srv_auth_drop(peer);
         }
     }
     for (i = 0; i < n; i++) srv_session_close(open[i]);

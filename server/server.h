@@ -57,6 +57,32 @@ void srv_log(int level, const char *fmt, ...)
  * opened (the handshake completed), else 0. */
 int srv_session(int fd, unsigned long id, volatile int *state);
 
+/* ---- who may open a session (auth.c; docs/security.md) ----
+ * A token shorter than this is refused at start: a guess must be hopeless. */
+#define SRV_MIN_TOKEN_BYTES 16u
+/* The longest a check waits behind the failures of its peer address. */
+#define SRV_AUTH_MAX_WAIT_MS 10000
+/* Reads the token file into srv_cfg.token: a regular file owned by silcd's
+ * effective user, readable by no one else, whose first line holds the token.
+ * -1 with the reason printed to stderr. */
+int srv_auth_load_token(const char *path);
+/* silcd --make-token: a new random token (32 hex digits) in a new file of
+ * mode 0600; never overwrites.  -1 with the reason printed. */
+int srv_auth_make_token(const char *path);
+/* The peer's address ("127.0.0.1"), or "" on a Unix socket. */
+void srv_peer_of(int fd, char *out, size_t outlen);
+/* The per-peer backoff of failed authentications, in memory shared with
+ * the session processes: setup once (before forking), hold an address while
+ * a connection from it lives, drop it when the connection ends. */
+int srv_auth_setup(int max_connections);
+void srv_auth_hold(const char *addr);
+void srv_auth_drop(const char *addr);
+/* The token a client sent on fd: 0 if it may in (or no token is required),
+ * else -1 with why.  A failure makes the peer's next check wait (doubling,
+ * reset by a success); may_wait 0 (silcd --mpi, one process for every
+ * session) refuses such a check unchecked instead of waiting. */
+int srv_auth_verify(int fd, const char *given, int may_wait, char *why, size_t whylen);
+
 /* ---- silcd --mpi (mpi_server.c; docs/server.md, docs/distributed.md) ----
  * Rank 0 holds every connection in one process and serves one request at a
  * time; each session's engine runs on every rank (dist.h), so before rank

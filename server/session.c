@@ -381,17 +381,6 @@ static int do_info(session *S, const char *name)
     return reply_text(S, PROTO_OK, NULL);
 }
 
-/* Length-independent timing: the loop runs over the expected token whatever
- * the client sent, and differences are OR-ed, never branched on. */
-static int token_matches(const char *given)
-{
-    size_t glen = given ? strlen(given) : 0, i;
-    unsigned diff = glen != srv_cfg.token_len;
-    for (i = 0; i < srv_cfg.token_len; i++)
-        diff |= (unsigned)(uint8_t)srv_cfg.token[i] ^ (unsigned)(i < glen ? (uint8_t)given[i] : 0);
-    return diff == 0;
-}
-
 /* The hello exchange must end within --handshake-timeout however slowly
  * the peer trickles its bytes: SIGALRM ends this process, and the parent
  * logs why (silcd.c, reap_children). */
@@ -453,9 +442,17 @@ static int handshake(session *S)
         snprintf(why, sizeof why, "protocol version %u is not supported (this server speaks %u)",
                  (unsigned)version, PROTO_VERSION);
         rc = -1;
-    } else if (srv_cfg.token && !token_matches(token)) {
-        snprintf(why, sizeof why, "authentication failed: %s token", token ? "wrong" : "missing");
-        rc = -1;
+    } else {
+        /* The hello is in: the deadline now leaves room for the wait that
+         * recent failures from this peer impose (auth.c; logged there). */
+        handshake_deadline(srv_cfg.handshake_timeout_ms + SRV_AUTH_MAX_WAIT_MS);
+        rc = srv_auth_verify(S->fd, token, !srv_mpi, why, sizeof why);
+        if (rc) {
+            free(token);
+            handshake_deadline(0);
+            reply_error(S, why);
+            return -1;
+        }
     }
     free(token);
     handshake_deadline(0);

@@ -99,7 +99,12 @@ static void usage(FILE *f)
           "  --listen URL            tcp://host:port (default tcp://127.0.0.1:7070) or unix:/path\n"
           "  --config FILE           silc.conf for every session's engine\n"
           "  --threads N             threads one operation may use (default: core.threads)\n"
-          "  --token-file FILE       shared secret clients must present (required off loopback)\n"
+          "  --token-file FILE       the secret clients must present; required on TCP (a file of\n"
+          "                          mode 0600 owned by silcd's user, a first line of 16+ bytes)\n"
+          "  --insecure              listen on TCP without a token (anyone who can connect may\n"
+          "                          run code as this user: loud warning at start)\n"
+          "  --make-token FILE       write a new random token to FILE (mode 0600; never\n"
+          "                          overwrites) and exit\n"
           "  --max-value-bytes N     largest value one PUT may carry (default 2G)\n"
           "  --max-session-bytes N   memory of the values bound in one session, 0 = no limit (default 4G)\n"
           "  --max-clients N         concurrent connections, handshakes included (default 256)\n"
@@ -119,15 +124,23 @@ static void usage(FILE *f)
           "  --help, --version\n", f);
 }
 
-/* "123", "64K", "512M", "2G" (powers of 1024). */
-static int parse_size(const char *s, uint64_t *out)
+/* The largest size an option takes: values are counted in int64_t bytes
+ * downstream, and a saturated strtoull must not pass for a real number. */
+#define SIZE_OPTION_MAX ((uint64_t)INT64_MAX)
+#define SECONDS_OPTION_MIN 0.001
+#define SECONDS_OPTION_MAX 86400.0
+
+/* "123", "64K", "512M", "2G" (powers of 1024), at most SIZE_OPTION_MAX;
+ * -1 with why on anything else. */
+static int parse_size(const char *s, uint64_t *out, char *why, size_t whylen)
 {
     char *end;
     unsigned long long x;
     int shift = 0;
-    if (!s || *s == '-') return -1;
+    snprintf(why, whylen, "expected a size in bytes with an optional K, M, G or T suffix");
+    if (!s || !(*s >= '0' && *s <= '9')) return -1;
+    errno = 0;
     x = strtoull(s, &end, 10);
-    if (end == s) return -1;
     switch (*end) {
     case 'k': case 'K': shift = 10; end++; break;
     case 'm': case 'M': shift = 20; end++; break;
@@ -135,68 +148,89 @@ static int parse_size(const char *s, uint64_t *out)
     case 't': case 'T': shift = 40; end++; break;
     default: break;
     }
-    if (*end || (shift && x > (UINT64_MAX >> shift))) return -1;
+    if (*end) return -1;
+    if (errno == ERANGE || x > (SIZE_OPTION_MAX >> shift)) {
+        snprintf(why, whylen, "too large: the maximum is %llu bytes",
+                 (unsigned long long)SIZE_OPTION_MAX);
+        return -1;
+    }
     *out = (uint64_t)x << shift;
     return 0;
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out)
+/* A decimal integer in [lo, hi]; -1 with why naming the range. */
+static int parse_count(const char *s, long long lo, long long hi, long long *out, char *why,
+                       size_t whylen)
 {
     char *end;
-    long x;
-    if (!s) return -1;
-    x = strtol(s, &end, 10);
-    if (end == s || *end || x < lo || x > hi) return -1;
+    long long x;
+    snprintf(why, whylen, "expected an integer from %lld to %lld", lo, hi);
+    if (!s || !((*s >= '0' && *s <= '9') || (*s == '-' && s[1] >= '0' && s[1] <= '9'))) return -1;
+    errno = 0;
+    x = strtoll(s, &end, 10);
+    if (*end || errno == ERANGE || x < lo || x > hi) return -1;
+    *out = x;
+    return 0;
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out, char *why, size_t whylen)
+{
+    long long x;
+    if (parse_count(s, lo, hi, &x, why, whylen)) return -1;
     *out = (int)x;
     return 0;
 }
 
-/* Seconds (fractions allowed, at most a day) as milliseconds, at least 1;
- * zero_ok admits 0 (= off). */
-static int parse_seconds(const char *s, int zero_ok, int *ms)
+/* Seconds (fractions allowed) from SECONDS_OPTION_MIN to SECONDS_OPTION_MAX,
+ * as milliseconds; zero_ok admits 0 (= off). */
+static int parse_seconds(const char *s, int zero_ok, int *ms, char *why, size_t whylen)
 {
     char *end;
-    double x = strtod(s, &end);
-    if (end == s || *end || !(x >= 0 && x <= 86400) || (x == 0 && !zero_ok)) return -1;
-    *ms = x == 0 ? 0 : (int)(x * 1000);
-    if (x > 0 && *ms < 1) *ms = 1;
-    return 0;
-}
-
-/* The secret: the file's first line, which must not be empty. */
-static int read_token(const char *path)
-{
-    char buf[PROTO_MAX_TOKEN + 2];
-    size_t n;
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fprintf(stderr, "silcd: cannot read token file '%s': %s\n", path, strerror(errno));
-        return -1;
-    }
-    n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    buf[strcspn(buf, "\r\n")] = '\0';
-    if (!*buf || strlen(buf) > PROTO_MAX_TOKEN) {
-        fprintf(stderr, "silcd: token file '%s' must hold a token of 1..%u bytes on its first "
-                "line\n", path, PROTO_MAX_TOKEN);
-        return -1;
-    }
-    srv_cfg.token_len = strlen(buf);
-    if (!(srv_cfg.token = malloc(srv_cfg.token_len + 1))) return -1;
-    memcpy(srv_cfg.token, buf, srv_cfg.token_len + 1);
+    double x;
+    snprintf(why, whylen, "expected %sseconds from %g to %g", zero_ok ? "0 (off) or " : "",
+             SECONDS_OPTION_MIN, SECONDS_OPTION_MAX);
+    if (!s || !((*s >= '0' && *s <= '9') || *s == '.')) return -1;
+    x = strtod(s, &end);
+    if (*end || !(x >= 0 && x <= SECONDS_OPTION_MAX)) return -1;
+    if (x == 0 ? !zero_ok : x < SECONDS_OPTION_MIN) return -1;
+    *ms = (int)(x * 1000 + 0.5);
     return 0;
 }
 
 static int mpi_mode;               /* --mpi */
+static int insecure;               /* --insecure: TCP without a token */
+static const char *make_token;     /* --make-token FILE */
 static int64_t dist_min_rows = 1000; /* --dist-min-rows */
+
+/* The options that take a value; any other "--name" is unknown (and
+ * --mpi, --insecure, --help, --version take none). */
+static const char *const value_options[] = {
+    "--listen", "--config", "--threads", "--token-file", "--make-token", "--max-value-bytes",
+    "--max-session-bytes", "--array-pool", "--max-clients", "--io-timeout",
+    "--handshake-timeout", "--idle-timeout", "--peer-share", "--log-level", "--ready-file",
+    "--dist-min-rows", NULL};
+
+static int takes_value(const char *name)
+{
+    int k;
+    for (k = 0; value_options[k]; k++)
+        if (strcmp(name, value_options[k]) == 0) return 1;
+    return 0;
+}
+
+static int unknown_option(const char *name)
+{
+    fprintf(stderr, "silcd: unknown option '%s'\n", name);
+    usage(stderr);
+    return -1;
+}
 
 static int parse_args(int argc, char **argv, const char **ready_file)
 {
     int i;
     for (i = 1; i < argc; i++) {
         const char *opt = argv[i], *val = NULL;
-        char name[64];
+        char name[64], why[160] = "";
         const char *eq = strchr(opt, '=');
         int ok = 1;
         if (strcmp(opt, "--help") == 0 || strcmp(opt, "-h") == 0) {
@@ -211,38 +245,49 @@ static int parse_args(int argc, char **argv, const char **ready_file)
             mpi_mode = 1;
             continue;
         }
-        if (strncmp(opt, "--", 2) != 0) {
+        if (strcmp(opt, "--insecure") == 0) {
+            insecure = 1;
+            continue;
+        }
+        if (opt[0] != '-') {
             fprintf(stderr, "silcd: unexpected argument '%s'\n", opt);
+            usage(stderr);
             return -1;
         }
-        if (eq) {
-            snprintf(name, sizeof name, "%.*s", (int)(eq - opt), opt);
-            val = eq + 1;
-        } else {
-            snprintf(name, sizeof name, "%s", opt);
-            if (i + 1 < argc) val = argv[++i];
-        }
+        snprintf(name, sizeof name, "%.*s", eq ? (int)(eq - opt) : (int)strlen(opt), opt);
+        if (!takes_value(name)) return unknown_option(name);
+        if (eq) val = eq + 1;
+        else if (i + 1 < argc) val = argv[++i];
         if (!val) {
             fprintf(stderr, "silcd: %s needs a value\n", name);
             return -1;
         }
         if (strcmp(name, "--listen") == 0) srv_cfg.listen = val;
         else if (strcmp(name, "--config") == 0) srv_cfg.engine_config = val;
-        else if (strcmp(name, "--threads") == 0) ok = !parse_int(val, 1, 4096, &srv_cfg.threads);
-        else if (strcmp(name, "--token-file") == 0) ok = !read_token(val);
-        else if (strcmp(name, "--max-value-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_value_bytes);
-        else if (strcmp(name, "--max-session-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_session_bytes);
-        else if (strcmp(name, "--array-pool") == 0) ok = !parse_size(val, &srv_cfg.pool_bytes);
-        else if (strcmp(name, "--max-clients") == 0) ok = !parse_int(val, 1, 65536, &srv_cfg.max_clients);
-        else if (strcmp(name, "--io-timeout") == 0) ok = !parse_seconds(val, 0, &srv_cfg.io_timeout_ms);
+        else if (strcmp(name, "--threads") == 0)
+            ok = !parse_int(val, 1, 4096, &srv_cfg.threads, why, sizeof why);
+        else if (strcmp(name, "--token-file") == 0) {
+            if (srv_auth_load_token(val)) return -1;   /* it said why */
+        } else if (strcmp(name, "--make-token") == 0) make_token = val;
+        else if (strcmp(name, "--max-value-bytes") == 0)
+            ok = !parse_size(val, &srv_cfg.max_value_bytes, why, sizeof why);
+        else if (strcmp(name, "--max-session-bytes") == 0)
+            ok = !parse_size(val, &srv_cfg.max_session_bytes, why, sizeof why);
+        else if (strcmp(name, "--array-pool") == 0)
+            ok = !parse_size(val, &srv_cfg.pool_bytes, why, sizeof why);
+        else if (strcmp(name, "--max-clients") == 0)
+            ok = !parse_int(val, 1, 65536, &srv_cfg.max_clients, why, sizeof why);
+        else if (strcmp(name, "--io-timeout") == 0)
+            ok = !parse_seconds(val, 0, &srv_cfg.io_timeout_ms, why, sizeof why);
         else if (strcmp(name, "--handshake-timeout") == 0)
-            ok = !parse_seconds(val, 0, &srv_cfg.handshake_timeout_ms);
+            ok = !parse_seconds(val, 0, &srv_cfg.handshake_timeout_ms, why, sizeof why);
         else if (strcmp(name, "--idle-timeout") == 0)
-            ok = !parse_seconds(val, 1, &srv_cfg.idle_timeout_ms);
+            ok = !parse_seconds(val, 1, &srv_cfg.idle_timeout_ms, why, sizeof why);
         else if (strcmp(name, "--peer-share") == 0) {
             char *end;
             srv_cfg.peer_share = strtod(val, &end);
             ok = end != val && !*end && srv_cfg.peer_share > 0 && srv_cfg.peer_share <= 1;
+            snprintf(why, sizeof why, "expected a fraction above 0 and at most 1");
         } else if (strcmp(name, "--log-level") == 0) {
             int k;
             ok = 0;
@@ -251,19 +296,15 @@ static int parse_args(int argc, char **argv, const char **ready_file)
                     srv_cfg.log_level = k;
                     ok = 1;
                 }
+            snprintf(why, sizeof why, "expected error, warn, info or debug");
         } else if (strcmp(name, "--ready-file") == 0) *ready_file = val;
         else if (strcmp(name, "--dist-min-rows") == 0) {
-            char *end;
-            long long r = strtoll(val, &end, 10);
-            ok = end != val && !*end && r >= 1;
+            long long r = 0;
+            ok = !parse_count(val, 1, INT64_MAX, &r, why, sizeof why);
             dist_min_rows = r;
         }
-        else {
-            fprintf(stderr, "silcd: unknown option '%s' (see silcd --help)\n", name);
-            return -1;
-        }
         if (!ok) {
-            fprintf(stderr, "silcd: invalid value '%s' for %s\n", val, name);
+            fprintf(stderr, "silcd: invalid value '%s' for %s: %s\n", val, name, why);
             return -1;
         }
     }
@@ -341,13 +382,11 @@ static int open_listener(const proto_addr *a, char *url, size_t urllen)
             fprintf(stderr, "silcd: cannot resolve '%s': %s\n", a->host, gai_strerror(rc));
             return -1;
         }
-        if (!is_loopback(res->ai_addr) && !srv_cfg.token) {
-            fprintf(stderr, "silcd: refusing to listen on non-loopback address %s without "
-                    "--token-file (anyone who can reach it could run code in this server)\n",
-                    a->host);
-            freeaddrinfo(res);
-            return -1;
-        }
+        if (!srv_cfg.token)   /* --insecure: main refused TCP without a token otherwise */
+            srv_log(LOG_ERROR, "WARNING: --insecure: listening on %s:%s with no token: %s can "
+                    "run code and read and write files as this user", a->host, a->port,
+                    is_loopback(res->ai_addr) ? "every local user"
+                                              : "anyone who can reach this address");
         fd = socket(res->ai_family, res->ai_socktype, res->ai_protocol);
         if (fd >= 0) setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
         if (fd < 0 || bind(fd, res->ai_addr, res->ai_addrlen) != 0 || listen(fd, 128) != 0) {
@@ -403,28 +442,42 @@ static void refuse(int fd, const char *why)
     close(fd);
 }
 
-/* The peer's address for --peer-share; "" on a Unix socket, whose mode
- * (0600) already admits only the server's owner. */
-static void peer_of(int fd, char *out, size_t outlen)
+/* Closes the oldest connection that has not completed its handshake, of
+ * peer (or of anyone: peer NULL), to make room; its slot, or -1 if every
+ * such connection is an open session.  A client completes its handshake in
+ * a millisecond, so connections that never send a byte (or wait out the
+ * delay of a failed authentication) cannot lock real clients out. */
+static int evict_unauthenticated(const char *peer, const char *limit)
 {
-    struct sockaddr_storage ss;
-    socklen_t sl = sizeof ss;
-    out[0] = '\0';
-    if (getpeername(fd, (struct sockaddr *)&ss, &sl) != 0) return;
-    if (ss.ss_family == AF_INET)
-        inet_ntop(AF_INET, &((struct sockaddr_in *)&ss)->sin_addr, out, (socklen_t)outlen);
-    else if (ss.ss_family == AF_INET6)
-        inet_ntop(AF_INET6, &((struct sockaddr_in6 *)&ss)->sin6_addr, out, (socklen_t)outlen);
+    int i, oldest = -1;
+    for (i = 0; i < n_conns; i++)
+        if (conns[i].pid && conn_state[i] == SLOT_HANDSHAKE &&
+            (!peer || strcmp(conns[i].peer, peer) == 0) &&
+            (oldest < 0 || conns[i].accepted < conns[oldest].accepted))
+            oldest = i;
+    if (oldest < 0) return -1;
+    srv_log(LOG_WARN, "session %lu%s%s: closed unauthenticated to make room (%s)", conns[oldest].id,
+            *conns[oldest].peer ? " from " : "", conns[oldest].peer, limit);
+    /* Waited for here, so that it cannot touch the slot's state once reused. */
+    kill(conns[oldest].pid, SIGKILL);
+    waitpid(conns[oldest].pid, NULL, 0);
+    close(conns[oldest].fd);
+    srv_auth_drop(conns[oldest].peer);
+    conns[oldest].pid = 0;
+    conns[oldest].fd = -1;
+    conn_state[oldest] = SLOT_FREE;
+    return oldest;
 }
 
-/* A free slot for a new connection from peer, or -1 with why set.  When
- * every slot is taken, the oldest connection still in its handshake gives
- * way: a client that completes its handshake takes a millisecond, so
- * connections that never send a byte cannot lock real clients out. */
+/* A free slot for a new connection from peer, or -1 with why set.  A peer
+ * at its share (--peer-share), or a full server (--max-clients), makes
+ * room by closing its oldest unauthenticated connection; only open
+ * sessions are never closed for a newcomer. */
 static int take_slot(const char *peer, char *why, size_t whylen)
 {
-    int i, free_slot = -1, oldest = -1, from_peer = 0;
+    int i, free_slot = -1, from_peer = 0, slot;
     int peer_cap = (int)(srv_cfg.peer_share * srv_cfg.max_clients);
+    char limit[96];
     if (peer_cap < 1) peer_cap = 1;
     for (i = 0; i < n_conns; i++) {
         if (!conns[i].pid) {
@@ -432,31 +485,22 @@ static int take_slot(const char *peer, char *why, size_t whylen)
             continue;
         }
         if (*peer && strcmp(conns[i].peer, peer) == 0) from_peer++;
-        if (conn_state[i] == SLOT_HANDSHAKE &&
-            (oldest < 0 || conns[i].accepted < conns[oldest].accepted))
-            oldest = i;
     }
     if (*peer && from_peer >= peer_cap) {
-        snprintf(why, whylen, "server busy: %s holds %d connections, its share of %d (silcd "
+        snprintf(limit, sizeof limit, "--peer-share %g of --max-clients %d", srv_cfg.peer_share,
+                 srv_cfg.max_clients);
+        if ((slot = evict_unauthenticated(peer, limit)) >= 0) return slot;
+        snprintf(why, whylen, "server busy: %s holds %d open sessions, its share of %d (silcd "
                  "--peer-share %g of --max-clients)", peer, from_peer, peer_cap,
                  srv_cfg.peer_share);
         return -1;
     }
     if (free_slot >= 0) return free_slot;
-    if (oldest < 0) {
-        snprintf(why, whylen, "server busy: too many sessions (silcd --max-clients %d)",
-                 srv_cfg.max_clients);
-        return -1;
-    }
-    srv_log(LOG_WARN, "session %lu: closed unauthenticated to make room (--max-clients %d)",
-            conns[oldest].id, srv_cfg.max_clients);
-    /* Waited for here, so that it cannot touch the slot's state once reused. */
-    kill(conns[oldest].pid, SIGKILL);
-    waitpid(conns[oldest].pid, NULL, 0);
-    close(conns[oldest].fd);
-    conns[oldest].pid = 0;
-    conns[oldest].fd = -1;
-    return oldest;
+    snprintf(limit, sizeof limit, "--max-clients %d", srv_cfg.max_clients);
+    if ((slot = evict_unauthenticated(NULL, limit)) >= 0) return slot;
+    snprintf(why, whylen, "server busy: too many sessions (silcd --max-clients %d)",
+             srv_cfg.max_clients);
+    return -1;
 }
 
 static void sigmask_session_signals(int how)
@@ -513,6 +557,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     conns[slot].accepted = util_now();
     snprintf(conns[slot].peer, sizeof conns[slot].peer, "%s", peer);
     conn_state[slot] = SLOT_HANDSHAKE;
+    srv_auth_hold(peer);   /* before fork: the child finds its peer's entry */
     sigmask_session_signals(SIG_BLOCK);   /* until the child has its own pipes */
     pid = fork();
     if (pid == 0) run_child(lfd, slot);
@@ -520,6 +565,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     if (pid < 0) {
         srv_log(LOG_ERROR, "cannot start a session process: %s", strerror(errno));
         refuse(fd, "server cannot start a session: fork failed");
+        srv_auth_drop(peer);
         conn_state[slot] = SLOT_FREE;
         return;
     }
@@ -557,6 +603,7 @@ static void reap_children(void)
                     WEXITSTATUS(status));
         }
         close(conns[i].fd);
+        srv_auth_drop(conns[i].peer);
         conns[i].pid = 0;
         conns[i].fd = -1;
         conn_state[i] = SLOT_FREE;
@@ -600,7 +647,7 @@ static void accept_loop(int lfd, int is_tcp)
         fd = accept(lfd, NULL, NULL);
         if (fd < 0) continue;
         if (is_tcp) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-        peer_of(fd, peer, sizeof peer);
+        srv_peer_of(fd, peer, sizeof peer);
         start_session(lfd, fd, next_id++, peer);
     }
 }
@@ -668,6 +715,7 @@ int main(int argc, char **argv)
     char url[600], err[512];
     int lfd, i;
     if (parse_args(argc, argv, &ready_file)) return 2;
+    if (make_token) return srv_auth_make_token(make_token) ? 1 : 0;
     if (*(const uint8_t *)&probe != 1) {
         fprintf(stderr, "silcd: the wire protocol needs a little-endian host\n");
         return 1;
@@ -675,6 +723,14 @@ int main(int argc, char **argv)
     if (proto_parse_url(srv_cfg.listen, &addr, err, sizeof err)) {
         fprintf(stderr, "silcd: --listen: %s\n", err);
         return 2;
+    }
+    if (!addr.is_unix && !srv_cfg.token && !insecure) {
+        fprintf(stderr, "silcd: refusing to listen on %s without --token-file: every local user "
+                "(and anyone who can reach the address) could run code as this user; create a "
+                "token with 'silcd --make-token FILE' and pass --token-file FILE, listen on a "
+                "Unix socket (unix:/path, mode 0600), or pass --insecure to accept the risk\n",
+                srv_cfg.listen);
+        return 1;
     }
     if (mpi_mode) {
 #ifdef SILC_HAVE_MPI
@@ -699,7 +755,8 @@ int main(int argc, char **argv)
     conns = calloc((size_t)n_conns, sizeof *conns);
     conn_state = mmap(NULL, (size_t)n_conns * sizeof *conn_state, PROT_READ | PROT_WRITE,
                       MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-    if (!conns || conn_state == MAP_FAILED || pipe(shutdown_pipe) != 0 || pipe(child_pipe) != 0) {
+    if (!conns || conn_state == MAP_FAILED || srv_auth_setup(n_conns) || pipe(shutdown_pipe) != 0 ||
+        pipe(child_pipe) != 0) {
         fprintf(stderr, "silcd: cannot set up: %s\n", strerror(errno));
         return 1;
     }
@@ -723,7 +780,7 @@ int main(int argc, char **argv)
     /* A statement's value is held to the same limit as one a PUT carries,
      * checked before it is allocated. */
     val_set_max_bytes(srv_cfg.max_value_bytes, "silcd --max-value-bytes");
-    if (preload_plugins()) return 1;
+    if (preload_plugins()) return 2;   /* the configuration is wrong: as a bad option */
     if ((lfd = open_listener(&addr, url, sizeof url)) < 0) return 1;
     pool_install((size_t)srv_cfg.pool_bytes); /* core/client/pool.c: each session's own */
     srv_log(LOG_INFO, "listening on %s (max %llu bytes per value, %llu per session%s)", url,

@@ -21,11 +21,14 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 typedef struct cfg_entry {
     char *key;
@@ -581,7 +584,12 @@ typedef struct file_ctx {
     int line;
     int err_line;          /* line of the first rejected key or line, 0 if none */
     char err[sizeof ((silc_engine *)0)->err];
+    long bytes;            /* read so far: at most CFG_MAX_FILE_BYTES */
 } file_ctx;
+
+/* A config file is a few hundred bytes of settings; anything this large is
+ * not one, and reading it would only cost memory and time. */
+#define CFG_MAX_FILE_BYTES (1L << 20)
 
 /* Hands inih one whole line.  inih reads into a buffer of its build's
  * INI_MAX_LINE bytes (num) and would silently cut a longer line, or take its
@@ -593,6 +601,11 @@ static char *file_reader(char *str, int num, void *stream)
     int len = 0, ch = 0;
     if (c->err_line) return NULL;          /* nothing after the first error */
     while (len < num - 1 && (ch = getc(c->fp)) != EOF) {
+        if (++c->bytes > CFG_MAX_FILE_BYTES) {   /* it grew after the size check */
+            c->err_line = c->line + 1;
+            snprintf(c->err, sizeof c->err, "the file is over %ld bytes, the limit", CFG_MAX_FILE_BYTES);
+            return NULL;
+        }
         if (ch == 0) {
             c->err_line = c->line + 1;
             snprintf(c->err, sizeof c->err, "a NUL byte: not a text file");
@@ -631,6 +644,32 @@ static int file_handler(void *user, const char *section, const char *name, const
     return 0;
 }
 
+/* The config file, if it is a regular file of at most CFG_MAX_FILE_BYTES:
+ * a directory, fifo or device is refused before a byte is read (opened
+ * O_NONBLOCK, so that a fifo cannot hang the open). */
+static FILE *open_config(silc_engine *E, const char *path)
+{
+    struct stat st;
+    FILE *fp;
+    int fd = open(path, O_RDONLY | O_NOCTTY | O_NONBLOCK);
+    if (fd < 0) {
+        eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        eng_error(E, "config file %s is not a regular file", path);
+    } else if (st.st_size > CFG_MAX_FILE_BYTES) {
+        eng_error(E, "config file %s is %lld bytes, over the limit of %ld", path,
+                  (long long)st.st_size, CFG_MAX_FILE_BYTES);
+    } else if ((fp = fdopen(fd, "r"))) {
+        return fp;
+    } else {
+        eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
+    }
+    close(fd);
+    return NULL;
+}
+
 int cfg_load_file(silc_engine *E, const char *path)
 {
     file_ctx c;
@@ -638,8 +677,7 @@ int cfg_load_file(silc_engine *E, const char *path)
     memset(&c, 0, sizeof c);
     c.E = E;
     c.path = path;
-    c.fp = fopen(path, "r");
-    if (!c.fp) return eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
+    if (!(c.fp = open_config(E, path))) return -1;
     rc = ini_parse_stream(file_reader, &c, file_handler, &c);
     fclose(c.fp);
     if (rc < 0) return eng_error(E, "%s: out of memory reading the config file", path);
