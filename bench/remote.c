@@ -6,7 +6,9 @@
  *     remote [max_mib]          max_mib: largest array (default 512, min 8)
  *
  * Starts its own silcd (the one built beside it) on tcp://127.0.0.1 with a
- * kernel-chosen port and on a Unix socket.  Raw throughput is one direction of
+ * kernel-chosen port and on a Unix socket, both with a token that
+ * `silcd --make-token` writes (TCP requires one); the clients present it
+ * through SILC_TOKEN_FILE.  Raw throughput is one direction of
  * a plain TCP loopback connection between two threads of this process, the
  * receiver reading into a buffer of the same size as the array (touched
  * beforehand, so neither side pays page faults, and on huge pages where the
@@ -125,6 +127,25 @@ static double raw_seconds(raw_link *L, size_t n, char *src, char *dst)
 }
 
 /* ---- silcd ----------------------------------------------------------------- */
+static char token_file[64];
+
+/* A fresh token file, made by silcd itself, for the servers and clients. */
+static int make_token(void)
+{
+    int status;
+    pid_t pid;
+    snprintf(token_file, sizeof token_file, "/tmp/silc-bench-token-%d", (int)getpid());
+    unlink(token_file);
+    pid = fork();
+    if (pid == 0) {
+        execl(SILCD_PATH, SILCD_PATH, "--make-token", token_file, (char *)NULL);
+        _exit(127);
+    }
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status))
+        return -1;
+    return setenv("SILC_TOKEN_FILE", token_file, 1);
+}
+
 static pid_t start_server(const char *listen, char *url, size_t urllen)
 {
     char ready[] = "/tmp/silc-bench-ready-XXXXXX";
@@ -137,7 +158,7 @@ static pid_t start_server(const char *listen, char *url, size_t urllen)
     if (pid == 0) {
         execl(SILCD_PATH, SILCD_PATH, "--listen", listen, "--ready-file", ready,
               "--log-level", "error", "--max-value-bytes", "1G", "--max-session-bytes", "0",
-              (char *)NULL);
+              "--token-file", token_file, (char *)NULL);
         _exit(127);
     }
     for (i = 0; i < 400; i++) {
@@ -306,6 +327,10 @@ int main(int argc, char **argv)
     signal(SIGPIPE, SIG_IGN);
     unsetenv("SILC_SERVER");
     snprintf(unix_listen, sizeof unix_listen, "unix:/tmp/silc-bench-%d.sock", (int)getpid());
+    if (make_token()) {
+        fprintf(stderr, "remote: silcd --make-token failed\n");
+        return 1;
+    }
     tcp_pid = start_server("tcp://127.0.0.1:0", tcp_url, sizeof tcp_url);
     unix_pid = start_server(unix_listen, unix_url, sizeof unix_url);
     if (tcp_pid < 0 || unix_pid < 0) {
@@ -411,5 +436,6 @@ int main(int argc, char **argv)
     kill(unix_pid, SIGTERM);
     waitpid(tcp_pid, NULL, 0);
     waitpid(unix_pid, NULL, 0);
+    unlink(token_file);
     return 0;
 }

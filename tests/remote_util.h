@@ -6,7 +6,11 @@
 #ifndef SILC_REMOTE_UTIL_H
 #define SILC_REMOTE_UTIL_H
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +23,7 @@
 #include <unistd.h>
 
 #include "client.h"
+#include "util.h"
 
 typedef struct test_server {
     pid_t pid;
@@ -228,6 +233,61 @@ static inline pid_t raw_partial_put(const char *url, const char *name, int64_t m
     }
     close(pfd[0]);
     return pid;
+}
+
+/* Connects to 127.0.0.1:port from the loopback address src (127.0.0.0/8). */
+static inline int tcp_from(const char *src, int port)
+{
+    struct sockaddr_in a, b;
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) return -1;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    inet_pton(AF_INET, src, &a.sin_addr);
+    memset(&b, 0, sizeof b);
+    b.sin_family = AF_INET;
+    b.sin_port = htons((uint16_t)port);
+    inet_pton(AF_INET, "127.0.0.1", &b.sin_addr);
+    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 ||
+        connect(fd, (struct sockaddr *)&b, sizeof b) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* 1 if the server closed fd within ms (EOF, after an optional reply). */
+static inline int closed_within(int fd, int ms)
+{
+    struct pollfd p;
+    char buf[512];
+    double end = util_now() + ms / 1000.0;
+    p.fd = fd;
+    p.events = POLLIN;
+    while (util_now() < end) {
+        ssize_t n;
+        p.revents = 0;
+        if (poll(&p, 1, 50) <= 0) continue;
+        n = read(fd, buf, sizeof buf);
+        if (n <= 0) return 1;
+    }
+    return 0;
+}
+
+/* A private token file for a TCP server (silcd requires one: mode 0600,
+ * 16 bytes or more): path gets its name; the caller unlinks it. */
+static inline int test_token_file(char *path, size_t len)
+{
+    static const char token[] = "0123456789abcdef0123456789abcdef\n";
+    int fd;
+    snprintf(path, len, "/tmp/silc-token-%d-XXXXXX", (int)getpid());
+    if ((fd = mkstemp(path)) < 0) return -1;   /* mode 0600 */
+    if (write(fd, token, sizeof token - 1) != (ssize_t)(sizeof token - 1)) {
+        close(fd);
+        unlink(path);
+        return -1;
+    }
+    return close(fd);
 }
 
 #endif

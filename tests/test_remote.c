@@ -290,6 +290,7 @@ static void test_tokens(void)
     silc_context *c = NULL;
     snprintf(tokf, sizeof tokf, "/tmp/silc-token-%d", (int)getpid());
     write_file(tokf, "correct horse battery staple\n");
+    chmod(tokf, 0600);   /* silcd refuses a token file others can read */
     snprintf(opt, sizeof opt, "--token-file=%s", tokf);
     opts[0] = opt;
     opts[1] = NULL;

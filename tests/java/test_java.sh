@@ -10,6 +10,7 @@ JAVA=$1 JAR=$2 CLASSES=$3 SILCD=$4
 "$JAVA" -cp "$JAR:$CLASSES" TestClient || exit 1
 . "$(dirname "$0")/../../tools/silcd_run.sh"
 echo "java-test-token-1234" > "$SILCD_DIR/token"
+chmod 600 "$SILCD_DIR/token"      # silcd refuses a token file others can read
 SILCD_LISTEN=tcp://127.0.0.1:0 silcd_start "$SILCD" --token-file "$SILCD_DIR/token"
 PORT=${SILCD_URL##*:}      # tcp://127.0.0.1:PORT
 SILC_TOKEN=java-test-token-1234 "$JAVA" -cp "$JAR:$CLASSES" TestClient token 127.0.0.1 "$PORT" java-test-token-1234
