@@ -152,30 +152,36 @@ static inline int raw_reply(int fd, char **text, int timeout_ms)
     return rc;
 }
 
-/* Connects and handshakes with the given version and token; returns the fd
- * after the server's OK, or -1 (with the ERROR text in *msg if one came). */
-static inline int raw_open(const char *url, uint32_t version, const char *token, char **msg)
+/* Handshakes on fd with the given version and token: the server's reply
+ * opcode (PROTO_OK; PROTO_ERROR with its text in *msg), -1 if the
+ * connection closed or failed, -2 if nothing came within timeout_ms. */
+static inline int raw_handshake(int fd, uint32_t version, const char *token, char **msg,
+                                int timeout_ms)
 {
     uint8_t hello[PROTO_HELLO_BYTES], back[PROTO_HELLO_BYTES];
     size_t tl = token ? strlen(token) : 0;
     proto_stream s;
     struct iovec iov;
     char err[128];
-    int fd = raw_connect(url), op;
     *msg = NULL;
-    if (fd < 0) return -1;
     proto_encode_hello(hello, version, (uint32_t)tl);
     raw_send(fd, hello, sizeof hello);
     if (tl) raw_send(fd, token, tl);
-    s = (proto_stream){fd, 5000, NULL, 0, 0};
+    s = (proto_stream){fd, timeout_ms, NULL, 0, 0};
     iov.iov_base = back;
     iov.iov_len = sizeof back;
-    if (proto_recv(&s, &iov, 1, err, sizeof err)) {
-        close(fd);
-        return -1;
-    }
-    op = raw_reply(fd, msg, 5000);
-    if (op != PROTO_OK) {
+    if (proto_recv(&s, &iov, 1, err, sizeof err)) return strstr(err, "timed out") ? -2 : -1;
+    return raw_reply(fd, msg, timeout_ms);
+}
+
+/* Connects and handshakes with the given version and token; returns the fd
+ * after the server's OK, or -1 (with the ERROR text in *msg if one came). */
+static inline int raw_open(const char *url, uint32_t version, const char *token, char **msg)
+{
+    int fd = raw_connect(url);
+    *msg = NULL;
+    if (fd < 0) return -1;
+    if (raw_handshake(fd, version, token, msg, 5000) != PROTO_OK) {
         close(fd);
         return -1;
     }
