@@ -5,7 +5,8 @@
 #     silcd_stop                              stop it (the next start may follow)
 #
 # The server listens on a Unix socket in a fresh directory $SILCD_DIR (or on
-# $SILCD_LISTEN when set, e.g. tcp://127.0.0.1:0); once it is ready $SILCD_URL
+# $SILCD_LISTEN when set, e.g. tcp://127.0.0.1:0, which needs --token-file among
+# the options); once it is ready $SILCD_URL
 # is the address it listens on (from its --ready-file, so port 0 resolves).
 # A server that does not start within 10 s ends the script with its log and
 # status 1.  An EXIT trap stops the server and removes $SILCD_DIR whatever
