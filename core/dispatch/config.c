@@ -644,9 +644,17 @@ static int file_handler(void *user, const char *section, const char *name, const
     return 0;
 }
 
-/* The config file, if it is a regular file of at most CFG_MAX_FILE_BYTES:
- * a directory, fifo or device is refused before a byte is read (opened
- * O_NONBLOCK, so that a fifo cannot hang the open). */
+/* The null device: "no settings", as `--config /dev/null` is often meant. */
+static int is_null_device(const struct stat *st)
+{
+    struct stat null;
+    return S_ISCHR(st->st_mode) && stat("/dev/null", &null) == 0 && S_ISCHR(null.st_mode) &&
+           st->st_rdev == null.st_rdev;
+}
+
+/* The config file, if it is a regular file of at most CFG_MAX_FILE_BYTES
+ * (or the null device): a directory, fifo or other device is refused before
+ * a byte is read (opened O_NONBLOCK, so that a fifo cannot hang the open). */
 static FILE *open_config(silc_engine *E, const char *path)
 {
     struct stat st;
@@ -656,7 +664,7 @@ static FILE *open_config(silc_engine *E, const char *path)
         eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
         return NULL;
     }
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fstat(fd, &st) != 0 || !(S_ISREG(st.st_mode) || is_null_device(&st))) {
         eng_error(E, "config file %s is not a regular file", path);
     } else if (st.st_size > CFG_MAX_FILE_BYTES) {
         eng_error(E, "config file %s is %lld bytes, over the limit of %ld", path,

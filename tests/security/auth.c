@@ -163,6 +163,13 @@ static void test_strict_options(void)
                    "--config a fifo");
     expect_refusal((const char *const[]){"--listen", sock, "--config", "/dev/zero", NULL}, NULL, NULL,
                    2, "silcd: config file /dev/zero is not a regular file", "--config a device");
+    {
+        /* /dev/null alone among devices: the empty config it is used as. */
+        test_server srv;
+        int rc = server_start(&srv, NULL, (const char *const[]){"--config", "/dev/null", NULL});
+        CHECK(rc == 0, "--config /dev/null was refused (%d)", rc);
+        if (rc == 0) CHECK(server_stop(&srv) == 0, "silcd --config /dev/null did not stop cleanly");
+    }
     snprintf(msg, sizeof msg, "silcd: config file %s is 2097152 bytes, over the limit of 1048576", big);
     expect_refusal((const char *const[]){"--listen", sock, "--config", big, NULL}, NULL, NULL, 2, msg,
                    "--config of 2 MiB");
