@@ -138,13 +138,13 @@ static const char *ch_ordering_name(int ordering)
 }
 
 /* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
-static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
+static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
 {
     cholmod_common *cc = ss_cholmod_common();
     cholmod_sparse A;
     cholmod_factor *L = NULL;
     ch_factor *F;
-    int sym_reused, status, rc, crude;
+    int sym_reused, status, rc;
     long long minor;
     *out = NULL;
     ch_sparse(a, &A);
@@ -205,12 +205,10 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
         ch_factor_free(F);
         return rc;
     }
-    crude = ss_square_cond(call, condest, a->n, ch_apply_inv, F, &F->info);
+    ss_pivot_ratio(&F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse Cholesky (CHOLMOD, %s, %s)",
              L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
-    snprintf(F->info.note, sizeof F->info.note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",
-             crude ? "condition estimate is CHOLMOD's crude 1/rcond (diagonal of L)"
-                   : "1-norm condition estimate (Hager/Higham)");
+    snprintf(F->info.note, sizeof F->info.note, "%s", sym_reused ? "symbolic analysis reused (same pattern)" : "");
     *out = F;
     return SILC_OK;
 }
@@ -231,10 +229,12 @@ int ss_cholmod_solve(silc_call *call)
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, CH_KEY, condest, ch_factor_new, ch_factor_free,
+        if ((rc = ss_attached_factor(call, &a, CH_KEY, ch_factor_new, ch_factor_free,
                                      "attaching the CHOLMOD factor", &f)))
             return rc;
         F = f;
+        /* (A symmetric: the transposed solves are the same solves) */
+        ss_square_cond(call, condest, n, ch_apply_inv, F, &F->info);
     }
 
     t0 = ss_host->now();

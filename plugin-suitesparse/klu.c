@@ -17,9 +17,9 @@
  * Zero-copy: the CSR arrays of A are the compressed columns of A', which is
  * what KLU factors; klu_l_tsolve then solves (A')' x = A x = b.
  *
- * Condition: klu_l_rcond (smallest over largest |U(k,k)|), cheap and crude.
- * When it is large (or always, per the option suitesparse.condest) a
- * Hager/Higham estimate replaces it.  klu_l_condest would estimate the
+ * Condition: klu_l_rcond (smallest over largest |U(k,k)|) is cheap and
+ * crude, reported as the pivot ratio only; the estimate is Hager/Higham's,
+ * made on the first solve that wants one (ss.h).  klu_l_condest would estimate the
  * condition of the matrix factored, A', i.e. the infinity-norm condition of
  * A, so the plugin's estimator is run on A instead (klu_l_tsolve for A^{-1},
  * klu_l_solve for A^{-T}), giving the 1-norm figure SILC reports.
@@ -137,14 +137,13 @@ static int kl_try_refactor(const silc_view *a, klu_l_symbolic *S, kl_numeric *nu
 }
 
 /* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
-static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
+static int kl_factor_new(silc_call *call, const silc_view *a, void **out)
 {
     klu_l_common c;
     klu_l_symbolic *S;
     kl_factor *F;
     kl_numeric *spare = NULL;
-    kl_apply u;
-    int sym_reused = 0, refactored = 0, crude;
+    int sym_reused = 0, refactored = 0;
     *out = NULL;
     kl_common(&c);
     F = ss_host->calloc(1, sizeof *F);
@@ -183,16 +182,13 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
         }
         F->info.rcond = F->num->rcond0 = c.rcond;
     }
-    u.F = F, u.n = a->n;
-    crude = ss_square_cond(call, condest, a->n, kl_apply_inv, &u, &F->info);
+    ss_pivot_ratio(&F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse LU (KLU, BTF + AMD, %lld block%s)",
              (long long)S->nblocks, S->nblocks == 1 ? "" : "s");
-    snprintf(F->info.note, sizeof F->info.note, "%s%s",
-             refactored   ? "numeric refactor (klu_l_refactor, pivot order reused); "
-             : sym_reused ? "symbolic analysis reused (same pattern); "
-                          : "",
-             crude ? "condition estimate is KLU's crude 1/rcond (pivot ratio)"
-                   : "1-norm condition estimate (Hager/Higham)");
+    snprintf(F->info.note, sizeof F->info.note, "%s",
+             refactored   ? "numeric refactor (klu_l_refactor, pivot order reused)"
+             : sym_reused ? "symbolic analysis reused (same pattern)"
+                          : "");
     *out = F;
     return SILC_OK;
 }
@@ -213,10 +209,15 @@ int ss_klu_solve(silc_call *call)
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, KL_KEY, condest, kl_factor_new, kl_factor_free,
+        if ((rc = ss_attached_factor(call, &a, KL_KEY, kl_factor_new, kl_factor_free,
                                      "attaching the KLU factors", &f)))
             return rc;
         F = f;
+        {
+            kl_apply u;
+            u.F = F, u.n = n;
+            ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info);
+        }
     }
 
     t0 = ss_host->now();
