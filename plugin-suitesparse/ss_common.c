@@ -12,6 +12,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -189,10 +190,14 @@ void ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx
                     void *ctx, ss_factor_info *fi)
 {
     double inv;
+    size_t len;
     if (fi->estimated || !ss_condest_wanted(call, mode)) return;
     if ((inv = ss_inv_norm1(n, solve, ctx)) < 0) return; /* a solve failed: no estimate */
     fi->cond = silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
     fi->estimated = 1;
+    len = strlen(fi->note);
+    snprintf(fi->note + len, sizeof fi->note - len, "%s1-norm condition estimate: Hager/Higham through the factors",
+             len ? "; " : "");
 }
 
 int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, ss_make_fn make,

@@ -700,12 +700,16 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 }
                 {
                     /* Deferral needs a measured first solve that passes
-                     * today's bound (vouched, above); distributed solves
-                     * keep the old rule (their ranks must agree). */
+                     * today's bound (vouched, above), unless the user gave
+                     * that check up (solve.backward_error = on_request);
+                     * distributed solves keep the old rule (their ranks
+                     * must agree). */
+                    const char *when = cfg_get(E, "solve.backward_error");
                     int local = call->op == SILC_OP_SOLVE && !ctx.collective && !E->dist;
                     int defer = may_defer &&
-                                (!local || vouched(call->in[0], b,
-                                                   acc_verify_limit(cfg_get(E, "solve.verify"), call->report)));
+                                (!local || (when && !strcmp(when, "on_request")) ||
+                                 vouched(call->in[0], b,
+                                         acc_verify_limit(cfg_get(E, "solve.verify"), call->report)));
                     rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, defer);
                     if (!rc && local && call->report->backward_error != ACC_DEFERRED)
                         vouch(call->in[0], b, call->report);
