@@ -106,7 +106,7 @@ static int ch_fail(silc_call *call, const char *fn, int status)
 }
 
 /* For the condition estimate (A symmetric: A^{-T} = A^{-1}). */
-static int ch_apply_inv(void *ctx, double *x, int trans)
+static int ch_apply_inv(void *ctx, double *x, int t, int trans)
 {
     ch_factor *F = ctx;
     cholmod_common *cc = ss_cholmod_common();
@@ -114,11 +114,11 @@ static int ch_apply_inv(void *ctx, double *x, int trans)
     int64_t n = (int64_t)F->L->n;
     int ok;
     (void)trans;
-    ch_dense(n, 1, x, &B);
+    ch_dense(n, t, x, &B);
     ss_lock();
     X = cholmod_l_solve(CHOLMOD_A, F->L, &B, cc);
     ok = X != NULL;
-    if (ok) memcpy(x, X->x, (size_t)n * sizeof(double));
+    if (ok) memcpy(x, X->x, (size_t)(n * t) * sizeof(double));
     cholmod_l_free_dense(&X, cc);
     ss_unlock();
     return ok ? 0 : -1;
@@ -222,7 +222,7 @@ int ss_cholmod_solve(silc_call *call)
     cholmod_dense Bh, *X = NULL;
     double *B, t0;
     int64_t n, k;
-    int owned, rc, condest, status;
+    int owned, rc, condest, status, fold;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
@@ -233,8 +233,6 @@ int ss_cholmod_solve(silc_call *call)
                                      "attaching the CHOLMOD factor", &f)))
             return rc;
         F = f;
-        /* (A symmetric: the transposed solves are the same solves) */
-        ss_square_cond(call, condest, n, ch_apply_inv, F, &F->info);
     }
 
     t0 = ss_host->now();
@@ -242,9 +240,13 @@ int ss_cholmod_solve(silc_call *call)
         call->out = ss_host->dense_new(n, k);
         return call->out ? SILC_OK : ss_nomem(call, "CHOLMOD result");
     }
-    B = ss_rhs_dense(&b, &owned);
+    /* When the estimate is due, its starting block rides along (ss.h);
+     * A is symmetric, so the transposed solves are the same solves. */
+    fold = ss_cond_due(call, condest, &F->info);
+    B = fold ? ss_rhs_with_start(&b, n) : ss_rhs_dense(&b, &owned);
+    if (fold) owned = 1;
     if (!B) return ss_nomem(call, "CHOLMOD right-hand side");
-    ch_dense(n, k, B, &Bh);
+    ch_dense(n, k + (fold ? SS_EST_COLS : 0), B, &Bh);
     ss_lock();
     X = cholmod_l_solve(CHOLMOD_A, F->L, &Bh, cc);
     status = cc->status;
@@ -252,6 +254,8 @@ int ss_cholmod_solve(silc_call *call)
     if (owned) ss_host->free(B);
     if (!X) return ch_fail(call, "cholmod_l_solve", status);
     call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
+    if (fold && (int64_t)X->d == n)
+        ss_square_cond(call, condest, n, ch_apply_inv, F, &F->info, (const double *)X->x + n * k);
     ss_lock();
     cholmod_l_free_dense(&X, cc);
     ss_unlock();

@@ -116,13 +116,13 @@ typedef struct kl_apply {
     int64_t n;
 } kl_apply;
 
-static int kl_apply_inv(void *ctx, double *x, int trans)
+static int kl_apply_inv(void *ctx, double *X, int t, int trans)
 {
     kl_apply *u = ctx;
     klu_l_common c;
     kl_common(&c);
-    if (trans) return klu_l_solve(kl_symbolic(u->F), u->F->num->N, u->n, 1, x, &c) ? 0 : -1;
-    return klu_l_tsolve(kl_symbolic(u->F), u->F->num->N, u->n, 1, x, &c) ? 0 : -1;
+    if (trans) return klu_l_solve(kl_symbolic(u->F), u->F->num->N, u->n, t, X, &c) ? 0 : -1;
+    return klu_l_tsolve(kl_symbolic(u->F), u->F->num->N, u->n, t, X, &c) ? 0 : -1;
 }
 
 /* Refactor into a donated numeric object; 1 if it is good enough to keep. */
@@ -200,7 +200,7 @@ int ss_klu_solve(silc_call *call)
     kl_factor *F = NULL;
     klu_l_common c;
     silc_value *out;
-    double t0;
+    double t0, *fold;
     int64_t n, k;
     int rc, condest;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
@@ -213,22 +213,29 @@ int ss_klu_solve(silc_call *call)
                                      "attaching the KLU factors", &f)))
             return rc;
         F = f;
-        {
-            kl_apply u;
-            u.F = F, u.n = n;
-            ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info);
-        }
     }
 
     t0 = ss_host->now();
-    /* KLU solves in place: straight in the result, as a caller of KLU would. */
+    /* KLU solves in place: straight in the result, as a caller of KLU would;
+     * when the estimate is due, in an array with its starting block after B,
+     * solved in the same call. */
     if (!(out = ss_host->dense_new_uninit(n, k))) return ss_nomem(call, "KLU result");
     ss_host->view(out, &o);
-    ss_rhs_copy(&b, o.val);
+    fold = F && ss_cond_due(call, condest, &F->info) ? ss_rhs_with_start(&b, n) : NULL;
+    if (!fold) ss_rhs_copy(&b, o.val);
     kl_common(&c);
-    if (n > 0 && k > 0 && !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k, o.val, &c)) {
+    if (n > 0 && (k > 0 || fold) &&
+        !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k + (fold ? SS_EST_COLS : 0), fold ? fold : o.val, &c)) {
         ss_host->release(out);
+        ss_host->free(fold);
         return kl_fail(call, "klu_l_tsolve", &c);
+    }
+    if (fold) {
+        kl_apply u;
+        memcpy(o.val, fold, (size_t)(n * k) * sizeof(double));
+        u.F = F, u.n = n;
+        ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info, fold + n * k);
+        ss_host->free(fold);
     }
     call->out = out;
     r->solve_seconds = ss_host->now() - t0;

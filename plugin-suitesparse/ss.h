@@ -73,8 +73,8 @@ double *ss_rhs_dense(const silc_view *b, int *owned);
 silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld);
 
 /*
- * The condition estimate is Hager/Higham's (ss_inv_norm1: about five pairs
- * of solves with the factors, once per factorization).  The libraries'
+ * The condition estimate is Hager/Higham's (ss_square_cond, below: block
+ * form through the factors, once per factorization).  The libraries'
  * cheap pivot ratio can miss ill-conditioning by orders of magnitude (5.07
  * from UMFPACK for the 1-D Laplacian of cond_1 840), so it is never reported as the
  * estimate, only as pivot_ratio, labelled.  The plugin option "condest":
@@ -117,11 +117,27 @@ typedef struct ss_factor_info {
     char note[160];
 } ss_factor_info;
 
-/* The condition estimate of a square factorization: fi->cond = norm1(A)
- * ||A^{-1}||_1 through solve, and fi->estimated, when this call wants one
- * (ss_condest_wanted) and fi has none yet; nothing otherwise. */
-void ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx, double *x, int trans),
-                    void *ctx, ss_factor_info *fi);
+/* The condition estimate of a square factorization: the block form of the
+ * host (Higham-Tisseur, SS_EST_COLS columns, SS_EST_STEPS steps: the
+ * two-column, two-step form MUMPS uses, 0.97-1.00 of cond_1 on the shared
+ * matrices) costs three applications of A^-1 or A^-T to two columns; the
+ * one-column dlacon form took about five pairs of solves.  The first
+ * application rides along with the user's solve when it is due
+ * (ss_cond_due): the solve takes ss_rhs_with_start's array, B with the
+ * starting block after it, and passes the solved block as Y0.
+ * apply(ctx, X, t, trans) overwrites the n x t X with A^-1 X (A^-T X).
+ * Sets fi->cond = norm1(A) ||A^{-1}||_1 and fi->estimated; nothing when
+ * not due. */
+#define SS_EST_COLS 2
+#define SS_EST_STEPS 2
+typedef int (*ss_block_fn)(void *ctx, double *X, int t, int trans);
+int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi);
+void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi,
+                    const double *Y0);
+/* B (b->n columns) then the estimator's starting block (SS_EST_COLS
+ * columns), n rows each, in one array from host->alloc; NULL when out of
+ * memory. */
+double *ss_rhs_with_start(const silc_view *b, int64_t n);
 
 /* The start every square solve shares: views of A and B, a decline unless A
  * is square CSR, and the condest option.  0, SILC_EDECLINE or an error. */

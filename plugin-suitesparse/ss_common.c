@@ -186,18 +186,34 @@ int ss_condest_wanted(const silc_call *call, int mode)
     return mode != SS_CONDEST_NEVER && !off;
 }
 
-void ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx, double *x, int trans),
-                    void *ctx, ss_factor_info *fi)
+int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi)
+{
+    return !fi->estimated && ss_condest_wanted(call, mode);
+}
+
+void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi,
+                    const double *Y0)
 {
     double inv;
     size_t len;
-    if (fi->estimated || !ss_condest_wanted(call, mode)) return;
-    if ((inv = ss_inv_norm1(n, solve, ctx)) < 0) return; /* a solve failed: no estimate */
+    if (!ss_cond_due(call, mode, fi)) return;
+    inv = ss_host->inv_norm1_est_block(n, SS_EST_COLS, SS_EST_STEPS, apply, ctx, Y0);
+    if (inv < 0) return; /* a solve failed: no estimate */
     fi->cond = silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
     fi->estimated = 1;
     len = strlen(fi->note);
-    snprintf(fi->note + len, sizeof fi->note - len, "%s1-norm condition estimate: Hager/Higham through the factors",
-             len ? "; " : "");
+    snprintf(fi->note + len, sizeof fi->note - len,
+             "%s1-norm condition estimate: block Hager/Higham through the factors (%d columns, %d steps%s)",
+             len ? "; " : "", SS_EST_COLS, SS_EST_STEPS, Y0 ? ", the first with this solve" : "");
+}
+
+double *ss_rhs_with_start(const silc_view *b, int64_t n)
+{
+    double *x = ss_host->alloc((size_t)(n * (b->n + SS_EST_COLS) + 1) * sizeof *x);
+    if (!x) return NULL;
+    ss_rhs_copy(b, x);
+    ss_host->inv_norm1_start(n, SS_EST_COLS, x + n * b->n);
+    return x;
 }
 
 int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, ss_make_fn make,
