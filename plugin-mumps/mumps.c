@@ -1021,7 +1021,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     analyse = analysis_due(F, b->n);
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    estimate = s->condest && F->cond_est < 0;
+    estimate = s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
     fold = estimate && !analyse;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {

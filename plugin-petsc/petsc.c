@@ -861,6 +861,7 @@ static int solve_run(silc_call *call)
     text = host->option_string(call, "options", "");
     if (!text) text = "";
     if ((rc = host->option_int(call, "condest", 1, &condest))) return rc;
+    if (host->abi_minor >= 7 && call->report->condest_off) condest = 0; /* accuracy.condest = off */
     ranks_open(call, &R);
     host->view(call->in[0], &a);
     host->view(call->in[1], &bv);

@@ -163,6 +163,13 @@ static int factor(int alg, const silc_view *a, const silc_props *P, ref_factor *
     return st;
 }
 
+/* F->rcond from F->cond (positive, or Inf for a singular factor). */
+static void set_rcond(ref_factor *F)
+{
+    F->rcond = F->cond > 0 ? 1.0 / F->cond : -1.0;
+    if (isinf(F->cond)) F->rcond = 0.0;
+}
+
 int ref_op_solve(silc_call *call)
 {
     silc_view a, b;
@@ -206,27 +213,26 @@ int ref_op_solve(silc_call *call)
             if (st == SILC_ENOMEM) return ref_nomem(call);
             return ref_host->error(call, st, "%s", msg);
         }
-        if (F->cond == 0.0) { /* square factor: ||A||_1 * est ||A^{-1}||_1 */
-            double *w = ref_alloc((size_t)(F->work_len + a.n + 1), sizeof(double));
-            if (!w) { /* no estimate would mean no warning of an ill-conditioned matrix */
-                ref_factor_free(F);
-                return ref_nomem(call);
-            }
-            /* The estimator fails only when it runs out of memory (it applies
-             * the solve of this factor, which does not fail). */
-            double est = ref_inv_norm1_est(a.n, F->solve, F->data, w);
-            ref_free(w);
-            if (est < 0) {
-                ref_factor_free(F);
-                return ref_nomem(call);
-            }
-            F->cond = ref_cond_from(P->norm1, est);
-        }
-        F->rcond = F->cond > 0 ? 1.0 / F->cond : (F->cond == 0.0 ? INFINITY : -1.0);
-        if (isinf(F->cond)) F->rcond = 0.0;
+        if (F->cond != 0.0) set_rcond(F); /* the factorization's own (diagonal, QR) */
         attached = ref_host->attach_set(call->in[0], alg_key[alg], F, ref_factor_free) == 0;
     }
     double t1 = ref_host->now();
+    /* A square factor's estimate ||A||_1 * est ||A^{-1}||_1 (F->cond == 0:
+     * none yet), on the first solve that wants one: accuracy.condest = off
+     * skips it, and a later solve with the setting on makes it. */
+    if (F->cond == 0.0 && !(ref_host->abi_minor >= 7 && rep->condest_off)) {
+        double *w = ref_alloc((size_t)(F->work_len + a.n + 1), sizeof(double)), est = -1;
+        /* The estimator fails only when it runs out of memory (it applies
+         * the solve of this factor, which does not fail). */
+        if (w) est = ref_inv_norm1_est(a.n, F->solve, F->data, w);
+        ref_free(w);
+        if (est < 0) { /* no estimate would mean no warning of an ill-conditioned matrix */
+            if (!attached) ref_factor_free(F);
+            return ref_nomem(call);
+        }
+        F->cond = ref_cond_from(P->norm1, est);
+        set_rcond(F);
+    }
 
     int64_t m = a.m, n = a.n, nrhs = b.n, len = m > n ? m : n;
     silc_value *out = ref_host->dense_new(n, nrhs);
@@ -270,8 +276,8 @@ int ref_op_solve(silc_call *call)
         size_t l = strlen(rep->method);
         if (l + sizeof tag <= sizeof rep->method) memcpy(rep->method + l, tag, sizeof tag);
     }
-    rep->cond_est = F->cond;
-    rep->rcond = F->rcond;
+    rep->cond_est = F->cond == 0.0 ? -1 : F->cond;
+    rep->rcond = F->cond == 0.0 ? -1 : F->rcond;
     rep->reused_factor = reused;
     rep->factor_seconds = reused ? 0.0 : t1 - t0;
     rep->solve_seconds = ref_host->now() - t1;

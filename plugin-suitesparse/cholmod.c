@@ -106,7 +106,7 @@ static int ch_fail(silc_call *call, const char *fn, int status)
 }
 
 /* For the condition estimate (A symmetric: A^{-T} = A^{-1}). */
-static int ch_apply_inv(void *ctx, double *x, int trans)
+static int ch_apply_inv(void *ctx, double *x, int t, int trans)
 {
     ch_factor *F = ctx;
     cholmod_common *cc = ss_cholmod_common();
@@ -114,11 +114,11 @@ static int ch_apply_inv(void *ctx, double *x, int trans)
     int64_t n = (int64_t)F->L->n;
     int ok;
     (void)trans;
-    ch_dense(n, 1, x, &B);
+    ch_dense(n, t, x, &B);
     ss_lock();
     X = cholmod_l_solve(CHOLMOD_A, F->L, &B, cc);
     ok = X != NULL;
-    if (ok) memcpy(x, X->x, (size_t)n * sizeof(double));
+    if (ok) memcpy(x, X->x, (size_t)(n * t) * sizeof(double));
     cholmod_l_free_dense(&X, cc);
     ss_unlock();
     return ok ? 0 : -1;
@@ -138,13 +138,13 @@ static const char *ch_ordering_name(int ordering)
 }
 
 /* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
-static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
+static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
 {
     cholmod_common *cc = ss_cholmod_common();
     cholmod_sparse A;
     cholmod_factor *L = NULL;
     ch_factor *F;
-    int sym_reused, status, rc, crude;
+    int sym_reused, status, rc;
     long long minor;
     *out = NULL;
     ch_sparse(a, &A);
@@ -205,12 +205,10 @@ static int ch_factor_new(silc_call *call, const silc_view *a, int condest, void 
         ch_factor_free(F);
         return rc;
     }
-    crude = ss_square_cond(call, condest, a->n, ch_apply_inv, F, &F->info);
+    ss_pivot_ratio(&F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse Cholesky (CHOLMOD, %s, %s)",
              L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
-    snprintf(F->info.note, sizeof F->info.note, "%s%s", sym_reused ? "symbolic analysis reused (same pattern); " : "",
-             crude ? "condition estimate is CHOLMOD's crude 1/rcond (diagonal of L)"
-                   : "1-norm condition estimate (Hager/Higham)");
+    snprintf(F->info.note, sizeof F->info.note, "%s", sym_reused ? "symbolic analysis reused (same pattern)" : "");
     *out = F;
     return SILC_OK;
 }
@@ -224,14 +222,14 @@ int ss_cholmod_solve(silc_call *call)
     cholmod_dense Bh, *X = NULL;
     double *B, t0;
     int64_t n, k;
-    int owned, rc, condest, status;
+    int owned, rc, condest, status, fold;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, CH_KEY, condest, ch_factor_new, ch_factor_free,
+        if ((rc = ss_attached_factor(call, &a, CH_KEY, ch_factor_new, ch_factor_free,
                                      "attaching the CHOLMOD factor", &f)))
             return rc;
         F = f;
@@ -242,9 +240,13 @@ int ss_cholmod_solve(silc_call *call)
         call->out = ss_host->dense_new(n, k);
         return call->out ? SILC_OK : ss_nomem(call, "CHOLMOD result");
     }
-    B = ss_rhs_dense(&b, &owned);
+    /* When the estimate is due, its starting block rides along (ss.h);
+     * A is symmetric, so the transposed solves are the same solves. */
+    fold = ss_cond_due(call, condest, &F->info);
+    B = fold ? ss_rhs_with_start(&b, n) : ss_rhs_dense(&b, &owned);
+    if (fold) owned = 1;
     if (!B) return ss_nomem(call, "CHOLMOD right-hand side");
-    ch_dense(n, k, B, &Bh);
+    ch_dense(n, k + (fold ? SS_EST_COLS : 0), B, &Bh);
     ss_lock();
     X = cholmod_l_solve(CHOLMOD_A, F->L, &Bh, cc);
     status = cc->status;
@@ -252,6 +254,8 @@ int ss_cholmod_solve(silc_call *call)
     if (owned) ss_host->free(B);
     if (!X) return ch_fail(call, "cholmod_l_solve", status);
     call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
+    if (fold && (int64_t)X->d == n)
+        ss_square_cond(call, condest, n, ch_apply_inv, F, &F->info, (const double *)X->x + n * k);
     ss_lock();
     cholmod_l_free_dense(&X, cc);
     ss_unlock();

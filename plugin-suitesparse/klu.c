@@ -17,9 +17,9 @@
  * Zero-copy: the CSR arrays of A are the compressed columns of A', which is
  * what KLU factors; klu_l_tsolve then solves (A')' x = A x = b.
  *
- * Condition: klu_l_rcond (smallest over largest |U(k,k)|), cheap and crude.
- * When it is large (or always, per the option suitesparse.condest) a
- * Hager/Higham estimate replaces it.  klu_l_condest would estimate the
+ * Condition: klu_l_rcond (smallest over largest |U(k,k)|) is cheap and
+ * crude, reported as the pivot ratio only; the estimate is Hager/Higham's,
+ * made on the first solve that wants one (ss.h).  klu_l_condest would estimate the
  * condition of the matrix factored, A', i.e. the infinity-norm condition of
  * A, so the plugin's estimator is run on A instead (klu_l_tsolve for A^{-1},
  * klu_l_solve for A^{-T}), giving the 1-norm figure SILC reports.
@@ -116,13 +116,13 @@ typedef struct kl_apply {
     int64_t n;
 } kl_apply;
 
-static int kl_apply_inv(void *ctx, double *x, int trans)
+static int kl_apply_inv(void *ctx, double *X, int t, int trans)
 {
     kl_apply *u = ctx;
     klu_l_common c;
     kl_common(&c);
-    if (trans) return klu_l_solve(kl_symbolic(u->F), u->F->num->N, u->n, 1, x, &c) ? 0 : -1;
-    return klu_l_tsolve(kl_symbolic(u->F), u->F->num->N, u->n, 1, x, &c) ? 0 : -1;
+    if (trans) return klu_l_solve(kl_symbolic(u->F), u->F->num->N, u->n, t, X, &c) ? 0 : -1;
+    return klu_l_tsolve(kl_symbolic(u->F), u->F->num->N, u->n, t, X, &c) ? 0 : -1;
 }
 
 /* Refactor into a donated numeric object; 1 if it is good enough to keep. */
@@ -137,14 +137,13 @@ static int kl_try_refactor(const silc_view *a, klu_l_symbolic *S, kl_numeric *nu
 }
 
 /* Makes the factorization of A (the ss_make_fn that ss_attached_factor calls). */
-static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void **out)
+static int kl_factor_new(silc_call *call, const silc_view *a, void **out)
 {
     klu_l_common c;
     klu_l_symbolic *S;
     kl_factor *F;
     kl_numeric *spare = NULL;
-    kl_apply u;
-    int sym_reused = 0, refactored = 0, crude;
+    int sym_reused = 0, refactored = 0;
     *out = NULL;
     kl_common(&c);
     F = ss_host->calloc(1, sizeof *F);
@@ -183,16 +182,13 @@ static int kl_factor_new(silc_call *call, const silc_view *a, int condest, void 
         }
         F->info.rcond = F->num->rcond0 = c.rcond;
     }
-    u.F = F, u.n = a->n;
-    crude = ss_square_cond(call, condest, a->n, kl_apply_inv, &u, &F->info);
+    ss_pivot_ratio(&F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse LU (KLU, BTF + AMD, %lld block%s)",
              (long long)S->nblocks, S->nblocks == 1 ? "" : "s");
-    snprintf(F->info.note, sizeof F->info.note, "%s%s",
-             refactored   ? "numeric refactor (klu_l_refactor, pivot order reused); "
-             : sym_reused ? "symbolic analysis reused (same pattern); "
-                          : "",
-             crude ? "condition estimate is KLU's crude 1/rcond (pivot ratio)"
-                   : "1-norm condition estimate (Hager/Higham)");
+    snprintf(F->info.note, sizeof F->info.note, "%s",
+             refactored   ? "numeric refactor (klu_l_refactor, pivot order reused)"
+             : sym_reused ? "symbolic analysis reused (same pattern)"
+                          : "");
     *out = F;
     return SILC_OK;
 }
@@ -204,7 +200,7 @@ int ss_klu_solve(silc_call *call)
     kl_factor *F = NULL;
     klu_l_common c;
     silc_value *out;
-    double t0;
+    double t0, *fold;
     int64_t n, k;
     int rc, condest;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
@@ -213,21 +209,33 @@ int ss_klu_solve(silc_call *call)
 
     if (n > 0) {
         void *f;
-        if ((rc = ss_attached_factor(call, &a, KL_KEY, condest, kl_factor_new, kl_factor_free,
+        if ((rc = ss_attached_factor(call, &a, KL_KEY, kl_factor_new, kl_factor_free,
                                      "attaching the KLU factors", &f)))
             return rc;
         F = f;
     }
 
     t0 = ss_host->now();
-    /* KLU solves in place: straight in the result, as a caller of KLU would. */
+    /* KLU solves in place: straight in the result, as a caller of KLU would;
+     * when the estimate is due, in an array with its starting block after B,
+     * solved in the same call. */
     if (!(out = ss_host->dense_new_uninit(n, k))) return ss_nomem(call, "KLU result");
     ss_host->view(out, &o);
-    ss_rhs_copy(&b, o.val);
+    fold = F && ss_cond_due(call, condest, &F->info) ? ss_rhs_with_start(&b, n) : NULL;
+    if (!fold) ss_rhs_copy(&b, o.val);
     kl_common(&c);
-    if (n > 0 && k > 0 && !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k, o.val, &c)) {
+    if (n > 0 && (k > 0 || fold) &&
+        !klu_l_tsolve(kl_symbolic(F), F->num->N, n, k + (fold ? SS_EST_COLS : 0), fold ? fold : o.val, &c)) {
         ss_host->release(out);
+        ss_host->free(fold);
         return kl_fail(call, "klu_l_tsolve", &c);
+    }
+    if (fold) {
+        kl_apply u;
+        memcpy(o.val, fold, (size_t)(n * k) * sizeof(double));
+        u.F = F, u.n = n;
+        ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info, fold + n * k);
+        ss_host->free(fold);
     }
     call->out = out;
     r->solve_seconds = ss_host->now() - t0;

@@ -180,6 +180,7 @@ static int qr_factor_new(silc_call *call, const silc_view *a, double tol, qr_fac
         F->info.cond = inv >= 0 ? (F->transposed ? p->norminf : p->norm1) * inv : -1;
     }
     F->info.rcond = F->info.cond > 0 ? (isinf(F->info.cond) ? 0 : 1 / F->info.cond) : -1;
+    F->info.estimated = F->info.cond >= 0;
     if (!full)
         snprintf(F->info.note, sizeof F->info.note,
                  "rank %lld of %lldx%lld (tol %.3g): basic solution (at most rank nonzeros), "

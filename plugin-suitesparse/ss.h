@@ -57,9 +57,9 @@ int ss_nomem(silc_call *call, const char *what);
  * by make() and attached (destroy frees it with A).  Sets report->
  * reused_factor and factor_seconds.  what names it in an out-of-memory
  * message.  Returns a silc_status. */
-typedef int (*ss_make_fn)(silc_call *call, const silc_view *a, int condest, void **out);
-int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, int condest,
-                       ss_make_fn make, void (*destroy)(void *), const char *what, void **out);
+typedef int (*ss_make_fn)(silc_call *call, const silc_view *a, void **out);
+int ss_attached_factor(silc_call *call, const silc_view *a, const char *key, ss_make_fn make,
+                       void (*destroy)(void *), const char *what, void **out);
 int ss_ends_with(const char *s, const char *suffix);
 /* Shared accepts: A must be CSR (and square when square is set). */
 int ss_accepts_csr(const silc_call *call, int square, const char **why);
@@ -73,18 +73,22 @@ double *ss_rhs_dense(const silc_view *b, int *owned);
 silc_value *ss_dense_value(int64_t m, int64_t k, const double *x, int64_t ld);
 
 /*
- * The plugin option "condest" decides when the Hager/Higham 1-norm estimate
- * (ss_inv_norm1, about ten extra solves) replaces the libraries' cheap pivot
- * ratio, which can miss ill-conditioning by orders of magnitude:
- *   auto (default)  when the cheap estimate exceeds SS_CONDEST_AUTO, so a
- *                   well-conditioned system pays nothing and a suspicious one
- *                   gets a number SILC's singularity warning can trust;
- *   true / false    always / never.
- * ss_condest_mode gives SS_CONDEST_*; ss_use_condest applies it to a cheap cond.
+ * The condition estimate is Hager/Higham's (ss_square_cond, below: block
+ * form through the factors, once per factorization).  The libraries'
+ * cheap pivot ratio can miss ill-conditioning by orders of magnitude (5.07
+ * from UMFPACK for the 1-D Laplacian of cond_1 840), so it is never reported as the
+ * estimate, only as pivot_ratio, labelled.  The plugin option "condest":
+ *   true (default; "auto" means the same) estimate;
+ *   false                                 no estimate ("not estimated"),
+ * and the session's accuracy.condest = off (report->condest_off, ABI 1.7)
+ * turns it off too.  A factorization made without an estimate gets one on
+ * its next solve that wants it, so the setting means the same whenever it
+ * is set.
  */
-enum { SS_CONDEST_AUTO = 0, SS_CONDEST_ALWAYS, SS_CONDEST_NEVER };
-#define SS_CONDEST_AUTO_ABOVE 1e6
+enum { SS_CONDEST_ALWAYS = 0, SS_CONDEST_NEVER };
 int ss_condest_mode(silc_call *call, int *mode);
+/* 1 when this call should have a condition estimate (mode and accuracy.condest). */
+int ss_condest_wanted(const silc_call *call, int mode);
 
 /* Estimate of ||A^{-1}||_1 for an n x n A given by solves with A (trans = 0)
  * and A' (trans = 1) in place on x; about 5 pairs of solves.  -1 on failure. */
@@ -106,22 +110,42 @@ enum { SS_UMFPACK = 0, SS_CHOLMOD, SS_KLU, SS_NCACHE };
 /* What a factorization tells every solve that uses it. */
 typedef struct ss_factor_info {
     double rcond;               /* the library's reciprocal estimate (SPQR: 1/cond), -1 = none */
-    double cond;                /* the condition estimate reported, -1 = none */
+    double cond;                /* the condition estimate, valid when estimated */
+    int estimated;              /* cond holds a Hager/Higham estimate */
+    double pivot_ratio;         /* the library's max/min factor diagonal (1/rcond), 0 = none */
     char method[64];
     char note[160];
 } ss_factor_info;
 
-/* The condition estimate of a new square factorization, from fi->rcond (the
- * library's cheap one, <= 0 when singular): fi->cond = 1/rcond, replaced by
- * norm1(A) ||A^{-1}||_1 through solve when mode asks for it.  Returns 1 when
- * fi->cond is the cheap estimate, 0 when it is Hager/Higham's. */
-int ss_square_cond(silc_call *call, int mode, int64_t n, int (*solve)(void *ctx, double *x, int trans),
-                   void *ctx, ss_factor_info *fi);
+/* The condition estimate of a square factorization: the block form of the
+ * host (Higham-Tisseur, SS_EST_COLS columns, SS_EST_STEPS steps: the
+ * two-column, two-step form MUMPS uses, 0.97-1.00 of cond_1 on the shared
+ * matrices) costs three applications of A^-1 or A^-T to two columns; the
+ * one-column dlacon form took about five pairs of solves.  The first
+ * application rides along with the user's solve when it is due
+ * (ss_cond_due): the solve takes ss_rhs_with_start's array, B with the
+ * starting block after it, and passes the solved block as Y0.
+ * apply(ctx, X, t, trans) overwrites the n x t X with A^-1 X (A^-T X).
+ * Sets fi->cond = norm1(A) ||A^{-1}||_1 and fi->estimated; nothing when
+ * not due. */
+#define SS_EST_COLS 2
+#define SS_EST_STEPS 2
+typedef int (*ss_block_fn)(void *ctx, double *X, int t, int trans);
+int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi);
+void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi,
+                    const double *Y0);
+/* B (b->n columns) then the estimator's starting block (SS_EST_COLS
+ * columns), n rows each, in one array from host->alloc; NULL when out of
+ * memory. */
+double *ss_rhs_with_start(const silc_view *b, int64_t n);
 
 /* The start every square solve shares: views of A and B, a decline unless A
  * is square CSR, and the condest option.  0, SILC_EDECLINE or an error. */
 int ss_square_solve_begin(silc_call *call, silc_view *a, silc_view *b, int *condest);
 
+/* fi->pivot_ratio from the library's rcond (UMFPACK, KLU, CHOLMOD: a ratio
+ * of the factor's extreme diagonal entries). */
+void ss_pivot_ratio(ss_factor_info *fi);
 /* Copies a factorization's method, note and estimates into the report. */
 void ss_report_factor(silc_report *r, const ss_factor_info *fi);
 

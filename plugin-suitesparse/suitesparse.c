@@ -55,10 +55,10 @@ static const silc_backend ss_backends[] = {
 };
 
 static const silc_option_spec ss_options[] = {
-    {"condest", SILC_OPT_STRING, "auto",
-     "1-norm condition estimate by Hager/Higham (about 10 extra solves per factorization) "
-     "instead of the libraries' cheap pivot ratio: auto (when the cheap one exceeds 1e6), "
-     "true, false"},
+    {"condest", SILC_OPT_STRING, "true",
+     "1-norm condition estimate by block Hager/Higham (2 columns, 2 steps, once per factorization): "
+     "true (auto means the same), false (none; the libraries' cheap pivot ratio is shown, "
+     "labelled, never as the estimate)"},
     {"umfpack_irstep", SILC_OPT_INT, "2", "UMFPACK: maximum steps of iterative refinement"},
     {"spqr_tol", SILC_OPT_DOUBLE, "-2",
      "SPQR: columns of 2-norm <= tol count as zero (rank detection); -2 = SPQR's default "

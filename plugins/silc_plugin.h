@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 6
+#define SILC_ABI_MINOR 7
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -142,7 +142,14 @@ enum silc_reduce {
 
 /* What a solver tells about its result.  The host fills backend, wall time and the
  * backward error itself; a plugin fills what it knows and leaves the rest alone
- * (the host zeroes the report and sets cond_est = -1 before the call). */
+ * (the host zeroes the report and sets cond_est = -1 before the call).
+ * cond_est must be an estimate of cond_1(A) = ||A||_1 ||A^-1||_1 that can be
+ * trusted to a small factor (Hager-Higham through the backend's own
+ * factorization: inv_norm1_est / inv_norm1_est_block), or -1: the host turns
+ * it into a forward-error bound.  A library's cheap pivot ratio is not such an
+ * estimate (it can be 200x low: UMFPACK's for the 40 x 40 1-D Laplacian is
+ * 5.07, cond_1 840); it goes in pivot_ratio (ABI 1.7).  An iterative method that makes no
+ * extra solves leaves cond_est at -1 ("not estimated"). */
 typedef struct silc_report {
     char method[64];        /* e.g. "LU (partial pivoting, COLAMD order)" */
     double cond_est;        /* 1-norm condition estimate, -1 = unknown */
@@ -166,6 +173,15 @@ typedef struct silc_report {
     double tol;             /* plugin: an iterative method's stopping tolerance on the relative
                                residual (the host verifies the result against it), 0 if none */
     char attempts[512];     /* host: the backends of the list that failed before this one */
+    /* ABI 1.7 (read or write these only when host->abi_minor >= 7) */
+    int condest_off;        /* host, set before the call: 1 when accuracy.condest = off: make no
+                               condition estimate (the host discards cond_est then anyway) */
+    double pivot_ratio;     /* plugin: a library's cheap max/min ratio of the factor's diagonal
+                               (UMFPACK's, KLU's, CHOLMOD's 1/rcond), shown labelled as such;
+                               not a bound, never used for one; 0 = none */
+    double forward_bound;   /* host: est ||A^-1||_1 * max_j ||b_j - A x_j||_1 / ||x_j||_1, the
+                               residual bound on the relative forward error with the
+                               estimate in place of ||A^-1||_1; -1 = none */
 } silc_report;
 
 typedef struct silc_call {

@@ -15,14 +15,27 @@
  *   - a per-call `backend = X` has nothing to fall back to: its failed
  *     verification is the error;
  *   - a direct result that misses the bound is refined first (bayer10 with
- *     KLU), unless solve.refine = 0.
+ *     KLU), unless solve.refine = 0; and solve.verify set after a first
+ *     solve with the same A (whose factorization is then reused) gives the
+ *     same refined result and report as set before it;
+ *   - a configured backend whose plugin is not on the plugin path (the
+ *     template plugin, built in build/plugins/template, outside the default
+ *     path) is an error at silc_open naming the plugin file and the
+ *     directories searched; written "template?" it is optional, left out of
+ *     explain's list, and the next backend solves; set in the session, the
+ *     solve fails instead of falling back to the reference; a plugin file
+ *     that cannot be loaded is warned about once per process.
  *
  * Skips (with a message) what needs a plugin this build does not have.
  */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "testlib.h"
@@ -160,6 +173,156 @@ static void test_refinement_first(silc_context *c)
           silc_context_errmsg(c));
 }
 
+/* solve.verify set after a first solve of the same A means what it means
+ * set before: the reused factorization's result is checked at once and
+ * refined (KLU leaves bayer10 at 8.3e-13; the bound 1e-13 asks for more). */
+static void test_verify_after_first_solve(void)
+{
+    silc_context *before = tl_open_printing(), *after = tl_open_printing();
+    char in_before[4096];
+    const char *in;
+    double be_b, be_a, raw_b, raw_a;
+    if (!before || !after) goto out;
+    if (put_system(before, "bayer10.mtx") < 0 || put_system(after, "bayer10.mtx") < 0) goto out;
+    CHECK(silc_exec(before, "set solve.verify = 1e-13; x = solve(A, b, \"backend = suitesparse.klu\")") == 0,
+          "verify before: %s", silc_context_errmsg(before));
+    snprintf(in_before, sizeof in_before, "%s", tl_out_info(before, "x"));
+    CHECK(silc_exec(after, "x0 = solve(A, b, \"backend = suitesparse.klu\"); set solve.verify = 1e-13; "
+                           "x = solve(A, b, \"backend = suitesparse.klu\")") == 0,
+          "verify after: %s", silc_context_errmsg(after));
+    in = tl_out_info(after, "x");
+    be_b = tl_out_number(in_before, "backward error: ");
+    be_a = tl_out_number(in, "backward error: ");
+    raw_b = tl_out_number(in_before, "backward error before: ");
+    raw_a = tl_out_number(in, "backward error before: ");
+    CHECK(be_a <= 1e-13 && be_a == be_b && raw_a == raw_b && raw_a > 1e-13 && !strstr(in, "computed now"),
+          "bayer10/KLU: solve.verify set after the first solve gives backward error %.3g (raw %.3g), set before "
+          "%.3g (raw %.3g):\nbefore:\n%s\nafter:\n%s",
+          be_a, raw_a, be_b, raw_b, in_before, in);
+    /* The raw result needed refinement: so does every later back-substitution. */
+    CHECK(silc_exec(before, "y = solve(A, 2 * b, \"backend = suitesparse.klu\")") == 0, "y: %s",
+          silc_context_errmsg(before));
+    in = tl_out_info(before, "y");
+    CHECK(strstr(in, "reused factorization: yes") && strstr(in, "refinement: 1 step") &&
+              tl_out_number(in, "backward error: ") <= 1e-13,
+          "the next solve with the factorization is refined too:\n%s", in);
+    printf("  bayer10/KLU, solve.verify = 1e-13 set before or after a first solve: %.3g -> %.3g both times\n",
+           raw_a, be_a);
+out:
+    silc_close(&before);
+    silc_close(&after);
+}
+
+/* Creates directory path (its parent exists); 0 when it exists after. */
+static int mkdir_p(const char *path)
+{
+    int ok = mkdir(path, 0755) == 0 || errno == EEXIST;
+    CHECK(ok, "cannot create %s: %s", path, strerror(errno));
+    return ok ? 0 : -1;
+}
+
+/* Writes text to path; 0 on success. */
+static int write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    int ok = f && fputs(text, f) >= 0;
+    if (f && fclose(f)) ok = 0;
+    CHECK(ok, "cannot write %s", path);
+    return ok ? 0 : -1;
+}
+
+/* The number of times needle occurs in hay. */
+static int count_of(const char *hay, const char *needle)
+{
+    int n = 0;
+    for (const char *p = hay; (p = strstr(p, needle)) != NULL; p += strlen(needle)) n++;
+    return n;
+}
+
+static void test_missing_plugin(void)
+{
+    const char *conf = SILC_BINARY_DIR "/tests/test_fallback_missing.conf";
+    const char *dir = SILC_BINARY_DIR "/tests/test_fallback_plugins";
+    const char *bogus = SILC_BINARY_DIR "/tests/test_fallback_plugins/libsilc_plugin_bogus.so";
+    const char *log = SILC_BINARY_DIR "/tests/test_fallback_stderr.txt";
+    char text[1024], *err = NULL;
+    silc_context *c = NULL;
+    const char *e;
+    int rc, saved;
+    FILE *f;
+    long len;
+    /* Named and absent: an error at start, naming the plugin and the path. */
+    if (write_file(conf, "[dispatch]\nsolve.sparse = template\n")) return;
+    rc = silc_open(&c, conf);
+    e = c ? silc_context_errmsg(c) : silc_errmsg();
+    CHECK(rc != 0 && tl_contains(e, "dispatch.solve.sparse names backend 'template', which is not installed") &&
+              tl_contains(e, "libsilc_plugin_template.so") && tl_contains(e, "searched: ") &&
+              tl_contains(e, SILC_BINARY_DIR "/plugins") && tl_contains(e, "'template?'"),
+          "a configured plugin that is absent is an error at silc_open: rc %d, %s", rc, e);
+    printf("  absent plugin: %s\n", e);
+    silc_close(&c);
+    /* Optional: left out, said so by explain, and the next backend solves. */
+    if (write_file(conf, "[dispatch]\nsolve.sparse = template?, suitesparse.umfpack\n")) return;
+    rc = silc_open(&c, conf);
+    CHECK(rc == 0, "an optional absent plugin opens: %s", c ? silc_context_errmsg(c) : silc_errmsg());
+    if (rc == 0) {
+        silc_set_output(c, tl_out_fn, NULL);
+        CHECK(silc_exec(c, "A = sparse([4, -1, 0; -2, 5, 1; 0, 1, 3]); b = [1; 2; 3]") == 0, "A: %s",
+              silc_context_errmsg(c));
+        e = tl_out_exec(c, "explain x = A \\ b");
+        CHECK(tl_contains(e, "backends (config key dispatch.solve.sparse): suitesparse.umfpack, reference "
+                             "(not installed, left out: template)") &&
+                  !tl_contains(e, "template: not installed"),
+              "explain shows only the backends that exist:\n%s", e);
+        CHECK(silc_exec(c, "x = A \\ b") == 0 && tl_contains(tl_out_info(c, "x"), "backend: suitesparse.umfpack"),
+              "optional absent: umfpack solves: %s\n%s", silc_context_errmsg(c), tl_out());
+        /* Set in the session: the solve fails, no silent reference. */
+        rc = silc_exec(c, "set dispatch.solve.sparse = template; y = A \\ b");
+        CHECK(rc != 0 && tl_contains(silc_context_errmsg(c), "names backend 'template', which is not installed"),
+              "a session list naming an absent plugin fails the solve: %s", rc ? silc_context_errmsg(c) : "solved");
+    }
+    silc_close(&c);
+    /* On the plugin path (core.plugin_path): found, and it runs. */
+    snprintf(text, sizeof text, "[core]\nplugin_path = %s/plugins/template\n[dispatch]\nsolve.sparse = template\n",
+             SILC_BINARY_DIR);
+    if (write_file(conf, text)) return;
+    rc = silc_open(&c, conf);
+    CHECK(rc == 0, "template on core.plugin_path opens: %s", c ? silc_context_errmsg(c) : silc_errmsg());
+    silc_close(&c);
+    /* A plugin file that cannot be loaded: warned about once per process,
+     * however many contexts or directory listings meet it. */
+    if (mkdir_p(dir) || write_file(bogus, "not a shared object\n")) return;
+    fflush(stderr);
+    saved = dup(2);
+    f = freopen(log, "w", stderr);
+    CHECK(f != NULL, "cannot redirect stderr to %s", log);
+    setenv("SILC_PLUGIN_PATH", dir, 1);
+    snprintf(text, sizeof text, "[core]\nplugin_path = %s\n", dir);
+    write_file(conf, text);
+    for (int i = 0; i < 3; i++) {
+        rc = silc_open(&c, conf);
+        CHECK(rc == 0, "open %d with a bogus plugin file: %s", i, c ? silc_context_errmsg(c) : silc_errmsg());
+        silc_close(&c);
+    }
+    unsetenv("SILC_PLUGIN_PATH");
+    fflush(stderr);
+    if (saved >= 0) {
+        dup2(saved, 2);
+        close(saved);
+    }
+    f = fopen(log, "r");
+    if (f && fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) >= 0 && (err = calloc((size_t)len + 1, 1)) &&
+        fseek(f, 0, SEEK_SET) == 0)
+        CHECK(fread(err, 1, (size_t)len, f) == (size_t)len, "cannot read %s", log);
+    if (f) fclose(f);
+    snprintf(text, sizeof text, "silc: warning: cannot load plugin %s:", bogus);
+    CHECK(err && count_of(err, text) == 1, "a plugin file that cannot be loaded is warned about once, not %d times:\n%s",
+          err ? count_of(err, text) : -1, err ? err : "");
+    free(err);
+    remove(bogus);
+    remove(conf);
+}
+
 int main(void)
 {
     silc_context *c = tl_open_printing();
@@ -173,6 +336,8 @@ int main(void)
     if (have(c, "suitesparse.umfpack") && have(c, "suitesparse.klu")) {
         test_refinement_first(c);
         test_all_fail(c);
+        test_verify_after_first_solve();
+        test_missing_plugin();
     }
     silc_close(&c);
     return check_done();

@@ -98,9 +98,11 @@ double *acc_dense_copy(const silc_value *v)
  * the common case, whose cost is one sparse product.  With norm_a, also
  * ||A||_inf, summed unscaled while the entries pass by (the properties'
  * norms would cost a pass of their own); +Inf when that sum overflowed, and
- * not complete when the residual is NaN. */
+ * not complete when the residual is NaN.  With col1 (k entries, zeroed by
+ * the caller), also each column's ||b_j - A x_j||_1, for the forward-error
+ * bound: one more add per row. */
 static double residual_norm_csr(const silc_value *A, const double *B, const double *X, int64_t k,
-                                double *norm_a)
+                                double *norm_a, double *col1)
 {
     silc_view a;
     double best = 0, best_a = 0;
@@ -118,12 +120,32 @@ static double residual_norm_csr(const silc_value *A, const double *B, const doub
             }
             if (c == 0) best_a = row_a > best_a ? row_a : best_a;
             s += fabs(r);
+            if (col1) col1[c] += fabs(r);
         }
         best = max_nan(best, s);
         if (isnan(best)) break;
     }
     if (norm_a) *norm_a = best_a;
     return best;
+}
+
+/* The largest over the k columns of ||r_j||_1 / ||x_j||_1 (r, x n x k; r1
+ * holds the residual's column norms when r is NULL): what multiplies
+ * ||A^-1||_1 in the forward-error bound.  0 for a zero residual, +Inf for a
+ * zero column of X with a nonzero residual. */
+static double residual_over_solution(const double *r1, const double *r, const double *x, int64_t n, int64_t k)
+{
+    double worst = 0;
+    int64_t i, c;
+    for (c = 0; c < k; c++) {
+        double rn = 0, xn = 0;
+        if (r1) rn = r1[c];
+        else
+            for (i = 0; i < n; i++) rn += fabs(r[i + c * n]);
+        for (i = 0; i < n; i++) xn += fabs(x[i + c * n]);
+        worst = max_nan(worst, rn == 0 ? 0 : rn / xn);
+    }
+    return worst;
 }
 
 /* G = A' R (A m x n, R m x k, G n x k zeroed by the caller). */
@@ -162,7 +184,8 @@ static void transpose_times(const silc_value *A, const double *R, int64_t k, dou
  * of A, so the second measures the normal equations' residual A'R, scaled so
  * that it is invariant under scaling A and B, as the first is.
  */
-static double backward_error_whole(const silc_value *A, const silc_value *B, const silc_value *X)
+static double backward_error_whole(const silc_value *A, const silc_value *B, const silc_value *X,
+                                   double *rx1)
 {
     /* A one-column B's infinity norm is its largest entry: the scan the
      * solve already made of it (val_max_abs), not a properties pass.  A's
@@ -173,21 +196,25 @@ static double backward_error_whole(const silc_value *A, const silc_value *B, con
     double nX, nR, be = -1;
     const double *b = B->format == SILC_FMT_DENSE ? B->val : NULL;
     const double *x = X->format == SILC_FMT_DENSE ? X->val : NULL;
-    double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL;
+    double *bc = NULL, *xc = NULL, *R = NULL, *G = NULL, *col1 = NULL;
     int64_t k = X->n;
+    if (rx1) *rx1 = -1;
     if (!b) b = bc = acc_dense_copy(B);
     if (!x) x = xc = acc_dense_copy(X);
     if (!b || !x) goto out;
     nX = acc_norm_inf(x, X->m, k);
     if (A->m == A->n && A->format == SILC_FMT_CSR) {
-        nR = residual_norm_csr(A, b, x, k, nA < 0 ? &nA : NULL);
+        if (rx1 && !(col1 = calloc((size_t)(k > 0 ? k : 1), sizeof *col1))) goto out;
+        nR = residual_norm_csr(A, b, x, k, nA < 0 ? &nA : NULL, col1);
         if (!isfinite(nA)) nA = -1; /* overflowed: the scaled sums below */
+        if (rx1) *rx1 = residual_over_solution(col1, NULL, x, A->n, k);
     } else {
         R = malloc((size_t)(A->m * k > 0 ? A->m * k : 1) * sizeof *R);
         if (!R) goto out;
         acc_residual(A, b, x, k, 0, R, NULL);
         if (A->m == A->n) {
             nR = acc_norm_inf(R, A->m, k);
+            if (rx1) *rx1 = residual_over_solution(NULL, R, x, A->n, k);
         } else {
             G = calloc((size_t)(A->n * k > 0 ? A->n * k : 1), sizeof *G);
             if (!G) goto out;
@@ -205,13 +232,31 @@ out:
     free(xc);
     free(R);
     free(G);
+    free(col1);
     return be;
 }
 
 double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
 {
     if (A->dist || B->dist || X->dist) return dist_backward_error(A, B, X);
-    return backward_error_whole(A, B, X);
+    return backward_error_whole(A, B, X, NULL);
+}
+
+/* The backward error, and r->forward_bound from the residual of the same
+ * pass when r holds a condition estimate of a square system (a distributed
+ * one gets no bound: its residual lives on the ranks). */
+static double backward_error_and_bound(const silc_value *A, const silc_value *B, const silc_value *X,
+                                       silc_report *r)
+{
+    double rx1 = -1, be, nA1;
+    r->forward_bound = -1;
+    if (A->dist || B->dist || X->dist) return dist_backward_error(A, B, X);
+    if (!(r->cond_est >= 0) || A->m != A->n) return backward_error_whole(A, B, X, NULL);
+    be = backward_error_whole(A, B, X, &rx1);
+    /* ||A^-1||_1 is estimated as cond_est / ||A||_1, as the plugin made it */
+    nA1 = val_props_part(A, SILC_PROPS_NORMS)->norm1;
+    if (rx1 >= 0 && nA1 > 0) r->forward_bound = isinf(r->cond_est) ? INFINITY : r->cond_est / nA1 * rx1;
+    return be;
 }
 
 /* ---- when -------------------------------------------------------------------- */
@@ -251,17 +296,17 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when
         else defer = r->reused_factor && !(when && strcmp(when, "always") == 0);
         if (defer) {
             r->backward_error = ACC_DEFERRED;
+            r->forward_bound = -1; /* with the backward error, when info asks */
             return;
         }
     }
-    r->backward_error = acc_backward_error(call->in[0], call->in[1], call->out);
+    r->backward_error = backward_error_and_bound(call->in[0], call->in[1], call->out, r);
     warn_if_unsolved(E, r->backend, r->backward_error);
 }
 
-double acc_pending_resolve(silc_engine *E, eng_pending *p, const char *backend)
+void acc_pending_resolve(silc_engine *E, eng_pending *p, silc_report *r)
 {
-    double be = p->A && p->B && p->X ? acc_backward_error(p->A, p->B, p->X) : -1;
-    warn_if_unsolved(E, backend, be);
+    r->backward_error = p->A && p->B && p->X ? backward_error_and_bound(p->A, p->B, p->X, r) : -1;
+    warn_if_unsolved(E, r->backend, r->backward_error);
     eng_pending_release(p);
-    return be;
 }

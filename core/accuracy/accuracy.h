@@ -54,13 +54,31 @@ double *acc_dense_copy(const silc_value *v);
  * computed. */
 double acc_backward_error(const silc_value *A, const silc_value *B, const silc_value *X);
 
+/*
+ * ---- the forward-error bound.  For a square system, x - x_true = A^-1 r with
+ * r = b - A x, so for every column
+ *
+ *     ||x - x_true||_1 / ||x||_1  <=  ||A^-1||_1 ||r||_1 / ||x||_1,
+ *
+ * a rigorous bound with the exact ||A^-1||_1.  The report's forward_bound is
+ * that right-hand side with ||A^-1||_1 replaced by its Hager-Higham estimate
+ * (cond_est / ||A||_1; a lower bound of the true norm, within a factor 3 on
+ * the shared matrices, tests/test_condest_matrices.c), the largest over the
+ * columns, relative to the computed x.  It comes from the same residual pass
+ * as the backward error (one more add per row) and exists only when the
+ * backend gave a condition estimate.  Relative to x_true it is B / (1 - B)
+ * for B < 1.  Unlike `cond x backward error` it needs no first-order
+ * argument and no norm mixing (the backward error is an infinity-norm one).
+ */
+
 /* Fills call->report->backward_error after a successful solve: at once, or
  * ACC_DEFERRED when the caller allows deferral (may_defer), the solve
  * neither iterated nor refined, and either it only reused a factorization
  * and solve.backward_error is not "always", or solve.backward_error is
  * "on_request".  Warns when the result does not solve the system.  when is
  * solve.backward_error (NULL when not set): the dispatcher reads the
- * options, this layer below it is told them. */
+ * options, this layer below it is told them.  Computed at once, it also
+ * fills report->forward_bound (above). */
 void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when);
 
 /* The largest backward error a solve's result may have and still count as
@@ -74,8 +92,9 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when
 double acc_verify_limit(const char *verify, const silc_report *r);
 
 /* The deferred backward error held by p (context.h: eng_pending_hold),
- * computed now (with the warning a bad one deserves); releases p. */
-double acc_pending_resolve(silc_engine *E, eng_pending *p, const char *backend);
+ * computed now into r->backward_error (with the warning a bad one
+ * deserves), with r->forward_bound; releases p. */
+void acc_pending_resolve(silc_engine *E, eng_pending *p, silc_report *r);
 
 /*
  * ---- refinement (refine.c): what the dispatcher asks of it: the finite-operand check

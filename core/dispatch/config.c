@@ -204,6 +204,7 @@ static int unknown_section(silc_engine *E, const char *section)
     cands[n++] = "tune";
     cands[n++] = "core";
     cands[n++] = "solve";
+    cands[n++] = "accuracy";
     for (i = 0; ld_known_backends[i] && nk < 16; i++) {
         plugin_part(ld_known_backends[i], known[nk], sizeof known[nk]);
         cands[n++] = known[nk++];
@@ -236,10 +237,17 @@ static int check_backend_list(silc_engine *E, const char *key, const char *value
         const char *comma = strchr(p, ',');
         size_t len = comma ? (size_t)(comma - p) : strlen(p);
         char name[128];
+        size_t nl;
+        int optional;
         trim_copy(name, sizeof name, p, len);
+        /* "name?" lists an optional backend (dispatch.c: disp_check_configured) */
+        nl = strlen(name);
+        optional = nl > 1 && name[nl - 1] == '?';
+        if (optional) name[nl - 1] = '\0';
         if (!name[0])
             return eng_error(E, "%s: empty backend name in list '%s'", key, value);
         if (!backend_known(E, name)) return unknown_backend(E, name, key);
+        if (optional) name[nl - 1] = '?';
         if (++count > CFG_MAX_LIST)
             return eng_error(E, "%s: more than %d backends listed", key, CFG_MAX_LIST);
         if ((count > 1 && sb_puts(norm, ", ")) || sb_puts(norm, name))
@@ -372,6 +380,12 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         } else if (strcmp(name, "plugin_path") != 0) {
             return unknown_key(E, section, name, core_keys, 2);
         }
+        return keep_value(E, norm, section, name, value);
+    }
+    if (strcmp(section, "accuracy") == 0) { /* accuracy.condest = on | off (dispatch.c: report_reset) */
+        if (strcmp(name, "condest") != 0) return unknown_key(E, section, name, (const char *const[]){"condest"}, 1);
+        if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
+            return eng_error(E, "accuracy.condest expects 'on' or 'off', got '%s'", value);
         return keep_value(E, norm, section, name, value);
     }
     if (strcmp(section, "solve") == 0) {

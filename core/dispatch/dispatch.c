@@ -81,6 +81,8 @@ typedef struct blist {
     char buf[1024];
     const char *names[DISP_MAX_LIST];
     int n;
+    char key[160];          /* the dispatch key the names come from; "" for a built-in list */
+    char absent[256];       /* optional or built-in names left out: not installed here */
     int forced;             /* per-call backend = X: no fallback */
     int nlisted;            /* names the configuration or default listed (then "reference") */
     char source[192];
@@ -248,20 +250,63 @@ int disp_classes(silc_engine *E, const silc_call *call, const char *out[4])
 
 /* ---- backend lists --------------------------------------------------------- */
 
-static void split_list(blist *L, const char *text)
+/* Splits a comma list into L->names.  A name written "name?" is optional:
+ * the '?' is dropped, and so is the name when no loaded plugin provides it
+ * (as every name of a built-in list, given by all_optional): the list is
+ * then the backends that exist, and L->absent says which were left out. */
+static void split_list(const silc_engine *E, blist *L, const char *text, int all_optional)
 {
     char *p;
     snprintf(L->buf, sizeof L->buf, "%s", text);
     L->n = 0;
     for (p = L->buf; p && L->n < DISP_MAX_LIST - 1;) {
         char *comma = strchr(p, ','), *end;
+        int optional = all_optional;
         if (comma) *comma = '\0';
         while (*p == ' ' || *p == '\t') p++;
         end = p + strlen(p);
         while (end > p && (end[-1] == ' ' || end[-1] == '\t')) *--end = '\0';
-        if (*p) L->names[L->n++] = p;
+        if (end - p > 1 && end[-1] == '?') *--end = '\0', optional = 1;
+        if (*p && optional && !ld_find(E, p)) {
+            size_t l = strlen(L->absent);
+            snprintf(L->absent + l, sizeof L->absent - l, "%s%s", l ? ", " : "", p);
+        } else if (*p) {
+            L->names[L->n++] = p;
+        }
         p = comma ? comma + 1 : NULL;
     }
+}
+
+/* E->err for a configured backend that is not loaded (key: the dispatch
+ * key that names it). */
+static int missing_backend(silc_engine *E, const char *key, const char *name)
+{
+    strbuf why;
+    int rc;
+    sb_init(&why);
+    ld_explain_missing(E, name, &why);
+    rc = eng_error(E, "%s names backend '%s', which is not installed: %s (write '%s?' to make it optional)", key,
+                   name, why.failed ? "out of memory" : sb_str(&why), name);
+    sb_free(&why);
+    return rc;
+}
+
+int disp_check_configured(silc_engine *E)
+{
+    size_t c;
+    for (c = 0; disp_class_names[c]; c++) {
+        char key[160];
+        const char *text;
+        blist L;
+        int i;
+        snprintf(key, sizeof key, "dispatch.%s", disp_class_names[c]);
+        if (!(text = cfg_get(E, key))) continue;
+        memset(&L, 0, sizeof L);
+        split_list(E, &L, text, 0);
+        for (i = 0; i < L.n; i++)
+            if (!ld_find(E, L.names[i])) return missing_backend(E, key, L.names[i]);
+    }
+    return 0;
 }
 
 static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
@@ -274,7 +319,7 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
     int c;
     memset(L, 0, sizeof *L);
     if (forced) {
-        split_list(L, forced);
+        split_list(E, L, forced, 0);
         L->nlisted = L->n;
         L->forced = 1;
         snprintf(L->source, sizeof L->source, "per-call option backend = %s", forced);
@@ -285,6 +330,7 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
         text = cfg_get(E, key);
         if (text) snprintf(L->source, sizeof L->source, "config key %s", key);
     }
+    if (text) snprintf(L->key, sizeof L->key, "%s", key);
     if (!text) {
         text = "reference";
         for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
@@ -294,7 +340,7 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
         snprintf(L->source, sizeof L->source, "built-in default for %s%s", chain[0],
                  distributed ? ", distributed operands" : "");
     }
-    split_list(L, text);
+    split_list(E, L, text, !L->key[0]);
     L->nlisted = L->n;
     for (c = 0; c < L->n; c++)
         if (strcmp(L->names[c], "reference") == 0) return;
@@ -355,6 +401,17 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
 
 /* ---- refinement (refine.c) -------------------------------------------------- */
 
+/* A report as a backend gets it: zeroed, estimates unknown, and told
+ * whether the session wants a condition estimate (accuracy.condest). */
+static void report_reset(silc_engine *E, silc_report *r)
+{
+    const char *c = cfg_get(E, "accuracy.condest");
+    memset(r, 0, sizeof *r);
+    r->cond_est = r->rcond = -1;
+    r->forward_bound = -1;
+    r->condest_off = c && !strcmp(c, "off");
+}
+
 /* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
  * with the call's class and options; NULL (and why in err) when it fails. */
 static silc_value *correction(const void *be, silc_engine *E, const silc_call *call, const silc_value *R,
@@ -365,8 +422,7 @@ static silc_value *correction(const void *be, silc_engine *E, const silc_call *c
     silc_report rep;
     host_call_ctx ctx;
     int rc;
-    memset(&rep, 0, sizeof rep);
-    rep.cond_est = rep.rcond = -1;
+    report_reset(E, &rep);
     memset(&ctx, 0, sizeof ctx);
     ctx.E = E;
     ctx.backend = b;
@@ -399,21 +455,20 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
 
 /* One attempt of backend b; the report is reset for every attempt so nothing
  * of a failed backend leaks into the one that succeeds. */
-static int run_one(silc_call *call, const ld_backend *b)
+static int run_one(silc_engine *E, silc_call *call, const ld_backend *b)
 {
     double t0;
     int rc;
     call->out = NULL;
-    if (call->op == SILC_OP_SOLVE) {
-        memset(call->report, 0, sizeof *call->report);
-        call->report->cond_est = -1;
-        call->report->rcond = -1;
-    }
+    if (call->op == SILC_OP_SOLVE) report_reset(E, call->report);
     t0 = util_now();
     rc = b->backend->ops[call->op].run(call);
     if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
         call->report->seconds = util_now() - t0;
         snprintf(call->report->backend, sizeof call->report->backend, "%s", b->full_name);
+        /* accuracy.condest = off: a plugin older than ABI 1.7 estimated
+         * anyway; the report says "not estimated" all the same. */
+        if (call->report->condest_off) call->report->cond_est = -1;
     }
     if (rc != SILC_OK) {
         val_release(call->out);
@@ -473,6 +528,48 @@ static void remember_failure(const silc_value *A, const char *name, int verifica
     if (val_attach_set(A, FAILED_KEY, list, free)) free(list);
 }
 
+/* What lets a back-substitution defer its backward error (accuracy.h):
+ * the factorization's first solve, checked at once, vouches for the later
+ * ones -- but only for the verification bound it was checked against.
+ * Each backend's largest measured backward error on A before refinement
+ * is kept with A (an attachment: it goes when A goes), and a solve defers
+ * only when that number passes the solve.verify bound in force now.  So a
+ * bound set after the first solve (KLU on bayer10 at 8e-13 under
+ * solve.verify = 1e-13) checks, and refines, the next solve at once, as
+ * it would have the first one had it been set before; and a factorization
+ * whose raw solves needed refinement gets it on every solve. */
+#define VOUCHED_KEY "dispatch.vouched:"
+
+static double *vouched_slot(const silc_value *A, const ld_backend *b, char *key, size_t keylen)
+{
+    snprintf(key, keylen, VOUCHED_KEY "%s", b->full_name);
+    return val_attach_get(A, key);
+}
+
+/* 1 when b's earlier results on A passed limit before refinement. */
+static int vouched(const silc_value *A, const ld_backend *b, double limit)
+{
+    char key[128];
+    const double *worst = vouched_slot(A, b, key, sizeof key);
+    return worst && *worst <= limit;
+}
+
+/* Remembers a result of b on A whose backward error was measured. */
+static void vouch(const silc_value *A, const ld_backend *b, const silc_report *r)
+{
+    char key[128];
+    double raw = r->backward_error_unrefined >= 0 ? r->backward_error_unrefined : r->backward_error;
+    double *worst = vouched_slot(A, b, key, sizeof key);
+    if (!(raw >= 0)) raw = INFINITY; /* NaN: never vouches */
+    if (worst) {
+        if (raw > *worst) *worst = raw;
+        return;
+    }
+    if (!(worst = malloc(sizeof *worst))) return; /* then the next solve is checked at once */
+    *worst = raw;
+    if (val_attach_set(A, key, worst, free)) free(worst);
+}
+
 /* Drops the warnings added since mark: they were a discarded result's. */
 static void drop_warnings(silc_engine *E, size_t mark)
 {
@@ -523,6 +620,15 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             size_t warned = E->warnings.len;
             double t0;
             if (ci > 0 && i == 0) sb_printf(&skipped, "[%s] ", chain[ci]);
+            if (!b && L->key[0]) {
+                /* A dispatch key set in the session after the start check
+                 * (disp_check_configured): the same error, not a substitute. */
+                missing_backend(E, L->key, L->names[i]);
+                call->host_private = NULL;
+                sb_free(&skipped);
+                sb_free(&attempts);
+                return SILC_EUNSUP;
+            }
             if (!b) {
                 sb_printf(&skipped, "%s not installed; ", L->names[i]);
                 continue;
@@ -561,7 +667,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&
                                  b->plugin->table->abi_minor < 6;
                 if (hide_guess) call->nin = 2;
-                rc = run_one(call, b);
+                rc = run_one(E, call, b);
                 if (hide_guess) call->nin = 3;
             }
             if (rc == SILC_OK && !call->out) {
@@ -592,7 +698,22 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                         snprintf(call->report->note + l, sizeof call->report->note - l, "%son %d ranks",
                                  l ? "; " : "", rk);
                 }
-                rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, may_defer);
+                {
+                    /* Deferral needs a measured first solve that passes
+                     * today's bound (vouched, above), unless the user gave
+                     * that check up (solve.backward_error = on_request);
+                     * distributed solves keep the old rule (their ranks
+                     * must agree). */
+                    const char *when = cfg_get(E, "solve.backward_error");
+                    int local = call->op == SILC_OP_SOLVE && !ctx.collective && !E->dist;
+                    int defer = may_defer &&
+                                (!local || (when && !strcmp(when, "on_request")) ||
+                                 vouched(call->in[0], b,
+                                         acc_verify_limit(cfg_get(E, "solve.verify"), call->report)));
+                    rc = call->op == SILC_OP_SOLVE && finish_solve(E, call, cholesky_failed, defer);
+                    if (!rc && local && call->report->backward_error != ACC_DEFERRED)
+                        vouch(call->in[0], b, call->report);
+                }
                 dist_walk_end(call, &swap);
                 call->host_private = NULL;
                 if (rc) {
@@ -783,6 +904,7 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     sb_printf(b, "%s\n", why);
     sb_printf(b, "backends (%s):", L.source);
     for (i = 0; i < L.n; i++) sb_printf(b, "%s %s", i ? "," : "", L.names[i]);
+    if (L.absent[0]) sb_printf(b, " (not installed, left out: %s)", L.absent);
     sb_puts(b, "\n");
     c = *call;
     c.op_class = chain[0];
@@ -792,7 +914,8 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         const char *reason = NULL;
         host_call_ctx ctx;
         if (!be) {
-            sb_printf(b, "  %s: not installed\n", L.names[i]);
+            sb_printf(b, "  %s: not installed (%s: a solve fails)\n", L.names[i],
+                      L.forced ? "the per-call backend" : "configured, not optional");
             continue;
         }
         if (!provides(be, call->op)) {

@@ -77,6 +77,18 @@ int ld_backend_collective(const ld_backend *b, int op);
 /* Names every backend may be configured with, loaded or not (for suggestions
  * and for telling "not installed" from "unknown"). */
 extern const char *const ld_known_backends[];
+/* Why this engine has no backend `name`: appends to b the directories it
+ * searched for plugins and, when a file of name's plugin was found but
+ * refused, the refusal. */
+void ld_explain_missing(const silc_engine *E, const char *name, strbuf *b);
+
+/* ---- dispatch.c: configured backends that must exist ------------------------ */
+/* 0 when every backend the configuration's dispatch lists name is loaded,
+ * or marked optional ("name?"); else -1 with E->err naming the key, the
+ * backend, its plugin and where plugins were searched (engine.c calls it
+ * once the configuration is read: an error at start, never a silent
+ * substitute). */
+int disp_check_configured(silc_engine *E);
 
 /* ---- host.c ---------------------------------------------------------------- */
 const silc_host_api *host_api(void);

@@ -56,7 +56,13 @@ struct ld_set {
     size_t nplugins;
     ld_backend **backends;
     size_t nbackends;
+    strbuf searched;            /* the plugin directories tried, "a, b" (for errors) */
+    strbuf refused;             /* "file: why\n" for each plugin file refused */
 };
+
+/* Plugin files already warned about in this process: a refused plugin is
+ * reported once, not once per directory listing or engine that meets it. */
+static strbuf g_warned;
 
 #define LD_FILE_PREFIX "libsilc_plugin_"
 #define LD_FILE_SUFFIX ".so"
@@ -260,8 +266,43 @@ void ld_destroy(silc_engine *E)
     }
     free(S->plugins);
     free(S->backends);
+    sb_free(&S->searched);
+    sb_free(&S->refused);
     free(S);
     E->plugins = NULL;
+}
+
+/* Records a refused plugin file with the engine, and warns about it on
+ * stderr the first time this process meets it. */
+static void note_refused(silc_engine *E, const char *path)
+{
+    int first;
+    sb_printf(&E->plugins->refused, "%s\n", E->err);
+    pthread_mutex_lock(&g_lock);
+    first = !g_warned.s || !strstr(g_warned.s, path);
+    if (first) sb_printf(&g_warned, "%s\n", path);
+    pthread_mutex_unlock(&g_lock);
+    if (first) fprintf(stderr, "silc: warning: %s\n", E->err);
+}
+
+void ld_explain_missing(const silc_engine *E, const char *name, strbuf *b)
+{
+    char plugin[64];
+    const char *dot = strchr(name, '.'), *line;
+    size_t len = dot ? (size_t)(dot - name) : strlen(name);
+    if (len >= sizeof plugin) len = sizeof plugin - 1;
+    memcpy(plugin, name, len);
+    plugin[len] = '\0';
+    sb_printf(b, "plugin '%s' (" LD_FILE_PREFIX "%s" LD_FILE_SUFFIX ") is not loaded; searched: %s", plugin,
+              plugin, E && E->plugins && E->plugins->searched.len ? sb_str(&E->plugins->searched) : "(no directory)");
+    /* a file of that plugin found but refused: say why */
+    for (line = E && E->plugins ? E->plugins->refused.s : NULL; line && *line;) {
+        size_t ll = strcspn(line, "\n");
+        char file[sizeof LD_FILE_PREFIX + 64 + sizeof LD_FILE_SUFFIX];
+        snprintf(file, sizeof file, LD_FILE_PREFIX "%s" LD_FILE_SUFFIX, plugin);
+        if (memmem(line, ll, file, strlen(file))) sb_printf(b, "; %.*s", (int)ll, line);
+        line += ll + (line[ll] != 0);
+    }
 }
 
 /* Opens, initialises and checks a plugin file not loaded before (caller holds
@@ -375,6 +416,8 @@ static int load_dir(silc_engine *E, const char *dir)
     struct dirent *ent;
     char **names = NULL;
     size_t n = 0, cap = 0, i;
+    if (!E->plugins->searched.s || !strstr(E->plugins->searched.s, dir))
+        sb_printf(&E->plugins->searched, "%s%s", E->plugins->searched.len ? ", " : "", dir);
     if (!d) return eng_error(E, "cannot read plugin directory %s: %s", dir, strerror(errno));
     /* An engine on a communicator (dist.h) takes the MPI builds of plugins
      * from dir/mpi first, and then not the sequential build of the same
@@ -401,7 +444,7 @@ static int load_dir(silc_engine *E, const char *dir)
         strbuf path;
         sb_init(&path);
         sb_printf(&path, "%s/%s", dir, names[i]);
-        if (ld_load_file(E, sb_str(&path))) fprintf(stderr, "silc: warning: %s\n", E->err);
+        if (ld_load_file(E, sb_str(&path))) note_refused(E, sb_str(&path));
         sb_free(&path);
         free(names[i]);
     }

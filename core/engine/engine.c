@@ -74,6 +74,9 @@ static int eng_setup(silc_engine *E, const char *config_path)
     if (path && cfg_load_file(E, path)) return -1;
     path = cfg_get(E, "core.plugin_path");
     if (path && *path && ld_load_path(E, path)) return -1;
+    /* A backend the configuration names must be loaded by now, unless it is
+     * marked optional ("lis-style?"): an error at start, not a substitute. */
+    if (disp_check_configured(E)) return -1;
     E->threads = config_threads(E);
     ld_set_threads(E, E->threads);
     return 0;

@@ -1043,7 +1043,7 @@ static int exec_info(lang_ev *V, const ast_node *s)
         const silc_report *r = &in->report;
         int deferred = in->has_solve && r->backward_error == ACC_DEFERRED;
         if (deferred)
-            in->report.backward_error = acc_pending_resolve(E, &in->pending, r->backend);
+            acc_pending_resolve(E, &in->pending, &in->report);
         sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
         sb_printf(&b, "  wall time: %.3g s\n", in->seconds);
         if (in->ranks)
@@ -1064,13 +1064,20 @@ static int exec_info(lang_ev *V, const ast_node *s)
                           r->refine_steps, r->refine_steps == 1 ? "" : "s",
                           r->backward_error_unrefined);
             if (r->cond_est >= 0) {
-                sb_printf(&b, "  condition estimate: %.3g\n", r->cond_est);
-                /* First-order bound on the relative forward error (Higham, 7.2). */
-                sb_printf(&b, "  forward error bound: cond x backward error = %.3g\n",
-                          r->cond_est * r->backward_error);
+                sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization)\n",
+                          r->cond_est);
+                /* The residual bound with the estimated ||A^-1||_1 (accuracy.h). */
+                if (r->forward_bound >= 0)
+                    sb_printf(&b, "  forward error bound (estimate: est ||A^-1||_1 ||b - A x||_1 / ||x||_1): %.3g\n",
+                              r->forward_bound);
             } else {
-                sb_puts(&b, "  condition estimate: not available\n");
+                sb_printf(&b, "  condition estimate: not estimated (%s); no forward error bound\n",
+                          r->condest_off ? "accuracy.condest = off"
+                          : r->iterations > 0 ? "iterative solver"
+                                              : "the backend gives none");
             }
+            if (r->pivot_ratio > 0)
+                sb_printf(&b, "  condition (factor-diagonal ratio, not a bound): %.3g\n", r->pivot_ratio);
             sb_printf(&b, "  iterations: %lld\n", (long long)r->iterations);
             if (r->initial_guess)
                 sb_printf(&b, "  initial guess: the previous value of %s (warm start)\n", s->name);
