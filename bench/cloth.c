@@ -204,7 +204,8 @@ static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np
         tmin = fmin(tmin, p[i].ms), tmax = fmax(tmax, p[i].ms);
     }
     if (emax == 0) emin = 1e-16, emax = 1;
-    emin = floor(log10(fmin(emin, s->accuracy))), emax = ceil(log10(fmax(emax, s->accuracy)));
+    /* a decade beyond the accuracy, so its line stands clear of the edge */
+    emin = floor(log10(fmin(emin, s->accuracy))), emax = fmax(ceil(log10(emax)), floor(log10(s->accuracy)) + 1);
     if (emax <= emin) emax = emin + 1;
     tmin = log10(tmin) - 0.08, tmax = log10(tmax) + 0.08;
 #define PX(e) ((e) > 0 ? L + (log10(e) - emin) / (emax - emin) * axis : ZERO)
@@ -255,6 +256,9 @@ static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np
         fprintf(f, "%.1f,%.1f ", PX(p[order[i]].err), PY(p[order[i]].ms));
     }
     fprintf(f, "'/>\n");
+    if (n == 1) /* a front of one point: ringed, so that it shows */
+        fprintf(f, "<circle cx='%.1f' cy='%.1f' r='9' fill='none' stroke='#ff7f0e' stroke-width='1.5'/>\n",
+                PX(p[order[0]].err), PY(p[order[0]].ms));
     for (i = 0; i < np; i++)
         if (isfinite(p[i].err))
             fprintf(f, "<circle cx='%.1f' cy='%.1f' r='%d' fill='%s'%s><title>%s, tol %g: %.3g ms, error %.2g</title>"
@@ -265,11 +269,11 @@ static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np
         fprintf(f, "<circle cx='%g' cy='%g' r='4' fill='%s'/><text x='%g' y='%g'>%s</text>\n", W - R + 12,
                 T + 10 + 16.0 * k, trade_solvers[k].color, W - R + 20, T + 14 + 16.0 * k,
                 trade_iterative(&trade_solvers[k]) ? trade_solvers[k].name : "direct: the reference");
-    fprintf(f, "<text x='%g' y='%g' font-size='9' fill='#555'>(%.34s)</text>\n", W - R + 20, T + 14 + 16.0 * NTS - 4,
-            direct);
+    fprintf(f, "<text x='%g' y='%g' font-size='9' fill='#555'>(%.*s)</text>\n", W - R + 20, T + 14 + 16.0 * NTS - 4,
+            (int)strcspn(direct, ","), direct);
     fprintf(f, "<polyline points='%g,%g %g,%g' stroke='#ff7f0e' stroke-width='1.5'/><text x='%g' y='%g'>Pareto "
-               "front</text>\n", W - R + 6, T + 10 + 16.0 * (NTS + 1), W - R + 18, T + 10 + 16.0 * (NTS + 1),
-            W - R + 20, T + 14 + 16.0 * (NTS + 1));
+               "front%s</text>\n", W - R + 6, T + 10 + 16.0 * (NTS + 1), W - R + 18, T + 10 + 16.0 * (NTS + 1),
+            W - R + 20, T + 14 + 16.0 * (NTS + 1), n == 1 ? ": one point" : "");
     fprintf(f, "<circle cx='%g' cy='%g' r='5' fill='none' stroke='black' stroke-width='2.5'/><text x='%g' y='%g'>"
                "fastest within the accuracy</text>\n", W - R + 12, T + 10 + 16.0 * (NTS + 2), W - R + 20,
             T + 14 + 16.0 * (NTS + 2));
