@@ -5,6 +5,7 @@
  *
  *     cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]
  *     cloth_bench SCENE... --trade [--steps N] [--svg DIR]
+ *     cloth_bench SCENE... --energy [--steps N] [--svg DIR]
  *
  * For each scene it runs original (plain C, its own CG), ltd and cmp from the
  * scene's start for N steps (default 50), R rounds (default 3), the drivers
@@ -12,19 +13,29 @@
  * and prints one markdown row per driver and solver: the best per-step time
  * of the rounds, its split into assembly / solve / update, and the ratio to
  * original's best from the same run.  ltd and cmp run twice: with SILC's
- * CG + Jacobi at original's tolerance (the same algorithm and stopping rule,
- * so the ratio is the cost of the mode) and with the configured dispatch
- * (a sparse Cholesky).  The largest position difference to original at the
- * end is printed too, so a fast wrong run shows.  SILC_SERVER, when set,
- * sends ltd and cmp to silcd; --label says so in the rows.
+ * CG + Jacobi at original's tolerance (meant as the same algorithm and
+ * stopping rule, so the ratio is the cost of the mode: a first, untimed
+ * round counts every solve's iterations so the table shows whether it is)
+ * and with the configured dispatch (a sparse Cholesky).  The tolerance is
+ * the scene's default (cloth_default_tol).  The largest position difference
+ * to original at the end is printed too, so a fast wrong run shows.
+ * SILC_SERVER, when set, sends ltd and cmp to silcd; --label says so.
  *
- * --trade: the speed/accuracy trade.  The scene runs N steps with the solve
- * by original's CG, lis-style CG + IC(0) and CG + SA-AMG, PETSc CG + ICC at
- * tolerances 1e-2 ... 1e-12, and a direct solve, each against a direct run
- * of the same steps: ms per step against the largest particle error
- * relative to the cloth size.  It prints a table marking the Pareto front
- * and the point the scene's accuracy selects (the fastest that meets it),
- * and with --svg DIR writes DIR/cloth_trade_SCENE.svg.
+ * --trade: the speed/accuracy trade over the whole scene (its own steps
+ * unless --steps says otherwise), with the solve by original's CG,
+ * lis-style CG + IC(0) and CG + SA-AMG, PETSc CG + ICC at tolerances 1e-2
+ * ... 1e-12, and the direct solve, each against a direct run of the same
+ * steps: ms per step against the largest particle error relative to the
+ * cloth size.  It prints a table marking the Pareto front (the points no
+ * other is both as fast and as accurate as, and better in one) and the
+ * point the scene's accuracy selects (the fastest that meets it), and with
+ * --svg DIR writes DIR/cloth_trade_SCENE.svg.
+ *
+ * --energy: each scene (hanging and large in docs/cloth.md) for N steps
+ * (default 200) twice, with the seeds' pin handling (a free solve, the
+ * pins' dv dropped after: cloth_model.pins_after_solve, reachable only
+ * here) and with the pins constrained in the solve: the largest spring
+ * stretch and the total energy, a table and DIR/cloth_energy.svg.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "progress.h"
@@ -49,21 +60,48 @@ enum { NV = sizeof variants / sizeof variants[0] };
 
 static progress bar; /* on stderr while the bench runs, when it is a terminal */
 
-/* One run from the scene's start: per-step times and the final positions
- * (3n, in x).  solver as in variant; tol is also original's CG tolerance.
- * -1 with err on failure. */
-static int run(const cloth_scene *s, cloth_mode mode, const char *solver, double tol, int steps, cloth_times *t,
-               double *x, char *err, size_t errlen)
+/* What one run gives back. */
+typedef struct run_out {
+    cloth_times t;
+    double *x;          /* 3n: the final positions, or NULL */
+    double *energy;     /* steps + 1: the total energy before each step and at the end, or NULL */
+    double stretch;     /* the largest spring stretch of the run (with energy) */
+    long iterations;    /* the solves' iterations summed (with count_iterations) */
+    char used[256];     /* ltd, cmp: what ran the solve (`info dv`) */
+} run_out;
+
+/* One run from the scene's start.  tol <= 0: cloth_default_tol.  old: the
+ * seeds' pins (dropped after a free solve).  count_iterations asks every
+ * solve's report, outside the timed phases.  -1 with err on failure. */
+static int run(const cloth_scene *s, cloth_mode mode, const char *solver, double tol, int steps, int old,
+               int count_iterations, run_out *o, char *err, size_t errlen)
 {
     cloth_model m;
     cloth_driver *d;
     int k, ok = 1;
-    memset(t, 0, sizeof *t);
+    memset(&o->t, 0, sizeof o->t);
+    o->stretch = 0, o->iterations = 0, o->used[0] = '\0';
     if (cloth_model_init(&m, s, err, errlen)) return -1;
-    d = cloth_driver_open(&m, mode, solver, tol, err, errlen);
-    for (k = 0; d && ok && k < steps; k++) ok = cloth_driver_step(d, t, err, errlen) == 0;
+    m.pins_after_solve = old;
+    d = cloth_driver_open(&m, mode, solver, tol > 0 ? tol : cloth_default_tol(&m), err, errlen);
+    if (d && o->energy) o->energy[0] = cloth_total_energy(&m, m.x, m.v);
+    for (k = 0; d && ok && k < steps; k++) {
+        ok = cloth_driver_step(d, &o->t, err, errlen) == 0;
+        if (ok && count_iterations) {
+            double berr, cond;
+            long it = 0;
+            ok = cloth_driver_solve_report(d, &berr, &cond, &it, err, errlen) == 0;
+            o->iterations += it;
+        }
+        if (ok && o->energy) {
+            ok = cloth_driver_sync(d, err, errlen) == 0;
+            o->energy[k + 1] = cloth_total_energy(&m, m.x, m.v);
+            o->stretch = fmax(o->stretch, cloth_max_stretch(&m, m.x));
+        }
+    }
     ok = d && ok && cloth_driver_sync(d, err, errlen) == 0;
-    if (ok) memcpy(x, m.x, (size_t)3 * m.n * sizeof *x);
+    if (ok && o->x) memcpy(o->x, m.x, (size_t)3 * m.n * sizeof *o->x);
+    if (ok) cloth_driver_solver(d, o->used, sizeof o->used);
     cloth_driver_close(d);
     cloth_model_free(&m);
     return ok ? 0 : -1;
@@ -75,6 +113,46 @@ static double max_diff(const double *a, const double *b, int n)
     int i;
     for (i = 0; i < n; i++) d = fmax(d, fabs(a[i] - b[i]));
     return d;
+}
+
+/* ---- SVG axes ---------------------------------------------------------------- */
+
+/* Ticks of a log axis over [lo, hi] (log10 units): 1-2-5 per decade, or
+ * every decade, or every k-th decade, whichever keeps labels at least
+ * `room` pixels apart on an axis of `px` pixels.  Values into v, their
+ * count returned. */
+static int log_ticks(double lo, double hi, double px, double room, double *v, int cap)
+{
+    static const double mant[3] = {1, 2, 5};
+    double per_decade = px / fmax(hi - lo, 1e-9);
+    int n = 0, e, j, fine = per_decade >= 3 * room, stride = fine ? 1 : (int)ceil(room / per_decade);
+    for (e = (int)floor(lo); e <= (int)ceil(hi) && n < cap; e++) {
+        if (((e % stride) + stride) % stride) continue;
+        for (j = 0; j < (fine ? 3 : 1) && n < cap; j++) {
+            double x = mant[j] * pow(10, e);
+            if (log10(x) >= lo - 1e-9 && log10(x) <= hi + 1e-9) v[n++] = x;
+        }
+    }
+    return n;
+}
+
+/* A tick label: 1e-6 style for decades beyond 1e+-3, plain otherwise. */
+static void tick_label(double x, char *buf, size_t len)
+{
+    double e = log10(x);
+    if ((e < -3 || e > 4) && fabs(e - round(e)) < 1e-9) snprintf(buf, len, "1e%d", (int)round(e));
+    else snprintf(buf, len, "%g", x);
+}
+
+/* Linear ticks over [lo, hi]: a 1-2-5 step giving 4 to 10 ticks. */
+static int lin_ticks(double lo, double hi, double *v, int cap)
+{
+    double span = hi - lo, step = pow(10, floor(log10(span > 0 ? span : 1))), x;
+    int n = 0;
+    if (span / step < 4) step /= 2;
+    if (span / step < 4) step /= 2.5;
+    for (x = ceil(lo / step) * step; x <= hi + 1e-9 * step && n < cap; x += step) v[n++] = fabs(x) < 1e-12 * step ? 0 : x;
+    return n;
 }
 
 /* ---- --trade: time against accuracy ------------------------------------------ */
@@ -92,7 +170,7 @@ static const trade_solver trade_solvers[] = {
     {"lis-style CG + IC(0)", "cg-ic", CLOTH_LTD, "#1f77b4"},
     {"lis-style CG + SA-AMG", "cg-amg", CLOTH_LTD, "#2ca02c"},
     {"petsc CG + ICC", "petsc-cg", CLOTH_LTD, "#d62728"},
-    {"direct (CHOLMOD)", "direct", CLOTH_LTD, "#9467bd"},
+    {"direct", "direct", CLOTH_LTD, "#9467bd"},
 };
 
 /* An iterative point: one per tolerance.  A direct solve has one point. */
@@ -106,256 +184,398 @@ static const double trade_tols[NTOL] = {1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
 typedef struct trade_point {
     int solver;
     double tol, ms, err; /* err: max particle distance to the direct run / cloth size */
-    int pareto;
+    int pareto;          /* no other point is as fast and as accurate, and better in one */
 } trade_point;
 
-static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np, int chosen)
+/* The plot: x = error (log), y = ms per step (log).  The direct solve is
+ * the reference, so its error is 0 by definition: it sits in a column of
+ * its own left of a break in the x axis, labelled so, not at a made-up
+ * small error.  The Pareto front joins the non-dominated points only, in
+ * order of error, as a staircase (between two front points nothing is
+ * attainable below the step). */
+static void svg_plot(FILE *f, const cloth_scene *s, const trade_point *p, int np, int chosen, const char *direct)
 {
-    const double W = 640, H = 420, L = 70, R = 190, T = 30, B = 50;
-    double emin = 1e300, emax = 0, tmin = 1e300, tmax = 0;
-    int i, k;
+    const double W = 720, H = 440, L = 130, R = 200, T = 34, B = 56, ZERO = 78;
+    double emin = 1e300, emax = 0, tmin = 1e300, tmax = 0, ticks[64], axis = W - L - R;
+    char lab[32];
+    int i, k, nt, order[64], n = 0;
     for (i = 0; i < np; i++) {
-        double e = fmax(p[i].err, 1e-16);
-        emin = fmin(emin, e), emax = fmax(emax, e), tmin = fmin(tmin, p[i].ms), tmax = fmax(tmax, p[i].ms);
+        if (p[i].err > 0 && isfinite(p[i].err)) emin = fmin(emin, p[i].err), emax = fmax(emax, p[i].err);
+        tmin = fmin(tmin, p[i].ms), tmax = fmax(tmax, p[i].ms);
     }
-    emin = floor(log10(emin)), emax = ceil(log10(emax)), tmin = log10(tmin) - 0.1, tmax = log10(tmax) + 0.1;
+    if (emax == 0) emin = 1e-16, emax = 1;
+    /* a decade beyond the accuracy, so its line stands clear of the edge */
+    emin = floor(log10(fmin(emin, s->accuracy))), emax = fmax(ceil(log10(emax)), floor(log10(s->accuracy)) + 1);
     if (emax <= emin) emax = emin + 1;
-#define PX(e) (L + (log10(fmax((e), 1e-16)) - emin) / (emax - emin) * (W - L - R))
+    tmin = log10(tmin) - 0.08, tmax = log10(tmax) + 0.08;
+#define PX(e) ((e) > 0 ? L + (log10(e) - emin) / (emax - emin) * axis : ZERO)
 #define PY(t) (H - B - (log10(t) - tmin) / (tmax - tmin) * (H - T - B))
     fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' "
                "font-size='11'>\n<rect width='100%%' height='100%%' fill='white'/>\n", W, H);
-    fprintf(f, "<text x='%g' y='18' font-size='13'>%s %dx%d: time per step against position error "
-               "(accuracy %g)</text>\n", L, s->name, s->nx, s->ny, s->accuracy);
-    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/><line x1='%g' y1='%g' x2='%g' y2='%g' "
-               "stroke='black'/>\n", L, H - B, W - R, H - B, L, T, L, H - B);
-    for (k = (int)emin; k <= (int)emax; k++)
-        fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>1e%d</text>\n", PX(pow(10, k)), H - B + 15, k);
-    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>max |x - x_direct| / cloth size</text>\n",
-            (L + W - R) / 2, H - 12);
-    fprintf(f, "<text x='14' y='%g' transform='rotate(-90 14 %g)' text-anchor='middle'>ms per step "
-               "(log)</text>\n", (T + H - B) / 2, (T + H - B) / 2);
-    for (k = (int)floor(tmin); k <= (int)ceil(tmax); k++)
-        if (k >= tmin && k <= tmax)
-            fprintf(f, "<text x='%g' y='%g' text-anchor='end'>%g</text>\n", L - 4, PY(pow(10, k)) + 4, pow(10, k));
-    /* the scene's accuracy as a vertical line */
-    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='#888' stroke-dasharray='4 3'/>\n",
-            PX(s->accuracy), T, PX(s->accuracy), H - B);
-    /* the Pareto front, joined in order of error */
+    fprintf(f, "<text x='%g' y='18' font-size='13'>%s %dx%d, %d steps: time per step against position error "
+               "(accuracy %g)</text>\n", 14.0, s->name, s->nx, s->ny, s->steps, s->accuracy);
+    /* axes, with a break between the error-0 column and the log axis */
+    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/>\n", ZERO - 22, H - B, ZERO + 22, H - B);
+    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/>\n", L - 8, H - B, W - R, H - B);
+    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>//</text>\n", (ZERO + 22 + L - 8) / 2, H - B + 4);
+    fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/>\n", ZERO - 22, T, ZERO - 22, H - B);
+    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>0 (the</text><text x='%g' y='%g' text-anchor='middle'>"
+               "reference)</text>\n", ZERO, H - B + 15, ZERO, H - B + 27);
+    nt = log_ticks(emin, emax, axis, 44, ticks, 64);
+    for (k = 0; k < nt; k++) {
+        tick_label(ticks[k], lab, sizeof lab);
+        fprintf(f, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='black'/><text x='%.1f' y='%g' "
+                   "text-anchor='middle'>%s</text>\n", PX(ticks[k]), H - B, PX(ticks[k]), H - B + 4, PX(ticks[k]),
+                H - B + 15, lab);
+    }
+    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>max |x - x_direct| / cloth size (log)</text>\n",
+            L + axis / 2, H - 14);
+    nt = log_ticks(tmin, tmax, H - T - B, 16, ticks, 64);
+    for (k = 0; k < nt; k++) {
+        tick_label(ticks[k], lab, sizeof lab);
+        fprintf(f, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='#ddd'/><text x='%g' y='%.1f' "
+                   "text-anchor='end'>%s</text>\n", ZERO - 22, PY(ticks[k]), W - R, PY(ticks[k]), ZERO - 26,
+                PY(ticks[k]) + 4, lab);
+    }
+    fprintf(f, "<text x='14' y='%g' transform='rotate(-90 14 %g)' text-anchor='middle'>ms per step (log)</text>\n",
+            (T + H - B) / 2, (T + H - B) / 2);
+    fprintf(f, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='#888' stroke-dasharray='4 3'/><text x='%.1f' "
+               "y='%g' fill='#555' text-anchor='middle'>accuracy</text>\n", PX(s->accuracy), T, PX(s->accuracy),
+            H - B, PX(s->accuracy), T - 4);
+    /* the front */
+    for (i = 0; i < np && n < 64; i++)
+        if (p[i].pareto) order[n++] = i;
+    for (i = 1; i < n; i++)
+        for (k = i; k > 0 && p[order[k]].err < p[order[k - 1]].err; k--) {
+            int t = order[k];
+            order[k] = order[k - 1], order[k - 1] = t;
+        }
     fprintf(f, "<polyline fill='none' stroke='#ff7f0e' stroke-width='1.5' points='");
-    /* (sorted by error: an insertion sort, the points are few) */
-    {
-        int order[64], n = 0, a, b;
-        for (i = 0; i < np && n < 64; i++)
-            if (p[i].pareto) order[n++] = i;
-        for (a = 1; a < n; a++)
-            for (b = a; b > 0 && p[order[b]].err < p[order[b - 1]].err; b--) {
-                int t = order[b];
-                order[b] = order[b - 1], order[b - 1] = t;
-            }
-        for (a = 0; a < n; a++) fprintf(f, "%.1f,%.1f ", PX(p[order[a]].err), PY(p[order[a]].ms));
+    for (i = 0; i < n; i++) {
+        if (i) fprintf(f, "%.1f,%.1f ", PX(p[order[i]].err), PY(p[order[i - 1]].ms));
+        fprintf(f, "%.1f,%.1f ", PX(p[order[i]].err), PY(p[order[i]].ms));
     }
     fprintf(f, "'/>\n");
+    if (n == 1) /* a front of one point: ringed, so that it shows */
+        fprintf(f, "<circle cx='%.1f' cy='%.1f' r='9' fill='none' stroke='#ff7f0e' stroke-width='1.5'/>\n",
+                PX(p[order[0]].err), PY(p[order[0]].ms));
     for (i = 0; i < np; i++)
-        fprintf(f, "<circle cx='%.1f' cy='%.1f' r='%d' fill='%s'%s><title>%s, tol %g: %.3g ms, error %.2g</title>"
-                   "</circle>\n",
-                PX(p[i].err), PY(p[i].ms), p[i].pareto ? 5 : 3, trade_solvers[p[i].solver].color,
-                i == chosen ? " stroke='black' stroke-width='2.5'" : "", trade_solvers[p[i].solver].name, p[i].tol,
-                p[i].ms, p[i].err);
+        if (isfinite(p[i].err))
+            fprintf(f, "<circle cx='%.1f' cy='%.1f' r='%d' fill='%s'%s><title>%s, tol %g: %.3g ms, error %.2g</title>"
+                       "</circle>\n", PX(p[i].err), PY(p[i].ms), p[i].pareto ? 5 : 3, trade_solvers[p[i].solver].color,
+                    i == chosen ? " stroke='black' stroke-width='2.5'" : "", trade_solvers[p[i].solver].name, p[i].tol,
+                    p[i].ms, p[i].err);
     for (k = 0; k < NTS; k++)
         fprintf(f, "<circle cx='%g' cy='%g' r='4' fill='%s'/><text x='%g' y='%g'>%s</text>\n", W - R + 12,
-                T + 10 + 16.0 * k, trade_solvers[k].color, W - R + 20, T + 14 + 16.0 * k, trade_solvers[k].name);
+                T + 10 + 16.0 * k, trade_solvers[k].color, W - R + 20, T + 14 + 16.0 * k,
+                trade_iterative(&trade_solvers[k]) ? trade_solvers[k].name : "direct: the reference");
+    fprintf(f, "<text x='%g' y='%g' font-size='9' fill='#555'>(%.*s)</text>\n", W - R + 20, T + 14 + 16.0 * NTS - 4,
+            (int)strcspn(direct, ","), direct);
     fprintf(f, "<polyline points='%g,%g %g,%g' stroke='#ff7f0e' stroke-width='1.5'/><text x='%g' y='%g'>Pareto "
-               "front</text>\n", W - R + 6, T + 10 + 16.0 * NTS, W - R + 18, T + 10 + 16.0 * NTS, W - R + 20,
-            T + 14 + 16.0 * NTS);
+               "front%s</text>\n", W - R + 6, T + 10 + 16.0 * (NTS + 1), W - R + 18, T + 10 + 16.0 * (NTS + 1),
+            W - R + 20, T + 14 + 16.0 * (NTS + 1), n == 1 ? ": one point" : "");
     fprintf(f, "<circle cx='%g' cy='%g' r='5' fill='none' stroke='black' stroke-width='2.5'/><text x='%g' y='%g'>"
-               "chosen by the accuracy</text>\n</svg>\n", W - R + 12, T + 10 + 16.0 * (NTS + 1), W - R + 20,
-            T + 14 + 16.0 * (NTS + 1));
+               "fastest within the accuracy</text>\n", W - R + 12, T + 10 + 16.0 * (NTS + 2), W - R + 20,
+            T + 14 + 16.0 * (NTS + 2));
+    fprintf(f, "<text x='%g' y='%g' font-size='10' fill='#555'>each iterative solver at</text><text x='%g' y='%g' "
+               "font-size='10' fill='#555'>tolerance 1e-2 ... 1e-12</text>\n</svg>\n", W - R + 8,
+            T + 14 + 16.0 * (NTS + 3.5), W - R + 8, T + 14 + 16.0 * (NTS + 4.5));
 #undef PX
 #undef PY
 }
 
-/* One run of the trade study: ms per step and the largest particle error
- * against xref. */
-static int trade_run(const cloth_scene *s, const trade_solver *ts, double tol, int steps, const double *xref,
-                     double *ms, double *err_out, char *err, size_t errlen)
-{
-    int n3 = 3 * s->nx * s->ny, rc;
-    double *x = malloc((size_t)n3 * sizeof *x);
-    cloth_times t;
-    if (!x) {
-        snprintf(err, errlen, "out of memory");
-        return -1;
-    }
-    rc = run(s, ts->mode, ts->solver, tol, steps, &t, x, err, errlen);
-    *ms = 1e3 * (t.assembly + t.solve + t.update) / steps;
-    *err_out = rc ? NAN : max_diff(x, xref, n3);
-    free(x);
-    return rc;
-}
-
-/* Every solver at every tolerance against a direct run of the same steps. */
+/* Every solver at every tolerance against a direct run of the whole scene. */
 static int trade(const char *path, int steps, const char *svg_dir)
 {
     cloth_scene s;
-    char err[1024];
+    char err[1024], direct[256] = "";
     trade_point pts[NTS * NTOL];
-    double *xref, size;
+    double *xref, *x, size;
     int np = 0, i, j, n3, chosen = -1;
+    run_out o;
     if (scene_read(path, &s, err, sizeof err)) {
         fprintf(stderr, "cloth_bench: %s\n", err);
         return -1;
     }
+    if (steps > 0) s.steps = steps;
     n3 = 3 * s.nx * s.ny;
     size = fmax(s.width, s.height);
     xref = calloc((size_t)n3, sizeof *xref);
-    if (!xref) return -1;
-    {
-        cloth_times t;
-        if (run(&s, CLOTH_LTD, "direct", 1e-12, steps, &t, xref, err, sizeof err)) {
-            fprintf(stderr, "cloth_bench: %s direct reference: %s\n", s.name, err);
-            free(xref);
-            return -1;
-        }
+    x = calloc((size_t)n3, sizeof *x);
+    if (!xref || !x) return -1;
+    memset(&o, 0, sizeof o);
+    o.x = xref;
+    if (run(&s, CLOTH_LTD, "direct", 1e-12, s.steps, 0, 0, &o, err, sizeof err)) {
+        fprintf(stderr, "cloth_bench: %s direct reference: %s\n", s.name, err);
+        free(xref), free(x);
+        return -1;
     }
+    snprintf(direct, sizeof direct, "%s", o.used);
+    o.x = x;
     for (i = 0; i < NTS; i++)
         for (j = 0; j < NTOL; j++) {
             const trade_solver *ts = &trade_solvers[i];
-            double ms, ms2, e;
+            double ms = INFINITY;
+            int r, ok = 1;
             if (!trade_iterative(ts) && j > 0) break;
+            progress_show(&bar, "cloth bench --trade: %s, %s, tolerance %g", s.name, ts->name, trade_tols[j]);
             /* Twice, the faster kept: a library's first run pays its start-up
              * (PETSc's is 0.25 s), which is no part of a step. */
-            if (trade_run(&s, ts, trade_tols[j], steps, xref, &ms, &e, err, sizeof err) ||
-                trade_run(&s, ts, trade_tols[j], steps, xref, &ms2, &e, err, sizeof err)) {
-                printf("| %s | %s | %g | failed: %.80s | | |\n", s.name, ts->name, trade_tols[j], err);
+            for (r = 0; r < 2 && ok; r++) {
+                ok = run(&s, ts->mode, ts->solver, trade_tols[j], s.steps, 0, 0, &o, err, sizeof err) == 0;
+                ms = fmin(ms, 1e3 * (o.t.assembly + o.t.solve + o.t.update) / s.steps);
+            }
+            if (!ok) {
+                progress_done(&bar);
+                printf("| %s | %g | failed: %.80s | | | |\n", ts->name, trade_tols[j], err);
                 continue;
             }
             pts[np].solver = i;
             pts[np].tol = trade_iterative(ts) ? trade_tols[j] : 0;
-            pts[np].ms = fmin(ms, ms2);
-            pts[np].err = isfinite(e) ? e / size : INFINITY;
-            pts[np].pareto = 0;
+            pts[np].ms = ms;
+            pts[np].err = max_diff(x, xref, n3) / size;
+            if (!isfinite(pts[np].err)) pts[np].err = INFINITY;
             np++;
         }
-    /* Pareto: no other point is as fast and as accurate, and better in one.
-     * 1: on the front of all points; 2: on the front of the iterative ones
-     * (where a direct solve with a reused factorization beats them all, the
-     * front of all is that one point). */
+    progress_done(&bar);
     for (i = 0; i < np; i++) {
-        int all = isfinite(pts[i].err), iter = all && trade_iterative(&trade_solvers[pts[i].solver]);
-        iter = iter || (all && trade_solvers[pts[i].solver].mode == CLOTH_ORIGINAL);
+        pts[i].pareto = isfinite(pts[i].err);
         for (j = 0; j < np; j++)
             if (j != i && pts[j].ms <= pts[i].ms && pts[j].err <= pts[i].err &&
-                (pts[j].ms < pts[i].ms || pts[j].err < pts[i].err)) {
-                all = 0;
-                if (pts[j].tol > 0) iter = 0;
-            }
-        pts[i].pareto = all ? 1 : iter ? 2 : 0;
+                (pts[j].ms < pts[i].ms || pts[j].err < pts[i].err))
+                pts[i].pareto = 0;
         if (pts[i].err <= s.accuracy && (chosen < 0 || pts[i].ms < pts[chosen].ms)) chosen = i;
     }
-    printf("\n%s %dx%d, %d steps, accuracy %g (max particle error / cloth size against a direct run):\n\n",
-           s.name, s.nx, s.ny, steps, s.accuracy);
-    printf("| solver | tolerance | ms/step | error | meets the accuracy | Pareto |\n|---|---:|---:|---:|---|---|\n");
-    for (i = 0; i < np; i++)
-        printf("| %s | %s | %.3f | %.2g | %s | %s |\n", trade_solvers[pts[i].solver].name,
-               pts[i].tol > 0 ? (snprintf(err, sizeof err, "%g", pts[i].tol), err) : "-", pts[i].ms, pts[i].err,
-               pts[i].err <= s.accuracy ? (i == chosen ? "yes: chosen (fastest that does)" : "yes") : "no",
-               pts[i].pareto == 1 ? "front" : pts[i].pareto == 2 ? "front of the iterative" : "");
+    printf("\n%s %dx%d, the whole run (%d steps), accuracy %g; error = max particle distance to the direct run "
+           "(%s) / cloth size:\n\n", s.name, s.nx, s.ny, s.steps, s.accuracy, direct);
+    printf("| solver | tolerance | ms/step | error | meets the accuracy | Pareto front |\n"
+           "|---|---:|---:|---:|---|---|\n");
+    for (i = 0; i < np; i++) {
+        char tol[32] = "-", e[32] = "0 (the reference)";
+        if (pts[i].tol > 0) snprintf(tol, sizeof tol, "%g", pts[i].tol);
+        if (pts[i].tol > 0 || pts[i].err > 0) snprintf(e, sizeof e, "%.2g", pts[i].err);
+        printf("| %s | %s | %.3f | %s | %s | %s |\n", trade_solvers[pts[i].solver].name, tol, pts[i].ms, e,
+               pts[i].err <= s.accuracy ? (i == chosen ? "yes: the fastest that does" : "yes") : "no",
+               pts[i].pareto ? "yes" : "");
+    }
     if (svg_dir) {
         char file[1024];
         FILE *f;
         snprintf(file, sizeof file, "%s/cloth_trade_%s.svg", svg_dir, s.name);
         if ((f = fopen(file, "w"))) {
-            svg_plot(f, &s, pts, np, chosen);
+            svg_plot(f, &s, pts, np, chosen, direct);
             fclose(f);
             printf("\n(plot: %s)\n", file);
         }
     }
-    free(xref);
+    free(xref), free(x);
     return 0;
 }
 
+/* ---- --energy: the pins before and after ---------------------------------------- */
+
+enum { ENERGY_SCENES = 4 };
+
+typedef struct energy_run {
+    const cloth_scene *s;
+    double *e[2];       /* [0]: the seeds' pins, [1]: constrained; steps + 1 values */
+    double stretch[2];
+} energy_run;
+
+/* One panel per scene: total energy against time, before and after. */
+static void energy_svg(FILE *f, const energy_run *r, int nr, int steps)
+{
+    const double PW = 380, H = 350, L = 70, T = 60, B = 50, R = 20;
+    int i, k, b, nt;
+    double ticks[64];
+    char lab[32];
+    fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' "
+               "font-size='11'>\n<rect width='100%%' height='100%%' fill='white'/>\n", PW * nr, H);
+    for (i = 0; i < nr; i++) {
+        double x0 = PW * i, lo = 0, hi = 0, tend = steps * r[i].s->dt;
+        for (b = 0; b < 2; b++)
+            for (k = 0; k <= steps; k++) lo = fmin(lo, r[i].e[b][k]), hi = fmax(hi, r[i].e[b][k]);
+        if (hi - lo <= 0) hi = lo + 1;
+        lo -= 0.04 * (hi - lo), hi += 0.04 * (hi - lo);
+#define EX(t) (x0 + L + (t) / tend * (PW - L - R))
+#define EY(e) (H - B - ((e) - lo) / (hi - lo) * (H - T - B))
+        fprintf(f, "<text x='%g' y='18' font-size='13'>%s %dx%d: total energy (kinetic + spring + gravity)</text>\n",
+                x0 + 10, r[i].s->name, r[i].s->nx, r[i].s->ny);
+        fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='black'/><line x1='%g' y1='%g' x2='%g' y2='%g' "
+                   "stroke='black'/>\n", EX(0), H - B, EX(tend), H - B, EX(0), T, EX(0), H - B);
+        nt = lin_ticks(lo, hi, ticks, 64);
+        for (k = 0; k < nt; k++)
+            fprintf(f, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='#ddd'/><text x='%g' y='%.1f' "
+                       "text-anchor='end'>%g</text>\n", EX(0), EY(ticks[k]), EX(tend), EY(ticks[k]), EX(0) - 4,
+                    EY(ticks[k]) + 4, ticks[k]);
+        nt = lin_ticks(0, tend, ticks, 64);
+        for (k = 0; k < nt; k++) {
+            snprintf(lab, sizeof lab, "%g", ticks[k]);
+            fprintf(f, "<text x='%.1f' y='%g' text-anchor='middle'>%s</text>\n", EX(ticks[k]), H - B + 15, lab);
+        }
+        fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>time, s</text>\n", EX(tend / 2), H - 18);
+        fprintf(f, "<text x='%g' y='%g' transform='rotate(-90 %g %g)' text-anchor='middle'>J</text>\n", x0 + 16,
+                (T + H - B) / 2, x0 + 16, (T + H - B) / 2);
+        for (b = 0; b < 2; b++) {
+            fprintf(f, "<polyline fill='none' stroke='%s' stroke-width='1.5' points='", b ? "#1f77b4" : "#d62728");
+            for (k = 0; k <= steps; k++) fprintf(f, "%.1f,%.1f ", EX(k * r[i].s->dt), EY(r[i].e[b][k]));
+            fprintf(f, "'/>\n");
+        }
+        fprintf(f, "<text x='%g' y='%g' fill='#d62728'>before: pins dropped after a free solve (stretch %.3gx)</text>\n",
+                x0 + 10, 36.0, r[i].stretch[0]);
+        fprintf(f, "<text x='%g' y='%g' fill='#1f77b4'>after: pins constrained in the solve (stretch %.3gx)</text>\n",
+                x0 + 10, 50.0, r[i].stretch[1]);
+#undef EX
+#undef EY
+    }
+    fprintf(f, "</svg>\n");
+}
+
+/* hanging and large (or the scenes given) before and after the pin fix:
+ * ltd with the direct solve, `steps` steps. */
+static int energy(const char *const *paths, int np, int steps, const char *svg_dir)
+{
+    cloth_scene s[ENERGY_SCENES];
+    energy_run r[ENERGY_SCENES];
+    char err[1024];
+    int i, b, rc = 0;
+    run_out o;
+    if (steps <= 0) steps = 200;
+    memset(r, 0, sizeof r);
+    memset(&o, 0, sizeof o);
+    printf("| scene | pins | steps | max spring stretch | largest energy above the start | energy at the end |\n"
+           "|---|---|---:|---:|---:|---:|\n");
+    for (i = 0; i < np && i < ENERGY_SCENES && !rc; i++) {
+        if (scene_read(paths[i], &s[i], err, sizeof err)) {
+            fprintf(stderr, "cloth_bench: %s\n", err);
+            rc = -1;
+            break;
+        }
+        r[i].s = &s[i];
+        for (b = 0; b < 2 && !rc; b++) {
+            double top = 0;
+            int k;
+            progress_show(&bar, "cloth bench --energy: %s, %s", s[i].name, b ? "after" : "before");
+            if (!(r[i].e[b] = malloc((size_t)(steps + 1) * sizeof(double)))) return -1;
+            o.energy = r[i].e[b];
+            if (run(&s[i], CLOTH_LTD, "direct", 1e-12, steps, !b, 0, &o, err, sizeof err)) {
+                fprintf(stderr, "cloth_bench: %s: %s\n", s[i].name, err);
+                rc = -1;
+                break;
+            }
+            r[i].stretch[b] = o.stretch;
+            for (k = 0; k <= steps; k++) top = fmax(top, r[i].e[b][k] - r[i].e[b][0]);
+            progress_done(&bar);
+            printf("| %s %dx%d | %s | %d | %.3gx | %+.4g J | %+.4g J |\n", s[i].name, s[i].nx, s[i].ny,
+                   b ? "after: constrained in the solve" : "before: dropped after a free solve", steps, o.stretch, top,
+                   r[i].e[b][steps] - r[i].e[b][0]);
+        }
+    }
+    if (!rc && svg_dir) {
+        char file[1024];
+        FILE *f;
+        snprintf(file, sizeof file, "%s/cloth_energy.svg", svg_dir);
+        if ((f = fopen(file, "w"))) {
+            energy_svg(f, r, i, steps);
+            fclose(f);
+            printf("\n(plot: %s)\n", file);
+        }
+    }
+    for (i = 0; i < ENERGY_SCENES; i++) free(r[i].e[0]), free(r[i].e[1]);
+    return rc;
+}
+
+static const char usage_text[] = "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]\n"
+                                 "       cloth_bench SCENE... --trade [--steps N] [--svg DIR]\n"
+                                 "       cloth_bench SCENE... --energy [--steps N] [--svg DIR]\n";
+
 int main(int argc, char **argv)
 {
-    int steps = 50, rounds = 3, a, sc, nscenes = 0;
+    int steps = 0, rounds = 3, a, sc, nscenes = 0, trading = 0, energies = 0;
     const char *label = "embedded", *scenes[16], *svg_dir = NULL;
-    int trading = 0;
     for (a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--steps") && a + 1 < argc) steps = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--rounds") && a + 1 < argc) rounds = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--label") && a + 1 < argc) label = argv[++a];
         else if (!strcmp(argv[a], "--trade")) trading = 1;
+        else if (!strcmp(argv[a], "--energy")) energies = 1;
         else if (!strcmp(argv[a], "--svg") && a + 1 < argc) svg_dir = argv[++a];
         else if (argv[a][0] != '-' && nscenes < 16) scenes[nscenes++] = argv[a];
         else {
-            fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT] | --trade [--svg DIR]\n");
+            fputs(usage_text, stderr);
             return 2;
         }
     }
-    if (!nscenes || steps < 1 || rounds < 1) {
-        fprintf(stderr, "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT] | --trade [--svg DIR]\n");
+    if (!nscenes || steps < 0 || rounds < 1) {
+        fputs(usage_text, stderr);
         return 2;
     }
+    if (energies) return energy(scenes, nscenes, steps, svg_dir) ? 1 : 0;
     if (trading) {
         for (sc = 0; sc < nscenes; sc++)
             if (trade(scenes[sc], steps, svg_dir)) return 1;
         return 0;
     }
+    if (!steps) steps = 50;
     printf("| scene | where | driver, solver | ms/step | assembly | solve | update | ratio to original | "
-           "max |x - x_original| |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
+           "iterations/step | max |x - x_original| |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (sc = 0; sc < nscenes; sc++) {
         cloth_scene s;
         char err[1024];
-        double best[NV], split[NV][3], diff[NV], *x0, *x, tol;
+        double best[NV], split[NV][3], diff[NV], its[NV], *x0, *x;
         int r, v, n3;
+        run_out o;
         if (scene_read(scenes[sc], &s, err, sizeof err)) {
             fprintf(stderr, "cloth_bench: %s\n", err);
             return 1;
         }
-        tol = s.accuracy / 100;
         n3 = 3 * s.nx * s.ny;
         x0 = calloc((size_t)n3, sizeof *x0);
         x = calloc((size_t)n3, sizeof *x);
         if (!x0 || !x) return 1;
-        for (v = 0; v < NV; v++) best[v] = INFINITY, diff[v] = NAN;
-        for (r = 0; r < rounds; r++)
+        memset(&o, 0, sizeof o);
+        for (v = 0; v < NV; v++) best[v] = INFINITY, diff[v] = NAN, its[v] = NAN;
+        /* Round 0 also counts every solve's iterations (outside the timed
+         * phases), so "the same CG" is shown, not assumed. */
+        for (r = 0; r <= rounds; r++)
             for (v = 0; v < NV; v++) {
-                cloth_times t;
                 double per;
-                progress_show(&bar, "cloth bench: %s, round %d of %d, %s", s.name, r + 1, rounds,
+                progress_show(&bar, "cloth bench: %s, round %d of %d, %s", s.name, r, rounds,
                               cloth_mode_name(variants[v].mode));
-                if (run(&s, variants[v].mode, variants[v].solver, tol, steps, &t, v == 0 ? x0 : x, err,
-                        sizeof err)) {
+                o.x = v == 0 ? x0 : x;
+                if (run(&s, variants[v].mode, variants[v].solver, 0, steps, 0, r == 0, &o, err, sizeof err)) {
                     fprintf(stderr, "cloth_bench: %s %s: %s\n", s.name, cloth_mode_name(variants[v].mode), err);
                     continue;
                 }
-                per = (t.assembly + t.solve + t.update) / steps;
-                if (v > 0) diff[v] = max_diff(x, x0, n3);
+                if (r == 0) {
+                    its[v] = (double)o.iterations / steps;
+                    if (v > 0) diff[v] = max_diff(x, x0, n3);
+                    continue;
+                }
+                per = (o.t.assembly + o.t.solve + o.t.update) / steps;
                 if (per < best[v]) {
                     best[v] = per;
-                    split[v][0] = t.assembly / steps, split[v][1] = t.solve / steps, split[v][2] = t.update / steps;
+                    split[v][0] = o.t.assembly / steps, split[v][1] = o.t.solve / steps, split[v][2] = o.t.update / steps;
                 }
             }
         progress_done(&bar);
         for (v = 0; v < NV; v++) {
-            char what[128];
+            char what[128], d[32] = "-";
             if (!isfinite(best[v])) {
-                printf("| %s | %s | %s | failed | | | | | |\n", s.name, label, cloth_mode_name(variants[v].mode));
+                printf("| %s | %s | %s | failed | | | | | | |\n", s.name, label, cloth_mode_name(variants[v].mode));
                 continue;
             }
             snprintf(what, sizeof what, "%s, %s", cloth_mode_name(variants[v].mode),
                      variants[v].mode == CLOTH_ORIGINAL ? "own CG + Jacobi" : cloth_solver_label(variants[v].solver));
-            {
-                char d[32] = "-";
-                if (v) snprintf(d, sizeof d, "%.2g", diff[v]);
-                printf("| %s %dx%d | %s | %s | %.3f | %.3f | %.3f | %.3f | %.2f | %s |\n", s.name, s.nx, s.ny,
-                       variants[v].mode == CLOTH_ORIGINAL ? "-" : label, what, 1e3 * best[v], 1e3 * split[v][0],
-                       1e3 * split[v][1], 1e3 * split[v][2], best[v] / best[0], d);
-            }
+            if (v) snprintf(d, sizeof d, "%.2g", diff[v]);
+            printf("| %s %dx%d | %s | %s | %.3f | %.3f | %.3f | %.3f | %.2f | %.1f | %s |\n", s.name, s.nx, s.ny,
+                   variants[v].mode == CLOTH_ORIGINAL ? "-" : label, what, 1e3 * best[v], 1e3 * split[v][0],
+                   1e3 * split[v][1], 1e3 * split[v][2], best[v] / best[0], its[v], d);
         }
         free(x0);
         free(x);
     }
-    printf("(%d steps per run, best of %d rounds; CG tolerance = the scene's accuracy / 100, relative to "
-           "||b||)\n", steps, rounds);
+    printf("(%d steps per run, best of %d timed rounds after one that counts iterations; CG tolerance = the "
+           "scene's default, accuracy / condition bound, relative to ||b||)\n", steps, rounds);
     return 0;
 }

@@ -25,6 +25,15 @@ if(TARGET silc_cloth)
   endforeach()
   set_tests_properties(test_cloth_scene PROPERTIES
     ENVIRONMENT "${SILC_TEST_ENV};SILC_CLOTH_SCENES=${PROJECT_SOURCE_DIR}/examples/cloth/scenes")
+  # Physics, accuracy and the checks that make wrong runs speak; it runs the
+  # program too.
+  silc_add_test(test_cloth_physics SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_cloth_physics.c)
+  target_link_libraries(test_cloth_physics PRIVATE silc_cloth)
+  target_compile_definitions(test_cloth_physics PRIVATE CLOTH_PROGRAM="$<TARGET_FILE:cloth>"
+                             CLOTH_SCRATCH="${CMAKE_CURRENT_BINARY_DIR}")
+  add_dependencies(test_cloth_physics cloth)
+  set_tests_properties(test_cloth_physics PROPERTIES
+    ENVIRONMENT "${SILC_TEST_ENV};SILC_CLOTH_SCENES=${PROJECT_SOURCE_DIR}/examples/cloth/scenes")
   add_test(NAME example_cloth COMMAND cloth ${PROJECT_SOURCE_DIR}/examples/cloth/scenes/hanging.scene
            --mode cmp --steps 20 --frames ${CMAKE_CURRENT_BINARY_DIR}/cloth-frames)
   set_tests_properties(example_cloth PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)

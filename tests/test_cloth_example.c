@@ -236,7 +236,8 @@ static void check_obstacle(const char *extra, const char *what)
     free(xc);
 }
 
-/* A is symmetric, and A v = (1 + dt c) M v + dt^2 Lk v for a random v. */
+/* A is symmetric, and A v = S ((1 + dt c) M + dt^2 Lk) S v + (I - S)(1 + dt c) M v
+ * for a random v, S = diag(fixed): the pins constrained. */
 static void check_matrix(void)
 {
     cloth_scene s;
@@ -259,9 +260,9 @@ static void check_matrix(void)
     for (k = 0; k < m.ns; k++)
         for (d = 0; d < 3; d++) {
             int64_t l = 3 * m.sl[k] + d, o = 3 * m.sr[k] + d;
-            double c = s.dt * s.dt * m.k[k] * (v[l] - v[o]);
-            y[l] += c;
-            y[o] -= c;
+            double c = s.dt * s.dt * m.k[k] * (m.fixed[l] * v[l] - m.fixed[o] * v[o]);
+            y[l] += c * m.fixed[l];
+            y[o] -= c * m.fixed[o];
         }
     for (r = 0; r < 3 * m.n; r++) {
         double sum = 0;

@@ -57,6 +57,34 @@ static void expect_error(int line, const char *text, const char *expected)
 }
 #define EXPECT_ERROR(text, expected) expect_error(__LINE__, (text), (expected))
 
+/* Values that parse but cannot be simulated: the message names the key (and
+ * its line) and the criterion. */
+static void expect_unsimulable(int line, const char *text, const char *start, const char *criterion)
+{
+    cloth_scene s;
+    char err[1024];
+    int rc = scene_parse(text, "t", &s, err, sizeof err);
+    bool ok = rc == -1 && strncmp(err, start, strlen(start)) == 0 && strstr(err, criterion) != NULL;
+    if (!ok) printf("FAIL (test_scene.c:%d): expected \"%s...%s...\", got %d and \"%s\"\n", line, start, criterion, rc, rc ? err : "");
+    check(ok, line, start);
+}
+
+static void test_unsimulable(void)
+{
+    cloth_scene s;
+    expect_unsimulable(__LINE__, BASE "mass = 1e-300\n", "t:4: mass: 1e-300 kg over 1 m^2 is 1e-300 kg/m^2",
+                       "below the floor of 1e-6 kg/m^2");
+    expect_unsimulable(__LINE__, BASE "dt = 1e9\n", "t:4: dt: in one step of 1e+09 s free fall alone covers",
+                       "more than the cloth's size 1 m");
+    expect_unsimulable(__LINE__, BASE "k_struct = 1e18\n", "t: the system's condition bound", "exceeds the accuracy");
+    EXPECT_ERROR(BASE "max_stretch = 1\n", "t:4: max_stretch: expected a number > 1, got '1'");
+    /* at the edges: 1e-6 kg/m^2 and free fall of exactly the size pass;
+     * without gravity dt meets only the condition bound */
+    check(PARSE_OK(BASE "mass = 1e-6\n", &s) && s.max_stretch == 1.5, __LINE__, "1e-6 kg/m^2 passes");
+    PARSE_OK(BASE "gravity = 0 0 -2\ndt = 1\n", &s);
+    PARSE_OK(BASE "gravity = 0 0 0\ndt = 100\n", &s);
+}
+
 static void test_defaults(void)
 {
     cloth_scene s;
@@ -335,7 +363,7 @@ static void test_print_keys(void)
 {
     static const char *names[] = {"name", "nx", "ny", "width", "height", "mass", "k_struct", "k_shear", "k_bend",
                                   "damping", "gravity", "dt", "steps", "frame_every", "pin", "tilt", "obstacle",
-                                  "accuracy"};
+                                  "accuracy", "max_stretch"};
     enum { KEYS = sizeof names / sizeof names[0] };
     FILE *f = tmpfile();
     if (!CHECK(f != NULL))
@@ -368,6 +396,7 @@ int main(int argc, char **argv)
     test_pins();
     test_obstacles();
     test_bad_values();
+    test_unsimulable();
     test_keys_and_lines();
     test_small_err();
     test_huge_text();

@@ -3,20 +3,29 @@
  * three drivers, PNG frames and a summary (cloth.h, README.md here).
  *
  *     cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR]
- *                 [--solver NAME|OPTIONS | --tune] [--tol T] [--size WxH]
+ *                 [--solver NAME|OPTIONS | --tune] [--tol T] [--size WxH] [--strict]
  *     cloth --keys                      the scene keys with their defaults
  *
  * The scene's accuracy sets the tolerance T of every iterative solve: the
  * original driver's CG and, in ltd and cmp, the solver --solver names
  * (direct, cg, cg-ic, cg-amg, petsc-cg: cloth.h) stop at a residual of T
- * relative to ||b||, T = accuracy / 100 unless --tol says otherwise.
+ * relative to ||b||, T = accuracy / (a bound on A's condition number:
+ * cloth_default_tol) unless --tol says otherwise.
  * Without --solver, ltd and cmp use SILC's configured dispatch (a sparse
  * Cholesky by default); --solver also takes SILC solve options as they
  * are ("backend = lis-style; lis-style.options = -i cg -p ic -tol 1e-8").
  * --tune lets SILC's tuner choose the backend (and threads) for the run,
  * under a backward-error target of T, and the summary says what it chose.
- * The exit status is 1 on any failure, with the message on stderr, 2 on a
- * usage error.
+ *
+ * After every step the monitor (monitor.c) checks the solve's accuracy
+ * bound, the obstacle (tunnelling), the springs' stretch and the energy
+ * account against the scene; the first failure of each kind is a warning
+ * on stderr naming the step, with a hint, and the summary counts them.
+ * --strict makes the first one an error.  In cmp this fetches x, v and two
+ * more position vectors every step.
+ * The exit status is 1 on any failure (and, with --strict, on a failed
+ * check), with the message on stderr, 2 on a usage error or a scene that is
+ * wrong or cannot be simulated (scene.c says which values).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -31,7 +40,7 @@
 
 static const char usage[] =
     "usage: cloth SCENE [--mode original|ltd|cmp] [--steps N] [--frames DIR] [--solver NAME|OPTIONS | --tune]\n"
-    "                   [--tol T] [--size WxH]\n"
+    "                   [--tol T] [--size WxH] [--strict]\n"
     "       cloth --keys\n";
 
 static int bad_usage(const char *why)
@@ -56,8 +65,9 @@ int main(int argc, char **argv)
 {
     const char *scene_path = NULL, *frames = NULL, *solver = NULL;
     cloth_mode mode = CLOTH_ORIGINAL;
-    int steps = -1, w = 640, h = 480, a, step, tune = 0;
-    double tol = -1, ek0, es0, ek, es, pinned = 0;
+    int steps = -1, w = 640, h = 480, a, step, tune = 0, strict = 0, k;
+    double tol = -1, ek0, es0, ek, es, pinned = 0, berr, cond;
+    cloth_monitor mon;
     cloth_scene scene;
     progress bar = {0, 0, 0, 0};
     cloth_model m;
@@ -75,6 +85,9 @@ int main(int argc, char **argv)
             return 0;
         } else if (!strcmp(opt, "--tune")) {
             tune = 1;
+            continue;
+        } else if (!strcmp(opt, "--strict")) {
+            strict = 1;
             continue;
         } else if (opt[0] != '-') {
             if (scene_path) return bad_usage("more than one scene given");
@@ -110,10 +123,9 @@ int main(int argc, char **argv)
     if (!scene_path) return bad_usage("no scene file given");
     if (scene_read(scene_path, &scene, err, sizeof err)) {
         fprintf(stderr, "cloth: %s\n", err);
-        return 1;
+        return 2;
     }
     if (steps > 0) scene.steps = steps;
-    if (tol < 0) tol = scene.accuracy / 100;
     if (frames && mkdir(frames, 0777) && errno != EEXIST) {
         fprintf(stderr, "cloth: cannot create '%s': %s\n", frames, strerror(errno));
         return 1;
@@ -122,6 +134,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "cloth: %s\n", err);
         return 1;
     }
+    if (tol < 0) tol = cloth_default_tol(&m);
     if (!(d = cloth_driver_open(&m, mode, solver, tol, err, sizeof err))) {
         fprintf(stderr, "cloth: %s\n", err);
         cloth_model_free(&m);
@@ -137,6 +150,7 @@ int main(int argc, char **argv)
         goto fail;
     }
     cloth_energy(&m, m.x, m.v, &ek0, &es0);
+    cloth_monitor_start(&mon, &m);
     if (frames && scene.frame_every > 0 && write_frame(frames, &scene, mode, 0, m.x, w, h)) goto fail;
     progress_start(&bar);
     for (step = 1; step <= scene.steps; step++) {
@@ -146,6 +160,18 @@ int main(int argc, char **argv)
             fprintf(stderr, "cloth: step %d: %s\n", step, err);
             goto fail;
         }
+        if (cloth_driver_solve_report(d, &berr, &cond, NULL, err, sizeof err) || cloth_driver_sync(d, err, sizeof err) ||
+            cloth_monitor_step(&mon, &m, step, berr, cond, err, sizeof err)) {
+            progress_done(&bar);
+            fprintf(stderr, "cloth: %s\n", err);
+            goto fail;
+        }
+        for (k = 0; mon.fresh && k < CLOTH_CHECKS; k++)
+            if (mon.fresh & (1u << k)) {
+                progress_done(&bar);
+                fprintf(stderr, "cloth: %s: %s\n", strict ? "error (--strict)" : "warning", mon.first[k]);
+                if (strict) goto fail;
+            }
         if (frames && scene.frame_every > 0 && step % scene.frame_every == 0) {
             progress_done(&bar); /* a failure's message gets a clean line */
             if (cloth_driver_sync(d, err, sizeof err)) {
@@ -180,7 +206,19 @@ int main(int argc, char **argv)
             printf("tolerance %.1e relative to ||b|| (%s)\n", tol, cloth_solver_label(solver));
     }
     printf("max displacement %.6g m; pinned particles moved %.3g m\n", cloth_max_displacement(&m, m.x), pinned);
-    printf("energy: kinetic %.6g J, spring %.6g J (at start %.6g, %.6g)\n", ek, es, ek0, es0);
+    printf("energy: kinetic %.6g J, spring %.6g J (at start %.6g, %.6g), gravity %.6g J\n", ek, es, ek0, es0,
+           cloth_gravity_energy(&m, m.x));
+    printf("energy account: total %.6g J at the start, %.6g J at the end: %.6g J taken by damping and contact; "
+           "largest one-step rise %.3g J (allowed: accuracy x energy scale %.3g J = %.3g J)\n",
+           mon.e_start, mon.e_prev, mon.e_start - mon.e_prev, mon.max_rise, mon.scale, scene.accuracy * mon.scale);
+    printf("max spring stretch %.4gx rest length (max_stretch %g)\n", mon.stretch, scene.max_stretch);
+    printf("solves: largest backward error %.2g, condition estimate %.3g, forward error bound %.2g (accuracy %g)\n",
+           mon.backward_error, mon.cond, mon.worst_bound, scene.accuracy);
+    if (!cloth_monitor_problems(&mon)) printf("checks: every step passed (solve accuracy, tunnelling, stretch, energy)\n");
+    for (k = 0; k < CLOTH_CHECKS; k++)
+        if (mon.count[k])
+            printf("checks: %s failed at %ld of %d steps, first at step %d\n", cloth_check_name(k), mon.count[k],
+                   scene.steps, mon.first_step[k]);
     cloth_driver_close(d);
     cloth_model_free(&m);
     return isfinite(ek + es) ? 0 : 1;

@@ -27,6 +27,9 @@ struct cloth_driver {
     double tol;
     char solve_stmt[1024];   /* ltd and cmp: the solve statement */
     char update_stmt[1024];  /* cmp: v, x and the obstacle */
+    char assembly_stmt[1024]; /* cmp: forces, A and b, the pins constrained */
+    double cond_bound;       /* cloth_condition_bound, once: A does not change */
+    int last_iterations;     /* original: the last step's CG iterations */
     double *f, *a_val, *b, *dv;
     /* ltd: the program's envelopes for A and b, built once; a_val and b
      * point into them, so cloth_system writes each step's values straight
@@ -40,6 +43,11 @@ static const char cmp_assembly[] =
     "A1 = Y_LT * C1 - Y_RT * C1; T1 = -A1 * A1'; "
     "f = Y_RT * fij - Y_LT * fij + M * g; DfDx = T1; DfDv = -damping * M; "
     "A = M - (dt * dt) * DfDx - dt * DfDv; b = dt * (f + dt * (DfDx * v))";
+/* The pins constrained inside the solve: S = diag(fixed) keeps the free
+ * coordinates' block of A, M_pin = (1 + dt damping) M on the pinned ones
+ * alone puts their rows back as a diagonal, and S b = fixed .* b makes their
+ * dv 0 (cloth_model.c's cloth_system does the same in C). */
+static const char cmp_constrain[] = "; A = S * A * S + M_pin; b = fixed *@ b";
 
 const char *cloth_mode_name(cloth_mode mode)
 {
@@ -145,6 +153,19 @@ static int cmp_setup(cloth_driver *d)
             pcol[3 * k + dd] = (double)(k + 1);
         }
     for (k = 0; k < N; k++) diag[k] = k;
+    {
+        int64_t *free_diag = malloc((size_t)N * sizeof *free_diag);
+        double *pin_mass = malloc((size_t)N * sizeof *pin_mass);
+        rc = !free_diag || !pin_mass;
+        for (k = 0; !rc && k < N; k++) {
+            free_diag[k] = m->fixed[k] != 0 ? k : -1;
+            pin_mass[k] = m->fixed[k] != 0 ? 0 : (1 + s->dt * s->damping) * m->mass[k];
+        }
+        rc = rc || put_selection(d->ctx, "S", N, N, free_diag, NULL) ||
+             put_selection(d->ctx, "M_pin", N, N, diag, pin_mass);
+        free(free_diag), free(pin_mass);
+        if (rc) goto out;
+    }
     rc = put_selection(d->ctx, "Y_L", S3, N, colL, NULL) || put_selection(d->ctx, "Y_R", S3, N, colR, NULL) ||
          put_selection_t(d->ctx, "Y_LT", S3, N, colL) || put_selection_t(d->ctx, "Y_RT", S3, N, colR) ||
          put_selection(d->ctx, "X", S3, m->ns, colX, NULL) || put_selection(d->ctx, "M", N, N, diag, m->mass) ||
@@ -266,7 +287,12 @@ cloth_driver *cloth_driver_open(cloth_model *m, cloth_mode mode, const char *sol
     } else {
         snprintf(d->solve_stmt, sizeof d->solve_stmt, "dv = A \\ b");
     }
-    snprintf(d->update_stmt, sizeof d->update_stmt, "v += dv *@ fixed; x += dt * v%s",
+    snprintf(d->assembly_stmt, sizeof d->assembly_stmt, "%s%s", cmp_assembly,
+             m->pins_after_solve ? "" : cmp_constrain);
+    d->cond_bound = cloth_condition_bound(m);
+    /* xp and xf: the positions before the step and before the obstacle's
+     * constraint, for the tunnelling check (cloth_driver_sync fetches them). */
+    snprintf(d->update_stmt, sizeof d->update_stmt, "xp = x; v += dv *@ fixed; x += dt * v; xf = x%s",
              m->scene->obstacle == OBSTACLE_SPHERE
                  ? "; dx = x - C; r = sqrt(Q * (dx *@ dx)); keep = QT * (r >= R); "
                    "x = C + dx *@ (QT * max(ones(rows(r), 1), R /@ r)); v = v *@ keep"
@@ -307,7 +333,7 @@ int cloth_driver_step(cloth_driver *d, cloth_times *t, char *err, size_t errlen)
     cloth_model *m = d->m;
     double t0 = now(), t1, t2;
     if (d->mode == CLOTH_CMP) {
-        if (silc_exec(d->ctx, cmp_assembly)) return silc_fail(d, "cmp assembly", err, errlen);
+        if (silc_exec(d->ctx, d->assembly_stmt)) return silc_fail(d, "cmp assembly", err, errlen);
         t1 = now();
         if (silc_exec(d->ctx, d->solve_stmt)) return silc_fail(d, d->solve_stmt, err, errlen);
         t2 = now();
@@ -325,6 +351,7 @@ int cloth_driver_step(cloth_driver *d, cloth_times *t, char *err, size_t errlen)
                 return -1;
             }
             t->cg_iterations += it;
+            d->last_iterations = it;
         }
         t2 = now();
         cloth_update(m, d->dv);
@@ -339,14 +366,19 @@ int cloth_driver_sync(cloth_driver *d, char *err, size_t errlen)
 {
     silc_envelope_t e;
     int k, rc = 0;
+    static const char *const names[] = {"x", "v", "xp", "xf"};
+    double *into[4];
     if (d->mode != CLOTH_CMP) return 0;
-    for (k = 0; k < 2 && !rc; k++) {
-        const char *name = k ? "v" : "x";
-        if (silc_get(d->ctx, &e, name)) return silc_fail(d, name, err, errlen);
-        rc = e.m == 3 * (int64_t)d->m->n && e.n == 1 ? silc_envelope_to_dense(&e, k ? d->m->v : d->m->x) : -1;
+    into[0] = d->m->x, into[1] = d->m->v, into[2] = d->m->xprev, into[3] = d->m->xfree;
+    for (k = 0; k < 4 && !rc; k++) {
+        if (silc_get(d->ctx, &e, names[k])) {
+            if (k >= 2) return 0; /* before the first step there is no xp, xf */
+            return silc_fail(d, names[k], err, errlen);
+        }
+        rc = e.m == 3 * (int64_t)d->m->n && e.n == 1 ? silc_envelope_to_dense(&e, into[k]) : -1;
         silc_envelope_free(&e);
     }
-    if (rc) snprintf(err, errlen, "cmp: x or v came back with the wrong shape");
+    if (rc) snprintf(err, errlen, "cmp: x, v, xp or xf came back with the wrong shape");
     return rc;
 }
 
@@ -390,6 +422,43 @@ static void info_field(const char *text, const char *key, char *out, size_t len)
     p += strlen(key);
     e = strchr(p, '\n');
     snprintf(out, len, "%.*s", (int)(e ? e - p : (ptrdiff_t)strlen(p)), p);
+}
+
+/* The number after `key: ` in an info text; -1 when absent or not a number
+ * ("not available"). */
+static double info_number(const char *text, const char *key)
+{
+    char field[64] = "", *end;
+    double x;
+    info_field(text, key, field, sizeof field);
+    x = strtod(field, &end);
+    return end != field ? x : -1;
+}
+
+int cloth_driver_solve_report(cloth_driver *d, double *backward_error, double *cond, long *iterations, char *err,
+                              size_t errlen)
+{
+    char text[2048] = "";
+    *cond = d->cond_bound;
+    if (d->mode == CLOTH_ORIGINAL) {
+        *backward_error = cloth_backward_error(d->m, d->a_val, d->b, d->dv);
+        if (iterations) *iterations = d->last_iterations;
+        return 0;
+    }
+    silc_set_output(d->ctx, collect, text);
+    if (silc_exec(d->ctx, "info dv")) {
+        silc_set_output(d->ctx, NULL, NULL);
+        return silc_fail(d, "info dv", err, errlen);
+    }
+    silc_set_output(d->ctx, NULL, NULL);
+    *backward_error = info_number(text, "  backward error: ");
+    if (info_number(text, "  condition estimate: ") >= 0) *cond = info_number(text, "  condition estimate: ");
+    if (iterations) *iterations = (long)fmax(0, info_number(text, "  iterations: "));
+    if (*backward_error < 0) {
+        snprintf(err, errlen, "info dv reports no backward error");
+        return -1;
+    }
+    return 0;
 }
 
 void cloth_driver_solver(cloth_driver *d, char *buf, size_t len)

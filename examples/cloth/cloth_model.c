@@ -12,6 +12,14 @@
  * DfDx does not depend on the positions under this linearization, so A is
  * the same every step; the drivers still form it every step, as the seeds'
  * programs did, so that the three time the same step.
+ *
+ * Pinned coordinates are constrained inside the solve (Baraff and Witkin's
+ * filter, written as a selection): with S = diag(fixed) the system solved is
+ *     (S A S + (I - S) (1 + dt damping) M) dv = S b,
+ * i.e. the free coordinates' block of A with the pinned rows and columns
+ * removed, and dv = 0 on the pinned ones.  Solving as if the pins were free
+ * and dropping their dv afterwards (the seeds' way) lets the pins' neighbours
+ * follow a fall the pins never make: 7.7x stretched springs on `hanging`.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "cloth.h"
@@ -140,7 +148,9 @@ int cloth_model_init(cloth_model *m, const cloth_scene *s, char *err, size_t err
     m->mass = calloc((size_t)3 * n, sizeof *m->mass);
     m->fixed = calloc((size_t)3 * n, sizeof *m->fixed);
     m->gvec = calloc((size_t)3 * n, sizeof *m->gvec);
-    if (!m->x || !m->v || !m->x0 || !m->mass || !m->fixed || !m->gvec) goto oom;
+    m->xprev = calloc((size_t)3 * n, sizeof *m->xprev);
+    m->xfree = calloc((size_t)3 * n, sizeof *m->xfree);
+    if (!m->x || !m->v || !m->x0 || !m->mass || !m->fixed || !m->gvec || !m->xprev || !m->xfree) goto oom;
     /* Flat in z = 0, then turned by `tilt` about the x axis. */
     for (j = 0; j < s->ny; j++)
         for (i = 0; i < s->nx; i++) {
@@ -151,6 +161,8 @@ int cloth_model_init(cloth_model *m, const cloth_scene *s, char *err, size_t err
             m->x[3 * p + 2] = Y * sin(tilt);
         }
     memcpy(m->x0, m->x, (size_t)3 * n * sizeof *m->x);
+    memcpy(m->xprev, m->x, (size_t)3 * n * sizeof *m->x);
+    memcpy(m->xfree, m->x, (size_t)3 * n * sizeof *m->x);
     for (p = 0; p < n; p++)
         for (d = 0; d < 3; d++) {
             m->mass[3 * p + d] = s->mass / n;
@@ -173,6 +185,7 @@ void cloth_model_free(cloth_model *m)
 {
     free(m->sl), free(m->sr), free(m->k), free(m->rest);
     free(m->x), free(m->v), free(m->x0), free(m->mass), free(m->fixed), free(m->gvec);
+    free(m->xprev), free(m->xfree);
     free(m->rowptr), free(m->colind), free(m->diag), free(m->spring_slot);
     memset(m, 0, sizeof *m);
 }
@@ -217,6 +230,13 @@ void cloth_system(const cloth_model *m, const double *f, const double *v, double
             b[q] += dt * kk * (v[l] - v[q]);
         }
     for (i = 0; i < 3 * m->n; i++) b[i] *= dt;
+    if (m->pins_after_solve) return;
+    for (r = 0; r < 3 * m->n; r++) {
+        b[r] *= m->fixed[r];
+        for (i = m->rowptr[r]; i < m->rowptr[r + 1]; i++)
+            if (m->colind[i] != r && (m->fixed[r] == 0 || m->fixed[m->colind[i]] == 0)) a_val[i] = 0;
+        if (m->fixed[r] == 0) a_val[m->diag[r]] = (1 + dt * s->damping) * m->mass[r];
+    }
 }
 
 void cloth_collide(const cloth_model *m, double *x, double *v)
@@ -244,8 +264,10 @@ void cloth_collide(const cloth_model *m, double *x, double *v)
 void cloth_update(cloth_model *m, const double *dv)
 {
     int i;
+    memcpy(m->xprev, m->x, (size_t)3 * m->n * sizeof *m->x);
     for (i = 0; i < 3 * m->n; i++) m->v[i] += dv[i] * m->fixed[i];
     for (i = 0; i < 3 * m->n; i++) m->x[i] += m->scene->dt * m->v[i];
+    memcpy(m->xfree, m->x, (size_t)3 * m->n * sizeof *m->x);
     cloth_collide(m, m->x, m->v);
 }
 
@@ -253,13 +275,98 @@ void cloth_energy(const cloth_model *m, const double *x, const double *v, double
 {
     double ek = 0, es = 0;
     int i, k;
-    for (i = 0; i < 3 * m->n; i++) ek += 0.5 * m->mass[i] * v[i] * v[i];
+    for (i = 0; v && i < 3 * m->n; i++) ek += 0.5 * m->mass[i] * v[i] * v[i];
     for (k = 0; k < m->ns; k++) {
         double e = dist3(x + 3 * m->sl[k], x + 3 * m->sr[k]) - m->rest[k];
         es += 0.5 * m->k[k] * e * e;
     }
     *kinetic = ek;
     *spring = es;
+}
+
+double cloth_gravity_energy(const cloth_model *m, const double *x)
+{
+    double e = 0;
+    int i;
+    for (i = 0; i < 3 * m->n; i++) e -= m->mass[i] * m->gvec[i] * x[i];
+    return e;
+}
+
+double cloth_total_energy(const cloth_model *m, const double *x, const double *v)
+{
+    double ek, es;
+    cloth_energy(m, x, v, &ek, &es);
+    return ek + es + cloth_gravity_energy(m, x);
+}
+
+double cloth_energy_scale(const cloth_model *m)
+{
+    const cloth_scene *s = m->scene;
+    double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
+    double ek, es;
+    cloth_energy(m, m->x0, NULL, &ek, &es);
+    return s->mass * g * fmax(s->width, s->height) + es;
+}
+
+double cloth_max_stretch(const cloth_model *m, const double *x)
+{
+    double worst = 0;
+    int k;
+    for (k = 0; k < m->ns; k++) {
+        double r = dist3(x + 3 * m->sl[k], x + 3 * m->sr[k]) / m->rest[k];
+        if (!(r <= worst)) worst = r; /* a NaN sticks */
+    }
+    return worst;
+}
+
+double cloth_condition_bound(const cloth_model *m)
+{
+    const cloth_scene *s = m->scene;
+    double dt2 = s->dt * s->dt, hi = 0, lo = INFINITY;
+    double *diag = calloc((size_t)3 * m->n, sizeof *diag), *off = calloc((size_t)3 * m->n, sizeof *off);
+    int k, d, r;
+    if (!diag || !off) {
+        free(diag), free(off);
+        return INFINITY;
+    }
+    for (k = 0; k < m->ns; k++)
+        for (d = 0; d < 3; d++) {
+            int l = 3 * m->sl[k] + d, q = 3 * m->sr[k] + d, both = m->fixed[l] != 0 && m->fixed[q] != 0;
+            diag[l] += dt2 * m->k[k] * (m->fixed[l] != 0);
+            diag[q] += dt2 * m->k[k] * (m->fixed[q] != 0);
+            off[l] += both ? dt2 * m->k[k] : 0;
+            off[q] += both ? dt2 * m->k[k] : 0;
+        }
+    for (r = 0; r < 3 * m->n; r++) {
+        double a = (1 + s->dt * s->damping) * m->mass[r] + diag[r];
+        hi = fmax(hi, a + off[r]);
+        lo = fmin(lo, a - off[r]);
+    }
+    free(diag), free(off);
+    return lo > 0 ? hi / lo : INFINITY;
+}
+
+double cloth_default_tol(const cloth_model *m)
+{
+    return m->scene->accuracy / cloth_condition_bound(m);
+}
+
+double cloth_backward_error(const cloth_model *m, const double *a_val, const double *b, const double *x)
+{
+    double rmax = 0, anorm = 0, xmax = 0, bmax = 0;
+    int64_t r, q;
+    for (r = 0; r < 3 * m->n; r++) {
+        double sum = 0, row = 0;
+        for (q = m->rowptr[r]; q < m->rowptr[r + 1]; q++) {
+            sum += a_val[q] * x[m->colind[q]];
+            row += fabs(a_val[q]);
+        }
+        rmax = fmax(rmax, fabs(b[r] - sum));
+        anorm = fmax(anorm, row);
+        xmax = fmax(xmax, fabs(x[r]));
+        bmax = fmax(bmax, fabs(b[r]));
+    }
+    return anorm * xmax + bmax > 0 ? rmax / (anorm * xmax + bmax) : 0;
 }
 
 double cloth_max_displacement(const cloth_model *m, const double *x)

@@ -44,6 +44,7 @@ typedef enum {
     KEY_TILT,
     KEY_OBSTACLE,
     KEY_ACCURACY,
+    KEY_MAX_STRETCH,
     KEY_COUNT
 } scene_key;
 
@@ -90,6 +91,9 @@ static const struct {
     [KEY_ACCURACY] = {"accuracy", "a number > 0 and < 1", "REL",
                       "how far a particle may be off after the run, relative to the cloth size, "
                       "> 0 and < 1 (required)"},
+    [KEY_MAX_STRETCH] = {"max_stretch", "a number > 1", "RATIO",
+                         "the longest a spring may get over its rest length before the program warns, > 1 "
+                         "(default 1.5)"},
 };
 
 /* The help for `pin` spells the limit out. */
@@ -352,6 +356,7 @@ static int set_value(parser *p, scene_key k, const char *value, cloth_scene *s)
     case KEY_TILT: ok = read_real(&c, &s->tilt); break;
     case KEY_OBSTACLE: ok = read_obstacle(&c, s); break;
     case KEY_ACCURACY: ok = read_real(&c, &s->accuracy) && s->accuracy > 0 && s->accuracy < 1; break;
+    case KEY_MAX_STRETCH: ok = read_real(&c, &s->max_stretch) && s->max_stretch > 1; break;
     case KEY_PIN:
     case KEY_COUNT: break;
     }
@@ -390,6 +395,36 @@ static int parse_line(parser *p, char *line, cloth_scene *s)
     return set_value(p, (scene_key)k, value, s);
 }
 
+/* Values that read well but cannot be simulated, each with the criterion:
+ *   - a mass per area below 1e-6 kg/m^2 (a soap film is about 1e-3): no
+ *     cloth is that light, and the mass term vanishes from the system;
+ *   - a step in which free fall alone, |g| dt^2 / 2, covers more than the
+ *     cloth's size: the step cannot resolve the motion it simulates;
+ *   - a system whose condition bound (1 + 2 dt^2 sum k / ((1 + dt damping)
+ *     m), the Gershgorin bound of cloth_condition_bound for the stiffest
+ *     particle) times the double-precision unit roundoff 1.1e-16 exceeds
+ *     the accuracy: no solver can give dv to the accuracy. */
+static int check_simulable(const parser *p, const cloth_scene *s)
+{
+    double size = fmax(s->width, s->height), density = s->mass / (s->width * s->height);
+    double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
+    double mp = s->mass / ((double)s->nx * s->ny), ksum = 4 * (s->k_struct + s->k_shear + s->k_bend);
+    double cond = 1 + 2 * s->dt * s->dt * ksum / ((1 + s->dt * s->damping) * mp);
+    if (!(density >= 1e-6))
+        return fail(p, p->key_line[KEY_MASS], "mass: %g kg over %g m^2 is %g kg/m^2, below the floor of 1e-6 kg/m^2 "
+                    "(a soap film weighs about 1e-3): too light to simulate", s->mass, s->width * s->height, density);
+    if (g * s->dt * s->dt / 2 > size)
+        return fail(p, p->key_line[KEY_DT], "dt: in one step of %g s free fall alone covers %.3g m, more than the "
+                    "cloth's size %g m: the step is meaningless (|g| dt^2 / 2 must stay below the size; dt <= %.3g s)",
+                    s->dt, g * s->dt * s->dt / 2, size, sqrt(2 * size / g));
+    if (!(cond * 1.1e-16 <= s->accuracy))
+        return fail(p, 0, "the system's condition bound %.3g (dt %g s, springs up to %g N/m on particles of %g kg) "
+                    "times the unit roundoff 1.1e-16 exceeds the accuracy %g: no solve in double precision can "
+                    "reach it (a smaller dt, softer springs or a heavier cloth)", cond, s->dt,
+                    fmax(s->k_struct, fmax(s->k_shear, s->k_bend)), mp, s->accuracy);
+    return 0;
+}
+
 /* What can only be checked once the whole file is read. */
 static int finish(parser *p, cloth_scene *s)
 {
@@ -411,13 +446,13 @@ static int finish(parser *p, cloth_scene *s)
                 return fail(p, p->pin_line[n], "pin: (%d, %d) is already pinned on line %d", i, j,
                             p->pin_line[m]);
     }
-    return 0;
+    return check_simulable(p, s);
 }
 
 static void set_defaults(cloth_scene *s, const char *name, size_t name_len)
 {
     *s = (cloth_scene){.width = 1, .height = 1, .mass = 1, .k_struct = 1000, .k_shear = 100, .k_bend = 10,
-                       .damping = 0.1, .gravity = {0, 0, -9.81}, .dt = 0.005, .steps = 100,
+                       .damping = 0.1, .gravity = {0, 0, -9.81}, .dt = 0.005, .steps = 100, .max_stretch = 1.5,
                        .obstacle = OBSTACLE_NONE};
     if (name_len >= sizeof s->name)
         name_len = sizeof s->name - 1;
