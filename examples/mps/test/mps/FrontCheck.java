@@ -68,8 +68,19 @@ public final class FrontCheck {
         }
     }
 
-    public static void main(String[] args) throws IOException {
+    public static void main(String[] args) {
         Locale.setDefault(Locale.ROOT);
+        try {
+            System.exit(run(args));
+        } catch (IOException | RuntimeException e) { // a missing file, a malformed row: say which, no stack trace
+            System.err.println("mps.FrontCheck: " + (e instanceof java.nio.file.NoSuchFileException
+                    ? "no such file: " : "") + e.getMessage());
+            System.exit(2);
+        }
+    }
+
+    /* The checks; returns the exit status. */
+    private static int run(String[] args) throws IOException {
         Path ko = null, svg = null;
         List<Path> files = new ArrayList<>();
         for (int k = 0; k < args.length; k++) {
@@ -85,7 +96,7 @@ public final class FrontCheck {
         }
         if (files.size() < 2) {
             System.err.println("usage: mps.FrontCheck [--ko KO.dat] [--svg OUT.svg] DATA RUN.csv [RUN.csv ...]");
-            System.exit(2);
+            return 2;
         }
         List<double[]> exp = new ArrayList<>(), small = new ArrayList<>();
         for (double[] row : readColumns(files.get(0), 3)) {
@@ -160,7 +171,7 @@ public final class FrontCheck {
             System.out.println("picture: " + svg);
         }
         System.out.println(ok ? "front check: passed" : "front check: FAILED");
-        System.exit(ok ? 0 : 1);
+        return ok ? 0 : 1;
     }
 
     /* The rows of a whitespace-separated data file ('#' starts a comment), each with at least `columns` numbers. */
@@ -198,8 +209,12 @@ public final class FrontCheck {
         double[] t = new double[n], z = new double[n];
         for (int k = 0; k < n; k++) {
             String[] f = lines.get(k + 1).split(",");
-            t[k] = Double.parseDouble(f[2]);
-            z[k] = Double.parseDouble(f[3]);
+            try {
+                t[k] = Double.parseDouble(f[2]);
+                z[k] = Double.parseDouble(f[3]);
+            } catch (NumberFormatException | ArrayIndexOutOfBoundsException e) {
+                throw new IOException(csv + " line " + (k + 2) + ": want t,front_x,T,Z_over_L");
+            }
         }
         String name = csv.getFileName().toString().replaceFirst("\\.csv$", "");
         return new Curve(name, t, z);
