@@ -522,6 +522,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     conns[slot].fd = fd;
     conns[slot].id = id;
     conns[slot].accepted = util_now();
+    conns[slot].hung_up = 0;
     snprintf(conns[slot].peer, sizeof conns[slot].peer, "%s", peer);
     conn_state[slot] = SLOT_HANDSHAKE;
     sigmask_session_signals(SIG_BLOCK);   /* until the child has its own pipes */

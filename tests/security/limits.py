@@ -13,7 +13,9 @@ Every wait is bounded; the only time asserted is the requirement's own:
 a session whose client is SIGKILLed is gone within 1 s (checked with 0.5 s
 of slack, in 50 ms steps).
 """
+import atexit
 import os
+import select
 import signal
 import socket
 import struct
@@ -31,9 +33,21 @@ RUNAWAY = "x = 1\nwhile (1) { x = 1 }"
 MiB = 1 << 20
 
 
+SERVERS = []
+
+
 def fail(msg):
     print("FAIL: " + msg)
     sys.exit(1)
+
+
+@atexit.register
+def _no_server_left():
+    """A failed case leaves no server behind (its sessions die with it)."""
+    for p in SERVERS:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
 
 
 def wait_until(pred, seconds, step=0.05):
@@ -80,10 +94,20 @@ def children(pid):
     return sorted(out)
 
 
+def descendants(pid):
+    out, todo = [], [pid]
+    while todo:
+        kids = children(todo.pop())
+        out += kids
+        todo += kids
+    return out
+
+
 class Server:
     """silcd (or mpirun -np 2 silcd --mpi) on a Unix socket of its own."""
 
     def __init__(self, *args, mpi=False):
+        self.mpi = mpi
         os.makedirs(STATEDIR, exist_ok=True)
         self.sock = os.path.join(STATEDIR, CASE + ".sock")
         ready = os.path.join(STATEDIR, CASE + ".ready")
@@ -98,6 +122,7 @@ class Server:
         self.log = open(self.logpath, "w")
         self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT,
                                      stdin=subprocess.DEVNULL)
+        SERVERS.append(self.proc)
         if not wait_until(lambda: os.path.exists(ready) or self.proc.poll() is not None, 60):
             fail("silcd did not start")
         if self.proc.poll() is not None:
@@ -112,9 +137,26 @@ class Server:
     def session(self):
         return RemoteSession(self.url)
 
+    def signal_server(self, sig):
+        """To silcd; under mpirun, to rank 0 (which decides for all ranks:
+        mpirun itself ends the job when signalled)."""
+        if not self.mpi:
+            self.proc.send_signal(sig)
+            return
+        for pid in descendants(self.proc.pid):
+            try:
+                with open("/proc/%d/environ" % pid, "rb") as f:
+                    env = f.read().split(b"\0")
+            except OSError:
+                continue
+            if b"OMPI_COMM_WORLD_RANK=0" in env:
+                os.kill(pid, sig)
+                return
+        fail("rank 0 of silcd --mpi not found")
+
     def stop(self):
         if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
+            self.signal_server(signal.SIGTERM)
             try:
                 self.proc.wait(30)
             except subprocess.TimeoutExpired:
@@ -144,7 +186,8 @@ def runaway_client(url):
             "s.exec(%r)\n") % (BINDINGS, url, RUNAWAY)
     p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
                          stderr=subprocess.DEVNULL, text=True)
-    if p.stdout.readline().strip() != "connected":
+    if not select.select([p.stdout], [], [], 30)[0] or p.stdout.readline().strip() != "connected":
+        p.kill()
         fail("the runaway client did not connect")
     time.sleep(0.3)   # its EXEC is on the wire and running (not asserted)
     return p
@@ -287,10 +330,12 @@ def case_max_clients():
 
 
 def sigterm(mpi):
+    """Two runaways (one under --mpi: its rank 0 serves one request at a
+    time, so a second client would wait for the first)."""
     srv = Server(mpi=mpi)
-    runaways = [runaway_client(srv.url) for _ in range(2)]
-    kids = [] if mpi else session_pids(srv, 2)
-    srv.proc.send_signal(signal.SIGTERM)
+    runaways = [runaway_client(srv.url) for _ in range(1 if mpi else 2)]
+    kids = descendants(srv.proc.pid) if mpi else session_pids(srv, 2)
+    srv.signal_server(signal.SIGTERM)
     try:
         srv.proc.wait(10)
     except subprocess.TimeoutExpired:
@@ -421,7 +466,8 @@ def case_stuck_disconnect():
             "s.exec('y = 17 * [1; 2]')\n") % (BINDINGS, srv.url)
     c = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
                          stderr=subprocess.DEVNULL, text=True)
-    if c.stdout.readline().strip() != "connected":
+    if not select.select([c.stdout], [], [], 30)[0] or c.stdout.readline().strip() != "connected":
+        c.kill()
         fail("the client did not connect")
     pid = session_pids(srv, 1)[0]
     time.sleep(0.3)
