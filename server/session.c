@@ -240,7 +240,7 @@ static int do_exec(session *S, const char *text)
     snapshot snap;
     char *warnings;
     uint64_t used;
-    int rc, guarded = exec_guarded(), r, stop;
+    int rc, guarded = exec_guarded(), r, stop, refused;
     int64_t over;
     if (guarded && snapshot_take(E, &snap)) {
         return reply_error(S, "out of memory preparing the statement");
@@ -251,6 +251,7 @@ static int do_exec(session *S, const char *text)
     srv_watch_begin(&S->watch, S->fd);
     rc = api_exec(E, text, S->err, sizeof S->err);
     srv_watch_end(&S->watch);
+    refused = val_budget_refused();
     exec_budget(E, 0);
     *S->state = SLOT_READY;
     stop = S->watch.stop;
@@ -261,9 +262,19 @@ static int do_exec(session *S, const char *text)
     }
     if (guarded) {
         used = session_bytes(E);
-        over = stop || (srv_cfg.max_session_bytes && used > srv_cfg.max_session_bytes);
+        /* A value refused at the peak fails the request like a limit
+         * crossed at its end: rolled back whole. */
+        over = stop || refused || (srv_cfg.max_session_bytes && used > srv_cfg.max_session_bytes);
         if (srv_mpi) srv_mpi->word(srv_mpi, &over); /* rank 0's verdict decides for all */
         if (stop) {
+            if (snapshot_restore(E, &snap))
+                snprintf(S->err, sizeof S->err, "out of memory restoring the session");
+            rc = -1;
+        } else if (over && refused) {
+            char why[1024];
+            snprintf(why, sizeof why, "%.1000s", S->err);
+            snprintf(S->err, sizeof S->err, "session memory limit exceeded: %s; the whole request "
+                     "was rolled back", why);
             if (snapshot_restore(E, &snap))
                 snprintf(S->err, sizeof S->err, "out of memory restoring the session");
             rc = -1;

@@ -126,6 +126,8 @@ void val_array_free(void *p);
  * whose arrays would bring val_live_bytes() - exempt over limit returns NULL
  * and val_refusal() says so, naming source.  limit 0 lifts it. */
 void val_budget_set(int64_t exempt, uint64_t limit, const char *source);
+/* 1 if a constructor was refused by the budget since it was last set. */
+int val_budget_refused(void);
 /* Bytes of the arrays of every value alive in this process. */
 int64_t val_live_bytes(void);
 

@@ -134,12 +134,19 @@ static _Atomic int64_t live_value_bytes;
 static int64_t budget_exempt;
 static uint64_t budget_limit;   /* 0: no budget */
 static const char *budget_source = "";
+static _Atomic int budget_refusals;   /* since the budget was set */
 
 void val_budget_set(int64_t exempt, uint64_t limit, const char *source)
 {
+    budget_refusals = 0;
     budget_exempt = exempt;
     budget_limit = limit;
     budget_source = source ? source : "";
+}
+
+int val_budget_refused(void)
+{
+    return budget_refusals > 0;
 }
 
 int64_t val_live_bytes(void)
@@ -157,6 +164,7 @@ static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
     util_fmt_over_limit(over, sizeof over, held + bytes, (double)budget_limit);
     snprintf(refusal, sizeof refusal, "%s would bring the values held at once (bound and "
              "temporary) to %s (%s)", what, over, budget_source);
+    budget_refusals++;
     return -1;
 }
 
