@@ -333,6 +333,15 @@ typedef struct silc_host_api {
      * distributed) and n columns, this rank's block zero-filled: the
      * result of a collective call (x = A \ b: like = b).  NULL on failure. */
     silc_value *(*dist_dense_new)(const silc_value *like, int64_t n);
+
+    /* ABI 1.7: 1 when the request running this call is to stop (silcd's
+     * --max-request-seconds, its client gone, the server shutting down),
+     * else 0.  An iterative method asks between iterations and then returns
+     * host->error(call, SILC_ELIB, "stopped on request"); the host reports
+     * the reason.  Cheap (a clock read; a system call every 20 ms).  Always
+     * 0 on a distributed call: its ranks must stop together, which they do
+     * after the statement.  Check struct_size >= SILC_HOST_NEEDS(cancelled). */
+    int (*cancelled)(silc_call *call);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

@@ -28,6 +28,8 @@ typedef struct srv_config {
     double peer_share;           /* of max_clients, the most one peer address may hold */
     int log_level;
     uint64_t pool_bytes;         /* freed value arrays kept for reuse; 0 = none */
+    int max_cpu_s;               /* CPU seconds of one session's process; 0 = no limit */
+    int max_request_ms;          /* wall-clock time of one request; 0 = no limit */
 } srv_config;
 
 extern srv_config srv_cfg;
@@ -41,8 +43,9 @@ extern int srv_shutdown_fd;
 enum {
     SLOT_FREE = 0,
     SLOT_HANDSHAKE,   /* accepted; no hello from the server yet */
-    SLOT_READY,       /* between replies: reading or computing a request */
-    SLOT_REPLYING     /* a reply is partly sent */
+    SLOT_READY,       /* between replies: reading a request */
+    SLOT_REPLYING,    /* a reply is partly sent */
+    SLOT_RUNNING      /* computing an EXEC: silcd watches for the client hanging up */
 };
 
 void srv_log(int level, const char *fmt, ...)
@@ -82,6 +85,38 @@ void srv_auth_drop(const char *addr);
  * reset by a success); may_wait 0 (silcd --mpi, one process for every
  * session) refuses such a check unchecked instead of waiting. */
 int srv_auth_verify(int fd, const char *given, int may_wait, char *why, size_t whylen);
+/* ---- limits.c: what no session may pass (docs/security.md, "Limits") ---- */
+#define SRV_REQUEST_GRACE_S 2.0   /* past --max-request-seconds, before the process is ended */
+#define SRV_SHUTDOWN_GRACE_S 2.0  /* a request in flight at SIGTERM, before it is stopped */
+#define SRV_HANGUP_GRACE_S 0.5    /* a client gone, before silcd kills its running session */
+#define SRV_WATCH_POLL_S 0.02     /* how often a running request looks at its socket */
+#define SRV_DATA_MARGIN ((uint64_t)256 << 20)
+#define SRV_MAX_STATEMENT_BYTES ((size_t)4 << 20)  /* longer statement texts are not parsed */
+/* The RLIMIT_DATA of a process holding this many sessions: what it has
+ * mapped already + 2 x --max-session-bytes each (the values, and as much
+ * again for a statement's temporaries and a library's work arrays) +
+ * --array-pool + SRV_DATA_MARGIN; 0 (none) without --max-session-bytes. */
+uint64_t srv_data_cap(int sessions);
+/* In a process that runs engines: die with parent (PR_SET_PDEATHSIG; exits
+ * at once if it is already gone), RLIMIT_DATA (srv_data_cap), RLIMIT_CPU
+ * (--max-cpu).  -1 if a cap could not be set. */
+int srv_limit_process(int parent, int sessions);
+/* What a session process's death by sig (in slot state) says about a
+ * limit, as a tail for the client's message ("" if nothing). */
+void srv_death_reason(int sig, int state, char *out, size_t outlen);
+enum { SRV_STOP_NONE = 0, SRV_STOP_TIME, SRV_STOP_GONE, SRV_STOP_SHUTDOWN };
+/* One running request's watch: the engine's cancel hook (srv_watch_check,
+ * user = the watch) stops it past --max-request-seconds, when the client on
+ * fd hangs up, or a grace after shutdown; stop says which. */
+typedef struct srv_watch {
+    int fd;
+    double deadline, next_poll, shutdown_at;
+    int stop;
+    char why[256];   /* the client's message once stop is set */
+} srv_watch;
+void srv_watch_begin(srv_watch *w, int fd);
+void srv_watch_end(srv_watch *w);
+int srv_watch_check(void *user, char *why, size_t whylen);
 
 /* ---- silcd --mpi (mpi_server.c; docs/server.md, docs/distributed.md) ----
  * Rank 0 holds every connection in one process and serves one request at a

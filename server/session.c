@@ -49,6 +49,7 @@ struct session {
     proto_limits lim;
     int slot;              /* the state of a session of silcd --mpi (no parent to share it with) */
     int announced;         /* silcd --mpi: the other ranks made an engine for it */
+    srv_watch watch;       /* of the running EXEC (limits.c) */
     char err[4096];
 };
 
@@ -213,24 +214,71 @@ static int finish_exec(session *S, int rc, const char *warnings)
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
 }
 
+/* An EXEC runs against a snapshot (rolled back whole on a verdict) when a
+ * memory or time limit may stop it; the same on every rank. */
+static int exec_guarded(void)
+{
+    return srv_cfg.max_session_bytes > 0 || srv_cfg.max_request_ms > 0;
+}
+
+/* The values an EXEC makes count at their peak, with those bound before it
+ * (values alive in the process for other reasons are exempt: another
+ * session's under silcd --mpi, the engine's caches). */
+static void exec_budget(const silc_engine *E, int on)
+{
+    if (!on || !srv_cfg.max_session_bytes) {
+        val_budget_set(0, 0, NULL);
+        return;
+    }
+    val_budget_set(val_live_bytes() - (int64_t)session_bytes(E), srv_cfg.max_session_bytes,
+                   "the session's limit, silcd --max-session-bytes");
+}
+
 static int do_exec(session *S, const char *text)
 {
     silc_engine *E = S->E;
     snapshot snap;
     char *warnings;
     uint64_t used;
-    int rc, guarded = srv_cfg.max_session_bytes > 0, r;
+    int rc, guarded = exec_guarded(), r, stop, refused;
     int64_t over;
     if (guarded && snapshot_take(E, &snap)) {
         return reply_error(S, "out of memory preparing the statement");
     }
     if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_EXEC, S->id, text);
+    *S->state = SLOT_RUNNING;
+    exec_budget(E, 1);
+    srv_watch_begin(&S->watch, S->fd);
     rc = api_exec(E, text, S->err, sizeof S->err);
+    srv_watch_end(&S->watch);
+    refused = val_budget_refused();
+    exec_budget(E, 0);
+    *S->state = SLOT_READY;
+    stop = S->watch.stop;
+    if (stop) {
+        /* The plain reason, not "statement k: " or "rank 0 of N: ". */
+        snprintf(S->err, sizeof S->err, "%s", S->watch.why);
+        srv_log(LOG_INFO, "session %lu: %s", S->id, S->watch.why);
+    }
     if (guarded) {
         used = session_bytes(E);
-        over = used > srv_cfg.max_session_bytes;
-        if (srv_mpi) srv_mpi->word(srv_mpi, &over); /* rank 0's count decides for all */
-        if (over) {
+        /* A value refused at the peak fails the request like a limit
+         * crossed at its end: rolled back whole. */
+        over = stop || refused || (srv_cfg.max_session_bytes && used > srv_cfg.max_session_bytes);
+        if (srv_mpi) srv_mpi->word(srv_mpi, &over); /* rank 0's verdict decides for all */
+        if (stop) {
+            if (snapshot_restore(E, &snap))
+                snprintf(S->err, sizeof S->err, "out of memory restoring the session");
+            rc = -1;
+        } else if (over && refused) {
+            char why[1024];
+            snprintf(why, sizeof why, "%.1000s", S->err);
+            snprintf(S->err, sizeof S->err, "session memory limit exceeded: %s; the whole request "
+                     "was rolled back", why);
+            if (snapshot_restore(E, &snap))
+                snprintf(S->err, sizeof S->err, "out of memory restoring the session");
+            rc = -1;
+        } else if (over) {
             char done[512];
             snprintf(done, sizeof done, "%.500s", rc ? S->err : "");
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: the values bound "
@@ -245,8 +293,11 @@ static int do_exec(session *S, const char *text)
             snapshot_free(&snap);
         }
     }
+    /* A client that has gone is not answered: the session ends. */
+    if (stop == SRV_STOP_GONE) return -1;
     warnings = util_strdup(sb_str(&E->warnings));
     r = finish_exec(S, rc, warnings);
+    if (stop == SRV_STOP_SHUTDOWN) r = -1;
     free(warnings);
     return r;
 }
@@ -407,6 +458,7 @@ static int session_engine(silc_engine **E, char *err, size_t errlen)
     } else {
         rc = eng_create(E, srv_cfg.engine_config, err, errlen);
     }
+    if (!rc) (*E)->max_statement_bytes = SRV_MAX_STATEMENT_BYTES;
     if (!rc && srv_cfg.threads > 0) {
         (*E)->threads = srv_cfg.threads;
         ld_set_threads(*E, srv_cfg.threads);
@@ -471,6 +523,8 @@ static int handshake(session *S)
     }
     S->E->output = capture_output;
     S->E->output_user = S;
+    S->E->cancel = srv_watch_check;
+    S->E->cancel_user = &S->watch;
     return reply_text(S, PROTO_OK, "silcd " SILC_VERSION);
 }
 
@@ -685,10 +739,12 @@ int srv_follow(void)
             eng_info_remove(E, text);
         } else if (cmd == SRV_CMD_EXEC) {
             snapshot snap;
-            int guarded = srv_cfg.max_session_bytes > 0, have = 0;
+            int guarded = exec_guarded(), have = 0;
             int64_t over = 0;
             if (guarded) have = snapshot_take(E, &snap) == 0;
+            exec_budget(E, 1);
             api_exec(E, text, err, sizeof err);
+            exec_budget(E, 0);
             if (guarded) {
                 srv_mpi->word(srv_mpi, &over);
                 if (over && have) snapshot_restore(E, &snap);

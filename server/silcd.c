@@ -14,8 +14,7 @@
  * children finish the requests in flight, and exits 0.  docs/server.md is
  * the user's guide.
  */
-#define _POSIX_C_SOURCE 200809L
-#define _DEFAULT_SOURCE   /* MAP_ANONYMOUS */
+#define _GNU_SOURCE      /* POLLRDHUP, MAP_ANONYMOUS */
 #include "server.h"
 #include "client.h"
 
@@ -53,7 +52,9 @@ srv_config srv_cfg = {
     256,                 /* max_clients */
     0.5,                 /* peer_share */
     LOG_INFO,
-    (uint64_t)1 << 30};  /* pool_bytes: 1 GiB */
+    (uint64_t)1 << 30,   /* pool_bytes: 1 GiB */
+    0,                   /* max_cpu_s: no limit */
+    0};                  /* max_request_ms: no limit */
 int srv_shutdown_fd = -1;
 
 /* Written by the signal handlers, read by the poll loops.  In a child,
@@ -69,9 +70,11 @@ typedef struct conn {
     unsigned long id;
     char peer[64];             /* "127.0.0.1", or "" on a Unix socket */
     double accepted;           /* util_now() */
+    double hung_up;            /* when its client hung up, 0 = not, -1 = killed for it */
 } conn;
 
 static conn *conns;
+static pid_t server_pid;           /* the parent, which session processes die with */
 static volatile int *conn_state;   /* max_clients ints, MAP_SHARED */
 static int n_conns;
 
@@ -115,6 +118,10 @@ static void usage(FILE *f)
           "  --idle-timeout S        close a session idle for S seconds, 0 = never (default 0)\n"
           "  --array-pool N          freed value arrays kept for the next PUT, 0 = none (default 1G)\n"
           "  --io-timeout SECONDS    drop a peer that stalls inside a frame (default 30)\n"
+          "  --max-request-seconds S stop a request running longer than S seconds; the store is\n"
+          "                          as before it (default 0 = no limit)\n"
+          "  --max-cpu SECONDS       CPU time one session's process may use, 0 = no limit\n"
+          "                          (default 0; not with --mpi)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
           "  --mpi                   run on every rank of mpirun: rank 0 serves, every session's\n"
@@ -208,7 +215,7 @@ static const char *const value_options[] = {
     "--listen", "--config", "--threads", "--token-file", "--make-token", "--max-value-bytes",
     "--max-session-bytes", "--array-pool", "--max-clients", "--io-timeout",
     "--handshake-timeout", "--idle-timeout", "--peer-share", "--log-level", "--ready-file",
-    "--dist-min-rows", NULL};
+    "--dist-min-rows", "--max-request-seconds", "--max-cpu", NULL};
 
 static int takes_value(const char *name)
 {
@@ -279,6 +286,10 @@ static int parse_args(int argc, char **argv, const char **ready_file)
             ok = !parse_int(val, 1, 65536, &srv_cfg.max_clients, why, sizeof why);
         else if (strcmp(name, "--io-timeout") == 0)
             ok = !parse_seconds(val, 0, &srv_cfg.io_timeout_ms, why, sizeof why);
+        else if (strcmp(name, "--max-request-seconds") == 0)
+            ok = !parse_seconds(val, 1, &srv_cfg.max_request_ms, why, sizeof why);
+        else if (strcmp(name, "--max-cpu") == 0)
+            ok = !parse_int(val, 0, 86400 * 365, &srv_cfg.max_cpu_s, why, sizeof why);
         else if (strcmp(name, "--handshake-timeout") == 0)
             ok = !parse_seconds(val, 0, &srv_cfg.handshake_timeout_ms, why, sizeof why);
         else if (strcmp(name, "--idle-timeout") == 0)
@@ -530,6 +541,7 @@ static void run_child(int lfd, int slot)
     sa.sa_handler = SIG_DFL;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGCHLD, &sa, NULL);
+    if (srv_limit_process(server_pid, 1)) _exit(1);
     if (pipe(shutdown_pipe) != 0) _exit(1);
     fcntl(shutdown_pipe[1], F_SETFL, O_NONBLOCK);
     srv_shutdown_fd = shutdown_pipe[0];
@@ -555,6 +567,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     conns[slot].fd = fd;
     conns[slot].id = id;
     conns[slot].accepted = util_now();
+    conns[slot].hung_up = 0;
     snprintf(conns[slot].peer, sizeof conns[slot].peer, "%s", peer);
     conn_state[slot] = SLOT_HANDSHAKE;
     srv_auth_hold(peer);   /* before fork: the child finds its peer's entry */
@@ -589,13 +602,16 @@ static void reap_children(void)
                         "(--handshake-timeout)", conns[i].id, srv_cfg.handshake_timeout_ms / 1000.0);
             } else if (st == SLOT_HANDSHAKE) {
                 srv_log(LOG_INFO, "session %lu: closed in its handshake (signal %d)", conns[i].id, sig);
+            } else if (conns[i].hung_up < 0) {
+                /* killed by watch_hangups, which logged it */
             } else {
-                char msg[512], err[128];
+                char msg[768], err[128], limit[300];
+                srv_death_reason(sig, st, limit, sizeof limit);
                 snprintf(msg, sizeof msg, "session %lu lost: the server process running it died "
-                         "of signal %d (%s); its values are gone, other sessions are unaffected",
-                         conns[i].id, sig, strsignal(sig));
+                         "of signal %d (%s)%s; its values are gone, other sessions are unaffected",
+                         conns[i].id, sig, strsignal(sig), limit);
                 srv_log(LOG_ERROR, "%s", msg);
-                if (st == SLOT_READY)
+                if (st == SLOT_READY || st == SLOT_RUNNING)
                     proto_send_text(conns[i].fd, PROTO_ERROR, msg, 1000, err, sizeof err);
             }
         } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
@@ -606,7 +622,58 @@ static void reap_children(void)
         srv_auth_drop(conns[i].peer);
         conns[i].pid = 0;
         conns[i].fd = -1;
+        conns[i].hung_up = 0;
         conn_state[i] = SLOT_FREE;
+    }
+}
+
+/* Every session's client, watched for hanging up (p from index 3 on);
+ * returns the poll timeout.  A session whose client has gone ends by
+ * itself when idle (it reads EOF) or running the evaluator (which looks at
+ * its socket every SRV_WATCH_POLL_S); one still computing SRV_HANGUP_GRACE_S
+ * after the hang-up is stuck inside a library call, and is killed here, so
+ * that a client gone frees its slot and its core within a second whatever
+ * the session runs.  Sessions that are finishing by themselves (exiting,
+ * their leak check in sanitizer builds) are left alone. */
+static int watch_hangups(struct pollfd *p, nfds_t *np)
+{
+    double now = util_now();
+    int i, wait = -1;
+    for (i = 0; i < n_conns; i++) {
+        if (!conns[i].pid) continue;
+        if (!conns[i].hung_up) {
+            p[*np].fd = conns[i].fd;
+            p[*np].events = POLLRDHUP;
+            p[*np].revents = 0;
+            (*np)++;
+        } else if (conn_state[i] == SLOT_RUNNING && now >= conns[i].hung_up + SRV_HANGUP_GRACE_S) {
+            srv_log(LOG_INFO, "session %lu: still computing %g s after its client hung up: "
+                    "killed", conns[i].id, SRV_HANGUP_GRACE_S);
+            kill(conns[i].pid, SIGKILL);   /* reaped on its SIGCHLD */
+            conns[i].hung_up = -1;         /* killed: no second kill */
+        } else if (conns[i].hung_up > 0) {
+            /* Until it ends: look again soon (it may start computing a
+             * request the client sent before it went). */
+            int ms = conn_state[i] == SLOT_RUNNING
+                         ? (int)((conns[i].hung_up + SRV_HANGUP_GRACE_S - now) * 1000) + 1
+                         : 100;
+            if (wait < 0 || ms < wait) wait = ms;
+        }
+    }
+    return wait;
+}
+
+static void note_hangups(const struct pollfd *p, nfds_t n)
+{
+    nfds_t k;
+    int i;
+    for (k = 3; k < n; k++) {
+        if (!(p[k].revents & (POLLRDHUP | POLLHUP | POLLERR))) continue;
+        for (i = 0; i < n_conns; i++)
+            if (conns[i].pid && conns[i].fd == p[k].fd && !conns[i].hung_up) {
+                srv_log(LOG_DEBUG, "session %lu: its client hung up", conns[i].id);
+                conns[i].hung_up = util_now();
+            }
     }
 }
 
@@ -626,7 +693,11 @@ static void drain_pipe(int fd)
 static void accept_loop(int lfd, int is_tcp)
 {
     unsigned long next_id = 1;
-    struct pollfd p[3];
+    struct pollfd *p = calloc((size_t)n_conns + 3, sizeof *p);
+    if (!p) {
+        srv_log(LOG_ERROR, "out of memory");
+        return;
+    }
     p[0].fd = lfd;
     p[0].events = POLLIN;
     p[1].fd = shutdown_pipe[0];
@@ -635,14 +706,20 @@ static void accept_loop(int lfd, int is_tcp)
     p[2].events = POLLIN;
     for (;;) {
         char peer[64];
-        int fd, one = 1;
+        int fd, one = 1, wait;
+        nfds_t np = 3;
         p[0].revents = p[1].revents = p[2].revents = 0;
-        if (poll(p, 3, -1) < 0) continue;
+        wait = watch_hangups(p, &np);
+        if (poll(p, np, wait) < 0) continue;
+        note_hangups(p, np);
         if (p[2].revents) {
             drain_pipe(child_pipe[0]);
             reap_children();
         }
-        if (p[1].revents) return;
+        if (p[1].revents) {
+            free(p);
+            return;
+        }
         if (!(p[0].revents & POLLIN)) continue;
         fd = accept(lfd, NULL, NULL);
         if (fd < 0) continue;
@@ -652,12 +729,14 @@ static void accept_loop(int lfd, int is_tcp)
     }
 }
 
-/* After SIGTERM: every session finishes the request it is in, the idle ones
- * close at once; a second signal kills what is left. */
+/* After SIGTERM: the idle sessions close at once; a request in flight
+ * gets SRV_SHUTDOWN_GRACE_S to finish (then its evaluator stops it) and
+ * one second more before its process is killed, as on a second signal. */
 static void drain_sessions(void)
 {
     struct pollfd p[2];
     int i, forced = 0;
+    double kill_at = util_now() + SRV_SHUTDOWN_GRACE_S + 1;
     /* A connection still in its handshake was promised nothing: it goes
      * now, instead of waiting out --handshake-timeout. */
     for (i = 0; i < n_conns; i++)
@@ -669,10 +748,11 @@ static void drain_sessions(void)
     p[1].events = POLLIN;
     while (reap_children(), live_sessions() > 0) {
         p[0].revents = p[1].revents = 0;
-        if (poll(p, 2, 1000) < 0) continue;
+        if (poll(p, 2, 200) < 0) continue;
         if (p[0].revents) drain_pipe(child_pipe[0]);
-        if (p[1].revents && !forced) {
-            srv_log(LOG_WARN, "second signal: killing %d session(s)", live_sessions());
+        if ((p[1].revents || util_now() >= kill_at) && !forced) {
+            srv_log(LOG_WARN, "%s: killing %d session(s)",
+                    p[1].revents ? "second signal" : "shutdown grace over", live_sessions());
             for (i = 0; i < n_conns; i++)
                 if (conns[i].pid) kill(conns[i].pid, SIGKILL);
             forced = 1;
@@ -724,6 +804,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "silcd: --listen: %s\n", err);
         return 2;
     }
+    if (mpi_mode && srv_cfg.max_cpu_s > 0) {
+        /* A rank waiting for the next command spins in MPI: its CPU time
+         * grows while it is idle, so a CPU cap would end idle servers. */
+        fprintf(stderr, "silcd: --max-cpu is not available with --mpi (idle MPI ranks spin on "
+                        "the CPU); use --max-request-seconds\n");
+        return 2;
+    }
     if (!addr.is_unix && !srv_cfg.token && !insecure) {
         fprintf(stderr, "silcd: refusing to listen on %s without --token-file: every local user "
                 "(and anyone who can reach the address) could run code as this user; create a "
@@ -735,6 +822,9 @@ int main(int argc, char **argv)
     if (mpi_mode) {
 #ifdef SILC_HAVE_MPI
         if (srv_mpi_init(&argc, &argv, dist_min_rows)) return 1;
+        /* Every rank: gone with the launcher's daemon, its data segment
+         * capped for the sessions it may hold. */
+        if (srv_limit_process(getppid(), srv_cfg.max_clients)) return 1;
         if (srv_mpi->rank != 0) {
             /* mpirun forwards SIGTERM and SIGINT to every rank: rank 0
              * alone decides when the others stop (SRV_CMD_STOP). */
@@ -751,6 +841,7 @@ int main(int argc, char **argv)
         return 2;
 #endif
     }
+    server_pid = getpid();
     n_conns = srv_cfg.max_clients;
     conns = calloc((size_t)n_conns, sizeof *conns);
     conn_state = mmap(NULL, (size_t)n_conns * sizeof *conn_state, PROT_READ | PROT_WRITE,

@@ -422,8 +422,8 @@ static void test_killed_server(void)
     }
 }
 
-/* SIGTERM during a long EXEC: it finishes and is answered, new connections
- * are refused, and silcd exits 0. */
+/* SIGTERM during a long EXEC: it is answered (done, or stopped after the
+ * shutdown grace), new connections are refused, and silcd exits 0. */
 static void test_sigterm_drains(void)
 {
     test_server srv;
@@ -447,7 +447,10 @@ static void test_sigterm_drains(void)
     for (i = 0; i < 3000 && waitpid(srv.pid, &status, WNOHANG) != srv.pid; i++) sleep_ms(20);
     CHECK(i < 3000, "silcd still running 60 s after SIGTERM");
     pthread_join(th, NULL);
-    CHECK(L.rc == 0, "the EXEC in flight at SIGTERM was not answered: %s", L.err);
+    /* Answered: finished within the shutdown grace, or stopped by it
+     * (docs/security.md, "Limits"; the loop takes seconds on a loaded machine). */
+    CHECK(L.rc == 0 || contains(L.err, "server shutting down: request stopped after a grace"),
+          "the EXEC in flight at SIGTERM was not answered: %s", L.err);
     CHECK(i < 3000 && WIFEXITED(status) && WEXITSTATUS(status) == 0, "silcd's exit after SIGTERM: %d",
           status);
     CHECK(silc_exec(idle, "x = 1") != 0, "an idle session survived SIGTERM");

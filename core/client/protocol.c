@@ -627,21 +627,35 @@ static void prefault(void *p, size_t n)
 #endif
 }
 
-/* Reads a value's arrays into rowptr/colind/values as laid out by L. */
+/* The most of an array mapped ahead of the bytes received: a PUT that
+ * announces 2 GiB and sends nothing costs its receiver 64 MiB of memory, not
+ * 2 GiB (the array is only reserved; its pages are touched as data comes). */
+#define RECV_CHUNK_BYTES ((size_t)64 << 20)
+
+/* Reads a value's arrays into rowptr/colind/values as laid out by L, each
+ * in chunks mapped (prefault) just before their bytes are read. */
 static int recv_arrays(proto_stream *s, const proto_layout *L, void *rowptr, void *colind,
                        void *values, char *err, size_t errlen)
 {
-    struct iovec iov[3];
-    prefault(rowptr, (size_t)L->rowptr_bytes);
-    prefault(colind, (size_t)L->colind_bytes);
-    prefault(values, (size_t)L->values_bytes);
-    iov[0].iov_base = rowptr;
-    iov[0].iov_len = (size_t)L->rowptr_bytes;
-    iov[1].iov_base = colind;
-    iov[1].iov_len = (size_t)L->colind_bytes;
-    iov[2].iov_base = values;
-    iov[2].iov_len = (size_t)L->values_bytes;
-    return proto_recv(s, iov, 3, err, errlen);
+    uint8_t *base[3];
+    size_t bytes[3];
+    int k, rc;
+    base[0] = rowptr, bytes[0] = (size_t)L->rowptr_bytes;
+    base[1] = colind, bytes[1] = (size_t)L->colind_bytes;
+    base[2] = values, bytes[2] = (size_t)L->values_bytes;
+    for (k = 0; k < 3; k++) {
+        size_t done = 0;
+        while (done < bytes[k]) {
+            struct iovec iov;
+            size_t n = bytes[k] - done < RECV_CHUNK_BYTES ? bytes[k] - done : RECV_CHUNK_BYTES;
+            prefault(base[k] + done, n);
+            iov.iov_base = base[k] + done;
+            iov.iov_len = n;
+            if ((rc = proto_recv(s, &iov, 1, err, errlen))) return rc;
+            done += n;
+        }
+    }
+    return 0;
 }
 
 /* The envelope view of arrays in the wire layout, for env_check. */

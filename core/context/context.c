@@ -44,6 +44,13 @@ int eng_oom(silc_engine *E)
     return eng_error(E, "%s", *why ? why : "out of memory");
 }
 
+int eng_cancel_check(silc_engine *E)
+{
+    char why[sizeof E->err];
+    if (!E->cancel || !E->cancel(E->cancel_user, why, sizeof why)) return 0;
+    return eng_error(E, "%s", why);
+}
+
 void eng_print(silc_engine *E, const char *text)
 {
     if (!text) return;

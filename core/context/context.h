@@ -65,6 +65,13 @@ struct silc_engine {
     void *tuner;                        /* tuner.c's state, NULL until needed; freed by tuner_free */
     struct dist_ctx *dist;              /* the communicator of an SPMD engine (dist.h), NULL = one process */
     struct eng_memo *memo;              /* repeated operations' results (lang.h: memo_lookup), NULL until needed */
+    /* Asked between statements and at each iteration of an empty `while`
+     * (eng_cancel_check): nonzero, with why filled, stops the running exec.
+     * NULL = never (embedded).  silcd sets it to enforce its request time
+     * limit and to stop a request whose client has gone. */
+    int (*cancel)(void *user, char *why, size_t whylen);
+    void *cancel_user;
+    size_t max_statement_bytes;         /* longest statement text an exec parses, 0 = no cap */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
 };
@@ -86,6 +93,9 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+/* 0 to go on; -1 with E->err set when the engine's cancel hook asks to
+ * stop the running exec (a request past its time limit, a client gone). */
+int eng_cancel_check(silc_engine *E);
 /* Copies info; takes over its pending references (also on failure). */
 int eng_info_set(silc_engine *E, const char *name, eng_info *info);
 /* As eng_info_set, but takes over info->statement (malloc'd) too; allocates

@@ -252,6 +252,14 @@ extern double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
                                       int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
                                       const double *Y0);
 
+static int h_cancelled(silc_call *call)
+{
+    host_call_ctx *ctx = call ? call->host_private : NULL;
+    char why[256];
+    if (!ctx || !ctx->E || !ctx->E->cancel || ctx->collective || ctx->E->dist) return 0;
+    return ctx->E->cancel(ctx->E->cancel_user, why, sizeof why) != 0;
+}
+
 static const silc_host_api host_table = {
     SILC_ABI_MAJOR,
     SILC_ABI_MINOR,
@@ -286,6 +294,7 @@ static const silc_host_api host_table = {
     h_comm,
     h_layout,
     h_dist_dense_new,
+    h_cancelled,
 };
 
 const silc_host_api *host_api(void)

@@ -1167,7 +1167,19 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
 {
     int rc = exec_stmt_here(V, s, flow);
+    /* After the statement, not before: on a communicator the ranks then
+     * learn of a stop in the agreement they make anyway, and all stop at
+     * the same statement (only rank 0's engine has a cancel hook). */
+    if (!rc && !V->explain) rc = eng_cancel_check(V->E);
     return V->E->dist && !V->explain ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+}
+
+/* A `while` whose body is empty runs no statement to check after: its
+ * iterations ask here (agreed between ranks as exec_stmt's checks are). */
+static int empty_loop_cancelled(lang_ev *V)
+{
+    int rc = eng_cancel_check(V->E);
+    return V->E->dist ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
 }
 
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
@@ -1255,6 +1267,7 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
                                (unsigned long long)V->E->loop_budget);
                 break;
             }
+            if (!s->kids[0]->nkids && !V->explain && (rc = empty_loop_cancelled(V))) break;
             if ((rc = exec_block(V, s->kids[0], flow))) break;
             if (outer) tuner_loop_step(V->E, key, util_now() - ti);
             if (*flow == FLOW_BREAK) break;
@@ -1276,6 +1289,9 @@ int lang_exec(silc_engine *E, const char *text)
     double t0 = util_now();
     if (!text) return eng_error(E, "no statement text");
     E->err[0] = 0;
+    if (E->max_statement_bytes && strlen(text) > E->max_statement_bytes)
+        return eng_error(E, "statement text of %zu bytes is over the limit of %zu bytes: split it, "
+                         "or PUT large data as a value", strlen(text), E->max_statement_bytes);
     if (program_for(E, text, &prog)) return -1;
     memset(&V, 0, sizeof V);
     V.E = E;

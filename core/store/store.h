@@ -121,6 +121,15 @@ const char *val_refusal(void);
  * For sizes claimed before any value exists (a Matrix Market size line). */
 int val_claim(double bytes, const char *what);
 void val_array_free(void *p);
+/* A budget for the values alive at once in this process (silcd's
+ * --max-session-bytes at a request's peak): while limit > 0, a constructor
+ * whose arrays would bring val_live_bytes() - exempt over limit returns NULL
+ * and val_refusal() says so, naming source.  limit 0 lifts it. */
+void val_budget_set(int64_t exempt, uint64_t limit, const char *source);
+/* 1 if a constructor was refused by the budget since it was last set. */
+int val_budget_refused(void);
+/* Bytes of the arrays of every value alive in this process. */
+int64_t val_live_bytes(void);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
 void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */

@@ -125,6 +125,56 @@ static int size_allowed(int format, int64_t m, int64_t n, double bytes)
     return val_claim(bytes, what);
 }
 
+/* The memory a request's values may hold at once (val_budget_set).  Every
+ * value array alive in this process is counted in live_value_bytes (an
+ * atomic add per value made or freed); while a budget is set, a constructor
+ * whose arrays would bring the count, less what was exempt, over the limit
+ * is refused before it allocates, as an oversized value is. */
+static _Atomic int64_t live_value_bytes;
+static int64_t budget_exempt;
+static uint64_t budget_limit;   /* 0: no budget */
+static const char *budget_source = "";
+static _Atomic int budget_refusals;   /* since the budget was set */
+
+void val_budget_set(int64_t exempt, uint64_t limit, const char *source)
+{
+    budget_refusals = 0;
+    budget_exempt = exempt;
+    budget_limit = limit;
+    budget_source = source ? source : "";
+}
+
+int val_budget_refused(void)
+{
+    return budget_refusals > 0;
+}
+
+int64_t val_live_bytes(void)
+{
+    return live_value_bytes;
+}
+
+static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
+{
+    double held = (double)(live_value_bytes - budget_exempt);
+    char what[96], over[200];
+    if (!budget_limit || held + bytes <= (double)budget_limit) return 0;
+    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
+             val_format_name(format));
+    util_fmt_over_limit(over, sizeof over, held + bytes, (double)budget_limit);
+    snprintf(refusal, sizeof refusal, "%s would bring the values held at once (bound and "
+             "temporary) to %s (%s)", what, over, budget_source);
+    budget_refusals++;
+    return -1;
+}
+
+/* Counts a value's arrays as alive (budget above), once they are made. */
+static silc_value *counted(silc_value *v)
+{
+    atomic_fetch_add(&live_value_bytes, (int64_t)val_bytes(v));
+    return v;
+}
+
 static silc_value *val_alloc(int64_t m, int64_t n, int format)
 {
     silc_value *v;
@@ -152,7 +202,9 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
 {
     int64_t count = count_mul(m, n);
     silc_value *v;
-    if (size_allowed(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double))) return NULL;
+    if (size_allowed(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double)) ||
+        budget_refuses(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double)))
+        return NULL;
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
     v->val = val_array_alloc(count, sizeof(double), zero);
     if (!v->val) {
@@ -160,14 +212,15 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
         return NULL;
     }
     v->nnz = v->cap = count;
-    return v;
+    return counted(v);
 }
 
 static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero)
 {
     silc_value *v;
-    if (size_allowed(SILC_FMT_CSR, m, n, ((double)m + 1) * sizeof(silc_index) +
-                     (double)nnz_capacity * (sizeof(silc_index) + sizeof(double))))
+    double bytes = ((double)m + 1) * sizeof(silc_index) +
+                   (double)nnz_capacity * (sizeof(silc_index) + sizeof(double));
+    if (size_allowed(SILC_FMT_CSR, m, n, bytes) || budget_refuses(SILC_FMT_CSR, m, n, bytes))
         return NULL;
     if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
     if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
@@ -179,14 +232,15 @@ static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero
         return NULL;
     }
     v->cap = nnz_capacity;
-    return v;
+    return counted(v);
 }
 
 static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int zero)
 {
     int64_t ld, count;
     silc_value *v;
-    if (size_allowed(SILC_FMT_BAND, m, n, ((double)kl + (double)ku + 1) * (double)n * sizeof(double)))
+    double bytes = ((double)kl + (double)ku + 1) * (double)n * sizeof(double);
+    if (size_allowed(SILC_FMT_BAND, m, n, bytes) || budget_refuses(SILC_FMT_BAND, m, n, bytes))
         return NULL;
     if (kl < 0 || ku < 0 || kl > INT64_MAX / 4 || ku > INT64_MAX / 4) return NULL;
     ld = kl + ku + 1;
@@ -201,7 +255,7 @@ static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int z
     v->ku = ku;
     v->ld = ld;
     v->nnz = v->cap = count;
-    return v;
+    return counted(v);
 }
 
 silc_value *val_dense_new(int64_t m, int64_t n)
@@ -266,6 +320,8 @@ void val_release(silc_value *v)
         val_release(v->dist->whole);
         dist_part_unref(v->dist->part);
         free(v->dist);
+    } else {
+        atomic_fetch_sub(&live_value_bytes, (int64_t)val_bytes(v));
     }
     val_free_arrays(v);
 }

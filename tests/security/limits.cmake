@@ -1,0 +1,36 @@
+# The limits a session cannot pass (docs/security.md, "Limits"): memory of
+# hostile PUTs and of a statement's temporaries, the statement text cap,
+# --max-request-seconds (cooperative and forced), --max-cpu, a client gone
+# during a runaway, --max-clients against orphaned runaways, SIGTERM and
+# SIGKILL of silcd with runaways; the cases that apply again under
+# `mpirun -np 2 silcd --mpi`.  Each case (tests/security/limits.py) starts
+# its own server on a Unix socket in the build directory.
+if(NOT TARGET silcd OR NOT SILC_SYSTEM_PYTHON)
+  message(STATUS "SILC: limit tests skipped (silcd or /usr/bin/python3 missing)")
+  return()
+endif()
+# A plugin that never returns by itself (one mode asks host->cancelled()).
+add_library(silc_test_stuck MODULE ${CMAKE_CURRENT_LIST_DIR}/limits_stuck_plugin.c)
+target_include_directories(silc_test_stuck PRIVATE ${PROJECT_SOURCE_DIR}/plugins)
+set_target_properties(silc_test_stuck PROPERTIES PREFIX "lib" OUTPUT_NAME silc_plugin_stuck
+  C_VISIBILITY_PRESET hidden LIBRARY_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/stuck-plugin)
+set(_limits_dir ${CMAKE_CURRENT_BINARY_DIR}/security-limits)
+set(_limits_env "${SILC_TEST_ENV};STUCK_PLUGIN_DIR=${CMAKE_CURRENT_BINARY_DIR}/stuck-plugin")
+foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_clients sigterm
+        parent_killed stuck_forced stuck_cooperative stuck_disconnect)
+  add_test(NAME security_limits_${case}
+           COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
+                   ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
+  set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+endforeach()
+if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
+  foreach(case request_time_mpi disconnect_mpi sigterm_mpi)
+    add_test(NAME security_limits_${case}
+             COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
+                     ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case}
+                     $<TARGET_FILE:silcd> ${MPIEXEC_EXECUTABLE})
+    set_tests_properties(security_limits_${case} PROPERTIES
+      ENVIRONMENT "${_limits_env};OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
+      TIMEOUT 180 RUN_SERIAL TRUE)
+  endforeach()
+endif()

@@ -1,0 +1,487 @@
+"""limits.py -- the attack suite's cases for the limits a session cannot
+pass (docs/security.md, "Limits"; registered by tests/security/limits.cmake):
+hostile PUTs that announce 2 GiB and send nothing, a runaway `while` loop
+against --max-request-seconds and --max-cpu, a client SIGKILLed during a
+runaway, two orphaned runaways against --max-clients 2, SIGTERM with
+runaways, a request's temporaries against --max-session-bytes, and a
+statement text over the cap.  Each case starts its own silcd (or `mpirun
+-np 2 silcd --mpi`) on a Unix socket in the build directory and stops it.
+
+    python3 limits.py BINDINGS_DIR STATEDIR CASE SILCD [MPIRUN]
+
+Every wait is bounded; the only time asserted is the requirement's own:
+a session whose client is SIGKILLed is gone within 1 s (checked with 0.5 s
+of slack, in 50 ms steps).
+"""
+import atexit
+import os
+import select
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+
+BINDINGS, STATEDIR, CASE, SILCD = sys.argv[1:5]
+MPIRUN = sys.argv[5] if len(sys.argv) > 5 else None
+sys.path.insert(0, BINDINGS)
+from silc._remote import PUT, RemoteSession, _DESC, _HEADER  # noqa: E402
+from silc._values import DENSE, SilcError  # noqa: E402
+
+RUNAWAY = "x = 1\nwhile (1) { x = 1 }"
+MiB = 1 << 20
+
+
+SERVERS = []
+
+
+def fail(msg):
+    print("FAIL: " + msg)
+    sys.exit(1)
+
+
+@atexit.register
+def _no_server_left():
+    """A failed case leaves no server behind (its sessions die with it)."""
+    for p in SERVERS:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
+def wait_until(pred, seconds, step=0.05):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if pred():
+            return True
+        time.sleep(step)
+    return pred()
+
+
+def proc_status(pid, field):
+    """A /proc/PID/status field in bytes (kB fields), None if pid is gone."""
+    try:
+        with open("/proc/%d/status" % pid) as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+    return None
+
+
+def alive(pid):
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+
+
+def children(pid):
+    out = []
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % d) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            out.append(int(d))
+    return sorted(out)
+
+
+def descendants(pid):
+    out, todo = [], [pid]
+    while todo:
+        kids = children(todo.pop())
+        out += kids
+        todo += kids
+    return out
+
+
+class Server:
+    """silcd (or mpirun -np 2 silcd --mpi) on a Unix socket of its own."""
+
+    def __init__(self, *args, mpi=False):
+        self.mpi = mpi
+        os.makedirs(STATEDIR, exist_ok=True)
+        self.sock = os.path.join(STATEDIR, CASE + ".sock")
+        ready = os.path.join(STATEDIR, CASE + ".ready")
+        self.logpath = os.path.join(STATEDIR, CASE + ".log")
+        for p in (self.sock, ready):
+            if os.path.exists(p):
+                os.unlink(p)
+        cmd = [SILCD, "--listen", "unix:" + self.sock, "--ready-file", ready,
+               "--log-level", "info"] + list(args)
+        if mpi:
+            cmd = [MPIRUN, "-np", "2"] + cmd[:1] + ["--mpi"] + cmd[1:]
+        self.log = open(self.logpath, "w")
+        self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT,
+                                     stdin=subprocess.DEVNULL)
+        SERVERS.append(self.proc)
+        if not wait_until(lambda: os.path.exists(ready) or self.proc.poll() is not None, 60):
+            fail("silcd did not start")
+        if self.proc.poll() is not None:
+            fail("silcd exited at start:\n" + self.text())
+        self.url = "unix:" + self.sock
+
+    def text(self):
+        self.log.flush()
+        with open(self.logpath) as f:
+            return f.read()
+
+    def session(self):
+        return RemoteSession(self.url)
+
+    def signal_server(self, sig):
+        """To silcd; under mpirun, to rank 0 (which decides for all ranks:
+        mpirun itself ends the job when signalled)."""
+        if not self.mpi:
+            self.proc.send_signal(sig)
+            return
+        for pid in descendants(self.proc.pid):
+            try:
+                with open("/proc/%d/environ" % pid, "rb") as f:
+                    env = f.read().split(b"\0")
+            except OSError:
+                continue
+            if b"OMPI_COMM_WORLD_RANK=0" in env:
+                os.kill(pid, sig)
+                return
+        fail("rank 0 of silcd --mpi not found")
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.signal_server(signal.SIGTERM)
+            try:
+                self.proc.wait(30)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+                fail("silcd did not stop on SIGTERM within 30 s:\n" + self.text())
+        self.log.close()
+        return self.proc.returncode
+
+
+def expect_error(fn, text, exact=True):
+    try:
+        fn()
+    except SilcError as e:
+        if (str(e) != text) if exact else (text not in str(e)):
+            fail("expected the error %r, got %r" % (text, str(e)))
+        return str(e)
+    fail("expected the error %r, the call succeeded" % text)
+
+
+def runaway_client(url):
+    """A separate process that starts a runaway request and waits for it."""
+    code = ("import sys; sys.path.insert(0, %r)\n"
+            "from silc._remote import RemoteSession\n"
+            "s = RemoteSession(%r)\n"
+            "print('connected', flush=True)\n"
+            "s.exec(%r)\n") % (BINDINGS, url, RUNAWAY)
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                         stderr=subprocess.DEVNULL, text=True)
+    if not select.select([p.stdout], [], [], 30)[0] or p.stdout.readline().strip() != "connected":
+        p.kill()
+        fail("the runaway client did not connect")
+    time.sleep(0.3)   # its EXEC is on the wire and running (not asserted)
+    return p
+
+
+def session_pids(srv, n):
+    if not wait_until(lambda: len(children(srv.proc.pid)) >= n, 10):
+        fail("expected %d session processes, found %s" % (n, children(srv.proc.pid)))
+    return children(srv.proc.pid)
+
+
+# ---- the cases -----------------------------------------------------------------
+
+def case_hostile_put():
+    """3 PUTs announcing 2 GiB each, sending 1 MiB and then nothing: each
+    session reserves the array (VmData grows by 2 GiB: the header was
+    taken) but its resident memory grows by at most a 64 MiB chunk."""
+    srv = Server("--max-session-bytes", "3G", "--max-value-bytes", "3G", "--io-timeout", "20")
+    idle = srv.session()
+    idle.exec("a = 1")
+    base_pid = session_pids(srv, 1)[0]
+    base_rss = proc_status(base_pid, "VmRSS")
+    base_data = proc_status(base_pid, "VmData")
+    m = n = 16384                          # 16384^2 doubles = 2 GiB
+    hostile = []
+    for _ in range(3):
+        s = srv.session()
+        desc = _DESC.pack(DENSE, 1, m, n, m * n, 0, 0)
+        s.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + m * n * 8) + desc + b"h")
+        s.sock.sendall(b"\0" * MiB)
+        hostile.append(s)
+    pids = [p for p in session_pids(srv, 4) if p != base_pid]
+    for pid in pids:
+        if not wait_until(lambda: (proc_status(pid, "VmData") or 0) > base_data + (2 << 30) - 64 * MiB, 20):
+            fail("session %d never reserved the announced 2 GiB (VmData %s)" %
+                 (pid, proc_status(pid, "VmData")))
+        rss = proc_status(pid, "VmRSS")
+        print("session %d: VmRSS %.1f MiB (an idle session: %.1f MiB)" % (pid, rss / MiB, base_rss / MiB))
+        if rss > base_rss + 128 * MiB:
+            fail("a PUT announcing 2 GiB made its session resident in %.0f MiB" % (rss / MiB))
+    for s in hostile:
+        s.sock.close()
+    idle.exec("b = a + 1")
+    if idle.get("b")[0, 0] != 2:
+        fail("the idle session was disturbed")
+    idle.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def request_time(mpi):
+    srv = Server("--max-request-seconds", "1", mpi=mpi)
+    s = srv.session()
+    s.exec("keep = 7")
+    msg = "request took longer than 1 s: stopped; the store is as before the statement"
+    expect_error(lambda: s.exec(RUNAWAY), msg)
+    expect_error(lambda: s.exec("keep = keep + 1\nwhile (1) { }"), msg)   # an empty loop too
+    if s.get("keep")[0, 0] != 7:
+        fail("keep changed by the stopped request")
+    if "x" in s.names():
+        fail("'x', assigned in the stopped request, is bound")
+    s.exec("y = keep * 2")       # the session goes on
+    if s.get("y")[0, 0] != 14:
+        fail("the session did not go on after a stopped request")
+    s.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_request_time():
+    request_time(False)
+
+
+def case_request_time_mpi():
+    request_time(True)
+
+
+def case_max_cpu():
+    srv = Server("--max-cpu", "1")
+    s = srv.session()
+    s.exec("keep = 1")
+    expect_error(lambda: s.exec(RUNAWAY), "CPU time a session may use (silcd --max-cpu)",
+                 exact=False)
+    s.sock.close()
+    other = srv.session()      # the server and other sessions go on
+    other.exec("z = 3")
+    other.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_disconnect():
+    srv = Server()
+    c = runaway_client(srv.url)
+    pid = session_pids(srv, 1)[0]
+    c.kill()
+    t0 = time.monotonic()
+    c.wait()
+    if not wait_until(lambda: not alive(pid), 1.5):
+        fail("the session of a SIGKILLed client still runs after 1.5 s")
+    print("session gone %.2f s after its client was SIGKILLed" % (time.monotonic() - t0))
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_disconnect_mpi():
+    """One process serves every session: the runaway must stop for another
+    client to be answered at all."""
+    srv = Server(mpi=True)
+    c = runaway_client(srv.url)
+    c.kill()
+    c.wait()
+    s = srv.session()
+    s.exec("a = 41 + 1")
+    if s.get("a")[0, 0] != 42:
+        fail("wrong answer after the runaway stopped")
+    s.close()
+    if "the client disconnected: request stopped" not in srv.text():
+        fail("the log does not say the runaway was stopped:\n" + srv.text())
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_max_clients():
+    srv = Server("--max-clients", "2")
+    runaways = [runaway_client(srv.url) for _ in range(2)]
+    pids = session_pids(srv, 2)
+    for c in runaways:
+        c.kill()
+        c.wait()
+    if not wait_until(lambda: not any(alive(p) for p in pids), 1.5):
+        fail("orphaned runaways still run after 1.5 s")
+    s = srv.session()
+    s.exec("a = 2 * 21")
+    if s.get("a")[0, 0] != 42:
+        fail("the third client got a wrong answer")
+    s.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def sigterm(mpi):
+    """Two runaways (one under --mpi: its rank 0 serves one request at a
+    time, so a second client would wait for the first)."""
+    srv = Server(mpi=mpi)
+    runaways = [runaway_client(srv.url) for _ in range(1 if mpi else 2)]
+    kids = descendants(srv.proc.pid) if mpi else session_pids(srv, 2)
+    srv.signal_server(signal.SIGTERM)
+    try:
+        srv.proc.wait(10)
+    except subprocess.TimeoutExpired:
+        srv.proc.kill()
+        fail("silcd still runs 10 s after SIGTERM with runaways:\n" + srv.text())
+    if srv.proc.returncode != 0:
+        fail("silcd exited with %s:\n%s" % (srv.proc.returncode, srv.text()))
+    if any(alive(p) for p in kids):
+        fail("session processes outlived silcd")
+    if "stopped" not in srv.text().splitlines()[-1]:
+        fail("silcd's last line is not 'stopped':\n" + srv.text())
+    for c in runaways:
+        try:
+            c.wait(10)   # told, or its connection closed
+        except subprocess.TimeoutExpired:
+            c.kill()
+            fail("a runaway's client was left waiting after silcd stopped")
+    srv.log.close()
+
+
+def case_sigterm():
+    sigterm(False)
+
+
+def case_sigterm_mpi():
+    sigterm(True)
+
+
+def case_parent_killed():
+    """A session process dies with silcd (PR_SET_PDEATHSIG)."""
+    srv = Server()
+    c = runaway_client(srv.url)
+    pid = session_pids(srv, 1)[0]
+    srv.proc.kill()
+    srv.proc.wait()
+    if not wait_until(lambda: not alive(pid), 5):
+        fail("a session process outlived its SIGKILLed silcd")
+    c.kill()
+    c.wait()
+    srv.log.close()
+
+
+def case_peak():
+    """Temporaries count: zeros(1000) holds 8 MB; with a 20 MB session
+    limit, a statement that ends binding a scalar but holds 24 MB at once
+    (a, d, ones(1000), their sum) is refused, and its whole request rolled
+    back."""
+    srv = Server("--max-session-bytes", "20M")
+    s = srv.session()
+    s.exec("a = zeros(1000)")
+    expect_error(lambda: s.exec("d = 5\nb = sum(a + ones(1000) + ones(1000))"),
+                 "session memory limit exceeded: statement 2: reference: a 1000x1000 dense value "
+                 "would bring the values held at once (bound and temporary) to 24000008 bytes "
+                 "(22.9 MiB), over the limit of 20971520 bytes (20.0 MiB) by 2.9 MiB (the "
+                 "session's limit, silcd --max-session-bytes); the whole request was rolled back")
+    if "b" in s.names() or "d" in s.names():
+        fail("a name bound by a request refused at its peak")
+    s.exec("c = sum(a + 1)")     # a and one temporary: 16 MB at once, under the limit
+    if float(s.get("c").sum()) != 1e6:
+        fail("the entries of sum(a + 1) do not add up to 1e6")
+    s.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_statement_cap():
+    srv = Server()
+    s = srv.session()
+    text = "a = [" + ",".join(["1"] * (2 << 20)) + "]"    # 4 MiB of text
+    expect_error(lambda: s.exec(text), "statement text of %d bytes is over the limit of %d "
+                 "bytes: split it, or PUT large data as a value" % (len(text), 4 << 20))
+    s.exec("a = [1, 2, 3]")
+    s.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def stuck_server(*args):
+    """A server whose sessions have the "stuck" plugin (limits_stuck_plugin.c)
+    first for scaling: `y = 17 * [1; 2]` never returns by itself."""
+    conf = os.path.join(STATEDIR, CASE + ".conf")
+    with open(conf, "w") as f:
+        f.write("[core]\nplugin_path = %s\n[dispatch]\nadd = stuck, reference\n"
+                % os.environ["STUCK_PLUGIN_DIR"])
+    return Server("--config", conf, *args)
+
+
+def case_stuck_forced():
+    """A call that never asks is ended by the session's timer 2 s past the
+    limit: its process dies, and silcd tells the client which limit."""
+    srv = stuck_server("--max-request-seconds", "1")
+    s = srv.session()
+    s.exec("y = 3 * [1; 2]")
+    if s.get("y")[1, 0] != 6:
+        fail("the stuck plugin's scale is wrong")
+    expect_error(lambda: s.exec("y = 17 * [1; 2]"),
+                 "session 1 lost: the server process running it died of signal 14 (%s): its "
+                 "request took longer than 1 s and did not stop within 2 s more (it was inside "
+                 "a library call) (silcd --max-request-seconds); its values are gone, other "
+                 "sessions are unaffected" % signal.strsignal(signal.SIGALRM))
+    s.sock.close()
+    other = srv.session()
+    other.exec("z = 1")
+    other.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_stuck_cooperative():
+    """A call that asks host->cancelled() stops at the limit; the session
+    and its store go on as before the statement."""
+    srv = stuck_server("--max-request-seconds", "1")
+    s = srv.session()
+    s.exec("y = 3 * [1; 2]")
+    expect_error(lambda: s.exec("w = 1\ny = 19 * [1; 2]"),
+                 "request took longer than 1 s: stopped; the store is as before the statement")
+    if s.get("y")[1, 0] != 6 or "w" in s.names():
+        fail("the store changed in a stopped request")
+    s.close()
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+def case_stuck_disconnect():
+    """A client SIGKILLed while its session is stuck in a call that never
+    asks: silcd kills the session, gone within 1 s (0.5 s slack)."""
+    srv = stuck_server()
+    code = ("import sys; sys.path.insert(0, %r)\n"
+            "from silc._remote import RemoteSession\n"
+            "s = RemoteSession(%r)\n"
+            "print('connected', flush=True)\n"
+            "s.exec('y = 17 * [1; 2]')\n") % (BINDINGS, srv.url)
+    c = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                         stderr=subprocess.DEVNULL, text=True)
+    if not select.select([c.stdout], [], [], 30)[0] or c.stdout.readline().strip() != "connected":
+        c.kill()
+        fail("the client did not connect")
+    pid = session_pids(srv, 1)[0]
+    time.sleep(0.3)
+    c.kill()
+    c.wait()
+    if not wait_until(lambda: not alive(pid), 1.5):
+        fail("a stuck session of a SIGKILLed client still runs after 1.5 s")
+    if srv.stop() != 0:
+        fail("silcd exited with %s" % srv.proc.returncode)
+
+
+globals()["case_" + CASE]()
+print("ok: " + CASE)
