@@ -28,6 +28,8 @@ typedef struct srv_config {
     double peer_share;           /* of max_clients, the most one peer address may hold */
     int log_level;
     uint64_t pool_bytes;         /* freed value arrays kept for reuse; 0 = none */
+    const char *data_dir;        /* --data-dir: sessions' files beneath it; NULL = none */
+    int shared_data_dir;         /* --shared-data-dir: one folder for all, not session-<id> */
 } srv_config;
 
 extern srv_config srv_cfg;

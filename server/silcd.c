@@ -53,7 +53,9 @@ srv_config srv_cfg = {
     256,                 /* max_clients */
     0.5,                 /* peer_share */
     LOG_INFO,
-    (uint64_t)1 << 30};  /* pool_bytes: 1 GiB */
+    (uint64_t)1 << 30,   /* pool_bytes: 1 GiB */
+    NULL,                /* data_dir: sessions keep no files */
+    0};                  /* shared_data_dir */
 int srv_shutdown_fd = -1;
 
 /* Written by the signal handlers, read by the poll loops.  In a child,
@@ -112,6 +114,9 @@ static void usage(FILE *f)
           "  --io-timeout SECONDS    drop a peer that stalls inside a frame (default 30)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
+          "  --data-dir DIR          sessions may save, load and plot files, each beneath its own\n"
+          "                          DIR/session-<id> (made 0700); default: no files (docs/security.md)\n"
+          "  --shared-data-dir       with --data-dir: every session works in DIR itself\n"
           "  --mpi                   run on every rank of mpirun: rank 0 serves, every session's\n"
           "                          engine runs on all ranks (docs/distributed.md)\n"
           "  --dist-min-rows N       with --mpi: PUT values of N rows or more are split in row\n"
@@ -211,6 +216,10 @@ static int parse_args(int argc, char **argv, const char **ready_file)
             mpi_mode = 1;
             continue;
         }
+        if (strcmp(opt, "--shared-data-dir") == 0) {
+            srv_cfg.shared_data_dir = 1;
+            continue;
+        }
         if (strncmp(opt, "--", 2) != 0) {
             fprintf(stderr, "silcd: unexpected argument '%s'\n", opt);
             return -1;
@@ -228,6 +237,11 @@ static int parse_args(int argc, char **argv, const char **ready_file)
         }
         if (strcmp(name, "--listen") == 0) srv_cfg.listen = val;
         else if (strcmp(name, "--config") == 0) srv_cfg.engine_config = val;
+        else if (strcmp(name, "--data-dir") == 0) {
+            struct stat st;
+            srv_cfg.data_dir = val;
+            ok = stat(val, &st) == 0 && S_ISDIR(st.st_mode);
+        }
         else if (strcmp(name, "--threads") == 0) ok = !parse_int(val, 1, 4096, &srv_cfg.threads);
         else if (strcmp(name, "--token-file") == 0) ok = !read_token(val);
         else if (strcmp(name, "--max-value-bytes") == 0) ok = !parse_size(val, &srv_cfg.max_value_bytes);
