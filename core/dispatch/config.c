@@ -870,7 +870,8 @@ static int file_place(silc_engine *E, const char *what, const char *path, int tr
 int cfg_file_read(silc_engine *E, const char *what, const char *path, cfg_file *f)
 {
     if (file_place(E, what, path, 0, 0, f)) return -1;
-    if ((f->fd = util_open_read_at(f->dirfd, f->leaf)) < 0) {
+    /* embedded, a link is the user's own: followed, as the OS would */
+    if ((f->fd = util_open_read_at(f->dirfd, f->leaf, !E->cfg->serving)) < 0) {
         int e = errno;
         cfg_file_close(f);
         if (e == ELOOP && E->cfg->serving)

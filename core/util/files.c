@@ -119,11 +119,11 @@ int util_tmp_create(int dirfd, const char *leaf, char *tmp, size_t tmplen)
     return errno = EEXIST, -1;
 }
 
-int util_open_read_at(int dirfd, const char *leaf)
+int util_open_read_at(int dirfd, const char *leaf, int follow)
 {
     struct stat st;
     /* O_NONBLOCK: a FIFO planted under the name must not hang the reader */
-    int fd = openat(dirfd, leaf, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+    int fd = openat(dirfd, leaf, O_RDONLY | (follow ? 0 : O_NOFOLLOW) | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return -1;
     if (fstat(fd, &st) || !S_ISREG(st.st_mode)) {
         close(fd);

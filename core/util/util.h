@@ -76,9 +76,10 @@ int util_dir_of(const char *path, char *leaf, size_t leaflen);
  * under a fresh name (written to tmp): a file or link already there is never
  * written through.  Returns its descriptor (write-only) or -1 + errno. */
 int util_tmp_create(int dirfd, const char *leaf, char *tmp, size_t tmplen);
-/* leaf in dirfd opened for reading, if it is a regular file and not a
- * symbolic link (a FIFO does not block the caller); -1 + errno otherwise. */
-int util_open_read_at(int dirfd, const char *leaf);
+/* leaf in dirfd opened for reading, if it is a regular file (a FIFO does
+ * not block the caller) and, unless follow, not a symbolic link; -1 + errno
+ * otherwise (EINVAL: not a regular file, ELOOP: a link). */
+int util_open_read_at(int dirfd, const char *leaf, int follow);
 /* "/proc/self/fd/N": a name for an open descriptor that libraries taking a
  * file name (HDF5) open as that very file. */
 void util_fd_path(int fd, char *out, size_t len);

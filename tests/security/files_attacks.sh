@@ -75,6 +75,9 @@ if [ "$MODE" = embedded ]; then
         [ -f out.h5 ] && [ ! -L out.h5 ] || fail "out.h5 is not a regular file"
         [ -f linked.h5 ] && [ ! -L linked.h5 ] || fail "the link at linked.h5 was not replaced by the file"
         run ok 'load "out.h5"; load "linked.h5"'
+        # embedded, a link of the user's own is still followed for reading
+        ln -s out.h5 alias.h5
+        run ok 'load "alias.h5"; if (x[1, 2] != 2) { error }'
     fi
     # the wisdom file and the plot of tune report, the same way
     cases=$((cases + 1))
@@ -145,6 +148,8 @@ run "'tune.wisdom' $server" "set tune.wisdom = $OUT/canary.txt"
 run "'tune.wisdom' $server" "x = solve([2, 0; 0, 2], [1; 1], \"tune.wisdom = $OUT/canary.txt\")"
 run "'tune.max_threads' $server" "set tune.max_threads = 4096"
 run "'core.threads' $server" "set core.threads = 4096"
+run "tune.threads = 4096 is over this server's cap of $(getconf _NPROCESSORS_ONLN) threads (tune.max_threads, a server setting, else the cores)" \
+    "set tune.threads = 4096"
 run "'mumps.icntl_1' $server" "set mumps.icntl_1 = 7"
 run "'mumps.icntl_22' $server" "set mumps.icntl_22 = 1"
 run "petsc.options: the character ':' is refused in a silcd session (it could name a file or a viewer); only letters, digits, spaces and _ . + , = - are allowed" \
