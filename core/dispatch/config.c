@@ -877,6 +877,9 @@ int cfg_file_read(silc_engine *E, const char *what, const char *path, cfg_file *
         if (e == ELOOP && E->cfg->serving)
             return eng_error(E, "%s: '%s' is refused: %s (files are named relative to the session's "
                                 "folder under silcd's --data-dir)", what, path, UTIL_WHY_SYMLINK);
+        if (e == EMLINK)
+            return eng_error(E, "%s: '%s' is refused: it has other hard links, which could lead out of "
+                                "silcd's --data-dir", what, path);
         if (e == EINVAL) return eng_error(E, "%s: '%s' is not a regular file", what, path);
         return eng_error(E, "%s: cannot read '%s': %s", what, path, strerror(e));
     }

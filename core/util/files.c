@@ -129,6 +129,11 @@ int util_open_read_at(int dirfd, const char *leaf, int follow)
         close(fd);
         return errno = EINVAL, -1;
     }
+    /* a second hard link may be a file from outside the root, linked in */
+    if (!follow && st.st_nlink > 1) {
+        close(fd);
+        return errno = EMLINK, -1;
+    }
     return fd;
 }
 

@@ -77,8 +77,9 @@ int util_dir_of(const char *path, char *leaf, size_t leaflen);
  * written through.  Returns its descriptor (write-only) or -1 + errno. */
 int util_tmp_create(int dirfd, const char *leaf, char *tmp, size_t tmplen);
 /* leaf in dirfd opened for reading, if it is a regular file (a FIFO does
- * not block the caller) and, unless follow, not a symbolic link; -1 + errno
- * otherwise (EINVAL: not a regular file, ELOOP: a link). */
+ * not block the caller) and, unless follow, neither a symbolic link nor a
+ * file with other hard links; -1 + errno otherwise (EINVAL: not a regular
+ * file, ELOOP: a symbolic link, EMLINK: hard links). */
 int util_open_read_at(int dirfd, const char *leaf, int follow);
 /* "/proc/self/fd/N": a name for an open descriptor that libraries taking a
  * file name (HDF5) open as that very file. */

@@ -200,6 +200,7 @@ ln -s "$OUT/canary.txt" "$D/shared/link.h5"
 if [ $have_h5 -eq 1 ]; then
     (cd "$OUT" && env -u SILC_SERVER "$CLI" -e 'secret = 42; save "secret.h5"') || fail "making the secret file"
     ln -s "$OUT/secret.h5" "$D/shared/secret.h5"
+    ln "$OUT/secret.h5" "$D/shared/hard.h5" 2>/dev/null || echo "(no hard link across these folders: that case is skipped)"
 fi
 state0=$(outside_state)
 start shared --data-dir "$D/shared" --shared-data-dir
@@ -215,6 +216,9 @@ if [ $have_h5 -eq 1 ]; then
     run "statement 2: save: 'esc/canary.txt' is refused: $symlink $beneath" 'x = 1; save "esc/canary.txt"'
     run "load: 'esc/secret.h5' is refused: $symlink $beneath" 'load "esc/secret.h5"'
     run "load: 'secret.h5' is refused: $symlink $beneath" 'load "secret.h5"'
+    [ -f "$D/shared/hard.h5" ] &&
+        run "load: 'hard.h5' is refused: it has other hard links, which could lead out of silcd's --data-dir" \
+            'load "hard.h5"'
     run ok 'x = 5; save "out.h5"; save "link.h5"'
     [ -f "$D/shared/link.h5" ] && [ ! -L "$D/shared/link.h5" ] || fail "the link at link.h5 was not replaced"
     [ -f "$D/shared/out.h5" ] && [ ! -L "$D/shared/out.h5" ] || fail "out.h5 is not a regular file"
