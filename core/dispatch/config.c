@@ -453,7 +453,7 @@ enum key_kind {
     KEY_SESSION,   /* settable by `set` and per-call options */
     KEY_SERVER,    /* names a path, loads code or raises a cap: silcd's config only */
     KEY_FREEFORM,  /* a plugin's free-form option string: sanitized (freeform_refusal) */
-    KEY_THREADS    /* a thread count: at most the operator's cap (threads_refusal) */
+    KEY_THREADS    /* a thread count: at most the operator's cap (session_thread_cap) */
 };
 
 typedef struct key_rule {

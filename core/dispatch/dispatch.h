@@ -3,7 +3,8 @@
  * database, the plugins, the host API handed to them and the dispatcher.
  *
  *   config.c    options database: config file (inih), `set`, per-call options;
- *               key validation with "did you mean"
+ *               key validation with "did you mean"; server vs session
+ *               settings and a silcd session's files (cfg_serve)
  *   loader.c    plugins: built-in reference, dlopen(RTLD_NOW|RTLD_LOCAL) of the
  *               rest, ABI checks, backend look-up by full name
  *   host.c      the silc_host_api table handed to plugins

@@ -1,8 +1,9 @@
 /*
  * util.h -- small shared helpers of the core: a growable string buffer, the
- * closest-name suggestion used by every "did you mean" message, and a
- * monotonic clock.  One implementation serves the parser, the config reader
- * and the dispatcher so their messages read alike.
+ * closest-name suggestion used by every "did you mean" message, a
+ * monotonic clock, and (files.c) opening files without following links out
+ * of a root or through a planted temporary.  One implementation serves the
+ * parser, the config reader and the dispatcher so their messages read alike.
  */
 #ifndef SILC_UTIL_H
 #define SILC_UTIL_H
