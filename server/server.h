@@ -30,6 +30,8 @@ typedef struct srv_config {
     uint64_t pool_bytes;         /* freed value arrays kept for reuse; 0 = none */
     int max_cpu_s;               /* CPU seconds of one session's process; 0 = no limit */
     int max_request_ms;          /* wall-clock time of one request; 0 = no limit */
+    const char *data_dir;        /* --data-dir: sessions' files beneath it; NULL = none */
+    int shared_data_dir;         /* --shared-data-dir: one folder for all, not session-<id> */
 } srv_config;
 
 extern srv_config srv_cfg;

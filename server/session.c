@@ -448,8 +448,9 @@ static void handshake_deadline(int ms)
 }
 
 /* A session's engine, with the server's configuration; on every rank of
- * silcd --mpi (collective there). */
-static int session_engine(silc_engine **E, char *err, size_t errlen)
+ * silcd --mpi (collective there).  It is a server session's (cfg_serve): no
+ * server settings, files only beneath --data-dir (docs/security.md). */
+static int session_engine(silc_engine **E, unsigned long id, char *err, size_t errlen)
 {
     int rc;
     if (srv_mpi) {
@@ -459,6 +460,11 @@ static int session_engine(silc_engine **E, char *err, size_t errlen)
         rc = eng_create(E, srv_cfg.engine_config, err, errlen);
     }
     if (!rc) (*E)->max_statement_bytes = SRV_MAX_STATEMENT_BYTES;
+    if (!rc && cfg_serve(*E, srv_cfg.data_dir, srv_cfg.shared_data_dir, id)) {
+        snprintf(err, errlen, "%s", (*E)->err);
+        eng_destroy(E);
+        return -1;
+    }
     if (!rc && srv_cfg.threads > 0) {
         (*E)->threads = srv_cfg.threads;
         ld_set_threads(*E, srv_cfg.threads);
@@ -515,7 +521,7 @@ static int handshake(session *S)
     }
     if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_OPEN, S->id, NULL);
     S->announced = srv_mpi != NULL;
-    rc = session_engine(&S->E, S->err, sizeof S->err);
+    rc = session_engine(&S->E, S->id, S->err, sizeof S->err);
     if (rc) {
         srv_log(LOG_ERROR, "session %lu: engine: %s", S->id, S->err);
         reply_error(S, S->err);
@@ -705,7 +711,7 @@ int srv_follow(void)
             /* its engine could not be made here: nothing to close */
         } else if (cmd == SRV_CMD_OPEN) {
             silc_engine *ne = NULL;
-            if (session_engine(&ne, err, sizeof err) == 0) {
+            if (session_engine(&ne, id, err, sizeof err) == 0) {
                 if (!(f = calloc(1, sizeof *f))) {
                     srv_log(LOG_ERROR, "rank %d: out of memory following session %lu", srv_mpi->rank, id);
                     abort(); /* this rank can no longer follow rank 0: the job ends */

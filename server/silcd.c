@@ -54,7 +54,9 @@ srv_config srv_cfg = {
     LOG_INFO,
     (uint64_t)1 << 30,   /* pool_bytes: 1 GiB */
     0,                   /* max_cpu_s: no limit */
-    0};                  /* max_request_ms: no limit */
+    0,                   /* max_request_ms: no limit */
+    NULL,                /* data_dir: sessions keep no files */
+    0};                  /* shared_data_dir */
 int srv_shutdown_fd = -1;
 
 /* Written by the signal handlers, read by the poll loops.  In a child,
@@ -124,6 +126,9 @@ static void usage(FILE *f)
           "                          (default 0; not with --mpi)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
+          "  --data-dir DIR          sessions may save, load and plot files, each beneath its own\n"
+          "                          DIR/session-<id> (made 0700); default: no files (docs/security.md)\n"
+          "  --shared-data-dir       with --data-dir: every session works in DIR itself\n"
           "  --mpi                   run on every rank of mpirun: rank 0 serves, every session's\n"
           "                          engine runs on all ranks (docs/distributed.md)\n"
           "  --dist-min-rows N       with --mpi: PUT values of N rows or more are split in row\n"
@@ -215,7 +220,7 @@ static const char *const value_options[] = {
     "--listen", "--config", "--threads", "--token-file", "--make-token", "--max-value-bytes",
     "--max-session-bytes", "--array-pool", "--max-clients", "--io-timeout",
     "--handshake-timeout", "--idle-timeout", "--peer-share", "--log-level", "--ready-file",
-    "--dist-min-rows", "--max-request-seconds", "--max-cpu", NULL};
+    "--dist-min-rows", "--max-request-seconds", "--max-cpu", "--data-dir", NULL};
 
 static int takes_value(const char *name)
 {
@@ -256,6 +261,10 @@ static int parse_args(int argc, char **argv, const char **ready_file)
             insecure = 1;
             continue;
         }
+        if (strcmp(opt, "--shared-data-dir") == 0) {
+            srv_cfg.shared_data_dir = 1;
+            continue;
+        }
         if (opt[0] != '-') {
             fprintf(stderr, "silcd: unexpected argument '%s'\n", opt);
             usage(stderr);
@@ -271,6 +280,12 @@ static int parse_args(int argc, char **argv, const char **ready_file)
         }
         if (strcmp(name, "--listen") == 0) srv_cfg.listen = val;
         else if (strcmp(name, "--config") == 0) srv_cfg.engine_config = val;
+        else if (strcmp(name, "--data-dir") == 0) {
+            struct stat st;
+            srv_cfg.data_dir = val;
+            ok = stat(val, &st) == 0 && S_ISDIR(st.st_mode);
+            if (!ok) snprintf(why, sizeof why, "not a directory silcd can reach");
+        }
         else if (strcmp(name, "--threads") == 0)
             ok = !parse_int(val, 1, 4096, &srv_cfg.threads, why, sizeof why);
         else if (strcmp(name, "--token-file") == 0) {

@@ -44,7 +44,7 @@ add_test(NAME silcd_mpi_start COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server
 add_test(NAME silcd_mpi_stop COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server.sh stop
          $<TARGET_FILE:silcd> ${SILC_MPI_SOCKET} ${_mpi_state})
 set_tests_properties(silcd_mpi_start PROPERTIES FIXTURES_SETUP silcd_mpi
-                     ENVIRONMENT "${SILC_MPI_ENV};SILC_LAUNCH=${MPIEXEC_EXECUTABLE} -np 2")
+                     ENVIRONMENT "${SILC_MPI_ENV};SILC_LAUNCH=${MPIEXEC_EXECUTABLE} -np 2;SILC_WISDOM=${_mpi_state}/wisdom")
 set_tests_properties(silcd_mpi_stop PROPERTIES FIXTURES_CLEANUP silcd_mpi)
 set(_mpi_remote_env "${SILC_TEST_ENV};SILC_SERVER=unix:${SILC_MPI_SOCKET}")
 foreach(t test_api test_lang test_truth test_examples)

@@ -75,7 +75,10 @@ add_test(NAME silcd_start COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server.sh 
          $<TARGET_FILE:silcd> ${SILC_TEST_SOCKET} ${_state})
 add_test(NAME silcd_stop COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/remote_server.sh stop
          $<TARGET_FILE:silcd> ${SILC_TEST_SOCKET} ${_state})
-set_tests_properties(silcd_start PROPERTIES FIXTURES_SETUP silcd ENVIRONMENT "${SILC_TEST_ENV}")
+# Its wisdom file is its operator's (tune.wisdom is a server setting): kept
+# in its state directory, not in $HOME.
+set_tests_properties(silcd_start PROPERTIES FIXTURES_SETUP silcd
+                     ENVIRONMENT "${SILC_TEST_ENV};SILC_WISDOM=${_state}/wisdom")
 set_tests_properties(silcd_stop PROPERTIES FIXTURES_CLEANUP silcd)
 
 set(_remote_env "${SILC_TEST_ENV};SILC_SERVER=unix:${SILC_TEST_SOCKET}")

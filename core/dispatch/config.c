@@ -15,6 +15,17 @@
  * being silently ignored.  Names that SILC knows but that are not installed
  * here (a [mumps] section on a machine without MUMPS) are accepted, so one
  * config file serves every machine.
+ *
+ * Settings come in two kinds (docs/security.md): server settings, which name
+ * a path, load code or raise a thread cap, and which only the operator sets
+ * (silcd's config file or command line), and session settings, which `set`
+ * and per-call options may change.  One table below (key_rules) says which
+ * is which; `help set` prints it.  An engine becomes a server session's with
+ * cfg_serve: from then on a session or call scope naming a server setting is
+ * refused, free-form plugin option strings are sanitized, and the files a
+ * statement names resolve beneath silcd's --data-dir (util/files.c does the
+ * opening).  An embedded engine is its own operator: everything stays
+ * settable and paths mean what the operating system says.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "dispatch.h"
@@ -38,6 +49,8 @@ typedef struct cfg_entry {
 
 struct cfg_db {
     cfg_entry *scope[3]; /* indexed by enum cfg_scope, each in insertion order */
+    int serving;         /* a silcd session's engine (cfg_serve) */
+    int data_fd;         /* its folder under --data-dir, -1 = file statements refused */
 };
 
 static const char *const scope_names[3] = {"file", "session", "call"};
@@ -447,6 +460,145 @@ static cfg_entry **find_slot(cfg_db *db, int scope, const char *key)
     return pe;
 }
 
+/* ---- server settings and session settings ------------------------------------ */
+
+/* What a session of silcd may do with a key. */
+enum key_kind {
+    KEY_SESSION,   /* settable by `set` and per-call options */
+    KEY_SERVER,    /* names a path, loads code or raises a cap: silcd's config only */
+    KEY_FREEFORM,  /* a plugin's free-form option string: sanitized (freeform_refusal) */
+    KEY_THREADS    /* a thread count: at most the operator's cap (session_thread_cap) */
+};
+
+typedef struct key_rule {
+    const char *key;   /* a key, or a pattern shown as such ("dispatch.<class>") */
+    enum key_kind kind;
+    const char *why;
+} key_rule;
+
+/* THE table of which key is whose (docs/security.md, `help set`).  A key not
+ * listed is a session setting: dispatch.<class>, solve.*, a plugin's typed
+ * options. */
+static const key_rule key_rules[] = {
+    {"core.plugin_path", KEY_SERVER, "folders whose plugins are loaded: loads code"},
+    {"core.threads", KEY_SERVER, "the thread budget of one operation"},
+    {"tune.wisdom", KEY_SERVER, "the wisdom file: names a path the tuner writes"},
+    {"tune.max_threads", KEY_SERVER, "the tuner's thread cap (may exceed the cores)"},
+    {"mumps.icntl_1", KEY_SERVER, "MUMPS error output unit: a Fortran unit writes a file"},
+    {"mumps.icntl_2", KEY_SERVER, "MUMPS diagnostics unit: a Fortran unit writes a file"},
+    {"mumps.icntl_3", KEY_SERVER, "MUMPS global information unit: a Fortran unit writes a file"},
+    {"mumps.icntl_22", KEY_SERVER, "MUMPS out-of-core factorization: writes the factors to files"},
+    {"tune.threads", KEY_THREADS, "threads of the solves, or 'auto' for the tuner; in silcd at most "
+                                  "tune.max_threads (else the cores)"},
+    {"petsc.options", KEY_FREEFORM, "PETSc's option string; in silcd no option that views, monitors, "
+                                    "logs, dumps, names a file, loads code or sets threads"},
+    {"lis-style.options", KEY_FREEFORM, "the Lis-style option string; sanitized as petsc.options"},
+    {"dispatch.<class>", KEY_SESSION, "the backends a class of operation tries, in order"},
+    {"tune.accuracy", KEY_SESSION, "the accuracy the tuner's backend choice must reach"},
+    {"tune.budget", KEY_SESSION, "the share of the run the tuner may spend measuring"},
+    {"solve.<option>", KEY_SESSION, "refine, refine_residual, backward_error, initial_guess, verify"},
+    {"<plugin>.<option>", KEY_SESSION, "a plugin's typed options (other than those above)"},
+};
+
+static const key_rule *rule_of(const char *key)
+{
+    size_t i;
+    for (i = 0; i < sizeof key_rules / sizeof key_rules[0]; i++)
+        if (!strcmp(key_rules[i].key, key)) return &key_rules[i];
+    return NULL;
+}
+
+void cfg_describe_keys(strbuf *b)
+{
+    size_t i;
+    int server;
+    for (server = 1; server >= 0; server--) {
+        sb_puts(b, server ? "server settings (silcd's config file or command line only; any setting in "
+                            "an embedded program):\n"
+                          : "session settings (set, or solve(A, b, \"key = value\")):\n");
+        for (i = 0; i < sizeof key_rules / sizeof key_rules[0]; i++)
+            if ((key_rules[i].kind == KEY_SERVER) == server)
+                sb_printf(b, "  %-20s %s\n", key_rules[i].key, key_rules[i].why);
+    }
+}
+
+/* Words in a free-form option's name that make it a server's business: what
+ * views, monitors, logs, dumps or names a file, loads code (-dll_append,
+ * -python), starts a debugger, or sets a thread count (PETSc's -*_view
+ * :file, -log_view, -options_file, -malloc_dump; Lis's -omp_num_threads;
+ * MUMPS's output units and out-of-core through PETSc). */
+static const char *const freeform_denied[] = {
+    "view", "monitor", "log", "dump", "file", "dll", "debug", "draw", "saws", "python", "history",
+    "info", "trace", "malloc", "options", "error", "display", "objects", "write", "save", "load",
+    "output", "print", "thread", "mumps_icntl_1", "mumps_icntl_2", "mumps_icntl_3", "mumps_icntl_4",
+    "mumps_icntl_22", "ooc", "yaml", "prefix", "memory", "help"};
+
+/* 0 if a session of silcd may pass text as key's free-form option string;
+ * else -1 with the refusal.  Characters are limited first (no ':' or '/'
+ * can then name a file or a viewer, no quotes can hide a space), then every
+ * "-name" is checked against freeform_denied. */
+static int freeform_refusal(silc_engine *E, const char *key, const char *text)
+{
+    const char *p;
+    size_t i;
+    for (p = text; *p; p++)
+        if (!isalnum((unsigned char)*p) && !strchr(" \t_.+,=-", *p))
+            return eng_error(E, "%s: the character '%c' is refused in a silcd session (it could name a "
+                                "file or a viewer); only letters, digits, spaces and _ . + , = - are allowed",
+                             key, *p);
+    for (p = text; *p;) {
+        size_t n;
+        while (*p == ' ' || *p == '\t') p++;
+        n = strcspn(p, " \t");
+        if (n > 1 && p[0] == '-' && isalpha((unsigned char)p[1])) {
+            char name[128];
+            trim_copy(name, sizeof name, p + 1, n - 1);
+            for (i = 0; name[i]; i++) name[i] = (char)tolower((unsigned char)name[i]);
+            for (i = 0; i < sizeof freeform_denied / sizeof freeform_denied[0]; i++)
+                if (strstr(name, freeform_denied[i]))
+                    return eng_error(E, "%s: '-%s' is refused in a silcd session: options that view, "
+                                        "monitor, log, dump, name a file, load code or set threads are "
+                                        "server settings (set them in silcd's config)", key, name);
+        }
+        p += n;
+    }
+    return 0;
+}
+
+/* The operator's thread cap of a session: tune.max_threads from the config
+ * file, else the cores. */
+static long session_thread_cap(const silc_engine *E)
+{
+    cfg_entry *e = *find_slot(E->cfg, CFG_SCOPE_FILE, "tune.max_threads");
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (e && strcmp(e->value, "auto")) return strtol(e->value, NULL, 10);
+    return cores > 0 ? cores : 1;
+}
+
+/* In a silcd session, what a session or call scope may not set, per
+ * key_rules: 0 if allowed, else -1 with the refusal. */
+static int session_refusal(silc_engine *E, int scope, const char *key, const char *value)
+{
+    const key_rule *r;
+    if (!E->cfg->serving || scope == CFG_SCOPE_FILE || !(r = rule_of(key))) return 0;
+    switch (r->kind) {
+    case KEY_SERVER:
+        return eng_error(E, "'%s' is a server setting: set it in silcd's config", key);
+    case KEY_FREEFORM:
+        return freeform_refusal(E, key, value);
+    case KEY_THREADS:
+        if (strcmp(value, "auto")) {
+            long cap = session_thread_cap(E), n = strtol(value, NULL, 10);
+            if (n > cap)
+                return eng_error(E, "%s = %ld is over this server's cap of %ld threads (tune.max_threads, a "
+                                    "server setting, else the cores)", key, n, cap);
+        }
+        return 0;
+    default:
+        return 0;
+    }
+}
+
 /* Stores key = value in scope (replacing an earlier value of that key). */
 static int store_value(silc_engine *E, int scope, const char *key, const char *value)
 {
@@ -473,6 +625,7 @@ int cfg_create(silc_engine *E)
 {
     E->cfg = calloc(1, sizeof *E->cfg);
     if (!E->cfg) return eng_error(E, "out of memory creating the options database");
+    E->cfg->data_fd = -1;
     return 0;
 }
 
@@ -481,6 +634,7 @@ void cfg_destroy(silc_engine *E)
     int s;
     if (!E || !E->cfg) return;
     for (s = 0; s < 3; s++) free_list(E->cfg->scope[s]);
+    if (E->cfg->data_fd >= 0) close(E->cfg->data_fd);
     free(E->cfg);
     E->cfg = NULL;
 }
@@ -499,7 +653,7 @@ static int set_parts(silc_engine *E, int scope, const char *section, const char 
     rc = check_key(E, scope, section, name, value, &norm);
     if (rc == 0 && (section[0] ? sb_printf(&key, "%s.%s", section, name) : sb_puts(&key, name)))
         rc = eng_error(E, "out of memory setting '%s%s%s'", section, section[0] ? "." : "", name);
-    else if (rc == 0)
+    else if (rc == 0 && (rc = session_refusal(E, scope, sb_str(&key), sb_str(&norm))) == 0)
         rc = store_value(E, scope, sb_str(&key), sb_str(&norm));
     if (rc == 0 && strcmp(section, "core") == 0 && strcmp(name, "plugin_path") == 0)
         rc = ld_load_path(E, value);
@@ -708,4 +862,129 @@ int cfg_load_file(silc_engine *E, const char *path)
         return eng_error(E, "%s:%d: %s", path, c.err_line, c.err);
     if (rc == 0) return 0;
     return eng_error(E, "%s:%d: syntax error (expected '[section]' or 'key = value')", path, rc);
+}
+
+/* ---- a silcd session's files ------------------------------------------------- */
+
+int cfg_serve(silc_engine *E, const char *data_dir, int shared, unsigned long session_id)
+{
+    int root, dir;
+    char name[64];
+    E->cfg->serving = 1;
+    if (!data_dir) return 0;
+    /* The operator's own path: resolved as the operating system does. */
+    if ((root = open(data_dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) < 0)
+        return eng_error(E, "silcd --data-dir %s: %s", data_dir, strerror(errno));
+    if (shared) {
+        E->cfg->data_fd = root;
+        return 0;
+    }
+    snprintf(name, sizeof name, "session-%lu", session_id);
+    /* Every rank of silcd --mpi makes it: the first one wins, the rest find it. */
+    if (mkdirat(root, name, 0700) && errno != EEXIST) {
+        int e = errno;
+        close(root);
+        return eng_error(E, "silcd --data-dir %s: cannot create %s: %s", data_dir, name, strerror(e));
+    }
+    dir = openat(root, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    close(root);
+    if (dir < 0) return eng_error(E, "silcd --data-dir %s: cannot open %s: %s", data_dir, name, strerror(errno));
+    E->cfg->data_fd = dir;
+    return 0;
+}
+
+int cfg_serving(const silc_engine *E)
+{
+    if (!E || !E->cfg || !E->cfg->serving) return 0;
+    return E->cfg->data_fd >= 0 ? 2 : 1;
+}
+
+/* The folder and name of the file a statement names: beneath the session's
+ * folder in silcd, as the operating system resolves it when embedded (or
+ * when the operator named it: trusted). */
+static int file_place(silc_engine *E, const char *what, const char *path, int trusted, int writing,
+                      cfg_file *f)
+{
+    char why[256];
+    f->fd = f->dirfd = -1;
+    f->tmp[0] = '\0';
+    if (!path || !*path) return eng_error(E, "%s: no file name", what);
+    if (trusted || !E->cfg->serving) {
+        if ((f->dirfd = util_dir_of(path, f->leaf, sizeof f->leaf)) < 0)
+            return eng_error(E, "%s: cannot %s '%s': %s", what, writing ? "create" : "read", path,
+                             strerror(errno));
+        return 0;
+    }
+    if (E->cfg->data_fd < 0)
+        return eng_error(E, "%s: this silcd keeps no files for sessions (the operator enables them with "
+                            "silcd --data-dir DIR)", what);
+    if ((f->dirfd = util_dir_beneath(E->cfg->data_fd, path, f->leaf, sizeof f->leaf, why, sizeof why)) < 0)
+        return eng_error(E, "%s: '%s' is refused: %s (files are named relative to the session's folder "
+                            "under silcd's --data-dir)", what, path, why);
+    return 0;
+}
+
+int cfg_file_read(silc_engine *E, const char *what, const char *path, cfg_file *f)
+{
+    if (file_place(E, what, path, 0, 0, f)) return -1;
+    /* embedded, a link is the user's own: followed, as the OS would */
+    if ((f->fd = util_open_read_at(f->dirfd, f->leaf, !E->cfg->serving)) < 0) {
+        int e = errno;
+        cfg_file_close(f);
+        if (e == ELOOP && E->cfg->serving)
+            return eng_error(E, "%s: '%s' is refused: %s (files are named relative to the session's "
+                                "folder under silcd's --data-dir)", what, path, UTIL_WHY_SYMLINK);
+        if (e == EMLINK)
+            return eng_error(E, "%s: '%s' is refused: it has other hard links, which could lead out of "
+                                "silcd's --data-dir", what, path);
+        if (e == EINVAL) return eng_error(E, "%s: '%s' is not a regular file", what, path);
+        return eng_error(E, "%s: cannot read '%s': %s", what, path, strerror(e));
+    }
+    return 0;
+}
+
+static int file_write(silc_engine *E, const char *what, const char *path, int trusted, cfg_file *f)
+{
+    if (file_place(E, what, path, trusted, 1, f)) return -1;
+    if ((f->fd = util_tmp_create(f->dirfd, f->leaf, f->tmp, sizeof f->tmp)) < 0) {
+        int e = errno;
+        f->tmp[0] = '\0';
+        cfg_file_close(f);
+        return eng_error(E, "%s: cannot create '%s': %s", what, path, strerror(e));
+    }
+    return 0;
+}
+
+int cfg_file_write(silc_engine *E, const char *what, const char *path, cfg_file *f)
+{
+    return file_write(E, what, path, 0, f);
+}
+
+int cfg_file_write_operator(silc_engine *E, const char *what, const char *path, cfg_file *f)
+{
+    return file_write(E, what, path, 1, f);
+}
+
+int cfg_file_commit(silc_engine *E, const char *what, const char *path, cfg_file *f)
+{
+    int rc = 0;
+    if (f->fd >= 0 && close(f->fd)) rc = eng_error(E, "%s: writing '%s' failed: %s", what, path, strerror(errno));
+    f->fd = -1;
+    /* rename replaces whatever is at the name, a symbolic link included,
+     * and never writes through it */
+    if (!rc && renameat(f->dirfd, f->tmp, f->dirfd, f->leaf))
+        rc = eng_error(E, "%s: cannot replace '%s': %s", what, path, strerror(errno));
+    else if (!rc)
+        f->tmp[0] = '\0';
+    cfg_file_close(f);
+    return rc;
+}
+
+void cfg_file_close(cfg_file *f)
+{
+    if (f->fd >= 0) close(f->fd);
+    if (f->tmp[0] && f->dirfd >= 0) unlinkat(f->dirfd, f->tmp, 0);
+    if (f->dirfd >= 0) close(f->dirfd);
+    f->fd = f->dirfd = -1;
+    f->tmp[0] = '\0';
 }

@@ -3,7 +3,8 @@
  * database, the plugins, the host API handed to them and the dispatcher.
  *
  *   config.c    options database: config file (inih), `set`, per-call options;
- *               key validation with "did you mean"
+ *               key validation with "did you mean"; server vs session
+ *               settings and a silcd session's files (cfg_serve)
  *   loader.c    plugins: built-in reference, dlopen(RTLD_NOW|RTLD_LOCAL) of the
  *               rest, ABI checks, backend look-up by full name
  *   host.c      the silc_host_api table handed to plugins
@@ -38,6 +39,40 @@ void cfg_clear_call_options(silc_engine *E);
 const char *cfg_get(const silc_engine *E, const char *key);
 /* Appends every set key with its value and scope to b (for `set` with no args). */
 void cfg_list(const silc_engine *E, strbuf *b);
+/* Appends the table of server and session settings (for `help set`). */
+void cfg_describe_keys(strbuf *b);
+
+/* Makes E a silcd session's engine (docs/security.md): from now on `set` and
+ * per-call options may not change a server setting, free-form plugin option
+ * strings are sanitized, and the files statements name resolve beneath
+ * data_dir/session-<session_id> (created 0700), or data_dir itself when
+ * shared; data_dir NULL refuses every file statement.  Call it after the
+ * config file was read. */
+int cfg_serve(silc_engine *E, const char *data_dir, int shared, unsigned long session_id);
+/* 0 embedded, 1 a silcd session that keeps no files, 2 one that does. */
+int cfg_serving(const silc_engine *E);
+
+/* A file a statement reads or writes: its folder, its name there, and the
+ * open file (read) or the temporary being written (write). */
+typedef struct cfg_file {
+    int dirfd, fd;
+    char leaf[256];
+    char tmp[300];   /* the temporary's name while one exists, else "" */
+} cfg_file;
+/* path opened for reading (a regular file, not a symbolic link): beneath
+ * the session's folder in silcd, as the operating system resolves it when
+ * embedded.  what ("load") starts every message.  -1 + E->err on refusal. */
+int cfg_file_read(silc_engine *E, const char *what, const char *path, cfg_file *f);
+/* A new temporary beside path (resolved as for cfg_file_read), created
+ * O_EXCL | O_NOFOLLOW; f->fd is open for writing.  cfg_file_commit renames
+ * it over path (a symbolic link there is replaced, not written through);
+ * cfg_file_close alone discards it and leaves path as it was. */
+int cfg_file_write(silc_engine *E, const char *what, const char *path, cfg_file *f);
+/* As cfg_file_write, for a path the operator named (the wisdom file):
+ * resolved as the operating system does, in silcd too. */
+int cfg_file_write_operator(silc_engine *E, const char *what, const char *path, cfg_file *f);
+int cfg_file_commit(silc_engine *E, const char *what, const char *path, cfg_file *f);
+void cfg_file_close(cfg_file *f);
 
 /* ---- loader.c -------------------------------------------------------------- */
 typedef struct ld_backend {

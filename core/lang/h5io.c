@@ -12,13 +12,20 @@
  *                 shape = (m, n)
  *
  * save writes a new file beside the old one and renames it over, so a
- * failed save leaves the old file; load reads every value first and binds
+ * failed save leaves the old file (the new one is created under a fresh name
+ * with O_EXCL | O_NOFOLLOW, so a link planted beside it redirects nothing, and
+ * a link at the name itself is replaced, not written through); load reads every value first and binds
  * them only when all were read, so a failed load changes nothing.  An
  * object that is none of the layouts is an error naming it.  Built only
  * with HDF5 (SILC_HAVE_HDF5); without it both statements say so.
+ *
+ * Which file a name means is the options database's (cfg_file_read,
+ * cfg_file_write: beneath silcd's --data-dir in a server session); HDF5 is
+ * handed the file already opened, as /proc/self/fd/N.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "context.h"
+#include "dispatch.h"
 #include "store.h"
 #include "lang.h"
 #include "util.h"
@@ -183,7 +190,8 @@ static int save_one(silc_engine *E, hid_t file, const char *name, const silc_val
 int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n)
 {
     const char **all = NULL;
-    char tmp[4200];
+    char fdpath[64];
+    cfg_file out;
     hid_t file;
     size_t i, count = n;
     int rc = 0;
@@ -204,16 +212,21 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
             return eng_error(E, "save: '%s' is distributed over ranks; save it from one process", names[i]);
         }
     }
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (cfg_file_write(E, "save", path, &out)) {
+        free(all);
+        return -1;
+    }
+    util_fd_path(out.fd, fdpath, sizeof fdpath);
+    file = H5Fcreate(fdpath, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file < 0) {
+        cfg_file_close(&out);
         free(all);
         return eng_error(E, "save: cannot create '%s' (H5Fcreate)", path);
     }
     for (i = 0; i < count && !rc; i++) rc = save_one(E, file, names[i], store_get(&E->store, names[i]));
     if (H5Fclose(file) < 0 && !rc) rc = eng_error(E, "save: closing '%s' failed (H5Fclose)", path);
-    if (!rc && rename(tmp, path)) rc = eng_error(E, "save: cannot replace '%s'", path);
-    if (rc) remove(tmp);
+    if (!rc) rc = cfg_file_commit(E, "save", path, &out);
+    else cfg_file_close(&out);
     free(all);
     return rc;
 }
@@ -353,13 +366,20 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
 {
     root_names all = {NULL, 0, 0, 0};
     silc_value **got = NULL, **olds = NULL;
+    char fdpath[64];
+    cfg_file in;
     hid_t file;
     size_t i, k, count = n;
     int rc = 0;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    if (access(path, R_OK)) return eng_error(E, "load: cannot read '%s'", path);
-    if (H5Fis_hdf5(path) <= 0) return eng_error(E, "load: '%s' is not an HDF5 file", path);
-    file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (cfg_file_read(E, "load", path, &in)) return -1;
+    util_fd_path(in.fd, fdpath, sizeof fdpath);
+    if (H5Fis_hdf5(fdpath) <= 0) {
+        cfg_file_close(&in);
+        return eng_error(E, "load: '%s' is not an HDF5 file", path);
+    }
+    file = H5Fopen(fdpath, H5F_ACC_RDONLY, H5P_DEFAULT);
+    cfg_file_close(&in); /* HDF5 holds its own descriptor of the same file */
     if (file < 0) return eng_error(E, "load: cannot open '%s' (H5Fopen)", path);
     if (!n) {
         if (H5Literate(file, H5_INDEX_NAME, H5_ITER_INC, NULL, add_name, &all) < 0 || all.failed)

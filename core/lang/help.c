@@ -3,9 +3,11 @@
  * line of usage and a sentence each: what `help` and `help NAME` print, what
  * the REPL completes, and the two tables of the README (test_help checks
  * that the README holds exactly lang_help_markdown's text).  A statement
- * or built-in added to the language gets its row here.
+ * or built-in added to the language gets its row here.  `help set` adds the
+ * options database's table of server and session settings (config.c).
  */
 #include "lang.h"
+#include "dispatch.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -36,7 +38,8 @@ static const help_entry entries[] = {
     {"clear", 1, "`clear`, `clear a b`", "remove names"},
     {"who", 1, "`who`", "names, shapes, formats"},
     {"set", 1, "`set key = value`, `set key`, `set`",
-     "session option (same keys as the config file), show one, list all"},
+     "session option (same keys as the config file), show one, list all; in silcd a server setting "
+     "(core.plugin_path, tune.wisdom, ...: `help set` lists them) is refused"},
     {"info", 1, "`info x`",
      "how `x` was last computed: statement, backend, method, time, backward error, condition estimate, "
      "iterations, factor reuse, warm start, earlier attempts of the fallback chain"},
@@ -49,7 +52,9 @@ static const help_entry entries[] = {
     {"save load", 1, "`save \"f.h5\" [a b ...]`, `load \"f.h5\" [a b ...]`",
      "values to and from HDF5 (all names, or those given): dense as a 2-D dataset, CSR as a group with "
      "`data`, `indices`, `indptr` and a `shape` attribute (scipy's and anndata's layout), band as LAPACK "
-     "storage with `kl`, `ku`; a failed save keeps the old file, a failed load changes no name"},
+     "storage with `kl`, `ku`; a failed save keeps the old file, a failed load changes no name; in silcd the "
+     "file is beneath the session's folder under `silcd --data-dir` (no absolute path, `..` or symbolic "
+     "link), refused without it"},
     {"[", 0, "`[1, 2; 3, 4]`, `[A, b; c', d]`",
      "matrix literal / concatenation: `,` side by side, `;` stacks; `[]` is 0×0 and is skipped in "
      "concatenation; CSR if any block is CSR"},
@@ -132,6 +137,7 @@ int lang_help(strbuf *out, const char *name, char *err, size_t errlen)
             sb_puts(out, "\n    ");
             put_plain(out, entries[i].text);
             sb_puts(out, "\n");
+            if (!strcmp(name, "set")) cfg_describe_keys(out);
             found++;
         }
     if (found) return 0;

@@ -117,6 +117,7 @@ typedef struct tuner {
     int max_rep;
     char signature[24];
     int progress;           /* a progress line is on the terminal */
+    int wisdom_ignored;     /* `tune forget` in silcd: the operator's file is kept, not read */
 } tuner;
 
 /* ---- the model ------------------------------------------------------------- */
@@ -555,17 +556,20 @@ static int mkdirs_for(const char *path)
  * appends the current results. */
 static void wisdom_write(silc_engine *E, tuner *T)
 {
-    char path[1024], tmp[1100], machine[300], prefix[400], line[4096];
+    char path[1024], machine[300], prefix[400], line[4096];
+    cfg_file place;
     FILE *in, *out;
     strbuf b;
     int i;
     tuner_wisdom_path(E, path, sizeof path);
     tuner_machine(machine, sizeof machine);
     snprintf(prefix, sizeof prefix, "%s\t%s\t", machine, T->signature);
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    if (mkdirs_for(path)) return;
-    out = fopen(tmp, "w");
-    if (!out) return;
+    if (mkdirs_for(path) || cfg_file_write_operator(E, "tune", path, &place)) return;
+    if (!(out = fdopen(place.fd, "w"))) {
+        cfg_file_close(&place);
+        return;
+    }
+    place.fd = -1; /* out owns it now */
     fputs("# silc wisdom v1: machine, signature, then 'threads' p_opt a b c q samples\n"
           "# (p:seconds:repeats, comma separated) or 'backend' class winner\n", out);
     in = fopen(path, "r");
@@ -587,7 +591,9 @@ static void wisdom_write(silc_engine *E, tuner *T)
         if (T->tab[i].ncand && T->tab[i].winner >= 0)
             fprintf(out, "%sbackend\t%s\t%s\t%s\n", prefix, T->tab[i].cls,
                     T->tab[i].cand[T->tab[i].winner].backend, T->tab[i].cand[T->tab[i].winner].opts);
-    if (fclose(out) || rename(tmp, path)) remove(tmp);
+    /* a failed write discards the temporary and keeps the old file */
+    if (fclose(out)) cfg_file_close(&place);
+    else cfg_file_commit(E, "tune", path, &place);
 }
 
 /* The setting a variant stands for: an option string ("-i cg -p none") is
@@ -652,6 +658,7 @@ static int wisdom_read(silc_engine *E, tuner *T, const char *sig, int apply)
     FILE *f;
     int found = 0;
     size_t ml;
+    if (T->wisdom_ignored) return 0;
     tuner_wisdom_path(E, path, sizeof path);
     tuner_machine(machine, sizeof machine);
     ml = strlen(machine);
@@ -1362,11 +1369,10 @@ void tuner_explain(silc_engine *E, const silc_call *call, strbuf *b)
 
 /* The plot: measured times as points, f(p) as a curve, p_opt as a dashed
  * line, on a log2 p axis. */
-static int write_svg(const tuner *T, const char *path)
+static int write_svg(const tuner *T, FILE *f)
 {
     const double W = 640, H = 400, L = 70, R = 20, TOP = 40, BOT = 50;
     double pmin = 1e300, pmax = 0, tmax = 0, x0, x1;
-    FILE *f;
     int i;
     for (i = 0; i < T->npts; i++) {
         if (T->pts[i].p < pmin) pmin = T->pts[i].p;
@@ -1382,8 +1388,6 @@ static int write_svg(const tuner *T, const char *path)
     x0 = log2(pmin), x1 = log2(pmax);
 #define SX(p) (L + (log2(p) - x0) / (x1 - x0) * (W - L - R))
 #define SY(t) (TOP + (1 - (t) / tmax) * (H - TOP - BOT))
-    f = fopen(path, "w");
-    if (!f) return -1;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
                "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"12\">\n",
@@ -1431,7 +1435,26 @@ static int write_svg(const tuner *T, const char *path)
     fprintf(f, "</svg>\n");
 #undef SX
 #undef SY
-    return fclose(f) ? -1 : 0;
+    return ferror(f) ? -1 : 0;
+}
+
+/* The plot written to place (cfg_file_write'n beside svg), renamed over svg
+ * when whole; a failed write keeps the old file. */
+static int save_svg(silc_engine *E, const tuner *T, const char *svg, cfg_file *place)
+{
+    FILE *f;
+    int bad;
+    if (!(f = fdopen(place->fd, "w"))) {
+        cfg_file_close(place);
+        return eng_error(E, "tune report: cannot write '%s': %s", svg, strerror(errno));
+    }
+    place->fd = -1; /* f owns it now */
+    bad = write_svg(T, f);
+    if (fclose(f) || bad) {
+        cfg_file_close(place);
+        return eng_error(E, "tune report: cannot write '%s': %s", svg, strerror(errno));
+    }
+    return cfg_file_commit(E, "tune report", svg, place);
 }
 
 static int report(silc_engine *E, tuner *T, const char *svg)
@@ -1439,12 +1462,23 @@ static int report(silc_engine *E, tuner *T, const char *svg)
     strbuf b;
     tuner saved;
     const tuner *show = T;
-    int rc = 0;
+    cfg_file place;
+    /* a silcd that keeps no files still reports, without the plot, unless
+     * the statement named a file */
+    int plot = svg || cfg_serving(E) != 1, rc = 0;
+    if (!svg) svg = "silc-tune.svg";
+    /* the file first: a refused name is refused whatever there is to show */
+    if (plot && cfg_file_write(E, "tune report", svg, &place)) return -1;
     if (!T->npts && T->phase != PH_DONE) {
         /* nothing tuned in this session: show the machine's last wisdom */
         memset(&saved, 0, sizeof saved);
+        saved.wisdom_ignored = T->wisdom_ignored;
         if (!wisdom_read(E, &saved, NULL, 0)) {
             char path[1024];
+            if (plot) cfg_file_close(&place);
+            if (cfg_serving(E))
+                return eng_error(E, "tune report: nothing tuned in this session and no wisdom for "
+                                    "this machine in the operator's wisdom file");
             tuner_wisdom_path(E, path, sizeof path);
             return eng_error(E, "tune report: nothing tuned in this session and no wisdom for "
                                 "this machine in '%s'", path);
@@ -1456,8 +1490,10 @@ static int report(silc_engine *E, tuner *T, const char *svg)
     sb_init(&b);
     sb_puts(&b, "tune report\n");
     describe(E, show, &b);
-    if (write_svg(show, svg))
-        rc = eng_error(E, "tune report: cannot write '%s': %s", svg, strerror(errno));
+    if (!plot)
+        sb_puts(&b, "plot: not written (this silcd keeps no files for sessions: silcd --data-dir)\n");
+    else if (save_svg(E, show, svg, &place))
+        rc = -1;
     else
         sb_printf(&b, "plot = %s\n", svg);
     if (!rc) eng_print(E, sb_str(&b));
@@ -1538,13 +1574,22 @@ int tuner_command(silc_engine *E, const char *word, const double *xs, int nx, co
     }
     if (!strcmp(word, "forget")) {
         char path[1024];
+        if (cfg_serving(E)) {
+            /* the wisdom file is the operator's (a server setting): the
+             * session tunes afresh without it, and the file stays */
+            reset(T);
+            T->wisdom_ignored = 1;
+            eng_print(E, "tune forget: this session's tuning is forgotten and it no longer reads the "
+                         "wisdom file, which is the operator's and was kept\n");
+            return 0;
+        }
         tuner_wisdom_path(E, path, sizeof path);
         if (remove(path) && errno != ENOENT)
             return eng_error(E, "tune forget: cannot remove '%s': %s", path, strerror(errno));
         reset(T);
         return 0;
     }
-    if (!strcmp(word, "report")) return report(E, T, arg && *arg ? arg : "silc-tune.svg");
+    if (!strcmp(word, "report")) return report(E, T, arg && *arg ? arg : NULL);
     return eng_error(E, "unknown tune command '%s' (on, off, status, step, forget, report, fit)",
                      word);
 }

@@ -1,8 +1,9 @@
 /*
  * util.h -- small shared helpers of the core: a growable string buffer, the
- * closest-name suggestion used by every "did you mean" message, and a
- * monotonic clock.  One implementation serves the parser, the config reader
- * and the dispatcher so their messages read alike.
+ * closest-name suggestion used by every "did you mean" message, a
+ * monotonic clock, and (files.c) opening files without following links out
+ * of a root or through a planted temporary.  One implementation serves the
+ * parser, the config reader and the dispatcher so their messages read alike.
  */
 #ifndef SILC_UTIL_H
 #define SILC_UTIL_H
@@ -55,5 +56,34 @@ void util_fmt_double(char *out, size_t outlen, double x);
  * claim (value.c, protocol.c), so a refusal says how far over it is.  need
  * is a double because a claimed size may not fit in 64 bits. */
 void util_fmt_over_limit(char *out, size_t outlen, double need, double limit);
+
+/* ---- files (files.c): opening what a statement names, without being led
+ * elsewhere ---- */
+
+/* Why util_dir_beneath refused a path, as the messages say it. */
+#define UTIL_WHY_ABSOLUTE "an absolute path is not allowed"
+#define UTIL_WHY_DOTDOT "'..' is not allowed"
+#define UTIL_WHY_SYMLINK "it passes through a symbolic link, which is not followed"
+
+/* The folder holding the file rel names beneath the directory rootfd, opened
+ * one component at a time with O_NOFOLLOW | O_DIRECTORY: an absolute path,
+ * '..', a symbolic link or a missing folder is refused with why filled.
+ * Returns the folder's descriptor and the file's own name in leaf, or -1. */
+int util_dir_beneath(int rootfd, const char *rel, char *leaf, size_t leaflen, char *why, size_t whylen);
+/* The folder holding path (resolved as the operating system does: the
+ * caller is its own operator) and the file's own name in leaf; -1 + errno. */
+int util_dir_of(const char *path, char *leaf, size_t leaflen);
+/* A new temporary beside leaf in dirfd, created O_CREAT | O_EXCL | O_NOFOLLOW
+ * under a fresh name (written to tmp): a file or link already there is never
+ * written through.  Returns its descriptor (write-only) or -1 + errno. */
+int util_tmp_create(int dirfd, const char *leaf, char *tmp, size_t tmplen);
+/* leaf in dirfd opened for reading, if it is a regular file (a FIFO does
+ * not block the caller) and, unless follow, neither a symbolic link nor a
+ * file with other hard links; -1 + errno otherwise (EINVAL: not a regular
+ * file, ELOOP: a symbolic link, EMLINK: hard links). */
+int util_open_read_at(int dirfd, const char *leaf, int follow);
+/* "/proc/self/fd/N": a name for an open descriptor that libraries taking a
+ * file name (HDF5) open as that very file. */
+void util_fd_path(int fd, char *out, size_t len);
 
 #endif
