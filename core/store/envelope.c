@@ -584,6 +584,8 @@ static int env_usable(const silc_envelope_t *e, char *err, size_t errlen)
     if (!e) return check_fail(err, errlen, "NULL envelope");
     if (env_not_constructed(e, why, sizeof why))
         return check_fail(err, errlen, "envelope was not constructed: %s", why);
+    if (e->format != SILC_DENSE && e->format != SILC_CSR && e->format != SILC_BAND)
+        return check_fail(err, errlen, "unknown envelope format %d", (int)e->format);
     return 0;
 }
 
