@@ -302,8 +302,8 @@ static int storage_allowed(silc_engine *E, hid_t d, const char *what, const char
     external = H5Pget_external_count(dcpl);
     layout = H5Pget_layout(dcpl);
     if (external != 0)
-        rc = eng_error(E, "load: %s in '%s' has external storage (its data is in %s other file): refused",
-                       what, path, external > 0 ? "an" : "an unknown");
+        rc = eng_error(E, "load: %s in '%s' has external storage (its raw data lives in another file): refused",
+                       what, path);
     else if (layout == H5D_VIRTUAL)
         rc = eng_error(E, "load: %s in '%s' is a virtual dataset (mapped from other datasets or files): refused",
                        what, path);
