@@ -100,6 +100,8 @@ static const row rows[] = {
     LANG("x = 1; v = v + [1; 2]",
          "statement 2: '+' needs operands of the same shape or a scalar: 'v' is 3x1, '[1; 2]' is 2x1"),
     LANG("if (v) { x = 1 }", "condition must be a scalar, got 3x1"),
+    LANG("if (nan) { x = 1 }", "condition is NaN"),
+    LANG("while (0 / 0) { x = 1 }", "condition is NaN"),
     LANG("x = nosuch(1)", "unknown function 'nosuch'"),
     LANG("x = abs(1, 2)", "abs takes 1 argument, got 2"),
     LANG("x = zeros(-1)", "zeros: argument 1 must be an integer >= 0, got -1"),
@@ -195,6 +197,20 @@ static const row rows[] = {
     MMF("%%MatrixMarket matrix coordinate real skew-symmetric\n2 2 1\n1 1 1\n",
         ":3:1: diagonal entry (1, 1) in a skew-symmetric file"),
     MMF("%%MatrixMarket matrix array real general\n2 1\n1\n", ":3: file ends before entry (2, 1)"),
+    /* numbers and symmetry by the format's rules (tests/security/values_mm.c has the full table) */
+    MMF("%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 1.5\n",
+        ":3:5: integer value '1.5' is not an integer"),
+    MMF("%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 0x10\n",
+        ":3:5: integer value '0x10' is not an integer"),
+    MMF("%%MatrixMarket matrix coordinate real general\n1 1 1\n1 1 1e400\n",
+        ":3:5: value '1e400' overflows the doubles (set SILC_MM_ALLOW_NONFINITE=1 to accept it as inf)"),
+    MMF("%%MatrixMarket matrix coordinate real general\n1 1 1\n1 1 nan\n",
+        ":3:5: value 'nan' is not finite (set SILC_MM_ALLOW_NONFINITE=1 to accept it)"),
+    MMF("%%MatrixMarket matrix coordinate real hermitian\n2 2 1\n2 1 3\n",
+        ":1: symmetry 'hermitian' needs a complex field, and this file's is 'real' (say symmetric for a real "
+        "symmetric matrix)"),
+    MMF("%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 4\n1 2 3\n",
+        ":4:1: entry (1, 2) is above the diagonal: a symmetric file stores the lower triangle only"),
     /* sizes claimed by the size line are checked before anything is allocated */
     MMF("%%MatrixMarket matrix array real general\n100000 100000\n1\n",
         ":2: the 100000x100000 array the size line announces needs 80000000000 bytes (74.5 GiB), "
