@@ -185,6 +185,13 @@ static int is_nonfinite_token(const char *s, size_t len)
            (len - k > 3 && !strncasecmp(s + k, "nan(", 4) && s[len - 1] == ')');
 }
 
+/* The token at p for a message: at most 40 bytes, then "...". */
+static const char *token_text(const char *p, size_t len, char *buf, size_t buflen)
+{
+    snprintf(buf, buflen, "%.*s%s", (int)(len < 40 ? len : 40), p, len > 40 ? "..." : "");
+    return buf;
+}
+
 /* Skips white space, then reads one whole integer token within int64.
  * what names the field in messages ("row index", "value"). */
 static int parse_int_token(mm_reader *r, const char **s, const char *what, int64_t *out)
@@ -195,14 +202,13 @@ static int parse_int_token(mm_reader *r, const char **s, const char *what, int64
     long long x;
     while (isspace((unsigned char)*p) && *p != '\n') p++;
     len = token_len(p);
-    snprintf(tok, sizeof tok, "%.*s", (int)(len < 40 ? len : 40), p);
     if (len == 0) return mm_fail_at(r, p, "expected %s, found the end of the line", what);
     if (!is_integer_token(p, len))
-        return mm_fail_at(r, p, "%s '%s%s' is not an integer", what, tok, len > 40 ? "..." : "");
+        return mm_fail_at(r, p, "%s '%s' is not an integer", what, token_text(p, len, tok, sizeof tok));
     errno = 0;
     x = strtoll(p, &end, 10);
     if (errno == ERANGE)
-        return mm_fail_at(r, p, "%s '%s%s' is outside the 64-bit integers", what, tok, len > 40 ? "..." : "");
+        return mm_fail_at(r, p, "%s '%s' is outside the 64-bit integers", what, token_text(p, len, tok, sizeof tok));
     *s = end;
     *out = (int64_t)x;
     return 0;
@@ -225,18 +231,18 @@ static int parse_value_token(mm_reader *r, const char **s, int field, double *ou
     }
     while (isspace((unsigned char)*p) && *p != '\n') p++;
     len = token_len(p);
-    snprintf(tok, sizeof tok, "%.*s", (int)(len < 40 ? len : 40), p);
     if (len == 0) return mm_fail_at(r, p, "expected a value, found the end of the line");
-    nonfinite = is_nonfinite_token(p, len);
-    if (!nonfinite && !is_decimal_token(p, len))
-        return mm_fail_at(r, p, "value '%s%s' is not a decimal number", tok, len > 40 ? "..." : "");
+    nonfinite = !is_decimal_token(p, len);
+    if (nonfinite && !is_nonfinite_token(p, len))
+        return mm_fail_at(r, p, "value '%s' is not a decimal number", token_text(p, len, tok, sizeof tok));
     if (nonfinite && !r->allow_nonfinite)
-        return mm_fail_at(r, p, "value '%s' is not finite (set SILC_MM_ALLOW_NONFINITE=1 to accept it)", tok);
+        return mm_fail_at(r, p, "value '%s' is not finite (set SILC_MM_ALLOW_NONFINITE=1 to accept it)",
+                          token_text(p, len, tok, sizeof tok));
     errno = 0;
     *out = strtod(p, &end);
     if (errno == ERANGE && isinf(*out) && !r->allow_nonfinite)
-        return mm_fail_at(r, p, "value '%s%s' overflows the doubles (set SILC_MM_ALLOW_NONFINITE=1 to accept "
-                                "it as inf)", tok, len > 40 ? "..." : "");
+        return mm_fail_at(r, p, "value '%s' overflows the doubles (set SILC_MM_ALLOW_NONFINITE=1 to accept "
+                                "it as inf)", token_text(p, len, tok, sizeof tok));
     *s = end;
     return 0;
 }
