@@ -193,7 +193,10 @@ int val_parts_claim(const val_parts *p, char *err, size_t errlen)
                               (long long)p->n);
         break;
     case SILC_FMT_CSR:
-        if (p->nnz < 0 || dense_count(p->nnz, 2) < 0 || dense_count(p->m + 1, 1) < 0 || p->m == INT64_MAX)
+        if (p->m >= INT64_MAX / 16 || dense_count(p->m + 1, 1) < 0)
+            return check_fail(err, errlen, "invalid size %lldx%lld: too many rows", (long long)p->m,
+                              (long long)p->n);
+        if (p->nnz < 0 || dense_count(p->nnz, 2) < 0)
             return check_fail(err, errlen, "a %lldx%lld csr value cannot have %lld entries",
                               (long long)p->m, (long long)p->n, (long long)p->nnz);
         break;
