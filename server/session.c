@@ -308,23 +308,39 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
     silc_value *v = NULL;
     const silc_value *old;
     uint64_t used, old_bytes;
-    char why[256];
+    val_parts claim;
+    double cost;
+    char why[512];
     int rc;
     if (api_check_name(q->text, S->err, sizeof S->err)) {
         if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
         return reply_error(S, S->err);
     }
+    /* The descriptor's claim, by the checker every value passes
+     * (val_parts_claim): overflow and the value limit, with band storage
+     * charged for its rows, before a byte of the arrays is read. */
+    memset(&claim, 0, sizeof claim);
+    claim.format = (int)q->desc.format;
+    claim.m = q->desc.m, claim.n = q->desc.n, claim.nnz = q->desc.nnz;
+    claim.kl = q->desc.kl, claim.ku = q->desc.ku;
+    if (claim.format != SILC_FMT_CSR) claim.nnz = 0;
+    if (val_parts_claim(&claim, why, sizeof why)) {
+        snprintf(S->err, sizeof S->err, "'%s': %s", q->text, why);
+        if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
+        return reply_error(S, S->err);
+    }
+    cost = val_parts_bytes(&claim);
+    if (cost < (double)q->layout.total) cost = (double)q->layout.total;
     if (srv_cfg.max_session_bytes > 0) {
         used = session_bytes(S->E);
         old = store_get(&S->E->store, q->text);
         old_bytes = old ? val_bytes(old) : 0;
-        if (used - old_bytes + q->layout.total > srv_cfg.max_session_bytes) {
+        if ((double)(used - old_bytes) + cost > (double)srv_cfg.max_session_bytes) {
             if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
-                     "(%llu bytes) would bring the session to %llu bytes, the limit is %llu "
-                     "bytes (silcd --max-session-bytes); '%s' is unchanged", q->text,
-                     (unsigned long long)q->layout.total,
-                     (unsigned long long)(used - old_bytes + q->layout.total),
+                     "(%.0f bytes) would bring the session to %.0f bytes, the limit is %llu "
+                     "bytes (silcd --max-session-bytes); '%s' is unchanged", q->text, cost,
+                     (double)(used - old_bytes) + cost,
                      (unsigned long long)srv_cfg.max_session_bytes, q->text);
             return reply_error(S, S->err);
         }

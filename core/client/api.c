@@ -280,7 +280,10 @@ int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e)
     if (!name) return ctx_error(ctx, "silc_put: NULL name");
     if (!e) return ctx_error(ctx, "silc_put: NULL envelope for '%s'", name);
     if (api_check_name(name, ctx->err, sizeof ctx->err)) return ctx_result(ctx, -1);
+    if (env_not_constructed(e, err, sizeof err))
+        return ctx_error(ctx, "envelope '%s' was not constructed: %s", name, err);
     if (ctx->R) {
+        /* The same checks as embedded, before anything is sent. */
         if (env_check(e, err, sizeof err)) return ctx_error(ctx, "'%s': %s", name, err);
         return ctx_result(ctx, rem_put(ctx->R, name, e, ctx->err, sizeof ctx->err));
     }
@@ -310,6 +313,8 @@ int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const 
     if (!name) rc = ctx_error(ctx, "silc_put_rows: NULL name");
     else if (!e) rc = ctx_error(ctx, "silc_put_rows: NULL envelope for '%s'", name);
     else if (api_check_name(name, ctx->err, sizeof ctx->err)) rc = -1;
+    else if (env_not_constructed(e, err, sizeof err))
+        rc = ctx_error(ctx, "envelope '%s' was not constructed: %s", name, err);
     else if (first_row < 0) rc = ctx_error(ctx, "silc_put_rows '%s': first row %lld is negative", name, (long long)first_row);
     else if (env_to_value(e, &v, err, sizeof err)) rc = ctx_error(ctx, "'%s': %s", name, err);
     if (!ctx->E || !ctx->E->dist) {

@@ -16,6 +16,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +40,7 @@ typedef struct mm_reader {
     char *err;
     size_t errlen;
     int failed;            /* a message is set: later ones would only follow from it */
+    int allow_nonfinite;   /* SILC_MM_ALLOW_NONFINITE=1: inf, nan and overflow read as IEEE values */
 } mm_reader;
 
 /* Formats "path:line: message" into the caller's buffer and the context-free
@@ -60,6 +62,28 @@ static int mm_fail(mm_reader *r, int64_t line, const char *fmt, ...)
     va_end(ap);
     if (line > 0) env_error("%s:%lld: %s", r->path, (long long)line, msg);
     else env_error("%s: %s", r->path, msg);
+    if (r->err && r->errlen) snprintf(r->err, r->errlen, "%s", env_error_last());
+    return -1;
+}
+
+/* mm_fail at the column of position at in the current line:
+ * "path:line:column: message". */
+static int mm_fail_at(mm_reader *r, const char *at, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static int mm_fail_at(mm_reader *r, const char *at, const char *fmt, ...)
+{
+    char msg[700];
+    va_list ap;
+    if (r->failed) return -1;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    r->failed = 1;
+    env_error("%s:%lld:%lld: %s", r->path, (long long)r->lineno, (long long)(at - r->line) + 1, msg);
     if (r->err && r->errlen) snprintf(r->err, r->errlen, "%s", env_error_last());
     return -1;
 }
@@ -106,23 +130,119 @@ static char *mm_next_data_line(mm_reader *r)
     }
 }
 
-static int parse_index(const char **s, int64_t *out)
+/* ---- tokens, by the format's rules --------------------------------------
+ * Matrix Market numbers are decimal: an integer is [+-]digits within int64;
+ * a real is [+-]digits[.digits][(e|E)[+-]digits] (or with the digits after
+ * the point only).  strtod alone would also take hex ("0x10"), "inf" and
+ * "nan", and strtoll would stop silently at "1.5"'s point; each token is
+ * therefore matched whole first, and a refusal names its line:column. */
+
+/* Length of the token at s (up to white space). */
+static size_t token_len(const char *s)
 {
-    char *end;
+    size_t n = 0;
+    while (s[n] && !isspace((unsigned char)s[n])) n++;
+    return n;
+}
+
+/* 1 when s[0..len) is [+-]digits. */
+static int is_integer_token(const char *s, size_t len)
+{
+    size_t k = (len > 0 && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+    if (k == len) return 0;
+    for (; k < len; k++)
+        if (!isdigit((unsigned char)s[k])) return 0;
+    return 1;
+}
+
+/* 1 when s[0..len) is a decimal real as above. */
+static int is_decimal_token(const char *s, size_t len)
+{
+    size_t k = 0, digits = 0;
+    if (k < len && (s[k] == '+' || s[k] == '-')) k++;
+    while (k < len && isdigit((unsigned char)s[k])) k++, digits++;
+    if (k < len && s[k] == '.') {
+        k++;
+        while (k < len && isdigit((unsigned char)s[k])) k++, digits++;
+    }
+    if (!digits) return 0;
+    if (k < len && (s[k] == 'e' || s[k] == 'E')) {
+        size_t exp_digits = 0;
+        k++;
+        if (k < len && (s[k] == '+' || s[k] == '-')) k++;
+        while (k < len && isdigit((unsigned char)s[k])) k++, exp_digits++;
+        if (!exp_digits) return 0;
+    }
+    return k == len;
+}
+
+/* 1 when s[0..len) spells an infinity or a NaN (as strtod reads them). */
+static int is_nonfinite_token(const char *s, size_t len)
+{
+    size_t k = (len > 0 && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+    return (len - k == 3 && (!strncasecmp(s + k, "inf", 3) || !strncasecmp(s + k, "nan", 3))) ||
+           (len - k == 8 && !strncasecmp(s + k, "infinity", 8)) ||
+           (len - k > 3 && !strncasecmp(s + k, "nan(", 4) && s[len - 1] == ')');
+}
+
+/* The token at p for a message: at most 40 bytes, then "...". */
+static const char *token_text(const char *p, size_t len, char *buf, size_t buflen)
+{
+    snprintf(buf, buflen, "%.*s%s", (int)(len < 40 ? len : 40), p, len > 40 ? "..." : "");
+    return buf;
+}
+
+/* Skips white space, then reads one whole integer token within int64.
+ * what names the field in messages ("row index", "value"). */
+static int parse_int_token(mm_reader *r, const char **s, const char *what, int64_t *out)
+{
+    const char *p = *s;
+    char *end, tok[64];
+    size_t len;
     long long x;
+    while (isspace((unsigned char)*p) && *p != '\n') p++;
+    len = token_len(p);
+    if (len == 0) return mm_fail_at(r, p, "expected %s, found the end of the line", what);
+    if (!is_integer_token(p, len))
+        return mm_fail_at(r, p, "%s '%s' is not an integer", what, token_text(p, len, tok, sizeof tok));
     errno = 0;
-    x = strtoll(*s, &end, 10);
-    if (end == *s || errno) return -1;
+    x = strtoll(p, &end, 10);
+    if (errno == ERANGE)
+        return mm_fail_at(r, p, "%s '%s' is outside the 64-bit integers", what, token_text(p, len, tok, sizeof tok));
     *s = end;
     *out = (int64_t)x;
     return 0;
 }
 
-static int parse_double(const char **s, double *out)
+/* Skips white space, then reads one value token of the field: an integer
+ * for integer fields, a decimal real for real ones; infinities, NaNs and
+ * reals beyond the doubles only when the reader allows non-finite values. */
+static int parse_value_token(mm_reader *r, const char **s, int field, double *out)
 {
-    char *end;
-    *out = strtod(*s, &end);
-    if (end == *s) return -1;
+    const char *p = *s;
+    char *end, tok[64];
+    size_t len;
+    int nonfinite;
+    if (field == MM_INTEGER) {
+        int64_t x;
+        if (parse_int_token(r, s, "integer value", &x)) return -1;
+        *out = (double)x;
+        return 0;
+    }
+    while (isspace((unsigned char)*p) && *p != '\n') p++;
+    len = token_len(p);
+    if (len == 0) return mm_fail_at(r, p, "expected a value, found the end of the line");
+    nonfinite = !is_decimal_token(p, len);
+    if (nonfinite && !is_nonfinite_token(p, len))
+        return mm_fail_at(r, p, "value '%s' is not a decimal number", token_text(p, len, tok, sizeof tok));
+    if (nonfinite && !r->allow_nonfinite)
+        return mm_fail_at(r, p, "value '%s' is not finite (set SILC_MM_ALLOW_NONFINITE=1 to accept it)",
+                          token_text(p, len, tok, sizeof tok));
+    errno = 0;
+    *out = strtod(p, &end);
+    if (errno == ERANGE && isinf(*out) && !r->allow_nonfinite)
+        return mm_fail_at(r, p, "value '%s' overflows the doubles (set SILC_MM_ALLOW_NONFINITE=1 to accept "
+                                "it as inf)", token_text(p, len, tok, sizeof tok));
     *s = end;
     return 0;
 }
@@ -153,9 +273,14 @@ static int mm_banner(mm_reader *r, int *is_array, int *field, int *sym)
     else if (strcasecmp(w[3], "pattern") == 0) *field = MM_PATTERN;
     else if (strcasecmp(w[3], "complex") == 0) return mm_fail(r, 1, "complex matrices are not supported yet");
     else return mm_fail(r, 1, "unknown field '%s' (expected real, integer or pattern)", w[3]);
-    /* For a real matrix "hermitian" means symmetric. */
+    /* Hermitian is a property of complex matrices only, which are refused
+     * above: a real, integer or pattern file that says hermitian is
+     * malformed (its writer meant something this reader cannot know). */
     if (strcasecmp(w[4], "general") == 0) *sym = MM_GENERAL;
-    else if (strcasecmp(w[4], "symmetric") == 0 || strcasecmp(w[4], "hermitian") == 0) *sym = MM_SYMMETRIC;
+    else if (strcasecmp(w[4], "symmetric") == 0) *sym = MM_SYMMETRIC;
+    else if (strcasecmp(w[4], "hermitian") == 0)
+        return mm_fail(r, 1, "symmetry 'hermitian' needs a complex field, and this file's is '%s' "
+                             "(say symmetric for a real symmetric matrix)", w[3]);
     else if (strcasecmp(w[4], "skew-symmetric") == 0) *sym = MM_SKEW;
     else return mm_fail(r, 1, "unknown symmetry '%s' (expected general, symmetric or skew-symmetric)", w[4]);
     if (*is_array && *field == MM_PATTERN) return mm_fail(r, 1, "an array file cannot have field 'pattern'");
@@ -184,7 +309,7 @@ static int mm_claim(int is_array, int64_t m, int64_t n, int64_t nz, int sym)
 
 /* Reads the array body (column-major; symmetric files hold the lower
  * triangle column by column, skew-symmetric ones without the diagonal). */
-static int mm_read_array(mm_reader *r, silc_envelope_t *e, int64_t m, int64_t n, int sym)
+static int mm_read_array(mm_reader *r, silc_envelope_t *e, int64_t m, int64_t n, int field, int sym)
 {
     int64_t i, j;
     double *a;
@@ -204,9 +329,10 @@ static int mm_read_array(mm_reader *r, silc_envelope_t *e, int64_t m, int64_t n,
                 return mm_fail(r, r->lineno, "file ends before entry (%lld, %lld)", (long long)i + 1,
                                (long long)j + 1);
             }
-            if (parse_double(&p, &x) || !only_space(p)) {
+            if (parse_value_token(r, &p, field, &x) ||
+                (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), "expected one number per line"))) {
                 silc_envelope_free(e);
-                return mm_fail(r, r->lineno, "expected one number");
+                return -1;
             }
             a[i + j * m] = x;
             if (sym == MM_SYMMETRIC) a[j + i * m] = x;
@@ -308,20 +434,33 @@ static int mm_read_coordinate(mm_reader *r, silc_envelope_t *e, int64_t m, int64
             triplets_free(&t);
             return mm_fail(r, r->lineno, "file ends after %lld of %lld entries", (long long)k, (long long)nz);
         }
-        if (parse_index(&p, &i) || parse_index(&p, &j) ||
-            (field != MM_PATTERN && parse_double(&p, &x)) || !only_space(p)) {
+        const char *start = p;
+        if (parse_int_token(r, &p, "row index", &i) || parse_int_token(r, &p, "column index", &j) ||
+            (field != MM_PATTERN && parse_value_token(r, &p, field, &x)) ||
+            (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), "unexpected text after '%s'",
+                                          field == MM_PATTERN ? "row column" : "row column value"))) {
             triplets_free(&t);
-            return mm_fail(r, r->lineno, "expected '%s'", field == MM_PATTERN ? "row column" : "row column value");
+            return -1;
         }
         if (i < 1 || i > m || j < 1 || j > n) {
             triplets_free(&t);
-            return mm_fail(r, r->lineno, "entry (%lld, %lld) is outside the %lldx%lld matrix",
-                           (long long)i, (long long)j, (long long)m, (long long)n);
+            return mm_fail_at(r, start, "entry (%lld, %lld) is outside the %lldx%lld matrix",
+                              (long long)i, (long long)j, (long long)m, (long long)n);
         }
         if (sym == MM_SKEW && i == j) {
             triplets_free(&t);
-            return mm_fail(r, r->lineno, "diagonal entry (%lld, %lld) in a skew-symmetric file",
-                           (long long)i, (long long)j);
+            return mm_fail_at(r, start, "diagonal entry (%lld, %lld) in a skew-symmetric file",
+                              (long long)i, (long long)j);
+        }
+        /* The format stores the lower triangle of a symmetric or
+         * skew-symmetric matrix; an entry above it is refused rather than
+         * mirrored, since the file then says A(i,j) where it may also say
+         * A(j,i) differently. */
+        if (sym != MM_GENERAL && i < j) {
+            triplets_free(&t);
+            return mm_fail_at(r, start, "entry (%lld, %lld) is above the diagonal: a %s file stores the "
+                                        "lower triangle only", (long long)i, (long long)j,
+                              sym == MM_SKEW ? "skew-symmetric" : "symmetric");
         }
         t.i[t.n] = i - 1;
         t.j[t.n] = j - 1;
@@ -351,25 +490,27 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
     const char *p;
     memset(&r, 0, sizeof r);
     r.path = path ? path : "(null)";
+    r.allow_nonfinite = getenv("SILC_MM_ALLOW_NONFINITE") && !strcmp(getenv("SILC_MM_ALLOW_NONFINITE"), "1");
     r.err = err;
     r.errlen = errlen;
     if (err && errlen) err[0] = '\0';
     if (!e) return mm_fail(&r, 0, "NULL envelope");
     memset(e, 0, sizeof *e);
-    if (!path) return mm_fail(&r, 0, "NULL path");
+    if (!path) return mm_fail(&r, 0, "NULL path"), env_mark_not_constructed(e);
     r.f = fopen(path, "r");
-    if (!r.f) return mm_fail(&r, 0, "cannot open: %s", strerror(errno));
+    if (!r.f) return mm_fail(&r, 0, "cannot open: %s", strerror(errno)), env_mark_not_constructed(e);
     rc = mm_banner(&r, &is_array, &field, &sym);
     if (rc == 0) {
         p = mm_next_data_line(&r);
         if (!p) rc = mm_fail(&r, r.lineno, "file ends before the size line");
-        else if (parse_index(&p, &m) || parse_index(&p, &n) || (!is_array && parse_index(&p, &nz)) ||
-                 !only_space(p) || m < 0 || n < 0 || nz < 0)
+        else if (parse_int_token(&r, &p, "row count", &m) || parse_int_token(&r, &p, "column count", &n) ||
+                 (!is_array && parse_int_token(&r, &p, "entry count", &nz)) || !only_space(p) || m < 0 ||
+                 n < 0 || nz < 0)
             rc = mm_fail(&r, r.lineno, "expected the size line '%s'", is_array ? "rows cols" : "rows cols entries");
         else if (mm_claim(is_array, m, n, nz, sym))
             rc = mm_fail(&r, r.lineno, "%s", val_refusal());
         else if (is_array)
-            rc = mm_read_array(&r, e, m, n, sym);
+            rc = mm_read_array(&r, e, m, n, field, sym);
         else
             rc = mm_read_coordinate(&r, e, m, n, nz, field, sym);
     }
@@ -377,6 +518,16 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
         silc_envelope_free(e);
         rc = -1;
     }
+    if (rc == 0) { /* what every value handed to SILC passes (val_parts_check) */
+        char why[512];
+        if (env_check(e, why, sizeof why)) {
+            silc_envelope_free(e);
+            rc = mm_fail(&r, 0, "%s", why);
+        }
+    }
+    /* A failed read leaves e as a failed constructor does: a PUT of it is
+     * refused with this message. */
+    if (rc) env_mark_not_constructed(e);
     free(r.line);
     fclose(r.f);
     return rc;

@@ -463,6 +463,7 @@ static int run_one(silc_engine *E, silc_call *call, const ld_backend *b)
     if (call->op == SILC_OP_SOLVE) report_reset(E, call->report);
     t0 = util_now();
     rc = b->backend->ops[call->op].run(call);
+    if (rc == SILC_OK) rc = host_check_result(call);
     if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
         call->report->seconds = util_now() - t0;
         snprintf(call->report->backend, sizeof call->report->backend, "%s", b->full_name);

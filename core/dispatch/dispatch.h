@@ -127,6 +127,9 @@ int disp_check_configured(silc_engine *E);
 
 /* ---- host.c ---------------------------------------------------------------- */
 const silc_host_api *host_api(void);
+/* SILC_OK, or SILC_EINTERNAL with the reason in the call's error when the
+ * result the plugin returned breaks its own claim (val_check_value). */
+int host_check_result(silc_call *call);
 /* The thread budget host->threads() reports; set by ld_set_threads. */
 void host_set_threads(int nthreads);
 /* Per-call bookkeeping behind call->host_private. */

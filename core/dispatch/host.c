@@ -297,6 +297,19 @@ static const silc_host_api host_table = {
     h_cancelled,
 };
 
+int host_check_result(silc_call *call)
+{
+    host_call_ctx *ctx = call->host_private;
+    char why[512];
+    /* A plugin builds its result with the host's constructors but fills
+     * the arrays itself: what it returns is checked as a PUT is
+     * (val_check_value), so a broken backend cannot bind a CSR value whose
+     * rowptr runs past its entries. */
+    if (!call->out || val_check_value(call->out, why, sizeof why) == 0) return SILC_OK;
+    if (ctx) snprintf(ctx->err, sizeof ctx->err, "returned a malformed result: %s", why);
+    return SILC_EINTERNAL;
+}
+
 const silc_host_api *host_api(void)
 {
     return &host_table;

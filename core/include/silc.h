@@ -73,7 +73,12 @@ typedef enum {
 
 /* A matrix in transit between the program and SILC.  Fields are readable; build
  * envelopes with the constructors below.  rowptr/colind are int64 whatever width
- * the caller gave. */
+ * the caller gave.  A hand-filled envelope must tell the truth about its arrays:
+ * a CSR one holds m+1 row pointers and nnz entries in colind and values
+ * (silc_put refuses rowptr[m] != nnz, but cannot see an array shorter than m
+ * says).  A constructor that fails leaves the envelope marked as not
+ * constructed (no arrays; free it or not): silc_put refuses it with
+ * "envelope 'A' was not constructed: <the constructor's message>". */
 typedef struct silc_envelope_t {
     int64_t m, n;
     silc_format_t format;
@@ -108,7 +113,13 @@ SILC_API void silc_envelope_free(silc_envelope_t *e);
 
 /* Matrix Market: read coordinate (real, integer, pattern; general, symmetric,
  * skew-symmetric) into CSR, or array into dense.  Complex files are refused with
- * a message.  Write: dense as array, CSR/band as coordinate general, %.17g. */
+ * a message.  Read by the format's rules, with "path:line:column: ..." messages:
+ * integer fields take integers within int64, reals are decimal (no hex), inf,
+ * nan and reals that overflow are refused unless the environment sets
+ * SILC_MM_ALLOW_NONFINITE=1, "hermitian" needs a complex field, and a symmetric
+ * or skew-symmetric file stores only the lower triangle (an entry above it is
+ * refused).  A failed read leaves e not constructed, as a failed constructor.
+ * Write: dense as array, CSR/band as coordinate general, %.17g. */
 SILC_API int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
 SILC_API int silc_mm_write(const silc_envelope_t *e, FILE *out);
 
@@ -131,10 +142,15 @@ SILC_API int silc_open(silc_context **out, const char *config_path);
 SILC_API int silc_open_remote(silc_context **out, const char *url);
 SILC_API void silc_close(silc_context **ctx);
 /* Binds a copy of e to name (the envelope stays the caller's).  The copy is
- * checked as it is made: a CSR envelope's rowptr must start at 0 and never
- * decrease, and each row's columns lie in [0, n) and strictly increase (the
- * constructors guarantee this; a hand-filled envelope gets a message naming
- * the row).  The same pass records what `\` asks of a matrix first
+ * checked as it is made, by the checker every value from outside passes (a
+ * remote context checks before sending, so the messages are the same): the
+ * claimed size first, against overflow and the value limit (silcd
+ * --max-value-bytes and the session's --max-session-bytes remotely; a band
+ * value is charged for its rows too), then a CSR envelope's rowptr must start
+ * at 0, never decrease and end at nnz, and each row's columns lie in [0, n)
+ * and strictly increase (the constructors guarantee this; a hand-filled
+ * envelope gets a message naming the row).  An envelope whose constructor
+ * failed is refused: "envelope 'A' was not constructed: ...".  The same pass records what `\` asks of a matrix first
  * (triangles, band widths, positive diagonal, NaN/Inf): on bcsstk16 the put
  * takes 0.85 ms and the solve that follows needs no pass of its own for it.
  * On failure name keeps its old value. */
@@ -144,7 +160,10 @@ SILC_API int silc_exec(silc_context *ctx, const char *statements);
 /* The statements `save "path" names` and `load "path" names` (HDF5; README
  * "Saving and loading"): names is a space-separated list, NULL or "" for
  * every name (save) or every object of the file (load).  A failed save
- * leaves the old file, a failed load changes no name.  On a remote context
+ * leaves the old file, a failed load changes no name.  load reads a file as
+ * untrusted input: no external link is followed, datasets with external
+ * storage and virtual datasets are refused, index datasets must be integers,
+ * and every shape is checked against the value limit before any read.  On a remote context
  * path is on the server's machine. */
 SILC_API int silc_save(silc_context *ctx, const char *path, const char *names);
 SILC_API int silc_load(silc_context *ctx, const char *path, const char *names);

@@ -1137,14 +1137,19 @@ static int condition(lang_ev *V, const ast_node *c, int *truth)
 {
     silc_value *v;
     char shape[48];
+    double x;
     if (ev_expr(V, c, &v)) return -1;
     if (!val_is_scalar(v)) {
         ev_shape(v, shape, sizeof shape);
         val_release(v);
         return eng_error(V->E, "condition must be a scalar, got %s", shape);
     }
-    *truth = val_scalar(v) != 0;
+    x = val_scalar(v);
     val_release(v);
+    /* NaN != 0 holds, so `if nan` would run its block and `while nan`
+     * loop for ever: an error, as Octave's `if NaN`. */
+    if (isnan(x)) return eng_error(V->E, "condition is NaN");
+    *truth = x != 0;
     return 0;
 }
 

@@ -112,9 +112,13 @@ static int get_attr_i64(hid_t obj, const char *name, int64_t *v, hssize_t count)
     hssize_t n;
     int rc = -1;
     if (H5Aexists(obj, name) <= 0 || (a = H5Aopen(obj, name, H5P_DEFAULT)) < 0) return -1;
+    hid_t t = H5Aget_type(a);
+    /* Integers only: a float shape or width would be truncated. */
+    int integer = t >= 0 && H5Tget_class(t) == H5T_INTEGER;
+    if (t >= 0) H5Tclose(t);
     sp = H5Aget_space(a);
     n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
-    if (n >= 1 && n <= count && H5Aread(a, H5T_NATIVE_INT64, v) >= 0) rc = (int)n;
+    if (integer && n >= 1 && n <= count && H5Aread(a, H5T_NATIVE_INT64, v) >= 0) rc = (int)n;
     if (sp >= 0) H5Sclose(sp);
     H5Aclose(a);
     return rc;
@@ -231,113 +235,276 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
     return rc;
 }
 
-/* ---- load ---------------------------------------------------------------------- */
+/* ---- load ----------------------------------------------------------------------
+ * A file is input: it may be crafted.  Every object is read through these
+ * checks (docs/security.md, "Values handed to SILC"):
+ *   - links: only hard and soft links are followed, and no open follows an
+ *     external link (the access lists refuse traversal), so a name cannot
+ *     make SILC open another file;
+ *   - storage: a dataset with external storage (H5Pset_external: raw data
+ *     in some other file) or a virtual one (mapped from other datasets or
+ *     files) is refused, naming it;
+ *   - claims: the shape an object announces (its dataspace, its shape, kl
+ *     and ku attributes) is checked by the checker every value passes
+ *     (val_parts_claim: overflow, the value limit) before anything is
+ *     allocated or read;
+ *   - indices: indptr and indices must be integer datasets (a float index
+ *     would be truncated) and attributes integers;
+ *   - CSR arrays are read into the value itself and checked as a PUT's
+ *     (val_parts_fill: indptr from 0, monotone, ending at len(data); columns
+ *     in range and increasing). */
+
+/* External links are never traversed while loading. */
+static herr_t refuse_external_link(const char *parent_file, const char *parent_group, const char *child_file,
+                                   const char *child_object, unsigned *flags, hid_t fapl, void *op_data)
+{
+    (void)parent_file, (void)parent_group, (void)child_file, (void)child_object, (void)flags, (void)fapl,
+        (void)op_data;
+    return -1;
+}
+
+/* The property lists of a load: link, group and dataset access, each
+ * refusing external links. */
+typedef struct h5_access {
+    hid_t link, group, dataset;
+} h5_access;
+
+static int access_open(h5_access *a)
+{
+    a->link = H5Pcreate(H5P_LINK_ACCESS);
+    a->group = H5Pcreate(H5P_GROUP_ACCESS);
+    a->dataset = H5Pcreate(H5P_DATASET_ACCESS);
+    if (a->link < 0 || a->group < 0 || a->dataset < 0 ||
+        H5Pset_elink_cb(a->link, refuse_external_link, NULL) < 0 ||
+        H5Pset_elink_cb(a->group, refuse_external_link, NULL) < 0 ||
+        H5Pset_elink_cb(a->dataset, refuse_external_link, NULL) < 0)
+        return -1;
+    return 0;
+}
+
+static void access_close(h5_access *a)
+{
+    if (a->link >= 0) H5Pclose(a->link);
+    if (a->group >= 0) H5Pclose(a->group);
+    if (a->dataset >= 0) H5Pclose(a->dataset);
+}
+
+/* 0 when the link name in loc stays in this file (hard or soft), else -1
+ * with E->err naming it (what: "'A'" or "'A/indices'"). */
+static int link_allowed(silc_engine *E, hid_t loc, const char *name, const char *what, const char *path)
+{
+    H5L_info_t li;
+    if (H5Lget_info(loc, name, &li, H5P_DEFAULT) < 0)
+        return eng_error(E, "load: cannot read the link %s in '%s'", what, path);
+    if (li.type == H5L_TYPE_EXTERNAL)
+        return eng_error(E, "load: %s in '%s' is an external link (to an object of another file): refused",
+                         what, path);
+    if (li.type != H5L_TYPE_HARD && li.type != H5L_TYPE_SOFT)
+        return eng_error(E, "load: %s in '%s' is a user-defined link: refused", what, path);
+    return 0;
+}
+
+/* 0 when dataset d keeps its data in this file in an ordinary layout, else
+ * -1 with E->err naming it. */
+static int storage_allowed(silc_engine *E, hid_t d, const char *what, const char *path)
+{
+    hid_t dcpl = H5Dget_create_plist(d);
+    int external, rc = 0;
+    H5D_layout_t layout;
+    if (dcpl < 0) return eng_error(E, "load: cannot read how %s in '%s' is stored", what, path);
+    external = H5Pget_external_count(dcpl);
+    layout = H5Pget_layout(dcpl);
+    if (external != 0)
+        rc = eng_error(E, "load: %s in '%s' has external storage (its raw data lives in another file): refused",
+                       what, path);
+    else if (layout == H5D_VIRTUAL)
+        rc = eng_error(E, "load: %s in '%s' is a virtual dataset (mapped from other datasets or files): refused",
+                       what, path);
+    else if (layout < 0)
+        rc = eng_error(E, "load: cannot read the layout of %s in '%s'", what, path);
+    H5Pclose(dcpl);
+    return rc;
+}
+
+/* The type class of dataset d (H5T_INTEGER, H5T_FLOAT, ...), or -1. */
+static int dataset_class(hid_t d)
+{
+    hid_t t = H5Dget_type(d);
+    int c = t >= 0 ? (int)H5Tget_class(t) : -1;
+    if (t >= 0) H5Tclose(t);
+    return c;
+}
+
+/* A checked claim, with the reason as "load: 'A' in 'f.h5': ..." */
+static int claim_allowed(silc_engine *E, const val_parts *p, const char *name, const char *path)
+{
+    char why[512];
+    if (val_parts_claim(p, why, sizeof why) == 0) return 0;
+    return eng_error(E, "load: '%s' in '%s': %s", name, path, why);
+}
+
+/* CSR: the group g holding data, indices, indptr and a shape attribute. */
+static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const char *path, const char *name)
+{
+    static const char *const parts[3] = {"data", "indices", "indptr"};
+    hid_t d[3] = {-1, -1, -1};
+    hssize_t len[3] = {-1, -1, -1};
+    int64_t shape[2];
+    silc_value *v = NULL;
+    val_parts claim;
+    char what[3][300], why[512];
+    int k, rc = 0;
+    if (get_attr_i64(g, "shape", shape, 2) != 2 || shape[0] < 0 || shape[1] < 0) {
+        eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, indptr "
+                     "and an integer shape attribute (m, n)", name, path);
+        return NULL;
+    }
+    for (k = 0; !rc && k < 3; k++) {
+        hid_t sp;
+        snprintf(what[k], sizeof what[k], "'%s/%s'", name, parts[k]);
+        if (H5Lexists(g, parts[k], acc->link) <= 0) {
+            rc = eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, "
+                              "indptr and a shape attribute (%s is missing)", name, path, what[k]);
+            break;
+        }
+        if ((rc = link_allowed(E, g, parts[k], what[k], path))) break;
+        if ((d[k] = H5Dopen2(g, parts[k], acc->dataset)) < 0) {
+            rc = eng_error(E, "load: cannot open %s in '%s'", what[k], path);
+            break;
+        }
+        if ((rc = storage_allowed(E, d[k], what[k], path))) break;
+        sp = H5Dget_space(d[k]);
+        if (sp < 0 || H5Sget_simple_extent_ndims(sp) != 1)
+            rc = eng_error(E, "load: %s in '%s' must be a 1-D dataset", what[k], path);
+        else
+            len[k] = H5Sget_simple_extent_npoints(sp);
+        if (sp >= 0) H5Sclose(sp);
+        if (!rc && k > 0 && dataset_class(d[k]) != H5T_INTEGER)
+            rc = eng_error(E, "load: %s in '%s' is not an integer dataset: indices must be integers "
+                              "(a float index would be truncated)", what[k], path);
+        if (!rc && k == 0 && dataset_class(d[k]) != H5T_FLOAT && dataset_class(d[k]) != H5T_INTEGER)
+            rc = eng_error(E, "load: %s in '%s' must hold numbers", what[k], path);
+    }
+    if (!rc && len[1] != len[0])
+        rc = eng_error(E, "load: '%s' in '%s': indices has %lld entries but data has %lld", name, path,
+                       (long long)len[1], (long long)len[0]);
+    if (!rc && len[2] != shape[0] + 1)
+        rc = eng_error(E, "load: '%s' in '%s': indptr has %lld entries but shape (%lld, %lld) needs %lld",
+                       name, path, (long long)len[2], (long long)shape[0], (long long)shape[1],
+                       (long long)shape[0] + 1);
+    memset(&claim, 0, sizeof claim);
+    claim.format = SILC_FMT_CSR, claim.m = shape[0], claim.n = shape[1], claim.nnz = len[0];
+    /* The claim is checked before anything is allocated or read. */
+    if (!rc) rc = claim_allowed(E, &claim, name, path);
+    if (!rc && !(v = val_new_unset(SILC_FMT_CSR, claim.m, claim.n, claim.nnz, 0, 0)))
+        rc = eng_error(E, "load: out of memory for '%s'", name);
+    if (!rc && ((claim.nnz > 0 && (H5Dread(d[0], H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->val) < 0 ||
+                                   H5Dread(d[1], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->colind) < 0)) ||
+                H5Dread(d[2], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->rowptr) < 0))
+        rc = eng_error(E, "load: reading '%s' in '%s' failed (H5Dread)", name, path);
+    if (!rc) { /* the arrays, in place, as a PUT's */
+        claim.rowptr = v->rowptr, claim.colind = v->colind, claim.values = v->val;
+        if (val_parts_fill(v, &claim, why, sizeof why)) rc = eng_error(E, "load: '%s' in '%s': %s", name, path, why);
+    }
+    for (k = 0; k < 3; k++)
+        if (d[k] >= 0) H5Dclose(d[k]);
+    if (rc) {
+        val_release(v);
+        return NULL;
+    }
+    return v;
+}
+
+/* Dense (a 1-D or 2-D dataset of numbers) or band (silc-format = "band"). */
+static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const char *name)
+{
+    hid_t sp = H5Dget_space(d);
+    hsize_t dims[2] = {0, 1};
+    int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1, cls = dataset_class(d);
+    char fmt[16], what[300];
+    silc_value *v = NULL;
+    val_parts claim;
+    double *buf = NULL;
+    int rc = 0;
+    if (sp >= 0) H5Sclose(sp);
+    snprintf(what, sizeof what, "'%s'", name);
+    if (rank < 1 || rank > 2 || (cls != H5T_FLOAT && cls != H5T_INTEGER))
+        return eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or 2-D array of numbers",
+                         name, path), NULL;
+    if (storage_allowed(E, d, what, path)) return NULL;
+    sp = H5Dget_space(d);
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+    H5Sclose(sp);
+    if (dims[0] > INT64_MAX || dims[1] > INT64_MAX)
+        return eng_error(E, "load: '%s' in '%s' has more rows or columns than SILC can index", name, path), NULL;
+    get_attr_str(d, "silc-format", fmt, sizeof fmt);
+    memset(&claim, 0, sizeof claim);
+    if (!strcmp(fmt, "band")) {
+        int64_t kl, ku, shape[2];
+        if (get_attr_i64(d, "kl", &kl, 1) != 1 || get_attr_i64(d, "ku", &ku, 1) != 1 ||
+            get_attr_i64(d, "shape", shape, 2) != 2 || kl < 0 || ku < 0 || kl > INT32_MAX || ku > INT32_MAX ||
+            rank != 2 || dims[0] != (hsize_t)(kl + ku + 1) || dims[1] != (hsize_t)shape[1] || shape[0] < 0)
+            return eng_error(E, "load: '%s' in '%s' is not a SILC band value: it needs integer kl, ku and shape "
+                                "attributes and kl+ku+1 rows of n columns", name, path), NULL;
+        claim.format = SILC_FMT_BAND, claim.m = shape[0], claim.n = shape[1], claim.kl = kl, claim.ku = ku;
+    } else {
+        claim.format = SILC_FMT_DENSE, claim.m = (int64_t)dims[0], claim.n = (int64_t)dims[1];
+    }
+    /* The claim (band: its rows too) before anything is allocated or read;
+     * band storage is then stored diagonals times columns. */
+    if (claim_allowed(E, &claim, name, path)) return NULL;
+    if (!(v = val_new_unset(claim.format, claim.m, claim.n, 0, claim.kl, claim.ku)) ||
+        !(buf = malloc((size_t)(dims[0] * dims[1] > 0 ? dims[0] * dims[1] : 1) * sizeof *buf)))
+        rc = eng_error(E, "load: out of memory reading '%s'", name);
+    if (!rc && dims[0] * dims[1] > 0 && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+        rc = eng_error(E, "load: reading '%s' in '%s' failed (H5Dread)", name, path);
+    if (!rc) { /* row-major (rows, n) into column-major */
+        int64_t i, j, r = (int64_t)dims[0], c = (int64_t)dims[1];
+        for (i = 0; i < r; i++)
+            for (j = 0; j < c; j++) v->val[i + j * r] = buf[i * c + j];
+    }
+    free(buf);
+    if (rc) {
+        val_release(v);
+        return NULL;
+    }
+    return v;
+}
 
 /* The value of the object name of file, or NULL with E->err naming it. */
 static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const char *name)
 {
     H5O_info_t info;
+    h5_access acc = {-1, -1, -1};
     silc_value *v = NULL;
-    int64_t shape[2];
-    if (H5Lexists(file, name, H5P_DEFAULT) <= 0) {
+    char what[300];
+    snprintf(what, sizeof what, "'%s'", name);
+    if (access_open(&acc)) {
+        access_close(&acc);
+        eng_error(E, "load: out of memory (HDF5 property lists)");
+        return NULL;
+    }
+    if (H5Lexists(file, name, acc.link) <= 0) {
         eng_error(E, "load: '%s' is not in '%s'", name, path);
-        return NULL;
-    }
-    if (H5Oget_info_by_name2(file, name, &info, H5O_INFO_BASIC, H5P_DEFAULT) < 0) {
-        eng_error(E, "load: cannot read '%s' in '%s'", name, path);
-        return NULL;
-    }
-    if (info.type == H5O_TYPE_GROUP) {
-        /* CSR: data, indices, indptr and shape, as scipy / anndata write it */
-        hid_t g = H5Gopen2(file, name, H5P_DEFAULT), d[3] = {-1, -1, -1};
-        static const char *const parts[3] = {"data", "indices", "indptr"};
-        hssize_t len[3];
-        silc_envelope_t e;
-        double *data = NULL;
-        int64_t *indices = NULL, *indptr = NULL;
-        char err[512];
-        int k, ok = g >= 0 && get_attr_i64(g, "shape", shape, 2) == 2 && shape[0] >= 0 && shape[1] >= 0;
-        for (k = 0; ok && k < 3; k++) {
-            hid_t sp;
-            ok = H5Lexists(g, parts[k], H5P_DEFAULT) > 0 && (d[k] = H5Dopen2(g, parts[k], H5P_DEFAULT)) >= 0;
-            sp = ok ? H5Dget_space(d[k]) : -1;
-            ok = ok && sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1;
-            len[k] = ok ? H5Sget_simple_extent_npoints(sp) : -1;
-            if (sp >= 0) H5Sclose(sp);
-        }
-        if (!ok || len[0] != len[1] || len[2] != shape[0] + 1) {
-            eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, indptr "
-                         "(%s) and a shape attribute", name, path, ok ? "of matching lengths" : "1-D");
-        } else if (!(data = malloc((size_t)(len[0] ? len[0] : 1) * sizeof *data)) ||
-                   !(indices = malloc((size_t)(len[1] ? len[1] : 1) * sizeof *indices)) ||
-                   !(indptr = malloc((size_t)len[2] * sizeof *indptr))) {
-            eng_error(E, "load: out of memory reading '%s'", name);
-        } else if (H5Dread(d[0], H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0 ||
-                   H5Dread(d[1], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, indices) < 0 ||
-                   H5Dread(d[2], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, indptr) < 0) {
-            eng_error(E, "load: reading '%s' in '%s' failed (H5Dread)", name, path);
+    } else if (link_allowed(E, file, name, what, path) == 0) {
+        if (H5Oget_info_by_name2(file, name, &info, H5O_INFO_BASIC, acc.link) < 0) {
+            eng_error(E, "load: cannot read '%s' in '%s'", name, path);
+        } else if (info.type == H5O_TYPE_GROUP) {
+            hid_t g = H5Gopen2(file, name, acc.group);
+            if (g < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
+            else v = load_csr(E, &acc, g, path, name);
+            if (g >= 0) H5Gclose(g);
+        } else if (info.type == H5O_TYPE_DATASET) {
+            hid_t d = H5Dopen2(file, name, acc.dataset);
+            if (d < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
+            else v = load_dataset(E, d, path, name);
+            if (d >= 0) H5Dclose(d);
         } else {
-            /* The envelope's checks, as a PUT's: rowptr, column range, order. */
-            memset(&e, 0, sizeof e);
-            e.m = shape[0], e.n = shape[1], e.format = SILC_CSR, e.nnz = len[0];
-            e.values = data, e.rowptr = indptr, e.colind = indices;
-            if (env_to_value(&e, &v, err, sizeof err))
-                eng_error(E, "load: '%s' in '%s': %s", name, path, err);
+            eng_error(E, "load: '%s' in '%s' is not a SILC value (neither a dataset nor a group)", name, path);
         }
-        for (k = 0; k < 3; k++)
-            if (d[k] >= 0) H5Dclose(d[k]);
-        if (g >= 0) H5Gclose(g);
-        free(data), free(indices), free(indptr);
-        return v;
     }
-    if (info.type == H5O_TYPE_DATASET) {
-        hid_t d = H5Dopen2(file, name, H5P_DEFAULT), sp = d >= 0 ? H5Dget_space(d) : -1, t = -1;
-        hsize_t dims[2] = {0, 1};
-        int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1, numeric;
-        char fmt[16];
-        double *buf = NULL;
-        if (rank >= 1 && rank <= 2) H5Sget_simple_extent_dims(sp, dims, NULL);
-        t = d >= 0 ? H5Dget_type(d) : -1;
-        numeric = t >= 0 && (H5Tget_class(t) == H5T_FLOAT || H5Tget_class(t) == H5T_INTEGER);
-        get_attr_str(d, "silc-format", fmt, sizeof fmt);
-        if (rank < 1 || rank > 2 || !numeric) {
-            eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or 2-D array of numbers",
-                      name, path);
-        } else if (!strcmp(fmt, "band")) {
-            int64_t kl, ku;
-            if (get_attr_i64(d, "kl", &kl, 1) != 1 || get_attr_i64(d, "ku", &ku, 1) != 1 ||
-                get_attr_i64(d, "shape", shape, 2) != 2 || kl < 0 || ku < 0 || rank != 2 ||
-                dims[0] != (hsize_t)(kl + ku + 1) || dims[1] != (hsize_t)shape[1] || shape[0] < 0)
-                eng_error(E, "load: '%s' in '%s' is not a SILC band value: it needs kl, ku and shape attributes "
-                             "and kl+ku+1 rows of n columns", name, path);
-            else if (!(v = val_band_new(shape[0], shape[1], kl, ku)))
-                eng_error(E, "load: out of memory for '%s'", name);
-        } else if (!(v = val_dense_new((int64_t)dims[0], (int64_t)dims[1]))) {
-            eng_error(E, "load: out of memory for '%s'", name);
-        }
-        if (v && !(buf = malloc((size_t)(dims[0] * dims[1] > 0 ? dims[0] * dims[1] : 1) * sizeof *buf))) {
-            val_release(v);
-            v = NULL;
-            eng_error(E, "load: out of memory reading '%s'", name);
-        }
-        if (v && dims[0] * dims[1] > 0 && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
-            val_release(v);
-            v = NULL;
-            eng_error(E, "load: reading '%s' in '%s' failed (H5Dread)", name, path);
-        }
-        if (v) { /* row-major (rows, n) into column-major */
-            int64_t i, j, r = (int64_t)dims[0], c = (int64_t)dims[1];
-            for (i = 0; i < r; i++)
-                for (j = 0; j < c; j++) v->val[i + j * r] = buf[i * c + j];
-        }
-        free(buf);
-        if (t >= 0) H5Tclose(t);
-        if (sp >= 0) H5Sclose(sp);
-        if (d >= 0) H5Dclose(d);
-        return v;
-    }
-    eng_error(E, "load: '%s' in '%s' is not a SILC value (neither a dataset nor a group)", name, path);
-    return NULL;
+    access_close(&acc);
+    return v;
 }
 
 /* The names of file's root, for a load of everything. */

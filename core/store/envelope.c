@@ -37,6 +37,61 @@ void env_error_forget(void)
     env_err_live = 0;
 }
 
+/* ---- envelopes that failed to be built ------------------------------------
+ * A constructor that fails leaves its envelope marked (format
+ * ENV_NOT_CONSTRUCTED, nnz a serial number) rather than as a 0x0 dense
+ * value, so that a PUT of it is refused with the constructor's message
+ * instead of binding an empty matrix.  The messages of the last few
+ * failures of this thread are kept by serial number. */
+#define ENV_NOT_CONSTRUCTED 0x4e6f7442 /* no silc_format_t */
+#define ENV_FAILED_KEPT 16
+static _Thread_local char env_failed_msg[ENV_FAILED_KEPT][512];
+static _Thread_local int64_t env_failed_serial;
+
+/* Marks e as not constructed with the thread's last message; returns -1. */
+static int env_mark_failed(silc_envelope_t *e)
+{
+    if (!e) return -1;
+    memset(e, 0, sizeof *e);
+    e->format = (silc_format_t)ENV_NOT_CONSTRUCTED;
+    e->nnz = ++env_failed_serial;
+    snprintf(env_failed_msg[e->nnz % ENV_FAILED_KEPT], sizeof env_failed_msg[0], "%.500s",
+             env_err_live ? env_err : "its constructor failed");
+    return -1;
+}
+
+int env_mark_not_constructed(silc_envelope_t *e)
+{
+    return env_mark_failed(e);
+}
+
+/* env_error, then e marked as not constructed. */
+static int env_failed(silc_envelope_t *e, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static int env_failed(silc_envelope_t *e, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(env_err, sizeof env_err, fmt, ap);
+    va_end(ap);
+    env_err_live = 1;
+    return env_mark_failed(e);
+}
+
+int env_not_constructed(const silc_envelope_t *e, char *err, size_t errlen)
+{
+    if (!e || (int)e->format != ENV_NOT_CONSTRUCTED) return 0;
+    if (e->nnz > 0 && e->nnz <= env_failed_serial && env_failed_serial - e->nnz < ENV_FAILED_KEPT)
+        snprintf(err, errlen, "%s", env_failed_msg[e->nnz % ENV_FAILED_KEPT]);
+    else
+        snprintf(err, errlen, "its constructor failed (the message is no longer kept)");
+    return 1;
+}
+
 /* Element count of an m x n array of doubles, or -1 if it cannot be allocated. */
 static int64_t dense_count(int64_t m, int64_t n)
 {
@@ -61,12 +116,12 @@ int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *
     memset(e, 0, sizeof *e);
     count = dense_count(m, n);
     if (count < 0)
-        return env_error("silc_envelope_dense: invalid size %lldx%lld", (long long)m, (long long)n);
+        return env_failed(e, "silc_envelope_dense: invalid size %lldx%lld", (long long)m, (long long)n);
     if (val_claim((double)count * sizeof(double), "the envelope"))
-        return env_error("silc_envelope_dense: %lldx%lld: %s", (long long)m, (long long)n,
+        return env_failed(e, "silc_envelope_dense: %lldx%lld: %s", (long long)m, (long long)n,
                          val_refusal());
     e->values = copy_array(colmajor, count, sizeof(double));
-    if (!e->values) return env_error("silc_envelope_dense: out of memory for %lldx%lld",
+    if (!e->values) return env_failed(e, "silc_envelope_dense: out of memory for %lldx%lld",
                                      (long long)m, (long long)n);
     e->m = m;
     e->n = n;
@@ -85,61 +140,188 @@ int silc_envelope_vector(silc_envelope_t *e, int64_t n, const double *x)
     return silc_envelope_dense(e, n, 1, x);
 }
 
-/* Checks the size, rowptr, and that the arrays its last entry counts exist. */
-static int csr_check_rowptr(int64_t m, int64_t n, const int64_t *rowptr, const int64_t *colind,
-                            const double *values, char *err, size_t errlen)
+/* ---- the checked constructor ----------------------------------------------
+ * Every value handed to SILC from outside is described as val_parts and
+ * passes here: envelopes of silc_put / SILC_PUT (embedded, and checked by the
+ * remote client before it sends), PUT descriptors and arrays in silcd, HDF5
+ * `load`, Matrix Market files, and the results plugins return.  The claim
+ * (format, shape, entry count) is checked first, with overflow-safe
+ * arithmetic and against the value limit, so that nothing is allocated or
+ * read for a value that cannot be; then the arrays: rowptr starts at 0,
+ * never decreases and ends at nnz (so every later read stays inside the
+ * nnz entries the caller has), and each row's columns lie in [0, n).
+ * Messages print sizes and indices, never an address. */
+
+static int check_fail(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static int check_fail(char *err, size_t errlen, const char *fmt, ...)
 {
-    int64_t i, nnz;
-    if (m < 0 || n < 0) {
-        snprintf(err, errlen, "invalid size %lldx%lld", (long long)m, (long long)n);
-        return -1;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* Element count of band storage, (kl+ku+1)*n, or -1. */
+static int64_t band_count(int64_t n, int64_t kl, int64_t ku)
+{
+    if (kl < 0 || ku < 0 || kl > INT32_MAX || ku > INT32_MAX) return -1;
+    return dense_count(kl + ku + 1, n);
+}
+
+double val_parts_bytes(const val_parts *p)
+{
+    return val_shape_bytes(p->format, p->m, p->n, p->nnz, p->kl, p->ku);
+}
+
+int val_parts_claim(const val_parts *p, char *err, size_t errlen)
+{
+    char what[160];
+    if (p->format != SILC_FMT_DENSE && p->format != SILC_FMT_CSR && p->format != SILC_FMT_BAND)
+        return check_fail(err, errlen, "unknown format %d", p->format);
+    if (p->m < 0 || p->n < 0)
+        return check_fail(err, errlen, "invalid size %lldx%lld", (long long)p->m, (long long)p->n);
+    switch (p->format) {
+    case SILC_FMT_DENSE:
+        if (dense_count(p->m, p->n) < 0)
+            return check_fail(err, errlen, "invalid size %lldx%lld: m*n overflows", (long long)p->m,
+                              (long long)p->n);
+        break;
+    case SILC_FMT_CSR:
+        if (p->m >= INT64_MAX / 16 || dense_count(p->m + 1, 1) < 0)
+            return check_fail(err, errlen, "invalid size %lldx%lld: too many rows", (long long)p->m,
+                              (long long)p->n);
+        if (p->nnz < 0 || dense_count(p->nnz, 2) < 0)
+            return check_fail(err, errlen, "a %lldx%lld csr value cannot have %lld entries",
+                              (long long)p->m, (long long)p->n, (long long)p->nnz);
+        break;
+    default:
+        if (band_count(p->n, p->kl, p->ku) < 0)
+            return check_fail(err, errlen, "invalid band size %lldx%lld with kl = %lld, ku = %lld",
+                              (long long)p->m, (long long)p->n, (long long)p->kl, (long long)p->ku);
+        break;
     }
-    if (!rowptr) {
-        snprintf(err, errlen, "rowptr is NULL");
-        return -1;
-    }
-    if (rowptr[0] != 0) {
-        snprintf(err, errlen, "rowptr[0] is %lld, must be 0", (long long)rowptr[0]);
-        return -1;
-    }
-    for (i = 0; i < m; i++) {
-        if (rowptr[i + 1] < rowptr[i]) {
-            snprintf(err, errlen, "rowptr decreases at row %lld (rowptr[%lld] = %lld > rowptr[%lld] = %lld)",
-                     (long long)i, (long long)i, (long long)rowptr[i], (long long)(i + 1),
-                     (long long)rowptr[i + 1]);
-            return -1;
-        }
-    }
-    nnz = rowptr[m];
-    if (nnz > 0 && (!colind || !values)) {
-        snprintf(err, errlen, "%s is NULL but rowptr[m] = %lld", colind ? "values" : "colind",
-                 (long long)nnz);
-        return -1;
-    }
-    if (dense_count(nnz, 1) < 0) {
-        snprintf(err, errlen, "too many entries (%lld)", (long long)nnz);
-        return -1;
-    }
+    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)p->m, (long long)p->n,
+             val_format_name(p->format));
+    if (p->format == SILC_FMT_CSR)
+        snprintf(what + strlen(what), sizeof what - strlen(what), " of %lld entries", (long long)p->nnz);
+    if (val_claim(val_parts_bytes(p), what)) return check_fail(err, errlen, "%s", val_refusal());
     return 0;
 }
 
-/* Checks rowptr and column range.  Sortedness is checked by the callers,
- * which differ: the constructor sorts, env_to_value insists. */
-static int csr_check_structure(int64_t m, int64_t n, const int64_t *rowptr,
-                               const int64_t *colind, const double *values,
-                               char *err, size_t errlen)
+/* The rows of a CSR claim whose rowptr is known good: columns in [0, n)
+ * and, when sorted is set, strictly increasing (the constructors sort
+ * instead). */
+static int csr_check_columns(const val_parts *p, int sorted, char *err, size_t errlen)
 {
     int64_t i, k;
-    if (csr_check_rowptr(m, n, rowptr, colind, values, err, errlen)) return -1;
-    for (i = 0; i < m; i++)
-        for (k = rowptr[i]; k < rowptr[i + 1]; k++)
-            if (colind[k] < 0 || colind[k] >= n) {
-                snprintf(err, errlen, "column index %lld out of range [0, %lld) in row %lld",
-                         (long long)colind[k], (long long)n, (long long)i);
-                return -1;
-            }
+    for (i = 0; i < p->m; i++)
+        for (k = p->rowptr[i]; k < p->rowptr[i + 1]; k++) {
+            if (p->colind[k] < 0 || p->colind[k] >= p->n)
+                return check_fail(err, errlen, "column index %lld out of range [0, %lld) in row %lld",
+                                  (long long)p->colind[k], (long long)p->n, (long long)i);
+            if (sorted && k > p->rowptr[i] && p->colind[k - 1] >= p->colind[k])
+                return check_fail(err, errlen, "columns of row %lld are %s (build CSR envelopes "
+                                  "with silc_envelope_csr, which sorts them)", (long long)i,
+                                  p->colind[k - 1] == p->colind[k] ? "duplicated" : "not sorted");
+        }
     return 0;
 }
+
+/* The claim, then rowptr: 0 first, never decreasing, nnz last, and the
+ * arrays its entries need present. */
+static int csr_check_rowptr(const val_parts *p, char *err, size_t errlen)
+{
+    int64_t i;
+    if (val_parts_claim(p, err, errlen)) return -1;
+    if (!p->rowptr) return check_fail(err, errlen, "rowptr is NULL");
+    if (p->rowptr[0] != 0)
+        return check_fail(err, errlen, "rowptr[0] is %lld, must be 0", (long long)p->rowptr[0]);
+    for (i = 0; i < p->m; i++)
+        if (p->rowptr[i + 1] < p->rowptr[i])
+            return check_fail(err, errlen, "rowptr decreases at row %lld (rowptr[%lld] = %lld > rowptr[%lld] = %lld)",
+                              (long long)i, (long long)i, (long long)p->rowptr[i], (long long)(i + 1),
+                              (long long)p->rowptr[i + 1]);
+    if (p->rowptr[p->m] != p->nnz)
+        return check_fail(err, errlen, "rowptr[m] = %lld but the value has %lld entries (nnz): "
+                          "m or rowptr is wrong", (long long)p->rowptr[p->m], (long long)p->nnz);
+    if (p->nnz > 0 && (!p->colind || !p->values))
+        return check_fail(err, errlen, "%s is NULL but rowptr[m] = %lld", p->colind ? "values" : "colind",
+                          (long long)p->nnz);
+    return 0;
+}
+
+int val_parts_check(const val_parts *p, char *err, size_t errlen)
+{
+    if (p->format == SILC_FMT_CSR)
+        return csr_check_rowptr(p, err, errlen) ? -1 : csr_check_columns(p, 1, err, errlen);
+    if (val_parts_claim(p, err, errlen)) return -1;
+    if (!p->values && (p->format == SILC_FMT_DENSE ? p->m * p->n : band_count(p->n, p->kl, p->ku)) > 0)
+        return check_fail(err, errlen, "%s value has no values (freed or never built?)",
+                          p->format == SILC_FMT_DENSE ? "dense" : "band");
+    return 0;
+}
+
+int val_parts_fill(silc_value *v, const val_parts *p, char *err, size_t errlen)
+{
+    if (csr_check_rowptr(p, err, errlen)) return -1;
+    if (val_csr_fill_checked(v, p->rowptr, p->colind, p->values) == 0) return 0;
+    /* The fast pass only knows that a row failed; the plain check finds it
+     * again and says how. */
+    if (csr_check_columns(p, 1, err, errlen) == 0)
+        check_fail(err, errlen, "CSR arrays refused with no reason found (internal error)");
+    return -1;
+}
+
+int val_from_parts(const val_parts *p, silc_value **out, char *err, size_t errlen)
+{
+    silc_value *v;
+    *out = NULL;
+    if (p->format == SILC_FMT_CSR) {
+        /* rowptr first, for the size; the entries are checked while copied,
+         * not in a pass of their own (val_parts_fill). */
+        if (csr_check_rowptr(p, err, errlen)) return -1;
+        v = val_new_unset(SILC_FMT_CSR, p->m, p->n, p->nnz, 0, 0);
+        if (v && val_parts_fill(v, p, err, errlen)) {
+            val_release(v);
+            return -1;
+        }
+    } else {
+        int64_t count;
+        if (val_parts_check(p, err, errlen)) return -1;
+        count = p->format == SILC_FMT_DENSE ? p->m * p->n : band_count(p->n, p->kl, p->ku);
+        v = val_new_unset(p->format, p->m, p->n, 0, p->kl, p->ku);
+        if (v && count > 0) memcpy(v->val, p->values, (size_t)count * sizeof(double));
+    }
+    if (!v)
+        return check_fail(err, errlen, "%s", val_refusal()[0] ? val_refusal() : "out of memory");
+    *out = v;
+    return 0;
+}
+
+int val_check_value(const silc_value *v, char *err, size_t errlen)
+{
+    val_parts p;
+    if (!v) return check_fail(err, errlen, "no value");
+    if (v->dist) return val_check_value(v->dist->block, err, errlen);
+    memset(&p, 0, sizeof p);
+    p.format = v->format, p.m = v->m, p.n = v->n, p.kl = v->kl, p.ku = v->ku;
+    p.rowptr = v->rowptr, p.colind = v->colind, p.values = v->val;
+    p.nnz = v->format == SILC_FMT_CSR ? v->nnz : 0;
+    if (v->format == SILC_FMT_CSR && v->nnz > v->cap)
+        return check_fail(err, errlen, "%lld entries in use but room for %lld", (long long)v->nnz,
+                          (long long)v->cap);
+    if (v->format == SILC_FMT_BAND && v->ld != v->kl + v->ku + 1)
+        return check_fail(err, errlen, "band storage of %lld rows for kl = %lld, ku = %lld", (long long)v->ld,
+                          (long long)v->kl, (long long)v->ku);
+    return val_parts_check(&p, err, errlen);
+}
+
 
 typedef struct col_val {
     int64_t col;
@@ -207,19 +389,23 @@ static int envelope_csr_own(silc_envelope_t *e, const char *fn, int64_t m, int64
     char msg[512];
     int64_t nnz;
     double *vals;
-    if (csr_check_structure(m, n, rowptr, colind, values, msg, sizeof msg)) {
-        free(rowptr), free(colind);
-        return env_error("%s: %s", fn, msg);
+    val_parts p;
+    memset(&p, 0, sizeof p);
+    p.format = SILC_FMT_CSR, p.m = m, p.n = n, p.nnz = rowptr[m];
+    p.rowptr = rowptr, p.colind = colind, p.values = values;
+    if (csr_check_rowptr(&p, msg, sizeof msg) || csr_check_columns(&p, 0, msg, sizeof msg)) {
+        val_array_free(rowptr), val_array_free(colind);
+        return env_failed(e, "%s: %s", fn, msg);
     }
     nnz = rowptr[m];
     vals = copy_array(values, nnz, sizeof(double));
     if (!vals) {
-        free(rowptr), free(colind);
-        return env_error("%s: out of memory for %lld entries", fn, (long long)nnz);
+        val_array_free(rowptr), val_array_free(colind);
+        return env_failed(e, "%s: out of memory for %lld entries", fn, (long long)nnz);
     }
     if (csr_sort_rows(m, rowptr, colind, vals, msg, sizeof msg)) {
-        free(rowptr), free(colind), free(vals);
-        return env_error("%s: %s", fn, msg);
+        val_array_free(rowptr), val_array_free(colind), val_array_free(vals);
+        return env_failed(e, "%s: %s", fn, msg);
     }
     e->m = m;
     e->n = n;
@@ -241,15 +427,15 @@ static int csr_args(const char *fn, silc_envelope_t *e, int64_t m, int64_t n, co
     if (!e) return env_error("%s: NULL envelope", fn);
     memset(e, 0, sizeof *e);
     if (m < 0 || n < 0 || dense_count(m + 1, 1) < 0)
-        return env_error("%s: invalid size %lldx%lld", fn, (long long)m, (long long)n);
-    if (!rowptr) return env_error("%s: rowptr is NULL", fn);
+        return env_failed(e, "%s: invalid size %lldx%lld", fn, (long long)m, (long long)n);
+    if (!rowptr) return env_failed(e, "%s: rowptr is NULL", fn);
     /* rowptr[m] is only trusted after the structure check; copying up to it
      * first is safe because a negative or huge count is rejected here. */
     *nnz = last(rowptr, m);
     if (*nnz < 0 || dense_count(*nnz, 1) < 0)
-        return env_error("%s: rowptr[m] = %lld is not a valid entry count", fn, (long long)*nnz);
+        return env_failed(e, "%s: rowptr[m] = %lld is not a valid entry count", fn, (long long)*nnz);
     if (*nnz > 0 && !colind)
-        return env_error("%s: colind is NULL but rowptr[m] = %lld", fn, (long long)*nnz);
+        return env_failed(e, "%s: colind is NULL but rowptr[m] = %lld", fn, (long long)*nnz);
     return 0;
 }
 
@@ -271,8 +457,8 @@ int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *r
     rp = copy_array(rowptr, m + 1, sizeof *rp);
     ci = copy_array(colind, nnz, sizeof *ci);
     if (!rp || !ci) {
-        free(rp), free(ci);
-        return env_error("silc_envelope_csr: out of memory for %lld entries", (long long)nnz);
+        val_array_free(rp), val_array_free(ci);
+        return env_failed(e, "silc_envelope_csr: out of memory for %lld entries", (long long)nnz);
     }
     return envelope_csr_own(e, "silc_envelope_csr", m, n, rp, ci, values);
 }
@@ -286,19 +472,12 @@ int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t 
     rp = copy_array(NULL, m + 1, sizeof *rp);
     ci = copy_array(NULL, nnz, sizeof *ci);
     if (!rp || !ci) {
-        free(rp), free(ci);
-        return env_error("silc_envelope_csr32: out of memory for %lld entries", (long long)nnz);
+        val_array_free(rp), val_array_free(ci);
+        return env_failed(e, "silc_envelope_csr32: out of memory for %lld entries", (long long)nnz);
     }
     for (k = 0; k <= m; k++) rp[k] = rowptr[k];
     for (k = 0; k < nnz; k++) ci[k] = colind[k];
     return envelope_csr_own(e, "silc_envelope_csr32", m, n, rp, ci, values);
-}
-
-/* Band storage size ld*n, or -1. */
-static int64_t band_count(int64_t n, int64_t kl, int64_t ku)
-{
-    if (kl < 0 || ku < 0 || kl > INT32_MAX || ku > INT32_MAX) return -1;
-    return dense_count(kl + ku + 1, n);
 }
 
 int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
@@ -309,13 +488,13 @@ int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int
     memset(e, 0, sizeof *e);
     count = band_count(n, kl, ku);
     if (m < 0 || count < 0)
-        return env_error("silc_envelope_band: invalid size %lldx%lld with kl = %lld, ku = %lld",
+        return env_failed(e, "silc_envelope_band: invalid size %lldx%lld with kl = %lld, ku = %lld",
                          (long long)m, (long long)n, (long long)kl, (long long)ku);
     if (val_claim((double)count * sizeof(double), "the envelope"))
-        return env_error("silc_envelope_band: %lldx%lld with kl = %lld, ku = %lld: %s",
+        return env_failed(e, "silc_envelope_band: %lldx%lld with kl = %lld, ku = %lld: %s",
                          (long long)m, (long long)n, (long long)kl, (long long)ku, val_refusal());
     e->values = copy_array(band, count, sizeof(double));
-    if (!e->values) return env_error("silc_envelope_band: out of memory");
+    if (!e->values) return env_failed(e, "silc_envelope_band: out of memory");
     e->m = m;
     e->n = n;
     e->format = SILC_BAND;
@@ -338,7 +517,10 @@ int64_t silc_envelope_cols(const silc_envelope_t *e)
 int silc_envelope_to_dense(const silc_envelope_t *e, double *out)
 {
     int64_t i, j, k, count;
+    char why[512];
     if (!e || !out) return env_error("silc_envelope_to_dense: NULL %s", e ? "output array" : "envelope");
+    if (env_not_constructed(e, why, sizeof why))
+        return env_error("silc_envelope_to_dense: the envelope was not constructed: %s", why);
     count = dense_count(e->m, e->n);
     if (count < 0) return env_error("silc_envelope_to_dense: invalid envelope size");
     if (count > 0 && !e->values)
@@ -384,69 +566,46 @@ void silc_envelope_free(silc_envelope_t *e)
 
 /* ---- envelopes <-> values ------------------------------------------------- */
 
-int env_check(const silc_envelope_t *e, char *err, size_t errlen)
+/* The parts an envelope claims.  Dense and band envelopes hold exactly
+ * m*n and (kl+ku+1)*n values by definition; a CSR envelope's nnz must say
+ * how many entries colind and values hold. */
+static void env_parts(const silc_envelope_t *e, val_parts *p)
 {
-    int64_t count, i, k;
-    if (!e) {
-        snprintf(err, errlen, "NULL envelope");
-        return -1;
-    }
-    switch (e->format) {
-    case SILC_DENSE:
-        count = dense_count(e->m, e->n);
-        if (count < 0) {
-            snprintf(err, errlen, "invalid size %lldx%lld", (long long)e->m, (long long)e->n);
-            return -1;
-        }
-        if (count > 0 && !e->values) {
-            snprintf(err, errlen, "dense envelope has no values (freed or never built?)");
-            return -1;
-        }
-        return 0;
-    case SILC_CSR:
-        if (csr_check_structure(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
-        for (i = 0; i < e->m; i++)
-            for (k = e->rowptr[i] + 1; k < e->rowptr[i + 1]; k++)
-                if (e->colind[k - 1] >= e->colind[k]) {
-                    snprintf(err, errlen, "columns of row %lld are %s (build CSR envelopes "
-                             "with silc_envelope_csr, which sorts them)", (long long)i,
-                             e->colind[k - 1] == e->colind[k] ? "duplicated" : "not sorted");
-                    return -1;
-                }
-        return 0;
-    case SILC_BAND:
-        count = band_count(e->n, e->kl, e->ku);
-        if (e->m < 0 || count < 0) {
-            snprintf(err, errlen, "invalid band size %lldx%lld with kl = %lld, ku = %lld",
-                     (long long)e->m, (long long)e->n, (long long)e->kl, (long long)e->ku);
-            return -1;
-        }
-        if (count > 0 && !e->values) {
-            snprintf(err, errlen, "band envelope has no values (freed or never built?)");
-            return -1;
-        }
-        return 0;
-    default:
-        snprintf(err, errlen, "unknown envelope format %d", (int)e->format);
-        return -1;
-    }
+    memset(p, 0, sizeof *p);
+    p->format = (int)e->format;
+    p->m = e->m, p->n = e->n;
+    p->nnz = e->format == SILC_CSR ? e->nnz : 0;
+    p->kl = e->format == SILC_BAND ? e->kl : 0;
+    p->ku = e->format == SILC_BAND ? e->ku : 0;
+    p->rowptr = e->rowptr, p->colind = e->colind, p->values = e->values;
 }
 
-/* env_csr_fill after its rowptr check. */
-static int csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
+/* NULL and not-constructed envelopes, with the reason in err. */
+static int env_usable(const silc_envelope_t *e, char *err, size_t errlen)
 {
-    if (val_csr_fill_checked(v, e->rowptr, e->colind, e->values) == 0) return 0;
-    /* The fast pass only knows that a row failed; env_check finds it again
-     * and says how. */
-    if (env_check(e, err, errlen) == 0)
-        snprintf(err, errlen, "CSR arrays refused with no reason found (internal error)");
-    return -1;
+    char why[512];
+    if (!e) return check_fail(err, errlen, "NULL envelope");
+    if (env_not_constructed(e, why, sizeof why))
+        return check_fail(err, errlen, "envelope was not constructed: %s", why);
+    if (e->format != SILC_DENSE && e->format != SILC_CSR && e->format != SILC_BAND)
+        return check_fail(err, errlen, "unknown envelope format %d", (int)e->format);
+    return 0;
+}
+
+int env_check(const silc_envelope_t *e, char *err, size_t errlen)
+{
+    val_parts p;
+    if (env_usable(e, err, errlen)) return -1;
+    env_parts(e, &p);
+    return val_parts_check(&p, err, errlen);
 }
 
 int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errlen)
 {
-    if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
-    return csr_fill(v, e, err, errlen);
+    val_parts p;
+    if (env_usable(e, err, errlen)) return -1;
+    env_parts(e, &p);
+    return val_parts_fill(v, &p, err, errlen);
 }
 
 int env_same_as_value(const silc_envelope_t *e, const silc_value *v)
@@ -469,33 +628,11 @@ int env_same_as_value(const silc_envelope_t *e, const silc_value *v)
 
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
 {
-    silc_value *v;
-    int64_t count;
+    val_parts p;
     *out = NULL;
-    if (e && e->format == SILC_CSR) {
-        /* rowptr first, for the size; the entries are checked while copied,
-         * not in a pass of their own (csr_fill). */
-        if (csr_check_rowptr(e->m, e->n, e->rowptr, e->colind, e->values, err, errlen)) return -1;
-        v = val_new_unset(SILC_FMT_CSR, e->m, e->n, e->rowptr[e->m], 0, 0);
-        if (v && csr_fill(v, e, err, errlen)) {
-            val_release(v);
-            return -1;
-        }
-    } else {
-        if (env_check(e, err, errlen)) return -1;
-        /* Dense or band (env_check refused every other format): one array,
-         * copied whole. */
-        count = e->format == SILC_DENSE ? e->m * e->n : band_count(e->n, e->kl, e->ku);
-        v = val_new_unset((int)e->format, e->m, e->n, 0, e->kl, e->ku);
-        if (v && count > 0) memcpy(v->val, e->values, (size_t)count * sizeof(double));
-    }
-    if (!v) {
-        snprintf(err, errlen, "out of memory copying a %lldx%lld %s matrix", (long long)e->m,
-                 (long long)e->n, val_format_name((int)e->format));
-        return -1;
-    }
-    *out = v;
-    return 0;
+    if (env_usable(e, err, errlen)) return -1;
+    env_parts(e, &p);
+    return val_from_parts(&p, out, err, errlen);
 }
 
 int env_from_value(const silc_value *v, silc_envelope_t *e)

@@ -130,6 +130,11 @@ void val_budget_set(int64_t exempt, uint64_t limit, const char *source);
 int val_budget_refused(void);
 /* Bytes of the arrays of every value alive in this process. */
 int64_t val_live_bytes(void);
+/* The bytes a value of this claim costs, the one formula every limit uses:
+ * its arrays, and for band storage also one double per row and column
+ * (the row sums of its norms, a product's result), which band storage
+ * itself does not grow with.  A double: claims may exceed 64 bits. */
+double val_shape_bytes(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
 void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */
@@ -210,6 +215,48 @@ size_t store_names(const silc_store *s, const char ***names);
  * message until a later failure on the default context supersedes it (the API
  * calls env_error_forget() when it records one).
  */
+
+/* ---- the checked constructor (envelope.c) ---------------------------------
+ * A value as someone outside claims it: format and shape, then arrays.
+ * Every value handed to SILC from outside is built or checked through
+ * these: silc_put / SILC_PUT (embedded, and by the remote client before it
+ * sends), silcd's PUT (descriptor first, arrays after they arrive), HDF5
+ * `load`, Matrix Market files, and plugin results (host.c).  The claim is
+ * checked first (sizes non-negative, m*n, nnz and (kl+ku+1)*n without
+ * overflow, val_shape_bytes within val_max_bytes()), so nothing is
+ * allocated or read for a value that cannot be; then the arrays: CSR
+ * rowptr 0 first, never decreasing, rowptr[m] == nnz, columns in [0, n)
+ * and strictly increasing in each row.  Messages print sizes and indices,
+ * never an address. */
+typedef struct val_parts {
+    int format;                 /* SILC_FMT_* */
+    int64_t m, n;
+    int64_t nnz;                /* csr: entries colind and values hold; else unused */
+    int64_t kl, ku;             /* band only */
+    const silc_index *rowptr;   /* csr: m+1 */
+    const silc_index *colind;   /* csr: nnz */
+    const double *values;       /* dense m*n, csr nnz, band (kl+ku+1)*n */
+} val_parts;
+/* The bytes the claim costs (val_shape_bytes). */
+double val_parts_bytes(const val_parts *p);
+/* The claim alone (no array is read): 0, or -1 with the reason in err. */
+int val_parts_claim(const val_parts *p, char *err, size_t errlen);
+/* The claim and the arrays. */
+int val_parts_check(const val_parts *p, char *err, size_t errlen);
+/* Checks and copies into a new value (refcount 1). */
+int val_from_parts(const val_parts *p, silc_value **out, char *err, size_t errlen);
+/* Checks p and fills v, a CSR value made for p's claim, from it (p's arrays
+ * may be v's own: data read in place), shape computed on the way. */
+int val_parts_fill(silc_value *v, const val_parts *p, char *err, size_t errlen);
+/* A finished value's arrays against its own claim (plugin results). */
+int val_check_value(const silc_value *v, char *err, size_t errlen);
+
+/* 1 when e was left by a failed constructor (or silc_mm_read), with that
+ * constructor's message in err; 0 otherwise.  A PUT of such an envelope is
+ * refused ("envelope 'A' was not constructed: ..."). */
+int env_not_constructed(const silc_envelope_t *e, char *err, size_t errlen);
+/* Marks e as not constructed with this thread's last env_error; -1. */
+int env_mark_not_constructed(silc_envelope_t *e);
 
 /* Validates an envelope without copying it (the checks env_to_value makes):
  * used by the remote client before sending and by silcd on what it received,

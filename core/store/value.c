@@ -110,6 +110,23 @@ int val_claim(double bytes, const char *what)
     return -1;
 }
 
+double val_shape_bytes(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku)
+{
+    switch (format) {
+    case SILC_FMT_DENSE:
+        return (double)m * (double)n * sizeof(double);
+    case SILC_FMT_CSR:
+        return ((double)m + 1) * sizeof(silc_index) + (double)nnz * (sizeof(silc_index) + sizeof(double));
+    default:
+        /* Band storage holds (kl+ku+1) x n, but the value still has m rows:
+         * its norms sum by row, a product with it makes m entries.  A
+         * 250000000 x 1 band value stores one double and needs 2 GB the
+         * moment anyone asks for its infinity norm, so the rows are charged
+         * here, where every limit looks. */
+        return ((double)kl + (double)ku + 1) * (double)n * sizeof(double) + ((double)m + (double)n) * sizeof(double);
+    }
+}
+
 /* val_claim for a value of this format and shape.  bytes is a double: a
  * claimed size may not fit in 64 bits (sparse(1, 1, 1, 1e10, 1e10) asks
  * for 80 GB of row pointers; zeros(1e10) for 8e20 bytes). */
@@ -202,8 +219,8 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
 {
     int64_t count = count_mul(m, n);
     silc_value *v;
-    if (size_allowed(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double)) ||
-        budget_refuses(SILC_FMT_DENSE, m, n, (double)m * (double)n * sizeof(double)))
+    double bytes = val_shape_bytes(SILC_FMT_DENSE, m, n, 0, 0, 0);
+    if (size_allowed(SILC_FMT_DENSE, m, n, bytes) || budget_refuses(SILC_FMT_DENSE, m, n, bytes))
         return NULL;
     if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
     v->val = val_array_alloc(count, sizeof(double), zero);
@@ -218,8 +235,7 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
 static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero)
 {
     silc_value *v;
-    double bytes = ((double)m + 1) * sizeof(silc_index) +
-                   (double)nnz_capacity * (sizeof(silc_index) + sizeof(double));
+    double bytes = val_shape_bytes(SILC_FMT_CSR, m, n, nnz_capacity, 0, 0);
     if (size_allowed(SILC_FMT_CSR, m, n, bytes) || budget_refuses(SILC_FMT_CSR, m, n, bytes))
         return NULL;
     if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
@@ -239,7 +255,7 @@ static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int z
 {
     int64_t ld, count;
     silc_value *v;
-    double bytes = ((double)kl + (double)ku + 1) * (double)n * sizeof(double);
+    double bytes = val_shape_bytes(SILC_FMT_BAND, m, n, 0, kl, ku);
     if (size_allowed(SILC_FMT_BAND, m, n, bytes) || budget_refuses(SILC_FMT_BAND, m, n, bytes))
         return NULL;
     if (kl < 0 || ku < 0 || kl > INT64_MAX / 4 || ku > INT64_MAX / 4) return NULL;
