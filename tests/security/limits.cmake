@@ -9,13 +9,11 @@ if(NOT TARGET silcd OR NOT SILC_SYSTEM_PYTHON)
   message(STATUS "SILC: limit tests skipped (silcd or /usr/bin/python3 missing)")
   return()
 endif()
-# A plugin that never returns by itself (one mode asks host->cancelled()).
-add_library(silc_test_stuck MODULE ${CMAKE_CURRENT_LIST_DIR}/limits_stuck_plugin.c)
-target_include_directories(silc_test_stuck PRIVATE ${PROJECT_SOURCE_DIR}/plugins)
-set_target_properties(silc_test_stuck PROPERTIES PREFIX "lib" OUTPUT_NAME silc_plugin_stuck
-  C_VISIBILITY_PRESET hidden LIBRARY_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/stuck-plugin)
+# The misbehaving plugin of the server tests (tests/server/crash_plugin.c,
+# built by remote.cmake): alpha 17 never returns, alpha 19 asks
+# host->cancelled().
 set(_limits_dir ${CMAKE_CURRENT_BINARY_DIR}/security-limits)
-set(_limits_env "${SILC_TEST_ENV};STUCK_PLUGIN_DIR=${CMAKE_CURRENT_BINARY_DIR}/stuck-plugin")
+set(_limits_env "${SILC_TEST_ENV};STUCK_PLUGIN_DIR=${CMAKE_CURRENT_BINARY_DIR}/crash-plugin")
 foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_clients sigterm
         parent_killed stuck_forced stuck_cooperative stuck_disconnect)
   add_test(NAME security_limits_${case}

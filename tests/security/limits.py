@@ -414,11 +414,11 @@ def case_statement_cap():
 
 
 def stuck_server(*args):
-    """A server whose sessions have the "stuck" plugin (limits_stuck_plugin.c)
+    """A server whose sessions have the "crash" plugin (tests/server/crash_plugin.c)
     first for scaling: `y = 17 * [1; 2]` never returns by itself."""
     conf = os.path.join(STATEDIR, CASE + ".conf")
     with open(conf, "w") as f:
-        f.write("[core]\nplugin_path = %s\n[dispatch]\nadd = stuck, reference\n"
+        f.write("[core]\nplugin_path = %s\n[dispatch]\nadd = crash, reference\n"
                 % os.environ["STUCK_PLUGIN_DIR"])
     return Server("--config", conf, *args)
 
@@ -430,7 +430,7 @@ def case_stuck_forced():
     s = srv.session()
     s.exec("y = 3 * [1; 2]")
     if s.get("y")[1, 0] != 6:
-        fail("the stuck plugin's scale is wrong")
+        fail("the crash plugin's scale is wrong")
     expect_error(lambda: s.exec("y = 17 * [1; 2]"),
                  "session 1 lost: the server process running it died of signal 14 (%s): its "
                  "request took longer than 1 s and did not stop within 2 s more (it was inside "
