@@ -496,6 +496,7 @@ static const key_rule key_rules[] = {
     {"dispatch.<class>", KEY_SESSION, "the backends a class of operation tries, in order"},
     {"tune.accuracy", KEY_SESSION, "the accuracy the tuner's backend choice must reach"},
     {"tune.budget", KEY_SESSION, "the share of the run the tuner may spend measuring"},
+    {"accuracy.condest", KEY_SESSION, "on or off: the condition estimate of every solve"},
     {"solve.<option>", KEY_SESSION, "refine, refine_residual, backward_error, initial_guess, verify"},
     {"<plugin>.<option>", KEY_SESSION, "a plugin's typed options (other than those above)"},
 };
