@@ -1169,6 +1169,13 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
  * ran it (dist.h): a statement that failed on one rank alone (out of
  * memory) stops all, instead of leaving that rank out of the next
  * collective. */
+/* rc as every rank of a communicator agrees on it (any failure fails all);
+ * rc itself without one, and under explain, which runs nothing collective. */
+static int ranks_agree(lang_ev *V, int rc)
+{
+    return V->E->dist && !V->explain ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+}
+
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
 {
     int rc = exec_stmt_here(V, s, flow);
@@ -1176,15 +1183,15 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow)
      * learn of a stop in the agreement they make anyway, and all stop at
      * the same statement (only rank 0's engine has a cancel hook). */
     if (!rc && !V->explain) rc = eng_cancel_check(V->E);
-    return V->E->dist && !V->explain ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+    return ranks_agree(V, rc);
 }
 
 /* A `while` whose body is empty runs no statement to check after: its
- * iterations ask here (agreed between ranks as exec_stmt's checks are). */
+ * iterations ask here (agreed between ranks as exec_stmt's checks are;
+ * the caller skips it under explain). */
 static int empty_loop_cancelled(lang_ev *V)
 {
-    int rc = eng_cancel_check(V->E);
-    return V->E->dist ? (dist_agree(V->E, rc) ? -1 : 0) : rc;
+    return ranks_agree(V, eng_cancel_check(V->E));
 }
 
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
@@ -1294,9 +1301,12 @@ int lang_exec(silc_engine *E, const char *text)
     double t0 = util_now();
     if (!text) return eng_error(E, "no statement text");
     E->err[0] = 0;
-    if (E->max_statement_bytes && strlen(text) > E->max_statement_bytes)
-        return eng_error(E, "statement text of %zu bytes is over the limit of %zu bytes: split it, "
-                         "or PUT large data as a value", strlen(text), E->max_statement_bytes);
+    if (E->max_statement_bytes) {
+        size_t len = strlen(text);
+        if (len > E->max_statement_bytes)
+            return eng_error(E, "statement text of %zu bytes is over the limit of %zu bytes: split it, "
+                             "or PUT large data as a value", len, E->max_statement_bytes);
+    }
     if (program_for(E, text, &prog)) return -1;
     memset(&V, 0, sizeof V);
     V.E = E;
