@@ -49,7 +49,7 @@ static _Thread_local char env_failed_msg[ENV_FAILED_KEPT][512];
 static _Thread_local int64_t env_failed_serial;
 
 /* Marks e as not constructed with the thread's last message; returns -1. */
-static int env_mark_failed(silc_envelope_t *e)
+int env_mark_not_constructed(silc_envelope_t *e)
 {
     if (!e) return -1;
     memset(e, 0, sizeof *e);
@@ -58,11 +58,6 @@ static int env_mark_failed(silc_envelope_t *e)
     snprintf(env_failed_msg[e->nnz % ENV_FAILED_KEPT], sizeof env_failed_msg[0], "%.500s",
              env_err_live ? env_err : "its constructor failed");
     return -1;
-}
-
-int env_mark_not_constructed(silc_envelope_t *e)
-{
-    return env_mark_failed(e);
 }
 
 /* env_error, then e marked as not constructed. */
@@ -79,7 +74,7 @@ static int env_failed(silc_envelope_t *e, const char *fmt, ...)
     vsnprintf(env_err, sizeof env_err, fmt, ap);
     va_end(ap);
     env_err_live = 1;
-    return env_mark_failed(e);
+    return env_mark_not_constructed(e);
 }
 
 int env_not_constructed(const silc_envelope_t *e, char *err, size_t errlen)
