@@ -166,6 +166,11 @@ class Server:
         self.log.close()
         return self.proc.returncode
 
+    def stop_cleanly(self):
+        """stop(), and fail unless silcd exited 0."""
+        if self.stop() != 0:
+            fail("silcd exited with %s" % self.proc.returncode)
+
 
 def expect_error(fn, text, exact=True):
     try:
@@ -234,8 +239,7 @@ def case_hostile_put():
     if idle.get("b")[0, 0] != 2:
         fail("the idle session was disturbed")
     idle.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def request_time(mpi):
@@ -253,8 +257,7 @@ def request_time(mpi):
     if s.get("y")[0, 0] != 14:
         fail("the session did not go on after a stopped request")
     s.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_request_time():
@@ -275,8 +278,7 @@ def case_max_cpu():
     other = srv.session()      # the server and other sessions go on
     other.exec("z = 3")
     other.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_disconnect():
@@ -289,8 +291,7 @@ def case_disconnect():
     if not wait_until(lambda: not alive(pid), 1.5):
         fail("the session of a SIGKILLed client still runs after 1.5 s")
     print("session gone %.2f s after its client was SIGKILLed" % (time.monotonic() - t0))
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_disconnect_mpi():
@@ -307,8 +308,7 @@ def case_disconnect_mpi():
     s.close()
     if "the client disconnected: request stopped" not in srv.text():
         fail("the log does not say the runaway was stopped:\n" + srv.text())
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_max_clients():
@@ -325,8 +325,7 @@ def case_max_clients():
     if s.get("a")[0, 0] != 42:
         fail("the third client got a wrong answer")
     s.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def sigterm(mpi):
@@ -397,8 +396,7 @@ def case_peak():
     if float(s.get("c").sum()) != 1e6:
         fail("the entries of sum(a + 1) do not add up to 1e6")
     s.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_statement_cap():
@@ -409,8 +407,7 @@ def case_statement_cap():
                  "bytes: split it, or PUT large data as a value" % (len(text), 4 << 20))
     s.exec("a = [1, 2, 3]")
     s.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def stuck_server(*args):
@@ -440,8 +437,7 @@ def case_stuck_forced():
     other = srv.session()
     other.exec("z = 1")
     other.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_stuck_cooperative():
@@ -455,8 +451,7 @@ def case_stuck_cooperative():
     if s.get("y")[1, 0] != 6 or "w" in s.names():
         fail("the store changed in a stopped request")
     s.close()
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 def case_stuck_disconnect():
@@ -479,8 +474,7 @@ def case_stuck_disconnect():
     c.wait()
     if not wait_until(lambda: not alive(pid), 1.5):
         fail("a stuck session of a SIGKILLed client still runs after 1.5 s")
-    if srv.stop() != 0:
-        fail("silcd exited with %s" % srv.proc.returncode)
+    srv.stop_cleanly()
 
 
 globals()["case_" + CASE]()
