@@ -196,6 +196,11 @@ static void test_dense(silc_context *L, silc_context *R)
     for (int64_t j = 0; j < n; j++)
         for (int64_t i = j; i < n; i++) S[i + j * n] = S[j + i * n] = i == j ? 1.0 : urand();
     check_square(L, R, "symmetric, positive diagonal, indefinite", n, S, "dsytrf");
+    {   /* The note names the method that solved (it said "used LU"). */
+        const char *text = tl_out_info(L, "x");
+        CHECK(tl_contains(text, "Cholesky failed (not positive definite); used symmetric indefinite LDL'"),
+              "the fallback note does not name LDL':\n%s", text);
+    }
 
     /* Triangular, lower and upper. */
     for (int64_t j = 0; j < n; j++)

@@ -380,7 +380,10 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
     double eps_cond;
     if (cholesky_failed) {
         char note[sizeof r->note];
-        snprintf(note, sizeof note, "Cholesky failed (not positive definite); used LU%s%.200s",
+        /* Name the method that did solve: after Cholesky, a symmetric
+         * matrix goes to LDL' (dsytrf), not necessarily to LU. */
+        snprintf(note, sizeof note, "Cholesky failed (not positive definite); used %.64s%s%.120s",
+                 r->method[0] ? r->method : "the next method in the chain",
                  r->note[0] ? "; " : "", r->note);
         memcpy(r->note, note, sizeof note);
     }
