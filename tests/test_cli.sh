@@ -173,5 +173,23 @@ check "help solve" has out 'solve(A, b, "options")'
 run "$SILC" -e 'help sparce'
 check "help of an unknown word" has err "no statement or built-in 'sparce' (did you mean 'sparse'?)"
 
+# Inputs that are not plain files: a FIFO with no writer reads as empty (it
+# hung), a device is refused at its first NUL byte, a script over 64 MiB is
+# refused before it is held (/dev/zero reached 2.1 GB); a pipe with a writer
+# still works.  `timeout` turns a hang into a failure, not a stuck test.
+mkfifo fifo
+run timeout 10 "$SILC" --put A=fifo -e 'x = 1'
+check "--put of a fifo with no writer" has err "--put A=fifo: fifo:1: empty file (expected a %%MatrixMarket banner)"
+run timeout 10 "$SILC" run fifo
+check "run a fifo with no writer: nothing to run" status_is 0
+run timeout 10 "$SILC" run /dev/zero
+check "run /dev/zero" has err "'/dev/zero' is not a text file (it contains NUL bytes)"
+head -c 68000000 /dev/zero | tr '\0' '\n' >big.silc
+run timeout 20 "$SILC" run big.silc
+check "a script over 64 MiB" has err "'big.silc' is over 64 MiB: not a script silc runs"
+rm -f big.silc
+printf 'x = 6 * 7\n' | (run timeout 10 "$SILC" run - --get x; same_numbers out "42")
+check "run - from a pipe" [ $? -eq 0 ]
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -31,6 +31,7 @@
 #endif
 
 #include "silc.h"
+#include "util.h" /* util_open_input: files.c is compiled in (tools/CMakeLists.txt) */
 
 static const char usage_text[] =
     "usage: silc [options] run FILE      run a script (\"-\" reads standard input)\n"
@@ -161,36 +162,58 @@ static int parse_args(int argc, char **argv, cli_options *o)
     return 0;
 }
 
-/* Reads a whole file ("-" = standard input) into a NUL-terminated buffer. */
+/* The longest script `silc run` reads: a bound on what a file (or a device
+ * such as /dev/zero) can make the CLI allocate before a statement runs. */
+#define SILC_MAX_SCRIPT_BYTES ((size_t)64 << 20)
+
+/* Reads a whole file ("-" = standard input) into a NUL-terminated buffer:
+ * at most SILC_MAX_SCRIPT_BYTES, text only (a NUL byte stops the read at
+ * once), and a FIFO with no writer reads as empty instead of hanging. */
 static char *read_file(const char *path)
 {
-    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
-    if (!f) {
+    int fd = strcmp(path, "-") ? util_open_input(path) : 0;
+    size_t len = 0, cap = 4096;
+    char *buf;
+    ssize_t got = 0;
+    if (fd < 0) {
         fail("cannot open '%s': %s", path, strerror(errno));
         return NULL;
     }
-    size_t len = 0, cap = 4096;
-    char *buf = malloc(cap);
+    buf = malloc(cap);
     while (buf) {
-        len += fread(buf + len, 1, cap - 1 - len, f);
-        if (len < cap - 1) break;
-        char *grown = realloc(buf, cap *= 2);
-        if (!grown) free(buf);
-        buf = grown;
+        got = read(fd, buf + len, cap - 1 - len);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) break;
+        if (memchr(buf + len, '\0', (size_t)got)) {
+            fail("'%s' is not a text file (it contains NUL bytes)", path);
+            break;
+        }
+        len += (size_t)got;
+        if (len == cap - 1) {
+            char *grown;
+            if (cap >= SILC_MAX_SCRIPT_BYTES) {
+                fail("'%s' is over %zu MiB: not a script silc runs", path, SILC_MAX_SCRIPT_BYTES >> 20);
+                break;
+            }
+            if (!(grown = realloc(buf, cap * 2))) {
+                fail("out of memory reading '%s'", path);
+                break;
+            }
+            buf = grown;
+            cap *= 2;
+        }
     }
-    int err = ferror(f);
-    if (f != stdin) fclose(f);
-    if (!buf || err) {
-        fail(buf ? "cannot read '%s'" : "out of memory reading '%s'", path);
+    if (fd > 0) close(fd);
+    if (!buf) {
+        fail("out of memory reading '%s'", path);
+        return NULL;
+    }
+    if (got != 0) { /* a read error, NUL bytes or the cap (said above) */
+        if (got < 0) fail("cannot read '%s': %s", path, strerror(errno));
         free(buf);
         return NULL;
     }
     buf[len] = '\0';
-    if (memchr(buf, '\0', len)) {
-        fail("'%s' is not a text file (it contains NUL bytes)", path);
-        free(buf);
-        return NULL;
-    }
     return buf;
 }
 

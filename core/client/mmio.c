@@ -21,8 +21,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "store.h"
+#include "util.h"
 
 enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN };
 enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW };
@@ -497,8 +499,14 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
     if (!e) return mm_fail(&r, 0, "NULL envelope");
     memset(e, 0, sizeof *e);
     if (!path) return mm_fail(&r, 0, "NULL path"), env_mark_not_constructed(e);
-    r.f = fopen(path, "r");
-    if (!r.f) return mm_fail(&r, 0, "cannot open: %s", strerror(errno)), env_mark_not_constructed(e);
+    {   /* util_open_input: a FIFO with no writer reads as empty, never hangs */
+        int fd = util_open_input(path);
+        if (fd < 0 || !(r.f = fdopen(fd, "r"))) {
+            int why = errno;
+            if (fd >= 0) close(fd);
+            return mm_fail(&r, 0, "cannot open: %s", strerror(why)), env_mark_not_constructed(e);
+        }
+    }
     rc = mm_banner(&r, &is_array, &field, &sym);
     if (rc == 0) {
         p = mm_next_data_line(&r);

@@ -823,12 +823,12 @@ static int is_null_device(const struct stat *st)
 
 /* The config file, if it is a regular file of at most CFG_MAX_FILE_BYTES
  * (or the null device): a directory, fifo or other device is refused before
- * a byte is read (opened O_NONBLOCK, so that a fifo cannot hang the open). */
+ * a byte is read (util_open_input: a fifo cannot hang the open). */
 static FILE *open_config(silc_engine *E, const char *path)
 {
     struct stat st;
     FILE *fp;
-    int fd = open(path, O_RDONLY | O_NOCTTY | O_NONBLOCK);
+    int fd = util_open_input(path);
     if (fd < 0) {
         eng_error(E, "cannot read config file %s: %s", path, strerror(errno));
         return NULL;

@@ -137,6 +137,18 @@ int util_open_read_at(int dirfd, const char *leaf, int follow)
     return fd;
 }
 
+int util_open_input(const char *path)
+{
+    int fd = open(path, O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC), flags;
+    if (fd < 0) return -1;
+    if ((flags = fcntl(fd, F_GETFL)) < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) < 0) {
+        int e = errno;
+        close(fd);
+        return errno = e, -1;
+    }
+    return fd;
+}
+
 void util_fd_path(int fd, char *out, size_t len)
 {
     snprintf(out, len, "/proc/self/fd/%d", fd);

@@ -82,6 +82,13 @@ int util_tmp_create(int dirfd, const char *leaf, char *tmp, size_t tmplen);
  * file with other hard links; -1 + errno otherwise (EINVAL: not a regular
  * file, ELOOP: a symbolic link, EMLINK: hard links). */
 int util_open_read_at(int dirfd, const char *leaf, int follow);
+/* Opens a user-named input file for reading without letting the open hang:
+ * a FIFO with no writer is opened (O_NONBLOCK) and then read blocking, so
+ * it reads as empty instead of waiting forever, while a pipe with a writer
+ * (`<(zcat a.mtx.gz)`) reads normally.  What kinds of file a caller accepts,
+ * and how many bytes, is the caller's rule (fstat the descriptor).  The
+ * descriptor is close-on-exec; -1 with errno on failure. */
+int util_open_input(const char *path);
 /* "/proc/self/fd/N": a name for an open descriptor that libraries taking a
  * file name (HDF5) open as that very file. */
 void util_fd_path(int fd, char *out, size_t len);
