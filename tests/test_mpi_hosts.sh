@@ -60,10 +60,13 @@ EOF
 chmod +x "$OUT/agent.sh"
 rm -f "$OUT/agent.log"
 # Everything mpirun needs to treat the namespaces as two hosts on one
-# network; `timeout` turns a hang into a failure.
+# network, ports pinned as docs/distributed.md tells a firewalled cluster;
+# `timeout` turns a hang into a failure.
 on_two_hosts() {
     timeout 120 ip netns exec "$H1" "$MPIRUN" --host $A1:1,$A2:1 -np 2 --mca plm_rsh_agent "$OUT/agent.sh" \
         --mca btl tcp,self --mca btl_tcp_if_include $NET --mca oob_tcp_if_include $NET \
+        --mca btl_tcp_port_min_v4 40000 --mca btl_tcp_port_range_v4 100 \
+        --mca oob_tcp_dynamic_ipv4_ports 40100-40199 \
         -x OPENBLAS_NUM_THREADS -x OMP_NUM_THREADS "$@"
 }
 export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1} OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
