@@ -96,7 +96,10 @@ int ref_op_matmul(silc_call *call)
         ref_sp_free(&B);
         return st;
     }
-    silc_value *out = ref_host->dense_new(m, n);
+    /* Sparse times dense writes every entry of C once: no zeroing pass
+     * (a whole extra sweep of the result, ~5 % of a 5-point SpMV). */
+    silc_value *out = a.format != SILC_FMT_DENSE && b.format == SILC_FMT_DENSE ? ref_host->dense_new_uninit(m, n)
+                                                                               : ref_host->dense_new(m, n);
     if (!out) return ref_nomem(call);
     silc_view o;
     ref_host->view(out, &o);

@@ -4,7 +4,7 @@
  * list of the same matrix's stored entries.
  *
  * For every real shared matrix, in CSR and (when small) dense storage, and
- * for hand-made CSR edge cases (explicit zeros at the ends of rows and on the
+ * for hand-made edge cases, in CSR and dense storage (explicit zeros at the ends of rows and on the
  * diagonal, empty rows, one asymmetric entry at the very end, a mirror with
  * a different value, an asymmetric entry in rows the symmetry probe samples
  * and in rows it does not, a rectangular matrix, NaN and Inf in the last entry, a
@@ -274,6 +274,19 @@ static void check_csr(const char *what, int64_t m, int64_t n, const int64_t *rp,
         return;
     }
     check_matrix(what, &e);
+    {   /* the same entries dense: value.c has its own pass for dense */
+        silc_envelope_t d;
+        double *a = malloc((size_t)(m * n > 0 ? m * n : 1) * sizeof *a);
+        char label[200];
+        snprintf(label, sizeof label, "%s (dense)", what);
+        if (a && !silc_envelope_to_dense(&e, a) && !silc_envelope_dense(&d, m, n, a)) {
+            check_matrix(label, &d);
+            silc_envelope_free(&d);
+        } else {
+            CHECK(0, "%s: no dense envelope", label);
+        }
+        free(a);
+    }
     silc_envelope_free(&e);
 }
 

@@ -85,7 +85,11 @@ typedef struct blist {
     char absent[256];       /* optional or built-in names left out: not installed here */
     int forced;             /* per-call backend = X: no fallback */
     int nlisted;            /* names the configuration or default listed (then "reference") */
-    char source[192];
+    /* Where the names came from, for explain (list_source formats it
+     * there: every operation resolves a list, few are explained). */
+    const char *forced_text;    /* the per-call backend = ... text */
+    const char *default_class;  /* the class whose built-in list applies */
+    int default_distributed;
 } blist;
 
 /* ---- classes --------------------------------------------------------------- */
@@ -309,6 +313,15 @@ int disp_check_configured(silc_engine *E)
     return 0;
 }
 
+/* Where resolve_list found L's names, as explain says it. */
+static void list_source(const blist *L, strbuf *b)
+{
+    if (L->forced) sb_printf(b, "per-call option backend = %s", L->forced_text);
+    else if (L->key[0]) sb_printf(b, "config key %s", L->key);
+    else sb_printf(b, "built-in default for %s%s", L->default_class,
+                   L->default_distributed ? ", distributed operands" : "");
+}
+
 static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
                          blist *L)
 {
@@ -322,13 +335,12 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
         split_list(E, L, forced, 0);
         L->nlisted = L->n;
         L->forced = 1;
-        snprintf(L->source, sizeof L->source, "per-call option backend = %s", forced);
+        L->forced_text = forced;
         return;
     }
     for (c = 0; c < nchain && !text; c++) {
         snprintf(key, sizeof key, "dispatch.%s", chain[c]);
         text = cfg_get(E, key);
-        if (text) snprintf(L->source, sizeof L->source, "config key %s", key);
     }
     if (text) snprintf(L->key, sizeof L->key, "%s", key);
     if (!text) {
@@ -337,8 +349,8 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
             if (strcmp(default_lists[i].cls, chain[0]) == 0) text = default_lists[i].list;
         for (i = 0; distributed && i < sizeof distributed_lists / sizeof distributed_lists[0]; i++)
             if (strcmp(distributed_lists[i].cls, chain[0]) == 0) text = distributed_lists[i].list;
-        snprintf(L->source, sizeof L->source, "built-in default for %s%s", chain[0],
-                 distributed ? ", distributed operands" : "");
+        L->default_class = chain[0];
+        L->default_distributed = distributed;
     }
     split_list(E, L, text, !L->key[0]);
     L->nlisted = L->n;
@@ -906,7 +918,9 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
     }
     resolve_list(E, call, chain, n, &L);
     sb_printf(b, "%s\n", why);
-    sb_printf(b, "backends (%s):", L.source);
+    sb_puts(b, "backends (");
+    list_source(&L, b);
+    sb_puts(b, "):");
     for (i = 0; i < L.n; i++) sb_printf(b, "%s %s", i ? "," : "", L.names[i]);
     if (L.absent[0]) sb_printf(b, " (not installed, left out: %s)", L.absent);
     sb_puts(b, "\n");

@@ -1,0 +1,243 @@
+/*
+ * limit.c -- how close SILC gets to the library it calls: SpMV against a
+ * plain C CSR loop, and a dense solve against LAPACKE's dgesv (issue 30,
+ * items 2 and 3).
+ *
+ *     limit [spmv|dense|all] [max_dense_n]    (default: all, n up to 3000)
+ *
+ * Part 1, SpMV: "y = A * x" through SILC against the plain C loop over the
+ * same CSR arrays (int64 row pointers and column indices, as SILC holds
+ * them), for the 5-point matrix of k x k grids with about 1e4, 1e5 and 1e6
+ * nonzeros.  The two are timed in alternating batches (SILC, then C, then
+ * SILC, ...) and the ratio taken batch by batch, so that load from other
+ * processes shifts both sides of a ratio alike; the table shows the
+ * medians.
+ *
+ * Part 2, dense solve: "x = A \ b" (a fresh PUT of A before each EXEC, so
+ * every EXEC factors) against LAPACKE_dgesv on a copy of A (the copy made
+ * outside the timing: dgesv destroys its input, SILC's values are
+ * immutable and pay for their own copy).  SILC runs twice: with the
+ * condition estimate (the default accuracy report) and with
+ * `accuracy.condest = off`; the condition estimate's cost is the
+ * difference, shown as its own column, and the ratio to dgesv is given
+ * with and without it.  A is random with a dominant diagonal (not
+ * symmetric), b = A * ones.
+ *
+ * Set OPENBLAS_NUM_THREADS (1 for the figures in docs/overhead.md).  Not
+ * run by the test suite: timings never are.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <lapacke.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "diffusion_common.h"
+#include "silc.h"
+
+#define BATCHES 7
+
+static silc_context *ctx;
+static volatile double sink;
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int check(int rc, const char *what)
+{
+    if (rc) fprintf(stderr, "limit: %s: %s\n", what, silc_context_errmsg(ctx));
+    return rc;
+}
+
+/* ---- part 1: SpMV ----------------------------------------------------------- */
+
+static void spmv_c(const silc_envelope_t *A, const double *x, double *y)
+{
+    for (int64_t i = 0; i < A->m; i++) {
+        double s = 0;
+        for (int64_t p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) s += A->values[p] * x[A->colind[p]];
+        y[i] = s;
+    }
+}
+
+/* Distinct vectors the products cycle through: more than the memo's 64 keys
+ * (core/lang/memo.c), so that no product is ever handed out again from it,
+ * as in a loop whose x changes every step.  The C loop cycles through the
+ * same vectors, so both sides read x from the same level of the cache. */
+#define SPMV_XS 80
+
+static int spmv_row(int64_t k)
+{
+    silc_envelope_t A = {0};
+    int64_t n = k * k;
+    double *x = malloc((size_t)n * SPMV_XS * sizeof *x), *y = malloc((size_t)n * sizeof *y);
+    double ts[BATCHES], tc[BATCHES], ratio[BATCHES];
+    char text[SPMV_XS][32];
+    int rc = !x || !y;
+    if (rc) fprintf(stderr, "limit: out of memory\n");
+    for (int64_t i = 0; !rc && i < n * SPMV_XS; i++) x[i] = 1.0 + (double)(i % 7) + (double)(i / n);
+    if (!rc) rc = diff_shifted_laplacian(2, k, diff2d_h(k), -1.0, &A);
+    if (!rc) rc = check(silc_put(ctx, "A", &A), "PUT A");
+    for (int v = 0; !rc && v < SPMV_XS; v++) {
+        silc_envelope_t xe = {0};
+        char name[16];
+        snprintf(name, sizeof name, "x%d", v);
+        snprintf(text[v], sizeof text[v], "y = A * x%d", v);
+        rc = silc_envelope_vector(&xe, n, x + (size_t)v * (size_t)n) || check(silc_put(ctx, name, &xe), "PUT x");
+        silc_envelope_free(&xe);
+    }
+    for (int v = 0; !rc && v < SPMV_XS; v++) rc = check(silc_exec(ctx, text[v]), text[v]); /* warm */
+    /* about 0.1 s of work per batch and side, whole cycles */
+    int reps = (int)(2e7 / (double)(A.nnz > 0 ? A.nnz : 1));
+    reps = reps < SPMV_XS ? SPMV_XS : reps / SPMV_XS * SPMV_XS;
+    for (int b = 0; !rc && b < BATCHES; b++) {
+        double t0 = now();
+        for (int r = 0; !rc && r < reps; r++) rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
+        ts[b] = (now() - t0) / reps;
+        t0 = now();
+        for (int r = 0; r < reps; r++) {
+            spmv_c(&A, x + (size_t)(r % SPMV_XS) * (size_t)n, y);
+            sink = y[r % n];
+        }
+        tc[b] = (now() - t0) / reps;
+        ratio[b] = ts[b] / tc[b];
+    }
+    if (!rc)
+        printf("%9lld %10lld %12.1f %12.1f %8.3f\n", (long long)A.nnz, (long long)n, median(ts, BATCHES) * 1e6,
+               median(tc, BATCHES) * 1e6, median(ratio, BATCHES));
+    silc_envelope_free(&A);
+    free(x);
+    free(y);
+    return rc || check(silc_exec(ctx, "clear"), "clear");
+}
+
+static int spmv(void)
+{
+    printf("SpMV y = A * x, 5-point matrix of a k x k grid; microseconds per product, median of %d\n"
+           "alternating batches; ratio = SILC / plain C, median of the per-batch ratios\n", BATCHES);
+    printf("%9s %10s %12s %12s %8s\n", "nnz", "rows", "SILC us", "plain C us", "ratio");
+    return spmv_row(45) || spmv_row(141) || spmv_row(447);
+}
+
+/* ---- part 2: dense solve ------------------------------------------------------ */
+
+static unsigned long long rng = 88172645463325252ULL;
+static double urand(void) /* uniform in [0, 1) */
+{
+    rng ^= rng << 13, rng ^= rng >> 7, rng ^= rng << 17;
+    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Seconds of one EXEC "x = A \ b" after a fresh PUT of A. */
+static int silc_solve_time(const silc_envelope_t *A, double *t)
+{
+    double t0;
+    if (check(silc_put(ctx, "A", A), "PUT A")) return 1;
+    t0 = now();
+    if (check(silc_exec(ctx, "x = A \\ b"), "x = A \\ b")) return 1;
+    *t = now() - t0;
+    return 0;
+}
+
+static int dense_row(int64_t n, int reps)
+{
+    size_t nn = (size_t)n * (size_t)n;
+    double *a = malloc(nn * sizeof *a), *w = malloc(nn * sizeof *w);
+    double *b = malloc((size_t)n * sizeof *b), *xb = malloc((size_t)n * sizeof *xb);
+    lapack_int *ipiv = malloc((size_t)n * sizeof *ipiv);
+    double tl[16], tcond[16], toff[16];
+    silc_envelope_t A = {0}, be = {0};
+    int rc = !a || !w || !b || !xb || !ipiv;
+    if (rc) fprintf(stderr, "limit: out of memory\n");
+    for (int64_t j = 0; !rc && j < n; j++)
+        for (int64_t i = 0; i < n; i++) a[i + j * n] = urand() - 0.5 + (i == j ? (double)n / 4 : 0);
+    for (int64_t i = 0; !rc && i < n; i++) {
+        double s = 0;
+        for (int64_t j = 0; j < n; j++) s += a[i + j * n];
+        b[i] = s;
+    }
+    if (!rc) rc = silc_envelope_dense(&A, n, n, a) || silc_envelope_vector(&be, n, b);
+    if (!rc) rc = check(silc_put(ctx, "b", &be), "PUT b");
+    for (int r = -1; !rc && r < reps; r++) { /* r = -1: a warm-up, not counted */
+        double t0;
+        /* A new matrix each time: SILC recognises a PUT of the same
+         * entries and reuses its factorization (docs/overhead.md). */
+        a[(size_t)(r + 1) % (size_t)n * (size_t)(n + 1)] += 1e-3;
+        memcpy(A.values, a, nn * sizeof *a);
+        memcpy(w, a, nn * sizeof *w);
+        memcpy(xb, b, (size_t)n * sizeof *xb);
+        t0 = now();
+        if (LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, 1, w, (lapack_int)n, ipiv, xb, (lapack_int)n)) {
+            fprintf(stderr, "limit: dgesv failed\n");
+            rc = 1;
+        }
+        t0 = now() - t0;
+        sink = xb[0];
+        if (r >= 0) tl[r] = t0;
+        rc = rc || check(silc_exec(ctx, "set accuracy.condest = on"), "set") ||
+             silc_solve_time(&A, r >= 0 ? &tcond[r] : &t0);
+        /* the same matrix once more, with its own change, without the estimate */
+        a[(size_t)(r + 1) % (size_t)n * (size_t)(n + 1)] += 1e-3;
+        memcpy(A.values, a, nn * sizeof *a);
+        rc = rc || check(silc_exec(ctx, "set accuracy.condest = off"), "set") ||
+             silc_solve_time(&A, r >= 0 ? &toff[r] : &t0);
+    }
+    if (!rc) {
+        double l = median(tl, reps), c = median(tcond, reps), o = median(toff, reps);
+        printf("%6lld %10.3f %12.3f %12.3f %10.3f %9.3f %9.3f\n", (long long)n, l, o, c, c - o, o / l,
+               c / l);
+    }
+    silc_envelope_free(&A);
+    silc_envelope_free(&be);
+    free(a), free(w), free(b), free(xb), free(ipiv);
+    return rc || check(silc_exec(ctx, "clear A b x; set accuracy.condest = on"), "clear");
+}
+
+static int dense(int64_t max_n)
+{
+    printf("\nDense solve x = A \\ b, A random n x n with a dominant diagonal (not symmetric); seconds,\n"
+           "median of the repetitions; SILC factors afresh each time (a new PUT of A)\n");
+    printf("%6s %10s %12s %12s %10s %9s %9s\n", "n", "dgesv s", "SILC s", "SILC+cond s", "condest s",
+           "ratio", "ratio+c");
+    for (int64_t n = 1000; n <= max_n; n += 1000)
+        if (dense_row(n, n <= 2000 ? 5 : 3)) return 1;
+    printf("ratio = SILC with accuracy.condest = off / dgesv; ratio+c = with the condition estimate\n"
+           "(the default); condest = its cost, the difference of the two SILC columns\n");
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *what = argc > 1 ? argv[1] : "all";
+    int64_t max_n = argc > 2 ? atoll(argv[2]) : 3000;
+    int rc;
+    if (argc > 3 || (strcmp(what, "all") && strcmp(what, "spmv") && strcmp(what, "dense")) || max_n < 1000) {
+        fprintf(stderr, "usage: limit [spmv|dense|all] [max_dense_n >= 1000]\n");
+        return 2;
+    }
+    if (silc_open(&ctx, NULL)) {
+        fprintf(stderr, "limit: %s\n", ctx ? silc_context_errmsg(ctx) : silc_errmsg());
+        silc_close(&ctx);
+        return 1;
+    }
+    rc = (strcmp(what, "dense") && spmv()) || (strcmp(what, "spmv") && dense(max_n));
+    silc_close(&ctx);
+    return rc ? 1 : 0;
+}
