@@ -786,6 +786,7 @@ static int preload_plugins(void)
         fprintf(stderr, "silcd: %s\n", err);
         return -1;
     }
+    eng_open_plugins(E); /* the engine opens plugins at first use; here, all of them */
     eng_destroy(&E);
     return 0;
 }

@@ -93,9 +93,13 @@ void ld_destroy(silc_engine *E);
  * file and the reason (wrong ABI major "plugin 2, host 1", index width, missing
  * symbol, init failure with the plugin's message, no ops at all). */
 int ld_load_file(silc_engine *E, const char *path);
-/* Loads every libsilc_plugin_*.so in the directories of a ':'-separated list;
- * refusals are logged as warnings, not errors. */
+/* Finds every libsilc_plugin_*.so in the directories of a ':'-separated
+ * list, to be opened when first needed (an engine on a communicator opens
+ * them at once); refusals are logged as warnings, not errors. */
 int ld_load_path(silc_engine *E, const char *dirs);
+/* Opens every plugin found and not opened yet (lookups that list every
+ * backend or plugin do it themselves). */
+void ld_open_all(const silc_engine *E);
 /* The plugin directory of the install this engine runs from (beside
  * libsilc.so, or beside the bindir of a program that links the engine), if
  * there is one: 0 and the path in out, else -1 (a build tree). */

@@ -11,6 +11,17 @@
  * at least one operation) and a refused plugin is closed again, so nothing of
  * it stays in the process.
  *
+ * Plugins are opened when first needed, not when their directory is read:
+ * a directory listing only records the files (ld_pending), and the first
+ * lookup of one of a file's backends (ld_find: a dispatch, a configured
+ * backend list checked at start, a plugin's option set) opens that file,
+ * found by its name (libsilc_plugin_NAME.so holds plugin NAME).  Opening
+ * every plugin at start cost `silc -e 'x = 1'` 70-80 ms, mostly PETSc's and
+ * MPI's libraries, whether the text needed them or not.  Whatever lists
+ * all backends or plugins (help, the tuner, suggestions) opens every file
+ * first, so it sees exactly what an eager load saw.  A file that cannot be
+ * opened is warned about when it is first needed, once per process.
+ *
  * An accepted plugin belongs to the process, not to the engine that loaded it:
  * it is opened and initialised once, shared by every context, and shut down at
  * exit, never dlclose'd.  Libraries behind plugins (MPI, PETSc, the Fortran
@@ -51,9 +62,17 @@ static struct {
 } g_loaded;
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 
+/* A plugin file found in a directory and not opened yet. */
+typedef struct ld_pending {
+    char *path;
+    char *name;                 /* NAME of libsilc_plugin_NAME.so */
+} ld_pending;
+
 struct ld_set {
     ld_plugin **plugins;        /* borrowed from g_loaded: backends point into them */
     size_t nplugins;
+    ld_pending *pending;        /* in the order an eager load would have opened them */
+    size_t npending, cappending;
     ld_backend **backends;
     size_t nbackends;
     strbuf searched;            /* the plugin directories tried, "a, b" (for errors) */
@@ -63,6 +82,8 @@ struct ld_set {
 /* Plugin files already warned about in this process: a refused plugin is
  * reported once, not once per directory listing or engine that meets it. */
 static strbuf g_warned;
+
+static const ld_plugin *find_loaded_plugin(const silc_engine *E, const char *plugin_name);
 
 #define LD_FILE_PREFIX "libsilc_plugin_"
 #define LD_FILE_SUFFIX ".so"
@@ -266,6 +287,11 @@ void ld_destroy(silc_engine *E)
     }
     free(S->plugins);
     free(S->backends);
+    for (i = 0; i < S->npending; i++) {
+        free(S->pending[i].path);
+        free(S->pending[i].name);
+    }
+    free(S->pending);
     sb_free(&S->searched);
     sb_free(&S->refused);
     free(S);
@@ -376,7 +402,7 @@ int ld_load_file(silc_engine *E, const char *path)
     if (!p) p = open_plugin(E, path, real);
     pthread_mutex_unlock(&g_lock);
     if (!p) return -1;
-    other = ld_find_plugin(E, p->table->name);
+    other = find_loaded_plugin(E, p->table->name);
     if (other)
         return eng_error(E,
                          "plugin '%s' (%s) not loaded: a plugin of that name is already loaded from %s",
@@ -397,6 +423,31 @@ static int plugin_file_name(const char *name)
 static int cmp_str(const void *a, const void *b)
 {
     return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* Records a plugin file to open when first needed; -1 when out of memory. */
+static int add_pending(ld_set *S, const char *path, const char *file)
+{
+    size_t np = strlen(LD_FILE_PREFIX), len = strlen(file) - np - strlen(LD_FILE_SUFFIX);
+    ld_pending q;
+    if (S->npending == S->cappending) {
+        size_t cap = S->cappending ? 2 * S->cappending : 8;
+        ld_pending *grown = realloc(S->pending, cap * sizeof *grown);
+        if (!grown) return -1;
+        S->pending = grown;
+        S->cappending = cap;
+    }
+    q.path = util_strdup(path);
+    q.name = malloc(len + 1);
+    if (!q.path || !q.name) {
+        free(q.path);
+        free(q.name);
+        return -1;
+    }
+    memcpy(q.name, file + np, len);
+    q.name[len] = '\0';
+    S->pending[S->npending++] = q;
+    return 0;
 }
 
 /* Loads the plugins of one directory in name order (so which of two
@@ -444,13 +495,47 @@ static int load_dir(silc_engine *E, const char *dir)
         strbuf path;
         sb_init(&path);
         sb_printf(&path, "%s/%s", dir, names[i]);
-        if (ld_load_file(E, sb_str(&path))) note_refused(E, sb_str(&path));
+        /* An engine on a communicator opens everything now: every rank
+         * must open the same plugins (PETSc's start is collective), and a
+         * lookup made by one rank alone (a message's suggestions) must not
+         * open one there.  Out of memory: open it now rather than lose it. */
+        if (E->dist || add_pending(E->plugins, sb_str(&path), names[i])) {
+            if (ld_load_file(E, sb_str(&path))) note_refused(E, sb_str(&path));
+        }
         sb_free(&path);
         free(names[i]);
     }
     free(names);
     E->err[0] = '\0';
     return 0;
+}
+
+/* Opens the pending files named name (NULL: all of them), in order; a file
+ * refused is noted and warned about as an eager load did.  E's error text is
+ * kept: a lookup is not an error of the statement that made it.  The set
+ * is a cache of what the directories hold, so a const engine's lookup may
+ * fill it. */
+static void open_pending(const silc_engine *cE, const char *name)
+{
+    silc_engine *E = (silc_engine *)cE;
+    ld_set *S = E->plugins;
+    char saved[sizeof E->err];
+    size_t i = 0;
+    memcpy(saved, E->err, sizeof saved);
+    while (i < S->npending) {
+        ld_pending q = S->pending[i];
+        if (name && strcmp(q.name, name) != 0) {
+            i++;
+            continue;
+        }
+        /* taken off the list first: opening may look plugins up again */
+        memmove(S->pending + i, S->pending + i + 1, (S->npending - i - 1) * sizeof *S->pending);
+        S->npending--;
+        if (ld_load_file(E, q.path)) note_refused(E, q.path);
+        free(q.path);
+        free(q.name);
+    }
+    memcpy(E->err, saved, sizeof saved);
 }
 
 #ifndef SILC_PLUGIN_LIBDIR_REL
@@ -525,20 +610,40 @@ int ld_backend_collective(const ld_backend *b, int op)
     return 0;
 }
 
-const ld_backend *ld_find(const silc_engine *E, const char *full_name)
+static const ld_backend *find_loaded(const silc_engine *E, const char *full_name)
 {
     size_t i;
-    if (!E || !E->plugins || !full_name) return NULL;
     for (i = 0; i < E->plugins->nbackends; i++)
         if (strcmp(E->plugins->backends[i]->full_name, full_name) == 0)
             return E->plugins->backends[i];
     return NULL;
 }
 
+const ld_backend *ld_find(const silc_engine *E, const char *full_name)
+{
+    const ld_backend *b;
+    char plugin[64];
+    size_t len;
+    if (!E || !E->plugins || !full_name) return NULL;
+    if ((b = find_loaded(E, full_name)) || !E->plugins->npending) return b;
+    /* the file of the backend's plugin first; if a plugin's name differs
+     * from its file's, only opening them all can tell */
+    len = strcspn(full_name, ".");
+    if (len < sizeof plugin) {
+        memcpy(plugin, full_name, len);
+        plugin[len] = '\0';
+        open_pending(E, plugin);
+        if ((b = find_loaded(E, full_name)) || !E->plugins->npending) return b;
+    }
+    open_pending(E, NULL);
+    return find_loaded(E, full_name);
+}
+
 size_t ld_backend_names(const silc_engine *E, const char ***names)
 {
     size_t i, n;
     *names = NULL;
+    ld_open_all(E);
     if (!E || !E->plugins || E->plugins->nbackends == 0) return 0;
     n = E->plugins->nbackends;
     *names = malloc(n * sizeof **names);
@@ -547,18 +652,34 @@ size_t ld_backend_names(const silc_engine *E, const char ***names)
     return n;
 }
 
-const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name)
+static const ld_plugin *find_loaded_plugin(const silc_engine *E, const char *plugin_name)
 {
     size_t i;
-    if (!E || !E->plugins || !plugin_name) return NULL;
     for (i = 0; i < E->plugins->nplugins; i++)
         if (strcmp(E->plugins->plugins[i]->table->name, plugin_name) == 0)
             return E->plugins->plugins[i];
     return NULL;
 }
 
+const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name)
+{
+    const ld_plugin *p;
+    if (!E || !E->plugins || !plugin_name) return NULL;
+    if ((p = find_loaded_plugin(E, plugin_name)) || !E->plugins->npending) return p;
+    open_pending(E, plugin_name);
+    if ((p = find_loaded_plugin(E, plugin_name)) || !E->plugins->npending) return p;
+    open_pending(E, NULL);
+    return find_loaded_plugin(E, plugin_name);
+}
+
+void ld_open_all(const silc_engine *E)
+{
+    if (E && E->plugins && E->plugins->npending) open_pending(E, NULL);
+}
+
 size_t ld_plugin_count(const silc_engine *E)
 {
+    ld_open_all(E);
     return E && E->plugins ? E->plugins->nplugins : 0;
 }
 
@@ -573,7 +694,8 @@ void ld_set_threads(silc_engine *E, int nthreads)
     if (!E || nthreads < 1) return;
     E->threads = nthreads;
     host_set_threads(nthreads);
-    for (i = 0; i < ld_plugin_count(E); i++)
+    /* the opened plugins; one opened later gets E->threads (add_plugin) */
+    for (i = 0; E->plugins && i < E->plugins->nplugins; i++)
         if (E->plugins->plugins[i]->table->set_threads)
             E->plugins->plugins[i]->table->set_threads(nthreads);
 }

@@ -132,3 +132,8 @@ void eng_destroy(silc_engine **pE)
     free(E);
     *pE = NULL;
 }
+
+void eng_open_plugins(silc_engine *E)
+{
+    ld_open_all(E);
+}

@@ -28,4 +28,7 @@ struct silc_comm_ops;
 int eng_create_comm(silc_engine **out, const char *config_path, struct silc_comm_ops *comm, char *err,
                     size_t errlen);
 void eng_destroy(silc_engine **E);
+/* Opens every plugin the engine found now instead of at first use (silcd's
+ * parent, so that sessions inherit them by fork). */
+void eng_open_plugins(silc_engine *E);
 #endif
