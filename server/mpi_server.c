@@ -212,6 +212,7 @@ typedef struct conn {
     double last_byte;       /* when the peer last sent, for --io-timeout inside a message */
     uint8_t *buf;           /* the message being assembled, as far as kept */
     size_t kept, cap;
+    size_t want;            /* bytes_to_keep as last asked (0: ask) */
     uint64_t drop;          /* bytes of the last message still to drop unread */
 } conn;
 
@@ -275,7 +276,7 @@ static int conn_decide(conn *c)
         c->drop = proto_get_u64(c->buf + 8) - (c->kept - PROTO_HEADER_BYTES);
         rc = srv_session_serve(c->S, c->buf, c->kept);
     }
-    c->kept = 0;
+    c->kept = c->want = 0;
     if (c->cap > READ_CHUNK) { /* a large message's buffer goes with it */
         free(c->buf);
         c->buf = NULL;
@@ -297,7 +298,10 @@ static int conn_read(conn *c)
             got = recv(c->fd, sink, c->drop < sizeof sink ? (size_t)c->drop : sizeof sink,
                        MSG_DONTWAIT);
         } else {
-            want = bytes_to_keep(c);
+            /* Asked again only when the bytes asked for are in: a PUT's
+             * admission is decided once, not per chunk of its arrays. */
+            if (!c->want || c->kept == c->want) c->want = bytes_to_keep(c);
+            want = c->want;
             if (c->kept == want) return conn_decide(c);
             if (c->cap < want) { /* grow with the bytes that came, not the announced ones */
                 size_t cap = c->cap * 2 > c->kept + READ_CHUNK ? c->cap * 2 : c->kept + READ_CHUNK;

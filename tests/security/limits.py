@@ -23,6 +23,8 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 BINDINGS, STATEDIR, CASE, SILCD = sys.argv[1:5]
 MPIRUN = sys.argv[5] if len(sys.argv) > 5 else None
 sys.path.insert(0, BINDINGS)
@@ -607,8 +609,10 @@ def case_admission_mpi():
     """Rank 0 reads every connection at once: a stalled PUT, a connection
     that sends nothing and a hello trickling a byte at a time do not stop
     another session's EXEC, which is answered while the three still stall;
-    then each of the three completes and is served."""
-    srv = Server("--io-timeout", "60", "--handshake-timeout", "60", mpi=True)
+    then each of the three completes and is served; a PUT over
+    --max-value-bytes is refused and its session goes on."""
+    srv = Server("--io-timeout", "60", "--handshake-timeout", "60", "--max-value-bytes", "1M",
+                 mpi=True)
     put = srv.session()
     put.exec("keep = 5")
     desc = _DESC.pack(DENSE, 1, 1000, 1, 1000, 0, 0)
@@ -641,6 +645,13 @@ def case_admission_mpi():
         reply += chunk
     if not reply.startswith(b"SILC"):
         fail("the trickled hello got %r" % reply)
+    # A PUT refused from its descriptor: its 2 MB of arrays are dropped
+    # unread as they come, and the session stays in step.
+    expect_error(lambda: other.put("big", np.ones((1000, 250))), "per value (silcd "
+                 "--max-value-bytes)", exact=False)
+    other.exec("c = a + 1")
+    if other.get("c")[0, 0] != 45 or "big" in other.names():
+        fail("the session was not in step after a refused PUT")
     for c in (silent, trickle):
         c.close()
     put.close()
