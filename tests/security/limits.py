@@ -166,11 +166,11 @@ class Server:
         if self.proc.poll() is None:
             self.signal_server(signal.SIGTERM)
             try:
-                self.proc.wait(30)
+                self.proc.wait(30 * EXIT_SLACK)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
-                fail("silcd did not stop on SIGTERM within 30 s:\n" + self.text())
+                fail("silcd did not stop on SIGTERM within %d s:\n%s" % (30 * EXIT_SLACK, self.text()))
         self.log.close()
         return self.proc.returncode
 
