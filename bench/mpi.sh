@@ -16,8 +16,8 @@
 # round runs every configuration once, modes interleaved so that drift of the
 # machine hits all of them alike; a table gives the best time of the rounds
 # and the spread (max - min) / min.  The silcd server runs only while its
-# client runs: its idle ranks spin in MPI (Open MPI busy-polls) and would
-# steal the cores from the other modes.
+# client runs (its idle ranks rest, but its start and end are not measured
+# here).  bench/mpi_wake.py measures what resting ranks add to a request.
 set -u
 cd "$(dirname "$0")/.." || exit 1
 QUICK=0

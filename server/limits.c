@@ -12,7 +12,12 @@
  *   a request stuck inside a library call is ended by a timer in the
  *   session's process (the process dies of SIGALRM and silcd tells the
  *   client, silcd.c reap_children) or, when its client has gone, killed by
- *   silcd.
+ *   silcd;
+ * - under silcd --mpi, where one process per rank holds every session, the
+ *   same caps end the whole job: --max-cpu caps each rank's CPU time over
+ *   its life, and the request timer ends rank 0; the rank says why as it
+ *   dies (srv_limit_job), mpirun takes the other ranks down, and the
+ *   operator's supervisor restarts the job (mpirun restarts nothing).
  */
 #define _GNU_SOURCE   /* POLLRDHUP */
 #include "server.h"
@@ -103,13 +108,47 @@ void srv_death_reason(int sig, int state, char *out, size_t outlen)
                  (unsigned long long)srv_data_cap(1));
 }
 
+/* The last words of a rank of silcd --mpi that a limit ends: made before,
+ * written from the signal handler (no allocation, no stdio there). */
+static char cpu_words[400], alarm_words[400];
+static size_t cpu_words_len, alarm_words_len;
+
+static void say_why_and_die(int sig)
+{
+    ssize_t w = sig == SIGXCPU ? write(2, cpu_words, cpu_words_len)
+                               : write(2, alarm_words, alarm_words_len);
+    (void)w;
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+void srv_limit_job(int rank)
+{
+    struct sigaction sa;
+    const char *restart = "every session is lost; mpirun restarts nothing: the operator's "
+                          "supervisor restarts silcd";
+    snprintf(cpu_words, sizeof cpu_words, "silcd[error]: rank %d used the %d s of CPU time a "
+             "rank may use (silcd --max-cpu): ending the MPI job; %s\n", rank,
+             srv_cfg.max_cpu_s, restart);
+    snprintf(alarm_words, sizeof alarm_words, "silcd[error]: rank %d: a request took longer "
+             "than %g s and did not stop within %g s more (it is inside a library call) "
+             "(silcd --max-request-seconds): ending the MPI job; %s\n", rank,
+             srv_cfg.max_request_ms / 1000.0, SRV_REQUEST_GRACE_S, restart);
+    cpu_words_len = strlen(cpu_words);
+    alarm_words_len = strlen(alarm_words);
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = say_why_and_die;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGXCPU, &sa, NULL);
+    sigaction(SIGALRM, &sa, NULL);
+}
+
 /* The forced end of a request stuck where the watch is never asked: the
- * default action of SIGALRM ends the process (silcd.c names the cause).
- * silcd --mpi holds every session in one process: no timer there. */
+ * default action of SIGALRM ends the process (silcd.c names the cause);
+ * under silcd --mpi, rank 0, and with it the job (srv_limit_job). */
 static void arm_request_timer(double seconds)
 {
     struct itimerval t;
-    if (srv_mpi) return;
     memset(&t, 0, sizeof t);
     t.it_value.tv_sec = (time_t)seconds;
     t.it_value.tv_usec = (suseconds_t)((seconds - (double)(time_t)seconds) * 1e6);

@@ -103,6 +103,11 @@ uint64_t srv_data_cap(int sessions);
  * at once if it is already gone), RLIMIT_DATA (srv_data_cap), RLIMIT_CPU
  * (--max-cpu).  -1 if a cap could not be set. */
 int srv_limit_process(int parent, int sessions);
+/* silcd --mpi, on every rank after srv_limit_process: a rank that reaches
+ * --max-cpu (SIGXCPU), or rank 0 whose request is stuck past
+ * --max-request-seconds and its grace (SIGALRM), logs why and dies, which
+ * ends the job. */
+void srv_limit_job(int rank);
 /* What a session process's death by sig (in slot state) says about a
  * limit, as a tail for the client's message ("" if nothing). */
 void srv_death_reason(int sig, int state, char *out, size_t outlen);
@@ -145,12 +150,19 @@ typedef struct srv_ranks {
 extern srv_ranks *srv_mpi;       /* NULL unless silcd --mpi */
 
 /* The pieces of srv_session that rank 0 of silcd --mpi drives from its own
- * poll loop: open (handshake and engine; NULL, fd closed, if it failed),
- * one request (0, or -1 when the session is over), close. */
+ * event loop, which reads every connection at once and hands a session
+ * only whole messages, in memory (mpi_server.c).  A memory stream holds
+ * what that reader kept: the bytes a decoder skips (a refused body, a
+ * refused PUT's arrays) are dropped unread (client.h, proto_skip).
+ * open: the client's hello (12 bytes and its token) in memory; handshake
+ * and engine; NULL, fd closed, if it failed.  wants_arrays: of a PUT whose
+ * header, descriptor and name are in head, whether its arrays will be read
+ * (1) or refused unread (0).  serve: one request, frame = its kept bytes;
+ * 0, or -1 when the session is over.  close. */
 typedef struct session session;
-session *srv_session_open(int fd, unsigned long id, volatile int *state);
-int srv_session_fd(const session *S);
-int srv_session_step(session *S);
+session *srv_session_open_hello(int fd, unsigned long id, const uint8_t *hello, size_t len);
+int srv_session_wants_arrays(session *S, const uint8_t *head, size_t len);
+int srv_session_serve(session *S, const uint8_t *frame, size_t len);
 void srv_session_close(session *S);
 /* The other ranks of silcd --mpi: follow rank 0's commands until STOP. */
 int srv_follow(void);

@@ -302,20 +302,17 @@ static int do_exec(session *S, const char *text)
     return r;
 }
 
-/* PUT: refuse before reading the arrays when the session cannot hold them. */
-static int do_put(session *S, proto_stream *st, const proto_request *q)
+/* Whether a PUT's arrays may be read: 0, or -1 with S->err saying why not
+ * (a bad name, a descriptor the value checker refuses, a session that cannot
+ * hold the value), decided from the descriptor alone. */
+static int put_refusal(session *S, const proto_request *q)
 {
-    silc_value *v = NULL;
     const silc_value *old;
     uint64_t used, old_bytes;
     val_parts claim;
     double cost;
     char why[512];
-    int rc;
-    if (api_check_name(q->text, S->err, sizeof S->err)) {
-        if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
-        return reply_error(S, S->err);
-    }
+    if (api_check_name(q->text, S->err, sizeof S->err)) return -1;
     /* The descriptor's claim, by the checker every value passes
      * (val_parts_claim): overflow and the value limit, with band storage
      * charged for its rows, before a byte of the arrays is read. */
@@ -326,8 +323,7 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
     if (claim.format != SILC_FMT_CSR) claim.nnz = 0;
     if (val_parts_claim(&claim, why, sizeof why)) {
         snprintf(S->err, sizeof S->err, "'%s': %s", q->text, why);
-        if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
-        return reply_error(S, S->err);
+        return -1;
     }
     cost = val_parts_bytes(&claim);
     if (cost < (double)q->layout.total) cost = (double)q->layout.total;
@@ -336,14 +332,26 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
         old = store_get(&S->E->store, q->text);
         old_bytes = old ? val_bytes(old) : 0;
         if ((double)(used - old_bytes) + cost > (double)srv_cfg.max_session_bytes) {
-            if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
                      "(%.0f bytes) would bring the session to %.0f bytes, the limit is %llu "
                      "bytes (silcd --max-session-bytes); '%s' is unchanged", q->text, cost,
                      (double)(used - old_bytes) + cost,
                      (unsigned long long)srv_cfg.max_session_bytes, q->text);
-            return reply_error(S, S->err);
+            return -1;
         }
+    }
+    return 0;
+}
+
+/* PUT: refuse before reading the arrays when the session cannot hold them. */
+static int do_put(session *S, proto_stream *st, const proto_request *q)
+{
+    silc_value *v = NULL;
+    char why[512];
+    int rc;
+    if (put_refusal(S, q)) {
+        if (proto_skip(st, q->layout.total, why, sizeof why)) return -1;
+        return reply_error(S, S->err);
     }
     rc = proto_read_value(st, q, &v, S->err, sizeof S->err);
     if (rc == PROTO_REFUSED) return reply_error(S, S->err);
@@ -488,8 +496,9 @@ static int session_engine(silc_engine **E, unsigned long id, char *err, size_t e
     return rc;
 }
 
-/* Hello both ways, then OK, or ERROR and -1. */
-static int handshake(session *S)
+/* Hello both ways, then OK, or ERROR and -1.  The client's hello comes from
+ * in (silcd --mpi: read already, in memory), else from the socket. */
+static int handshake(session *S, const proto_stream *in)
 {
     proto_stream st = {S->fd, srv_cfg.handshake_timeout_ms, NULL, 0, 0};
     uint8_t hello[PROTO_HELLO_BYTES];
@@ -497,6 +506,7 @@ static int handshake(session *S)
     uint32_t version;
     char *token = NULL, why[512];
     int rc;
+    if (in) st = *in;
     handshake_deadline(srv_cfg.handshake_timeout_ms);
     rc = proto_read_hello(&st, &version, &token, why, sizeof why);
     if (rc) {
@@ -626,7 +636,8 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
     return rc;
 }
 
-session *srv_session_open(int fd, unsigned long id, volatile int *state)
+static session *session_open(int fd, unsigned long id, volatile int *state,
+                             const proto_stream *hello)
 {
     session *S = calloc(1, sizeof *S);
     if (!S) {
@@ -640,7 +651,7 @@ session *srv_session_open(int fd, unsigned long id, volatile int *state)
     S->lim.max_value_bytes = srv_cfg.max_value_bytes;
     S->lim.max_text_bytes = srv_cfg.max_text_bytes;
     S->st = (proto_stream){fd, srv_cfg.io_timeout_ms, NULL, 0, 0};
-    if (handshake(S)) {
+    if (handshake(S, hello)) {
         srv_session_close(S);
         return NULL;
     }
@@ -649,12 +660,32 @@ session *srv_session_open(int fd, unsigned long id, volatile int *state)
     return S;
 }
 
-int srv_session_fd(const session *S)
+session *srv_session_open_hello(int fd, unsigned long id, const uint8_t *hello, size_t len)
 {
-    return S->fd;
+    proto_stream st = {-1, 0, hello, len, 0};
+    return session_open(fd, id, NULL, &st);
 }
 
-int srv_session_step(session *S)
+int srv_session_wants_arrays(session *S, const uint8_t *head, size_t len)
+{
+    proto_stream st = {-1, 0, head, len, 0};
+    proto_request q;
+    char why[512];
+    int want = proto_read_request(&st, &S->lim, &q, why, sizeof why) == 0 &&
+               q.op == PROTO_PUT && put_refusal(S, &q) == 0;
+    proto_request_free(&q);
+    return want;
+}
+
+int srv_session_serve(session *S, const uint8_t *frame, size_t len)
+{
+    proto_stream st = {-1, 0, frame, len, 0};
+    int rc = serve_one(S, &st, &S->lim);
+    *S->state = SLOT_READY;
+    return rc;
+}
+
+static int session_step(session *S)
 {
     int rc = serve_one(S, &S->st, &S->lim);
     *S->state = SLOT_READY;
@@ -676,9 +707,9 @@ void srv_session_close(session *S)
 
 int srv_session(int fd, unsigned long id, volatile int *state)
 {
-    session *S = srv_session_open(fd, id, state);
+    session *S = session_open(fd, id, state, NULL);
     if (!S) return 0;
-    while (await_request(S) == 0 && srv_session_step(S) == 0) {}
+    while (await_request(S) == 0 && session_step(S) == 0) {}
     srv_session_close(S);
     return 1;
 }

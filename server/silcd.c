@@ -123,7 +123,8 @@ static void usage(FILE *f)
           "  --max-request-seconds S stop a request running longer than S seconds; the store is\n"
           "                          as before it (default 0 = no limit)\n"
           "  --max-cpu SECONDS       CPU time one session's process may use, 0 = no limit\n"
-          "                          (default 0; not with --mpi)\n"
+          "                          (default 0; with --mpi: of each rank over the job's life,\n"
+          "                          all sessions together: reaching it ends the job)\n"
           "  --log-level LEVEL       error, warn, info (default) or debug\n"
           "  --ready-file FILE       write the listening address to FILE once ready\n"
           "  --data-dir DIR          sessions may save, load and plot files, each beneath its own\n"
@@ -820,13 +821,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "silcd: --listen: %s\n", err);
         return 2;
     }
-    if (mpi_mode && srv_cfg.max_cpu_s > 0) {
-        /* A rank waiting for the next command spins in MPI: its CPU time
-         * grows while it is idle, so a CPU cap would end idle servers. */
-        fprintf(stderr, "silcd: --max-cpu is not available with --mpi (idle MPI ranks spin on "
-                        "the CPU); use --max-request-seconds\n");
-        return 2;
-    }
     if (!addr.is_unix && !srv_cfg.token && !insecure) {
         fprintf(stderr, "silcd: refusing to listen on %s without --token-file: every local user "
                 "(and anyone who can reach the address) could run code as this user; create a "
@@ -841,6 +835,7 @@ int main(int argc, char **argv)
         /* Every rank: gone with the launcher's daemon, its data segment
          * capped for the sessions it may hold. */
         if (srv_limit_process(getppid(), srv_cfg.max_clients)) return 1;
+        srv_limit_job(srv_mpi->rank);
         if (srv_mpi->rank != 0) {
             /* mpirun forwards SIGTERM and SIGINT to every rank: rank 0
              * alone decides when the others stop (SRV_CMD_STOP). */

@@ -187,6 +187,10 @@ int proto_send_frame(int fd, uint32_t op, const struct iovec *body, int n, int t
                      char *err, size_t errlen);
 int proto_send_text(int fd, uint32_t op, const char *text, int timeout_ms, char *err,
                     size_t errlen);
+/* Drops nbytes of the stream unread.  A memory stream holds what its filler
+ * kept of a message (silcd --mpi's reader keeps only the bytes a decoder
+ * reads, server/mpi_server.c): skipping past its end succeeds, those bytes
+ * never having been kept; reading past it fails. */
 int proto_skip(proto_stream *s, uint64_t nbytes, char *err, size_t errlen);
 
 /* ---- decoding -------------------------------------------------------------- */

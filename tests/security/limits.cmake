@@ -22,7 +22,8 @@ foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_
   set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endforeach()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
-  foreach(case request_time_mpi disconnect_mpi sigterm_mpi)
+  foreach(case request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
+               admission_mpi announce_mpi)
     add_test(NAME security_limits_${case}
              COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
                      ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case}

@@ -23,6 +23,8 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 BINDINGS, STATEDIR, CASE, SILCD = sys.argv[1:5]
 MPIRUN = sys.argv[5] if len(sys.argv) > 5 else None
 sys.path.insert(0, BINDINGS)
@@ -164,11 +166,11 @@ class Server:
         if self.proc.poll() is None:
             self.signal_server(signal.SIGTERM)
             try:
-                self.proc.wait(30)
+                self.proc.wait(30 * EXIT_SLACK)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
-                fail("silcd did not stop on SIGTERM within 30 s:\n" + self.text())
+                fail("silcd did not stop on SIGTERM within %d s:\n%s" % (30 * EXIT_SLACK, self.text()))
         self.log.close()
         return self.proc.returncode
 
@@ -416,14 +418,14 @@ def case_statement_cap():
     srv.stop_cleanly()
 
 
-def stuck_server(*args):
+def stuck_server(*args, mpi=False):
     """A server whose sessions have the "crash" plugin (tests/server/crash_plugin.c)
     first for scaling: `y = 17 * [1; 2]` never returns by itself."""
     conf = os.path.join(STATEDIR, CASE + ".conf")
     with open(conf, "w") as f:
         f.write("[core]\nplugin_path = %s\n[dispatch]\nadd = crash, reference\n"
                 % os.environ["STUCK_PLUGIN_DIR"])
-    return Server("--config", conf, *args)
+    return Server("--config", conf, *args, mpi=mpi)
 
 
 def case_stuck_forced():
@@ -480,6 +482,227 @@ def case_stuck_disconnect():
     c.wait()
     if not wait_until(lambda: not alive(pid), 1.5):
         fail("a stuck session of a SIGKILLed client still runs after 1.5 s")
+    srv.stop_cleanly()
+
+
+# ---- silcd --mpi: ranks at rest, limits that end the job, rank 0's reader ------
+
+def rank_pids(srv):
+    """{rank: pid} of the silcd ranks under mpirun."""
+    out = {}
+    for pid in descendants(srv.proc.pid):
+        try:
+            with open("/proc/%d/environ" % pid, "rb") as f:
+                env = f.read().split(b"\0")
+        except OSError:
+            continue
+        for e in env:
+            if e.startswith(b"OMPI_COMM_WORLD_RANK="):
+                out[int(e.split(b"=")[1])] = pid
+    if len(out) != 2:
+        fail("expected ranks 0 and 1 under mpirun, found %s" % out)
+    return out
+
+
+def cpu_seconds(pid):
+    with open("/proc/%d/stat" % pid) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def case_idle_cpu_mpi():
+    """An idle `mpirun -np 2 silcd --mpi` rests: over 3 s with no request,
+    each rank uses under 10 % of a core (20 % under ASan); spinning in MPI
+    used 99 %.  A request after the rest is answered rightly."""
+    srv = Server("--dist-min-rows", "2", mpi=True)
+    s = srv.session()
+    s.exec("x = [1; 2; 3; 4]")          # split among the ranks: both took part
+    ranks = rank_pids(srv)
+    time.sleep(0.5)
+    before = {r: cpu_seconds(p) for r, p in ranks.items()}
+    t0 = time.monotonic()
+    time.sleep(3)
+    wall = time.monotonic() - t0
+    bound = 0.2 if "ASAN_OPTIONS" in os.environ else 0.1
+    for r, p in sorted(ranks.items()):
+        share = (cpu_seconds(p) - before[r]) / wall
+        print("rank %d idle: %.1f %% of a core" % (r, 100 * share))
+        if share > bound:
+            fail("rank %d used %.0f %% of a core while idle (bound %.0f %%)" % (r, 100 * share, 100 * bound))
+    s.exec("n = x' * x")
+    if s.get("n")[0, 0] != 30:
+        fail("x'x of [1;2;3;4] after the rest is not 30")
+    s.close()
+    srv.stop_cleanly()
+
+
+def case_max_cpu_mpi():
+    """--max-cpu under --mpi caps each rank over the job's life: resting
+    ranks do not reach it, a runaway does, and the rank that dies says why
+    before mpirun ends the job."""
+    cap = 5 if "ASAN_OPTIONS" in os.environ else 2   # rank start-up counts too
+    srv = Server("--max-cpu", str(cap), mpi=True)
+    s = srv.session()
+    s.exec("a = 1")
+    time.sleep(cap + 1)                  # longer than the cap, at rest
+    s.exec("b = a + 1")
+    if s.get("b")[0, 0] != 2:
+        fail("the server was not serving after resting past --max-cpu")
+    try:
+        s.exec(RUNAWAY)
+        fail("the runaway returned")
+    except (SilcError, OSError):
+        pass
+    try:
+        srv.proc.wait(30 * EXIT_SLACK)
+    except subprocess.TimeoutExpired:
+        fail("the job still runs after a rank reached --max-cpu:\n" + srv.text())
+    if srv.proc.returncode == 0:
+        fail("mpirun exited 0 after a rank reached --max-cpu")
+    if "s of CPU time a rank may use (silcd --max-cpu): ending the MPI job" not in srv.text():
+        fail("the log does not say why the job ended:\n" + srv.text())
+    srv.log.close()
+
+
+def case_stuck_mpi():
+    """A call stuck inside a library under --mpi cannot be stopped alone:
+    rank 0 ends the job 2 s past --max-request-seconds and says why; the
+    client's connection closes (the supervisor restarts silcd).  3 s: the
+    small requests before it must not reach the limit on a busy machine."""
+    srv = stuck_server("--max-request-seconds", "3", mpi=True)
+    s = srv.session()
+    s.exec("y = 3 * [1; 2]")
+    if s.get("y")[1, 0] != 6:
+        fail("the crash plugin's scale is wrong")
+    try:
+        s.exec("y = 17 * [1; 2]")
+        fail("the stuck call returned")
+    except (SilcError, OSError):
+        pass
+    try:
+        srv.proc.wait(30 * EXIT_SLACK)
+    except subprocess.TimeoutExpired:
+        fail("the job still runs with a stuck request:\n" + srv.text())
+    if srv.proc.returncode == 0:
+        fail("mpirun exited 0 after a stuck request ended the job")
+    if ("took longer than 3 s and did not stop within 2 s more (it is inside a library "
+            "call) (silcd --max-request-seconds): ending the MPI job" not in srv.text()):
+        fail("the log does not say why the job ended:\n" + srv.text())
+    srv.log.close()
+
+
+HELLO = b"SILC" + struct.pack("<II", 1, 0)
+
+
+def raw(srv):
+    c = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    c.connect(srv.sock)
+    return c
+
+
+def answered(c):
+    """Whether the server has written to (or closed) c."""
+    return bool(select.select([c], [], [], 0)[0])
+
+
+def case_admission_mpi():
+    """Rank 0 reads every connection at once: a stalled PUT, a connection
+    that sends nothing and a hello trickling a byte at a time do not stop
+    another session's EXEC, which is answered while the three still stall;
+    then each of the three completes and is served; a PUT over
+    --max-value-bytes is refused and its session goes on."""
+    srv = Server("--io-timeout", "60", "--handshake-timeout", "60", "--max-value-bytes", "1M",
+                 mpi=True)
+    put = srv.session()
+    put.exec("keep = 5")
+    desc = _DESC.pack(DENSE, 1, 1000, 1, 1000, 0, 0)
+    body = struct.pack("<1000d", *range(1000))
+    put.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + len(body)) + desc + b"v" + body[:100])
+    silent = raw(srv)
+    trickle = raw(srv)
+    trickle.sendall(HELLO[:1])
+    other = srv.session()                # its handshake, then its requests
+    for k in range(2, 5):
+        trickle.sendall(HELLO[k - 1:k])
+        other.exec("a = 40 + %d" % k)
+    if other.get("a")[0, 0] != 44:
+        fail("the other session's answer is wrong")
+    for name, c in (("stalled PUT", put.sock), ("silent connection", silent),
+                    ("trickling hello", trickle)):
+        if answered(c):
+            fail("the %s was answered or closed before it completed" % name)
+    put.sock.sendall(body[100:])         # the PUT completes: stored, in step
+    put._reply()
+    put.exec("s = sum(v)")
+    if put.get("s")[0, 0] != sum(range(1000)) or put.get("keep")[0, 0] != 5:
+        fail("the completed PUT was not stored rightly")
+    trickle.sendall(HELLO[4:])
+    reply = b""
+    while len(reply) < 12:
+        chunk = trickle.recv(12 - len(reply))
+        if not chunk:
+            fail("the trickled hello was refused:\n" + srv.text())
+        reply += chunk
+    if not reply.startswith(b"SILC"):
+        fail("the trickled hello got %r" % reply)
+    # A PUT refused from its descriptor: its 2 MB of arrays are dropped
+    # unread as they come, and the session stays in step.
+    expect_error(lambda: other.put("big", np.ones((1000, 250))), "per value (silcd "
+                 "--max-value-bytes)", exact=False)
+    other.exec("c = a + 1")
+    if other.get("c")[0, 0] != 45 or "big" in other.names():
+        fail("the session was not in step after a refused PUT")
+    for c in (silent, trickle):
+        c.close()
+    put.close()
+    other.close()
+    srv.stop_cleanly()
+
+
+def case_announce_mpi():
+    """A PUT header announcing 256 MiB (81 bytes sent) does not raise rank
+    0's peak memory by more than a few MiB: its buffer grows with the bytes
+    that arrive.  A hello trickling a byte every 0.3 s is closed at
+    --handshake-timeout, however long it would go on."""
+    srv = Server("--handshake-timeout", "1", mpi=True)
+    r0 = rank_pids(srv)[0]
+    s = srv.session()
+    s.exec("a = 1")
+    base = proc_status(r0, "VmHWM")
+    hostile = srv.session()
+    m = (256 * MiB) // 8
+    desc = _DESC.pack(DENSE, 17, m, 1, m, 0, 0)
+    hostile.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 17 + m * 8) + desc + b"h" * 17)
+    s.exec("b = a + 1")                  # served after the header was read
+    time.sleep(0.5)
+    grown = proc_status(r0, "VmHWM") - base
+    print("rank 0's VmHWM grew by %.1f MiB after a header announcing 256 MiB" % (grown / MiB))
+    if grown > 8 * MiB:
+        fail("a header announcing 256 MiB raised rank 0's peak memory by %.0f MiB" % (grown / MiB))
+    trickle = raw(srv)
+    closed = False
+    end = time.monotonic() + 20 * EXIT_SLACK
+    k = 0
+    while time.monotonic() < end and not closed:
+        try:
+            if k < len(HELLO) - 1:       # never the last byte
+                trickle.sendall(HELLO[k:k + 1])
+        except OSError:
+            closed = True
+            break
+        k += 1
+        if select.select([trickle], [], [], 0.3)[0]:
+            closed = trickle.recv(64) == b""
+    if not closed:
+        fail("a trickling hello was not closed at --handshake-timeout:\n" + srv.text())
+    # mpirun forwards the ranks' output: the line may come a little later.
+    if not wait_until(lambda: "no handshake within 1 s, closed (--handshake-timeout)"
+                      in srv.text(), 10 * EXIT_SLACK):
+        fail("the log does not say why the trickling hello was closed:\n" + srv.text())
+    if s.get("b")[0, 0] != 2:
+        fail("the session's answer is wrong")
+    hostile.sock.close()
+    s.close()
     srv.stop_cleanly()
 
 
