@@ -132,6 +132,8 @@ with silc.Session() as s:
     bound = 0.5 * h * h * math.exp(-0.5) / 12
     check(err < 1.5 * bound + 1e-5, "diffusion1d error %.3e vs estimate %.3e" % (err, bound))
 
+import os  # noqa: E402
+
 # A server that is not there: silc.Error naming the socket, not a bare
 # FileNotFoundError.
 missing = "unix:/nonexistent-dir/silc.sock"
@@ -141,8 +143,14 @@ try:
 except silc.Error as e:
     check(missing in str(e) and "No such file" in str(e), "missing socket: %s" % e)
 
+# Limits given wrong are errors naming them.
+expect_error(lambda: silc.Session(missing, timeout=-1), "a timeout must be >= 0", "timeout=-1")
+os.environ["SILC_IO_TIMEOUT"] = "soon"
+expect_error(lambda: silc.Session(missing), "SILC_IO_TIMEOUT = 'soon': expected seconds",
+             "SILC_IO_TIMEOUT=soon")
+del os.environ["SILC_IO_TIMEOUT"]
+
 # __version__ is the CMake project's, and help(silc.Session) shows examples.
-import os  # noqa: E402
 import pydoc  # noqa: E402
 import re  # noqa: E402
 with open(os.path.join(sys.argv[1] if len(sys.argv) > 1 else "bindings/python", "..", "..",

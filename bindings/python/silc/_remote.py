@@ -36,6 +36,7 @@ _HELLO = struct.Struct("<4sII")
 _DESC = struct.Struct("<IIqqqqq")
 _MAX_TEXT = 64 << 20                 # silcd's own cap on a statement
 _TEXT_CHUNK = 1 << 20
+_SEND_CHUNK = 16 << 20
 DEFAULT_TIMEOUT = 300.0
 _IO = object()                       # "the I/O timeout" for a first wait
 _OPS = {OK: "OK", ERROR: "ERROR", VALUE: "VALUE", TEXT: "TEXT", WARN: "WARN"}
@@ -214,9 +215,13 @@ class RemoteSession:
         return b"".join(parts).decode("utf-8", "replace")
 
     def _sendall(self, data):
+        # In chunks: sendall's timeout bounds the whole call, and a large
+        # PUT over a slow link may rightly take longer than one timeout.
+        data = memoryview(data).cast("B")
         try:
             self.sock.settimeout(self.timeout)
-            self.sock.sendall(data)
+            for at in range(0, len(data), _SEND_CHUNK):
+                self.sock.sendall(data[at:at + _SEND_CHUNK])
         except socket.timeout:
             self._fail(Timeout("silc server %s accepted nothing for %s s (SILC_IO_TIMEOUT; "
                                "connection closed)" % (self.url, _fmt_seconds(self.timeout))))
