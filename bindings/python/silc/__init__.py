@@ -20,6 +20,8 @@ name: silc.UndefinedName); a remote session's errors name the server.
 """
 import os
 
+import numpy as np
+
 from ._values import Error, ProtocolError, SilcError, Timeout, UndefinedName
 
 __version__ = "1.0.0"      # the CMake project's VERSION (test_python checks they agree)
@@ -86,9 +88,10 @@ def _ndim_of(value):
     """The dimensions a dense value was put with (0, 1, 2), or None."""
     if hasattr(value, "tocsr") or isinstance(value, tuple):
         return None
-    if isinstance(value, (int, float)):
-        return 0
-    return getattr(value, "ndim", None)
+    try:
+        return np.ndim(value)
+    except (TypeError, ValueError):
+        return None
 
 
 class Session:
