@@ -2,8 +2,8 @@
 "Replies a client gets"; issue 33): a fake silcd on a Unix socket in the
 build directory speaks the handshake, then answers each request with the
 case's hostile reply.  The client under test runs as its own process (the
-C runner clients_c, the Fortran runner and the Java runner once per case,
-one Python child for all cases), does the calls the case names and prints one line per call, "OK ..." or
+C runner clients_c and the Fortran runner once per case, one Python child
+and one JVM for all cases), does the calls the case names and prints one line per call, "OK ..." or
 "ERROR <type>: <message>"; this script checks the exact error, that it is
 the client's own type, that the message names the socket, that the
 process exited by itself (no signal) and, for the Python client, that no
@@ -255,9 +255,11 @@ def main(argv):
     os.makedirs(workdir, exist_ok=True)
     cases = list(CASES) if client != "fortran" else ["csr_index"]
     paths = {case: os.path.join(workdir, "%s-%s.sock" % (client, case)) for case in cases}
-    if client == "python":
+    if client in ("python", "java"):
+        # Every case in one process; Java's limits then come as setters, so
+        # one case more runs alone with its limit in the environment.
         servers = [FakeServer(paths[case], case) for case in cases]
-        cmd = [sys.executable, "-c", PYTHON_RUNNER, tail[0]]
+        cmd = [sys.executable, "-c", PYTHON_RUNNER, tail[0]] if client == "python" else list(tail)
         for case in cases:
             calls, _replies, _want, env = CASES[case]
             cmd += ["--case", case, "unix:" + paths[case]] + \
@@ -270,11 +272,13 @@ def main(argv):
         sections = dict((sec.split("\n", 1) + [""])[:2] for sec in out.split("CASE ")[1:])
         for case in cases:
             judge(client, case, paths[case], rc, sections.get(case, ""), err)
-        # The interpreter with numpy and scipy is ~60 MB; the 1 GiB text
-        # header or the band reply as a 7.2 GB dense array would show far
-        # above 200 MB.
-        check(peak < 200 * 1024, "python: peak memory %d KiB" % peak)
-        done()
+        if client == "python":
+            # The interpreter with numpy and scipy is ~60 MB; the 1 GiB text
+            # header or the band reply as a 7.2 GB dense array would show
+            # far above 200 MB.
+            check(peak < 200 * 1024, "python: peak memory %d KiB" % peak)
+            done()
+        cases = ["silent"]
     for case in cases:
         calls, _replies, _want, env = CASES[case]
         url = "unix:" + paths[case]
