@@ -179,15 +179,19 @@ static int bad_reply(rem_conn *c, int rc, const char *why, char *err, size_t err
 }
 
 /* Waits up to timeout_ms (-1: for ever) for the first byte of a reply; -1
- * with why ("sent nothing for 300 s (SILC_IO_TIMEOUT)") when none came. */
+ * with why ("sent nothing for 300 s (SILC_IO_TIMEOUT)") when none came.
+ * Always here, never in proto_recv, whose waits are the I/O timeout: an
+ * EXEC's reply may rightly take longer.  Spins first (PROTO_SPIN_NS), as
+ * every wait of the protocol does, so a small request's round trip does
+ * not pay for waking a sleeping thread. */
 static int await_first_byte(rem_conn *c, int timeout_ms, const char *var, char *why,
                             size_t whylen)
 {
     struct pollfd p;
     int rc;
-    if (timeout_ms < 0) return 0;
     p.fd = c->fd;
     p.events = POLLIN;
+    if (proto_spin(&p, 1)) return 0;
     do rc = poll(&p, 1, timeout_ms);
     while (rc < 0 && errno == EINTR);
     if (rc > 0) return 0;

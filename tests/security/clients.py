@@ -84,6 +84,10 @@ CASES = {
     "silent_exec": (["exec:x = 1"], [None], ["sent nothing for 1 s (SILC_EXEC_TIMEOUT"],
                     {"SILC_EXEC_TIMEOUT": "1"}),
     "unknown_op": (["get:A"], [frame(77, b"zz")], ["unknown reply opcode 77"], {}),
+    # Not hostile: an EXEC that computes longer than the I/O timeout must
+    # not be cut off by it (only SILC_EXEC_TIMEOUT bounds that wait).
+    "slow_exec": (["exec:x = 1"], [("delay", 1.5, frame(OK, b""))], ["OK exec"],
+                  {"SILC_IO_TIMEOUT": "1"}),
     "closed": (["get:A"], [value(0, 2, 2, 4, arrays=f64(1.0), length=DESC.size + 32), "close"],
                ["connection closed by peer"], {}),
 }
@@ -156,6 +160,9 @@ class FakeServer:
                 while c.recv(4096):      # silent until the client hangs up
                     pass
                 return
+            if isinstance(reply, tuple):          # ("delay", seconds, bytes)
+                time.sleep(reply[1])
+                reply = reply[2]
             c.sendall(reply)
             if replies and replies[0] == "close":
                 return
