@@ -143,32 +143,10 @@ static void usage(FILE *f)
 #define SECONDS_OPTION_MIN 0.001
 #define SECONDS_OPTION_MAX 86400.0
 
-/* "123", "64K", "512M", "2G" (powers of 1024), at most SIZE_OPTION_MAX;
- * -1 with why on anything else. */
+/* "123", "64K", "512M", "2G" (util_parse_size), at most SIZE_OPTION_MAX. */
 static int parse_size(const char *s, uint64_t *out, char *why, size_t whylen)
 {
-    char *end;
-    unsigned long long x;
-    int shift = 0;
-    snprintf(why, whylen, "expected a size in bytes with an optional K, M, G or T suffix");
-    if (!s || !(*s >= '0' && *s <= '9')) return -1;
-    errno = 0;
-    x = strtoull(s, &end, 10);
-    switch (*end) {
-    case 'k': case 'K': shift = 10; end++; break;
-    case 'm': case 'M': shift = 20; end++; break;
-    case 'g': case 'G': shift = 30; end++; break;
-    case 't': case 'T': shift = 40; end++; break;
-    default: break;
-    }
-    if (*end) return -1;
-    if (errno == ERANGE || x > (SIZE_OPTION_MAX >> shift)) {
-        snprintf(why, whylen, "too large: the maximum is %llu bytes",
-                 (unsigned long long)SIZE_OPTION_MAX);
-        return -1;
-    }
-    *out = (uint64_t)x << shift;
-    return 0;
+    return util_parse_size(s, SIZE_OPTION_MAX, out, why, whylen);
 }
 
 /* A decimal integer in [lo, hi]; -1 with why naming the range. */

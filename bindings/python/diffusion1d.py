@@ -41,7 +41,7 @@ def run(session, n=100, steps=500, t_end=0.5):
     session.put("u", np.sin(x))
     for _ in range(steps):
         session.exec("b = B * u; u = A \\ b")
-    u = session.get("u")[:, 0]
+    u = session.get("u")                   # 1-D, as it was put
     return float(np.max(np.abs(u - math.exp(-t_end) * np.sin(x)))), u
 
 

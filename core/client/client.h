@@ -206,7 +206,9 @@ int proto_read_request(proto_stream *s, const proto_limits *lim, proto_request *
 int proto_read_value(proto_stream *s, const proto_request *r, silc_value **out, char *err,
                      size_t errlen);
 void proto_request_free(proto_request *r);
-/* Client side: one reply, VALUE arrays read straight into r->env. */
+/* Client side: one reply, VALUE arrays read straight into r->env and
+ * checked as a PUT's are.  A well-framed VALUE over lim->max_value_bytes is
+ * skipped and PROTO_REFUSED; any other bad reply is PROTO_FATAL. */
 int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, char *err,
                      size_t errlen);
 void proto_reply_free(proto_reply *r);

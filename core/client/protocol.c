@@ -748,8 +748,9 @@ int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, c
     case PROTO_TEXT:
     case PROTO_WARN:
         if (len > lim->max_text_bytes)
-            return perr(PROTO_FATAL, err, errlen, "%s reply of %llu bytes exceeds the limit",
-                        proto_op_name(r->op), (unsigned long long)len);
+            return perr(PROTO_FATAL, err, errlen, "%s reply of %llu bytes exceeds the limit of "
+                        "%llu bytes", proto_op_name(r->op), (unsigned long long)len,
+                        (unsigned long long)lim->max_text_bytes);
         if ((rc = recv_text(s, len, &r->text, err, errlen))) return rc;
         r->textlen = (size_t)len;
         if (!r->text && !(r->text = calloc(1, 1)))
@@ -762,10 +763,20 @@ int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, c
         decode_desc(d, &desc);
         if (desc.namelen != 0)
             return perr(PROTO_FATAL, err, errlen, "VALUE reply with a name length");
-        if (proto_layout_of(&desc, lim->max_value_bytes, &L, err, errlen)) return PROTO_FATAL;
+        if (proto_layout_of(&desc, UINT64_MAX, &L, err, errlen)) return PROTO_FATAL;
         if (L.total != len - PROTO_DESC_BYTES)
-            return perr(PROTO_FATAL, err, errlen, "VALUE reply of %llu bytes, its descriptor "
-                        "needs %llu", (unsigned long long)len, (unsigned long long)L.total);
+            return perr(PROTO_FATAL, err, errlen, "VALUE reply carries %llu bytes of arrays, "
+                        "its descriptor needs %llu", (unsigned long long)(len - PROTO_DESC_BYTES),
+                        (unsigned long long)L.total);
+        if (L.total > lim->max_value_bytes) {
+            /* A consistent frame over the receiver's cap: skipped, so that
+             * the stream stays in step and the session keeps its values. */
+            char over[200];
+            util_fmt_over_limit(over, sizeof over, (double)L.total, (double)lim->max_value_bytes);
+            perr(0, err, errlen, "a %lldx%lld %s value of %s per value (SILC_MAX_REPLY_BYTES)",
+                 (long long)desc.m, (long long)desc.n, val_format_name((int)desc.format), over);
+            return skip_refused(s, L.total, err, errlen);
+        }
         /* From the pool: a GET of the same size each step receives into the
          * array the last one freed. */
         e->values = val_array_alloc((int64_t)L.values_bytes, 1, 0);

@@ -5,19 +5,28 @@
  * Arrays travel without being copied: a PUT sends the envelope's own arrays
  * with one sendmsg (header, descriptor, name, rowptr, colind, values), and a
  * VALUE reply is received straight into freshly allocated envelope arrays.
- * The client waits for the server without a timeout, since a statement may
- * compute for as long as it needs; a server that dies shows as a closed
- * connection, and one whose machine vanishes (no FIN ever comes) is found by
- * TCP keepalive probes within about 25 s (keep_alive below).
+ *
+ * The client trusts the server no more than the server trusts it: every
+ * reply goes through protocol.c's checks (lengths against the descriptor,
+ * CSR structure by the store's checked constructor), a value larger than
+ * SILC_MAX_REPLY_BYTES (default 2 GiB) or a text over 64 MiB is refused
+ * before anything is allocated, and a server that stops sending is an error
+ * naming it after SILC_IO_TIMEOUT seconds (default 300).  The wait for an
+ * EXEC's first reply has no timeout unless SILC_EXEC_TIMEOUT is set, since a
+ * statement may compute for as long as it needs; a server whose machine
+ * vanishes (no FIN ever comes) is found by TCP keepalive probes within about
+ * 25 s (keep_alive below).
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE   /* TCP_KEEPIDLE and friends */
 #include "client.h"
 
 #include <errno.h>
+#include <math.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,11 +57,54 @@ static void keep_alive(int fd)
 struct rem_conn {
     int fd;
     int broken;
+    int io_timeout_ms;         /* SILC_IO_TIMEOUT: the longest silence inside a reply; -1 none */
+    int exec_timeout_ms;       /* SILC_EXEC_TIMEOUT: the longest wait for an EXEC's reply; -1 none */
+    proto_limits limits;       /* SILC_MAX_REPLY_BYTES per value; text as silcd's statements */
     char url[512];
 };
 
-/* Replies a client accepts: text up to 1 GiB, values as large as memory. */
-static const proto_limits client_limits = {UINT64_MAX / 2, (uint64_t)1 << 30};
+/* Defaults of the client's reply limits (docs/remote.md, "What a client
+ * accepts"): 2 GiB per value, text up to silcd's own 64 MiB statement cap,
+ * 300 s of silence inside a reply. */
+#define CLIENT_MAX_VALUE_BYTES ((uint64_t)2 << 30)
+#define CLIENT_MAX_TEXT_BYTES ((uint64_t)64 << 20)
+#define CLIENT_IO_TIMEOUT_S 300.0
+
+/* Seconds from the variable var (a decimal, 0 = no timeout), else dflt, as
+ * poll's milliseconds (-1 for none); -1 with a message naming var. */
+static int timeout_from_env(const char *var, double dflt, int *ms, char *err, size_t errlen)
+{
+    const char *v = getenv(var);
+    double sec = dflt;
+    if (v && *v) {
+        char *end;
+        errno = 0;
+        sec = strtod(v, &end);
+        if (*end || errno || !(sec >= 0) || sec > 86400 * 365) {
+            snprintf(err, errlen, "%s = '%s': expected seconds (a number >= 0; 0 for no timeout)",
+                     var, v);
+            return -1;
+        }
+    }
+    *ms = sec > 0 ? (int)ceil(sec * 1000) : -1;
+    return 0;
+}
+
+/* The connection's limits and timeouts from the environment. */
+static int limits_from_env(rem_conn *c, char *err, size_t errlen)
+{
+    const char *v = getenv("SILC_MAX_REPLY_BYTES");
+    char why[160];
+    c->limits.max_value_bytes = CLIENT_MAX_VALUE_BYTES;
+    c->limits.max_text_bytes = CLIENT_MAX_TEXT_BYTES;
+    if (v && *v && util_parse_size(v, (uint64_t)INT64_MAX, &c->limits.max_value_bytes, why, sizeof why)) {
+        snprintf(err, errlen, "SILC_MAX_REPLY_BYTES = '%s': %s", v, why);
+        return -1;
+    }
+    if (timeout_from_env("SILC_IO_TIMEOUT", CLIENT_IO_TIMEOUT_S, &c->io_timeout_ms, err, errlen))
+        return -1;
+    return timeout_from_env("SILC_EXEC_TIMEOUT", 0, &c->exec_timeout_ms, err, errlen);
+}
 
 static int connect_addr(const proto_addr *a, char *err, size_t errlen)
 {
@@ -100,16 +152,74 @@ static int lost(rem_conn *c, const char *why, char *err, size_t errlen)
     return -1;
 }
 
-/* The reply that ends a request: OK, ERROR (its text into err), or VALUE into
- * *env when env is not NULL.  TEXT and WARN before it go to fn and warnings. */
-static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, void *user,
-                       strbuf *warnings, char *err, size_t errlen)
+/* A reply that could not be read (rc from protocol.c).  A value over the
+ * cap was skipped whole (PROTO_REFUSED): the session goes on.  Otherwise
+ * the stream is out of step, so the connection is closed and later calls
+ * say so; the message says whether the server fell silent, closed, or sent
+ * something a server must not. */
+static int bad_reply(rem_conn *c, int rc, const char *why, char *err, size_t errlen)
 {
-    proto_stream s = {c->fd, -1, NULL, 0, 0};
+    if (rc == PROTO_REFUSED) {
+        snprintf(err, errlen, "silc server %s: reply refused: %s", c->url, why);
+        return -1;
+    }
+    if (rc != PROTO_BROKEN) {
+        c->broken = 1;
+        snprintf(err, errlen, "silc server %s sent a bad reply: %s (connection closed)", c->url,
+                 why);
+        return -1;
+    }
+    if (strncmp(why, "timed out", 9) == 0) {
+        c->broken = 1;
+        snprintf(err, errlen, "silc server %s stopped sending in the middle of a reply: %s "
+                 "(SILC_IO_TIMEOUT; connection closed)", c->url, why);
+        return -1;
+    }
+    return lost(c, why, err, errlen);
+}
+
+/* Waits up to timeout_ms (-1: for ever) for the first byte of a reply; -1
+ * with why ("sent nothing for 300 s (SILC_IO_TIMEOUT)") when none came.
+ * Always here, never in proto_recv, whose waits are the I/O timeout: an
+ * EXEC's reply may rightly take longer.  Spins first (PROTO_SPIN_NS), as
+ * every wait of the protocol does, so a small request's round trip does
+ * not pay for waking a sleeping thread. */
+static int await_first_byte(rem_conn *c, int timeout_ms, const char *var, char *why,
+                            size_t whylen)
+{
+    struct pollfd p;
+    int rc;
+    p.fd = c->fd;
+    p.events = POLLIN;
+    if (proto_spin(&p, 1)) return 0;
+    do rc = poll(&p, 1, timeout_ms);
+    while (rc < 0 && errno == EINTR);
+    if (rc > 0) return 0;
+    if (rc < 0) snprintf(why, whylen, "poll: %s", strerror(errno));
+    else snprintf(why, whylen, "sent nothing for %g s (%s)", timeout_ms / 1000.0, var);
+    return -1;
+}
+
+/* The reply that ends a request: OK, ERROR (its text into err), or VALUE into
+ * *env when env is not NULL.  TEXT and WARN before it go to fn and warnings.
+ * Each reply frame is awaited for the I/O timeout, or for an EXEC (exec set)
+ * the EXEC timeout; inside a frame every wait is the I/O timeout. */
+static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, void *user,
+                       strbuf *warnings, int exec, char *err, size_t errlen)
+{
+    proto_stream s = {c->fd, c->io_timeout_ms, NULL, 0, 0};
     for (;;) {
         proto_reply r;
         char why[512];
-        if (proto_read_reply(&s, &client_limits, &r, why, sizeof why)) return lost(c, why, err, errlen);
+        int rc;
+        if (await_first_byte(c, exec ? c->exec_timeout_ms : c->io_timeout_ms,
+                             exec ? "SILC_EXEC_TIMEOUT" : "SILC_IO_TIMEOUT", why, sizeof why)) {
+            c->broken = 1;
+            snprintf(err, errlen, "silc server %s %s; connection closed", c->url, why);
+            return -1;
+        }
+        if ((rc = proto_read_reply(&s, &c->limits, &r, why, sizeof why)))
+            return bad_reply(c, rc, why, err, errlen);
         switch (r.op) {
         case PROTO_TEXT:
             if (fn) fn(user, r.text);
@@ -120,7 +230,7 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
             break;
         case PROTO_OK:
             proto_reply_free(&r);
-            return env ? lost(c, "OK reply where a value was expected", err, errlen) : 0;
+            return env ? bad_reply(c, PROTO_FATAL, "OK reply where a value was expected", err, errlen) : 0;
         case PROTO_ERROR:
             snprintf(err, errlen, "%s", r.text);
             proto_reply_free(&r);
@@ -128,7 +238,7 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
         default: /* PROTO_VALUE */
             if (!env) {
                 proto_reply_free(&r);
-                return lost(c, "unexpected VALUE reply", err, errlen);
+                return bad_reply(c, PROTO_FATAL, "unexpected VALUE reply", err, errlen);
             }
             *env = r.env;
             memset(&r.env, 0, sizeof r.env);
@@ -173,6 +283,10 @@ int rem_open(rem_conn **out, const char *url, const char *token, char *err, size
         return -1;
     }
     snprintf(c->url, sizeof c->url, "%s", url);
+    if (limits_from_env(c, err, errlen)) {
+        free(c);
+        return -1;
+    }
     if ((c->fd = connect_addr(&a, why, sizeof why)) < 0) {
         snprintf(err, errlen, "cannot connect to silc server %s: %s", url, why);
         free(c);
@@ -183,8 +297,9 @@ int rem_open(rem_conn **out, const char *url, const char *token, char *err, size
     iov[0].iov_len = sizeof hello;
     iov[1].iov_base = (void *)(uintptr_t)token;
     iov[1].iov_len = toklen;
-    s = (proto_stream){c->fd, -1, NULL, 0, 0};
-    if (proto_send(c->fd, iov, 2, -1, why, sizeof why) ||
+    s = (proto_stream){c->fd, c->io_timeout_ms, NULL, 0, 0};
+    if (proto_send(c->fd, iov, 2, c->io_timeout_ms, why, sizeof why) ||
+        await_first_byte(c, c->io_timeout_ms, "SILC_IO_TIMEOUT", why, sizeof why) ||
         proto_read_hello(&s, &version, &tok, why, sizeof why)) {
         snprintf(err, errlen, "handshake with silc server %s failed: %s", url, why);
         free(tok);
@@ -193,8 +308,9 @@ int rem_open(rem_conn **out, const char *url, const char *token, char *err, size
         return -1;
     }
     free(tok);
-    if (await_reply(c, NULL, NULL, NULL, NULL, why, sizeof why)) {
-        snprintf(err, errlen, "silc server %s refused the connection: %s", url, why);
+    if (await_reply(c, NULL, NULL, NULL, NULL, 0, why, sizeof why)) {
+        if (c->broken) snprintf(err, errlen, "%s", why);
+        else snprintf(err, errlen, "silc server %s refused the connection: %s", url, why);
         close(c->fd);
         free(c);
         return -1;
@@ -209,8 +325,10 @@ void rem_close(rem_conn **pc)
     char why[256];
     if (!pc || !*pc) return;
     c = *pc;
+    /* Closing waits 5 s at most for the server's goodbye. */
+    if (c->io_timeout_ms < 0 || c->io_timeout_ms > 5000) c->io_timeout_ms = 5000;
     if (!c->broken && proto_send_text(c->fd, PROTO_BYE, NULL, 5000, why, sizeof why) == 0)
-        await_reply(c, NULL, NULL, NULL, NULL, why, sizeof why);
+        await_reply(c, NULL, NULL, NULL, NULL, 0, why, sizeof why);
     close(c->fd);
     free(c);
     *pc = NULL;
@@ -255,18 +373,18 @@ int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, 
     body[3].iov_len = (size_t)L.colind_bytes;
     body[4].iov_base = e->values;
     body[4].iov_len = (size_t)L.values_bytes;
-    if (proto_send_frame(c->fd, PROTO_PUT, body, 5, -1, why, sizeof why))
+    if (proto_send_frame(c->fd, PROTO_PUT, body, 5, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, NULL, NULL, NULL, NULL, err, errlen);
+    return await_reply(c, NULL, NULL, NULL, NULL, 0, err, errlen);
 }
 
 int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, char *err, size_t errlen)
 {
     char why[512];
     if (usable(c, err, errlen)) return -1;
-    if (proto_send_text(c->fd, PROTO_GET, name, -1, why, sizeof why))
+    if (proto_send_text(c->fd, PROTO_GET, name, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, e, NULL, NULL, NULL, err, errlen);
+    return await_reply(c, e, NULL, NULL, NULL, 0, err, errlen);
 }
 
 int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
@@ -274,7 +392,7 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
 {
     char why[512];
     if (usable(c, err, errlen)) return -1;
-    if (proto_send_text(c->fd, PROTO_EXEC, statements, -1, why, sizeof why))
+    if (proto_send_text(c->fd, PROTO_EXEC, statements, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, NULL, fn, user, warnings, err, errlen);
+    return await_reply(c, NULL, fn, user, warnings, 1, err, errlen);
 }

@@ -137,8 +137,13 @@ SILC_API int silc_open(silc_context **out, const char *config_path);
  * silc_open and SILC_INIT do the same with SILC_SERVER when it is set (the
  * server's configuration then applies, config_path is not used).  Every other
  * call behaves as on an embedded context: same results, same messages; a lost
- * connection is reported by the call that meets it.  On failure the message is
- * in silc_errmsg(). */
+ * connection is reported by the call that meets it.  Replies are checked as
+ * silcd checks requests: a value over SILC_MAX_REPLY_BYTES (default 2G) is
+ * refused (the session goes on), a malformed reply or a server silent for
+ * SILC_IO_TIMEOUT seconds (default 300; inside a reply, or before the reply
+ * to anything but silc_exec, whose wait SILC_EXEC_TIMEOUT bounds, none by
+ * default) fails the call naming the server and closes the connection
+ * (docs/remote.md).  On failure the message is in silc_errmsg(). */
 SILC_API int silc_open_remote(silc_context **out, const char *url);
 SILC_API void silc_close(silc_context **ctx);
 /* Binds a copy of e to name (the envelope stays the caller's).  The copy is

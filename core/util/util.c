@@ -8,6 +8,7 @@
 #include "util.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -192,4 +193,32 @@ void util_fmt_over_limit(char *out, size_t outlen, double need, double limit)
     fmt_binary(c, sizeof c, need - limit);
     snprintf(out, outlen, "%.0f bytes (%s), over the limit of %.0f bytes (%s) by %s", need, a,
              limit, b, c);
+}
+
+/* "123", "64K", "512M", "2G" (powers of 1024), at most max;
+ * -1 with why on anything else. */
+int util_parse_size(const char *s, uint64_t max, uint64_t *out, char *why, size_t whylen)
+{
+    char *end;
+    unsigned long long x;
+    int shift = 0;
+    snprintf(why, whylen, "expected a size in bytes with an optional K, M, G or T suffix");
+    if (!s || !(*s >= '0' && *s <= '9')) return -1;
+    errno = 0;
+    x = strtoull(s, &end, 10);
+    switch (*end) {
+    case 'k': case 'K': shift = 10; end++; break;
+    case 'm': case 'M': shift = 20; end++; break;
+    case 'g': case 'G': shift = 30; end++; break;
+    case 't': case 'T': shift = 40; end++; break;
+    default: break;
+    }
+    if (*end) return -1;
+    if (errno == ERANGE || x > (max >> shift)) {
+        snprintf(why, whylen, "too large: the maximum is %llu bytes",
+                 (unsigned long long)max);
+        return -1;
+    }
+    *out = (uint64_t)x << shift;
+    return 0;
 }

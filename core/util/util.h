@@ -10,6 +10,7 @@
 
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct strbuf {
     char *s;
@@ -92,5 +93,10 @@ int util_open_input(const char *path);
 /* "/proc/self/fd/N": a name for an open descriptor that libraries taking a
  * file name (HDF5) open as that very file. */
 void util_fd_path(int fd, char *out, size_t len);
+
+/* A size as silcd's options and the clients' SILC_MAX_REPLY_BYTES take it:
+ * "123", "64K", "512M", "2G", "1T" (powers of 1024), at most max; -1 with
+ * why on anything else. */
+int util_parse_size(const char *s, uint64_t max, uint64_t *out, char *why, size_t whylen);
 
 #endif

@@ -11,7 +11,7 @@ import os
 
 import numpy as np
 
-from ._values import CSR, DENSE, SilcError, from_parts, to_parts
+from ._values import CSR, DENSE, SilcError, UndefinedName, from_parts, to_parts
 
 
 class _Envelope(ctypes.Structure):
@@ -92,7 +92,8 @@ class EmbeddedSession:
 
     def _check(self, rc):
         if rc:
-            raise SilcError(self._lib.silc_context_errmsg(self._ctx).decode("utf-8", "replace"))
+            msg = self._lib.silc_context_errmsg(self._ctx).decode("utf-8", "replace")
+            raise (UndefinedName if msg.startswith("undefined name '") else SilcError)(msg)
 
     def put(self, name, value):
         fmt, m, n, arrays = to_parts(name, value)
@@ -104,7 +105,7 @@ class EmbeddedSession:
         # silc_put copies: the arrays only need to live through the call
         self._check(self._lib.silc_put(self._ctx, name.encode(), ctypes.byref(e)))
 
-    def get(self, name):
+    def get(self, name, sparse="array"):
         e = _Envelope()
         self._check(self._lib.silc_get(self._ctx, ctypes.byref(e), name.encode()))
         try:
@@ -113,7 +114,7 @@ class EmbeddedSession:
                           _copy(e.values, e.nnz, np.float64)]
             else:
                 arrays = [_copy(e.values, e.nnz, np.float64)]
-            return from_parts(e.format, e.m, e.n, e.kl, e.ku, arrays)
+            return from_parts(e.format, e.m, e.n, e.kl, e.ku, arrays, sparse)
         finally:
             self._lib.silc_envelope_free(ctypes.byref(e))
 
@@ -147,7 +148,7 @@ class EmbeddedSession:
 
     def delete(self, name):
         if name not in self.names():
-            raise SilcError("undefined name '%s'" % name)
+            raise UndefinedName("undefined name '%s'" % name)
         self.exec("clear " + name)
 
     def close(self):

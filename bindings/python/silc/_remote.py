@@ -4,6 +4,18 @@ Python and a socket can use SILC.  Arrays travel without extra copies: they
 are sent from and received into their numpy buffers.  silc/__init__.py is
 the package's front; this is one of its two back ends (_embedded.py the
 other).
+
+Replies are not trusted: every frame's length must agree with what it
+carries, a value's descriptor is checked and held to the client's cap
+(max_value_bytes, SILC_MAX_REPLY_BYTES, default 2 GiB) before anything is
+allocated, text to 64 MiB (silcd's own cap on statements) and read as it
+arrives, CSR arrays are checked before scipy sees them, and every wait for
+the server is bounded: timeout (SILC_IO_TIMEOUT, default 300 s) between
+the bytes of a reply and for the reply to every request but exec, whose
+reply may take as long as its statements compute unless exec_timeout
+(SILC_EXEC_TIMEOUT) is set.  Failures are silc.Error subclasses naming the
+server; after one that leaves the stream out of step the connection is
+closed and later calls say so.
 """
 import os
 import socket
@@ -12,20 +24,25 @@ import sys
 
 import numpy as np
 
-from ._values import CSR, SilcError, from_parts, to_parts
+from ._values import (CSR, DEFAULT_MAX_VALUE_BYTES, Error, ProtocolError, Timeout,
+                      UndefinedName, check_csr, from_parts, layout, over_cap, to_parts)
 
+SilcError = Error
 PROTOCOL_VERSION = 1
 PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE = range(1, 9)
 OK, ERROR, VALUE, TEXT, WARN = range(128, 133)
 _HEADER = struct.Struct("<IIQ")
 _HELLO = struct.Struct("<4sII")
 _DESC = struct.Struct("<IIqqqqq")
-_MAX_TEXT = 1 << 30
+_MAX_TEXT = 64 << 20                 # silcd's own cap on a statement
+_TEXT_CHUNK = 1 << 20
+_SEND_CHUNK = 16 << 20
+DEFAULT_TIMEOUT = 300.0
+_IO = object()                       # "the I/O timeout" for a first wait
+_OPS = {OK: "OK", ERROR: "ERROR", VALUE: "VALUE", TEXT: "TEXT", WARN: "WARN"}
 
 if sys.byteorder != "little":
     raise ImportError("silc.py: the wire protocol needs a little-endian host")
-
-
 
 
 def _token_from_env():
@@ -34,71 +51,220 @@ def _token_from_env():
         return tok
     path = os.environ.get("SILC_TOKEN_FILE")
     if path:
-        with open(path) as f:
-            return f.readline().rstrip("\r\n")
+        try:
+            with open(path) as f:
+                return f.readline().rstrip("\r\n")
+        except OSError as e:
+            raise Error("cannot read SILC_TOKEN_FILE '%s': %s" % (path, e.strerror)) from None
     return None
+
+
+def _seconds(value, var, default):
+    """A timeout in seconds from the argument, else the variable var, else
+    default; 0 means none (None to the socket)."""
+    if value is None:
+        text = os.environ.get(var)
+        if not text:
+            value = default
+        else:
+            try:
+                value = float(text)
+            except ValueError:
+                value = -1
+            if not value >= 0:
+                raise Error("%s = '%s': expected seconds (a number >= 0; 0 for no timeout)"
+                            % (var, text))
+    if value is not None and value < 0:
+        raise Error("a timeout must be >= 0 seconds (0 for none), not %r" % value)
+    return value or None
+
+
+def _size(value):
+    """The value cap in bytes from the argument, else SILC_MAX_REPLY_BYTES
+    ("123", "64K", "512M", "2G", as silcd's size options), else 2 GiB."""
+    if value is not None:
+        return int(value)
+    text = os.environ.get("SILC_MAX_REPLY_BYTES")
+    if not text:
+        return DEFAULT_MAX_VALUE_BYTES
+    shift = {"k": 10, "m": 20, "g": 30, "t": 40}.get(text[-1:].lower(), 0)
+    digits = text[:-1] if shift else text
+    if not digits.isdigit():
+        raise Error("SILC_MAX_REPLY_BYTES = '%s': expected a size in bytes with an optional "
+                    "K, M, G or T suffix" % text)
+    return int(digits) << shift
+
+
+def _fmt_seconds(t):
+    return "%g" % t
 
 
 class RemoteSession:
     """One session on a silcd server: its own names, closed by close()."""
 
-    def __init__(self, url=None, token=None):
+    def __init__(self, url=None, token=None, timeout=None, exec_timeout=None,
+                 max_value_bytes=None):
         url = url or os.environ.get("SILC_SERVER")
         if not url:
-            raise SilcError("no server address: pass one or set SILC_SERVER")
+            raise Error("no server address: pass one or set SILC_SERVER")
         token = token if token is not None else _token_from_env()
         self.url = url
         self.warnings = ""
-        self.sock = self._connect(url)
+        self.sock = None
+        self.broken = None
+        self.timeout = _seconds(timeout, "SILC_IO_TIMEOUT", DEFAULT_TIMEOUT)
+        self.exec_timeout = _seconds(exec_timeout, "SILC_EXEC_TIMEOUT", 0)
+        self.max_value_bytes = _size(max_value_bytes)
+        try:
+            self.sock = self._connect(url)
+        except OSError as e:
+            raise Error("cannot connect to silc server %s: %s"
+                        % (url, e.strerror or e)) from None
         tok = (token or "").encode()
-        self.sock.sendall(_HELLO.pack(b"SILC", PROTOCOL_VERSION, len(tok)) + tok)
-        magic, _version, _ = _HELLO.unpack(self._recv_exact(_HELLO.size))
-        if magic != b"SILC":
-            raise SilcError("%s is not a SILC server" % url)
-        self._reply()
+        try:
+            self._sendall(_HELLO.pack(b"SILC", PROTOCOL_VERSION, len(tok)) + tok)
+            magic, _version, _ = _HELLO.unpack(self._recv_exact(_HELLO.size, mid=False))
+            if magic != b"SILC":
+                raise ProtocolError("%s is not a SILC server (bad magic in its hello)" % url)
+            self._reply()
+        except Error:
+            self._drop()
+            raise
 
-    @staticmethod
-    def _connect(url):
+    def _connect(self, url):
         if url.startswith("unix:"):
             path = url[5:]
             if path.startswith("//"):
                 path = path[2:]
             s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-            s.connect(path)
+            try:
+                s.settimeout(self.timeout)
+                s.connect(path)
+            except OSError:
+                s.close()
+                raise
             return s
         if not url.startswith("tcp://"):
-            raise SilcError("'%s': server address must be tcp://host:port or unix:/path" % url)
+            raise Error("'%s': server address must be tcp://host:port or unix:/path" % url)
         host, _, port = url[6:].rpartition(":")
         host = host.strip("[]")
-        s = socket.create_connection((host, int(port)))
+        if not host or not port.isdigit():
+            raise Error("'%s': server address must be tcp://host:port or unix:/path" % url)
+        s = socket.create_connection((host, int(port)), timeout=self.timeout)
         s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         return s
 
     # ---- framing ----------------------------------------------------------
-    def _recv_into(self, view):
+    def _drop(self):
+        if self.sock is not None:
+            self.sock.close()
+            self.sock = None
+
+    def _fail(self, exc):
+        """Closes the connection (its stream is out of step) and raises exc;
+        later calls say the connection was lost."""
+        self.broken = str(exc)
+        self._drop()
+        raise exc
+
+    def _usable(self):
+        if self.sock is None:
+            raise Error("connection to silc server %s was lost earlier (%s); open a new session"
+                        % (self.url, self.broken) if self.broken else
+                        "the session on %s is closed" % self.url)
+
+    def _recv_into(self, view, first_wait=_IO, mid=True):
+        """Fills view.  Inside a frame (mid) every wait is the I/O timeout;
+        the first byte of a frame may take first_wait seconds (_IO: the I/O
+        timeout, None: for ever, else exec_timeout)."""
         view = memoryview(view).cast("B")
         while len(view):
-            n = self.sock.recv_into(view)
+            try:
+                self.sock.settimeout(self.timeout if mid or first_wait is _IO else first_wait)
+                n = self.sock.recv_into(view)
+            except socket.timeout:
+                if mid:
+                    self._fail(Timeout("silc server %s stopped sending in the middle of a "
+                                       "reply: nothing for %s s (SILC_IO_TIMEOUT; connection "
+                                       "closed)" % (self.url, _fmt_seconds(self.timeout))))
+                io = first_wait is _IO
+                self._fail(Timeout("silc server %s sent nothing for %s s (%s; connection closed)"
+                                   % (self.url, _fmt_seconds(self.timeout if io else first_wait),
+                                      "SILC_IO_TIMEOUT" if io else "SILC_EXEC_TIMEOUT")))
+            except OSError as e:
+                self._fail(Error("connection to silc server %s lost: %s"
+                                 % (self.url, e.strerror or e)))
             if n == 0:
-                raise SilcError("connection to silc server %s lost" % self.url)
+                self._fail(Error("connection to silc server %s lost: connection closed by peer"
+                                 % self.url))
+            mid = True
             view = view[n:]
 
-    def _recv_exact(self, n):
+    def _recv_exact(self, n, first_wait=_IO, mid=True):
         buf = bytearray(n)
-        self._recv_into(buf)
+        self._recv_into(buf, first_wait, mid)
         return bytes(buf)
 
+    def _recv_text(self, length):
+        """length bytes as they arrive, so a header that lies costs nothing."""
+        parts = []
+        while length:
+            k = min(length, _TEXT_CHUNK)
+            parts.append(self._recv_exact(k))
+            length -= k
+        return b"".join(parts).decode("utf-8", "replace")
+
+    def _sendall(self, data):
+        # In chunks: sendall's timeout bounds the whole call, and a large
+        # PUT over a slow link may rightly take longer than one timeout.
+        data = memoryview(data).cast("B")
+        try:
+            self.sock.settimeout(self.timeout)
+            for at in range(0, len(data), _SEND_CHUNK):
+                self.sock.sendall(data[at:at + _SEND_CHUNK])
+        except socket.timeout:
+            self._fail(Timeout("silc server %s accepted nothing for %s s (SILC_IO_TIMEOUT; "
+                               "connection closed)" % (self.url, _fmt_seconds(self.timeout))))
+        except OSError as e:
+            self._fail(Error("connection to silc server %s lost: %s" % (self.url, e.strerror or e)))
+
     def _send(self, op, *parts):
+        self._usable()
         parts = [memoryview(p).cast("B") for p in parts]
-        self.sock.sendall(_HEADER.pack(op, 0, sum(len(p) for p in parts)))
+        self._sendall(_HEADER.pack(op, 0, sum(len(p) for p in parts)))
         for p in parts:
             if len(p):
-                self.sock.sendall(p)
+                self._sendall(p)
 
-    def _read_value(self, length):
+    def _bad(self, why):
+        self._fail(ProtocolError("silc server %s sent a bad reply: %s (connection closed)"
+                                 % (self.url, why)))
+
+    def _skip(self, n):
+        while n:
+            k = min(n, _TEXT_CHUNK)
+            self._recv_exact(k)
+            n -= k
+
+    def _read_value(self, length, sparse):
         if length < _DESC.size:
-            raise SilcError("VALUE reply shorter than its descriptor")
-        fmt, _, m, n, nnz, kl, ku = _DESC.unpack(self._recv_exact(_DESC.size))
+            self._bad("VALUE reply shorter than its descriptor")
+        fmt, namelen, m, n, nnz, kl, ku = _DESC.unpack(self._recv_exact(_DESC.size))
+        if namelen != 0:
+            self._bad("VALUE reply with a name length")
+        try:
+            rowptr_bytes, colind_bytes, values_bytes = layout(fmt, m, n, nnz, kl, ku)
+        except ProtocolError as e:
+            self._bad(e)
+        total = rowptr_bytes + colind_bytes + values_bytes
+        if total != length - _DESC.size:
+            self._bad("VALUE reply carries %d bytes of arrays, its descriptor needs %d"
+                      % (length - _DESC.size, total))
+        refusal = over_cap(fmt, m, n, total, self.max_value_bytes)
+        if refusal:
+            # Well framed: skipped, so that the session keeps its values.
+            self._skip(total)
+            raise ProtocolError("silc server %s: reply refused: %s" % (self.url, refusal))
         if fmt == CSR:
             arrays = [np.empty(m + 1, dtype=np.int64), np.empty(nnz, dtype=np.int64),
                       np.empty(nnz, dtype=np.float64)]
@@ -106,19 +272,28 @@ class RemoteSession:
             arrays = [np.empty(nnz, dtype=np.float64)]
         for a in arrays:
             self._recv_into(a)
-        return from_parts(fmt, m, n, kl, ku, arrays)
+        if fmt == CSR:
+            try:
+                check_csr(arrays[0], arrays[1], m, n, nnz)
+            except ProtocolError as e:
+                self._bad("'VALUE': %s" % e)
+        return from_parts(fmt, m, n, kl, ku, arrays, sparse, self.max_value_bytes)
 
-    def _reply(self, out=None):
-        """Reads replies up to the final one; returns its text or value."""
+    def _reply(self, out=None, first_wait=_IO, sparse="array"):
+        """Reads replies up to the final one; returns its text or value.  The
+        first byte of each reply may take first_wait seconds (exec)."""
         while True:
-            op, flags, length = _HEADER.unpack(self._recv_exact(_HEADER.size))
+            op, flags, length = _HEADER.unpack(self._recv_exact(_HEADER.size, first_wait, False))
             if flags != 0:
-                raise SilcError("malformed reply from %s" % self.url)
+                self._bad("frame flags %d are not 0 (protocol version 1)" % flags)
             if op == VALUE:
-                return self._read_value(length)
+                return self._read_value(length, sparse)
+            if op not in _OPS:
+                self._bad("unknown reply opcode %d" % op)
             if length > _MAX_TEXT:
-                raise SilcError("reply of %d bytes from %s is too long" % (length, self.url))
-            text = self._recv_exact(length).decode("utf-8", "replace")
+                self._bad("%s reply of %d bytes exceeds the limit of %d bytes"
+                          % (_OPS[op], length, _MAX_TEXT))
+            text = self._recv_text(length)
             if op == TEXT:
                 if out is not None:
                     out.append(text)
@@ -128,10 +303,10 @@ class RemoteSession:
                 self.warnings += text
             elif op == OK:
                 return text
-            elif op == ERROR:
-                raise SilcError(text)
             else:
-                raise SilcError("unknown reply opcode %d from %s" % (op, self.url))
+                if text.startswith("undefined name '"):
+                    raise UndefinedName(text)
+                raise Error(text)
 
     # ---- the calls --------------------------------------------------------
     def put(self, name, value):
@@ -142,17 +317,17 @@ class RemoteSession:
         self._send(PUT, desc, nm, *arrays)
         self._reply()
 
-    def get(self, name):
+    def get(self, name, sparse="array"):
         """The value bound to name (numpy array, or CSR as described above)."""
         self._send(GET, name.encode())
-        return self._reply()
+        return self._reply(sparse=sparse)
 
     def exec(self, statements, out=None):
         """Runs statements.  Text printed by who/info/explain goes to out (a
         list) when given, else to stdout; warnings are in self.warnings."""
         self.warnings = ""
         self._send(EXEC, statements.encode())
-        self._reply(out)
+        self._reply(out, first_wait=self.exec_timeout)
 
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""
@@ -180,12 +355,12 @@ class RemoteSession:
     def close(self):
         if self.sock is not None:
             try:
+                self.timeout = min(self.timeout or 5.0, 5.0)
                 self._send(BYE)
                 self._reply()
-            except (OSError, SilcError):
+            except Error:
                 pass
-            self.sock.close()
-            self.sock = None
+            self._drop()
 
     def __enter__(self):
         return self

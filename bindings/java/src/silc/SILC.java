@@ -17,6 +17,17 @@
  * Values stream through one reused direct buffer, so a step's PUT of a large
  * matrix allocates nothing on the Java heap.  A SILC object is one session
  * and is not thread-safe (as a C context is not); open one per thread.
+ *
+ * Replies are not trusted: a frame's length must agree with its descriptor,
+ * CSR arrays are checked (rowptr from 0 to nnz and never decreasing, columns
+ * in range and increasing) with the C library's messages, a value over the
+ * client's cap (setMaxValueBytes, SILC_MAX_REPLY_BYTES, default 2 GiB) is
+ * skipped and refused while the session goes on, text is held to 64 MiB,
+ * and a band value comes back dense only when m*n doubles fit that cap.  A
+ * server that sends nothing for the I/O timeout (setTimeouts,
+ * SILC_IO_TIMEOUT, default 300 s) inside a reply or before answering any
+ * call but EXEC is an error naming it; EXEC waits as long as its
+ * statements compute unless SILC_EXEC_TIMEOUT is set.
  */
 package silc;
 
@@ -27,6 +38,8 @@ import java.net.StandardSocketOptions;
 import java.net.UnixDomainSocketAddress;
 import java.nio.ByteBuffer;
 import java.nio.ByteOrder;
+import java.nio.channels.SelectionKey;
+import java.nio.channels.Selector;
 import java.nio.channels.SocketChannel;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
@@ -45,16 +58,103 @@ public final class SILC implements AutoCloseable {
     static final int DESCRIPTOR_BYTES = 48;
     /** Longest text reply accepted (the server's own limit on text). */
     static final long MAX_TEXT = 64L << 20;
+    static final long DEFAULT_MAX_VALUE_BYTES = 2L << 30;
+    static final double DEFAULT_IO_TIMEOUT = 300;
     private static final int BUFFER_BYTES = 1 << 20;
 
     private SocketChannel channel;
+    private Selector selector;
+    private SelectionKey key;
+    /* Milliseconds; 0 = wait for ever (Selector.select's convention). */
+    private long ioTimeoutMs, execTimeoutMs;
+    private long maxValueBytes;
     private String url = "";
     private String warnings = "";
     private Consumer<String> output = System.out::print;
     /* One buffer for everything sent and received; values stream through it. */
     private final ByteBuffer buf = ByteBuffer.allocateDirect(BUFFER_BYTES).order(ByteOrder.LITTLE_ENDIAN);
 
-    public SILC() {}
+    /* A malformed SILC_* limit variable, reported by INIT. */
+    private String envError;
+
+    /** A client with the limits of SILC_IO_TIMEOUT, SILC_EXEC_TIMEOUT and
+     *  SILC_MAX_REPLY_BYTES, else 300 s, none and 2 GiB (a malformed
+     *  variable makes INIT fail, naming it). */
+    public SILC() {
+        try {
+            setTimeouts(seconds("SILC_IO_TIMEOUT", DEFAULT_IO_TIMEOUT), seconds("SILC_EXEC_TIMEOUT", 0));
+            setMaxValueBytes(size("SILC_MAX_REPLY_BYTES", DEFAULT_MAX_VALUE_BYTES));
+        } catch (SILCException e) {
+            envError = e.getMessage();
+        }
+    }
+
+    /** The longest silence accepted inside a reply and before the reply to
+     *  any call but EXEC, and before EXEC's replies; seconds, 0 for none. */
+    public void setTimeouts(double ioSeconds, double execSeconds) throws SILCException {
+        if (!(ioSeconds >= 0) || !(execSeconds >= 0))
+            throw new SILCException("a timeout must be >= 0 seconds (0 for none)");
+        ioTimeoutMs = (long) Math.ceil(ioSeconds * 1000);
+        execTimeoutMs = (long) Math.ceil(execSeconds * 1000);
+    }
+
+    /** The largest value (bytes of its arrays) a reply may hold. */
+    public void setMaxValueBytes(long bytes) throws SILCException {
+        if (bytes < 0) throw new SILCException("setMaxValueBytes: " + bytes + " is negative");
+        maxValueBytes = bytes;
+    }
+
+    private static double seconds(String var, double dflt) throws SILCException {
+        String v = System.getenv(var);
+        if (v == null || v.isEmpty()) return dflt;
+        try {
+            double x = Double.parseDouble(v);
+            if (x >= 0) return x;
+        } catch (NumberFormatException e) {
+            // reported below
+        }
+        throw new SILCException(var + " = '" + v + "': expected seconds (a number >= 0; 0 for no timeout)");
+    }
+
+    /* "123", "64K", "512M", "2G", "1T", as silcd's size options. */
+    private static long size(String var, long dflt) throws SILCException {
+        String v = System.getenv(var);
+        if (v == null || v.isEmpty()) return dflt;
+        int shift = switch (Character.toLowerCase(v.charAt(v.length() - 1))) {
+            case 'k' -> 10;
+            case 'm' -> 20;
+            case 'g' -> 30;
+            case 't' -> 40;
+            default -> 0;
+        };
+        String digits = shift > 0 ? v.substring(0, v.length() - 1) : v;
+        try {
+            long x = Long.parseLong(digits);
+            if (x >= 0 && x <= (Long.MAX_VALUE >> shift) && digits.chars().allMatch(Character::isDigit))
+                return x << shift;
+        } catch (NumberFormatException e) {
+            // reported below
+        }
+        throw new SILCException(var + " = '" + v + "': expected a size in bytes with an optional K, M, G or T suffix");
+    }
+
+    /* A reply that breaks the protocol, or a silent server: the stream is
+     * out of step, so the connection is closed; the message is complete. */
+    private static final class BadReply extends IOException {
+        private static final long serialVersionUID = 1L;
+
+        BadReply(String message) {
+            super(message);
+        }
+    }
+
+    private BadReply bad(String why) {
+        return new BadReply("silc server " + url + " sent a bad reply: " + why + " (connection closed)");
+    }
+
+    private static String secs(long ms) {
+        return ms % 1000 == 0 ? Long.toString(ms / 1000) : Double.toString(ms / 1000.0);
+    }
 
     // ---- opening and closing --------------------------------------------------
 
@@ -79,20 +179,27 @@ public final class SILC implements AutoCloseable {
     public void INIT(String url, String token) throws SILCException {
         if (channel != null) throw new SILCException("INIT: this client already has a session on " + this.url);
         if (url == null) throw new SILCException("INIT: null server address");
+        if (envError != null) throw new SILCException(envError);
         this.url = url;
         byte[] tok = (token != null ? token : tokenFromEnv()).getBytes(StandardCharsets.UTF_8);
         if (tok.length > 4096) throw new SILCException("INIT: the token is longer than 4096 bytes");
         try {
             channel = connect(url);
+            channel.configureBlocking(false);
+            selector = Selector.open();
+            key = channel.register(selector, 0);
             buf.clear();
             buf.put("SILC".getBytes(StandardCharsets.US_ASCII)).putInt(PROTOCOL_VERSION).putInt(tok.length).put(tok);
             flush();
-            readFully(12);
+            readFully(12, ioTimeoutMs, false);
             byte[] magic = new byte[4];
             buf.get(magic);
             if (!Arrays.equals(magic, "SILC".getBytes(StandardCharsets.US_ASCII)))
                 throw new SILCException(url + " is not a SILC server");
             reply(null, null);
+        } catch (BadReply e) {
+            drop();
+            throw new SILCException(e.getMessage(), e);
         } catch (IOException e) {
             drop();
             throw new SILCException("cannot connect to silc server " + url + ": " + e.getMessage(), e);
@@ -106,6 +213,7 @@ public final class SILC implements AutoCloseable {
     public void FINALIZE() throws SILCException {
         if (channel == null) return;
         try {
+            if (ioTimeoutMs == 0 || ioTimeoutMs > 5000) ioTimeoutMs = 5000; // goodbye waits 5 s at most
             request(BYE, null);
             reply(null, null);
         } finally {
@@ -187,7 +295,7 @@ public final class SILC implements AutoCloseable {
     public void EXEC(String statements) throws SILCException {
         warnings = "";
         request(EXEC, text(statements, "EXEC"));
-        reply(output, null);
+        reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT");
     }
 
     /** The warnings of the last EXEC, one per line ("" when none). */
@@ -287,10 +395,19 @@ public final class SILC implements AutoCloseable {
 
     private SILCException lost(IOException e) {
         drop();
+        if (e instanceof BadReply) return new SILCException(e.getMessage(), e);
         return new SILCException("connection to silc server " + url + " lost: " + e.getMessage(), e);
     }
 
     private void drop() {
+        if (selector != null) {
+            try {
+                selector.close();
+            } catch (IOException e) {
+                // Nothing more to do.
+            }
+            selector = null;
+        }
         if (channel != null) {
             try {
                 channel.close();
@@ -325,9 +442,20 @@ public final class SILC implements AutoCloseable {
         return sb.toString();
     }
 
+    /* Waits up to timeoutMs (0: for ever) for the channel to be ready for op. */
+    private boolean await(int op, long timeoutMs) throws IOException {
+        key.interestOps(op);
+        int ready = selector.select(timeoutMs);
+        selector.selectedKeys().clear();
+        return ready > 0;
+    }
+
     private void flush() throws IOException {
         buf.flip();
-        while (buf.hasRemaining()) channel.write(buf);
+        while (buf.hasRemaining())
+            if (channel.write(buf) == 0 && !await(SelectionKey.OP_WRITE, ioTimeoutMs))
+                throw new BadReply("silc server " + url + " accepted nothing for " + secs(ioTimeoutMs)
+                        + " s (SILC_IO_TIMEOUT; connection closed)");
         buf.clear();
     }
 
@@ -361,12 +489,33 @@ public final class SILC implements AutoCloseable {
         }
     }
 
-    /* Reads exactly n <= buf.capacity() bytes into buf, ready to get. */
-    private void readFully(int n) throws IOException {
+    /* Reads exactly n <= buf.capacity() bytes into buf, ready to get.
+     * Inside a frame (mid) every wait is the I/O timeout; the first byte of
+     * a frame may take firstWaitMs (0: for ever; var names its setting). */
+    private void readFully(int n, long firstWaitMs, boolean mid, String var) throws IOException {
         buf.clear().limit(n);
-        while (buf.hasRemaining())
-            if (channel.read(buf) < 0) throw new IOException("the server closed the connection");
+        while (buf.hasRemaining()) {
+            int got = channel.read(buf);
+            if (got < 0) throw new IOException("connection closed by peer");
+            if (got > 0) {
+                mid = true;
+                continue;
+            }
+            if (!await(SelectionKey.OP_READ, mid ? ioTimeoutMs : firstWaitMs))
+                throw new BadReply(mid ? "silc server " + url + " stopped sending in the middle of a reply: nothing for "
+                        + secs(ioTimeoutMs) + " s (SILC_IO_TIMEOUT; connection closed)"
+                        : "silc server " + url + " sent nothing for " + secs(firstWaitMs) + " s (" + var
+                        + "; connection closed)");
+        }
         buf.flip();
+    }
+
+    private void readFully(int n, long firstWaitMs, boolean mid) throws IOException {
+        readFully(n, firstWaitMs, mid, "SILC_IO_TIMEOUT");
+    }
+
+    private void readFully(int n) throws IOException {
+        readFully(n, ioTimeoutMs, true, "SILC_IO_TIMEOUT");
     }
 
     private void readInts(int[] a, long count) throws IOException {
@@ -376,7 +525,7 @@ public final class SILC implements AutoCloseable {
             for (int q = 0; q < k; q++) {
                 long x = buf.getLong();
                 if (x < Integer.MIN_VALUE || x > Integer.MAX_VALUE)
-                    throw new IOException("an index " + x + " does not fit a Java int");
+                    throw bad("an index " + x + " does not fit a Java int");
                 a[at + q] = (int) x;
             }
             at += k;
@@ -406,23 +555,44 @@ public final class SILC implements AutoCloseable {
      * ERROR's message.
      */
     private Object reply(Consumer<String> out, ColumnVector into) throws SILCException {
+        return reply(out, into, ioTimeoutMs, "SILC_IO_TIMEOUT");
+    }
+
+    private static String opName(int op) {
+        return switch (op) {
+            case OK -> "OK";
+            case ERROR -> "ERROR";
+            case TEXT -> "TEXT";
+            case WARN -> "WARN";
+            default -> "VALUE";
+        };
+    }
+
+    private Object reply(Consumer<String> out, ColumnVector into, long firstWaitMs, String var) throws SILCException {
         need();
         try {
             for (;;) {
-                readFully(16);
+                readFully(16, firstWaitMs, false, var);
                 int op = buf.getInt(), flags = buf.getInt();
                 long length = buf.getLong();
-                if (flags != 0 || length < 0) throw new IOException("malformed reply header");
+                if (flags != 0) throw bad("frame flags " + flags + " are not 0 (protocol version 1)");
                 if (op == VALUE) return readValue(length, into);
-                if (length > MAX_TEXT) throw new IOException("a reply of " + length + " bytes is too long");
-                byte[] t = new byte[(int) length];
-                for (int at = 0; at < t.length;) {
-                    int k = Math.min(buf.capacity(), t.length - at);
+                if (op != OK && op != ERROR && op != TEXT && op != WARN)
+                    throw bad("unknown reply opcode " + op);
+                if (length < 0 || length > MAX_TEXT)
+                    throw bad(opName(op) + " reply of " + Long.toUnsignedString(length)
+                            + " bytes exceeds the limit of " + MAX_TEXT + " bytes");
+                // Read as it arrives: a header that lies about its length costs nothing.
+                java.io.ByteArrayOutputStream t = new java.io.ByteArrayOutputStream();
+                for (long at = 0; at < length;) {
+                    int k = (int) Math.min(buf.capacity(), length - at);
                     readFully(k);
-                    buf.get(t, at, k);
+                    byte[] chunk = new byte[k];
+                    buf.get(chunk);
+                    t.write(chunk, 0, k);
                     at += k;
                 }
-                String s = new String(t, StandardCharsets.UTF_8);
+                String s = t.toString(StandardCharsets.UTF_8);
                 switch (op) {
                     case TEXT -> (out != null ? out : output).accept(s);
                     case WARN -> warnings += s;
@@ -438,21 +608,70 @@ public final class SILC implements AutoCloseable {
         }
     }
 
+    /* A descriptor's array bytes, checked as protocol.c checks it (same messages). */
+    private long layout(int format, long m, long n, long nnz, long kl, long ku) throws BadReply {
+        if (format < DENSE || format > BAND) throw bad("unknown value format " + format);
+        if (m < 0 || n < 0 || nnz < 0 || kl < 0 || ku < 0)
+            throw bad("negative size in value descriptor (m = " + m + ", n = " + n + ", nnz = " + nnz
+                    + ", kl = " + kl + ", ku = " + ku + ")");
+        if (m > (1L << 40) || n > (1L << 40))
+            throw bad("dimensions " + m + "x" + n + " exceed the protocol's limit of 2^40");
+        if (format == DENSE) {
+            if (Math.multiplyHigh(m, n) != 0 || m * n != nnz || nnz > Long.MAX_VALUE / 8)
+                throw bad("dense " + m + "x" + n + " value declares " + nnz + " entries");
+            if (kl != 0 || ku != 0) throw bad("dense value with band widths");
+            return 8 * nnz;
+        }
+        if (format == CSR_FORMAT) {
+            if (kl != 0 || ku != 0) throw bad("csr value with band widths");
+            if (nnz > Long.MAX_VALUE / 32) throw bad("csr value declares " + nnz + " entries");
+            return 8 * (m + 1) + 16 * nnz;
+        }
+        if (kl > Integer.MAX_VALUE || ku > Integer.MAX_VALUE || Math.multiplyHigh(kl + ku + 1, n) != 0
+                || (kl + ku + 1) * n != nnz || nnz > Long.MAX_VALUE / 8)
+            throw bad("band " + m + "x" + n + " value with kl = " + kl + ", ku = " + ku + " declares " + nnz + " entries");
+        return 8 * nnz;
+    }
+
+    /* CSR arrays as the C library checks them, in its order and words. */
+    private void checkCsr(int[] rowptr, int[] colind, int m, int n, int nnz) throws BadReply {
+        if (rowptr[m] != nnz)
+            throw bad("'VALUE': rowptr[m] = " + rowptr[m] + " but the descriptor declares " + nnz + " entries");
+        if (rowptr[0] != 0) throw bad("'VALUE': rowptr[0] is " + rowptr[0] + ", must be 0");
+        for (int i = 0; i < m; i++)
+            if (rowptr[i + 1] < rowptr[i])
+                throw bad("'VALUE': rowptr decreases at row " + i + " (rowptr[" + i + "] = " + rowptr[i] + " > rowptr["
+                        + (i + 1) + "] = " + rowptr[i + 1] + ")");
+        for (int i = 0; i < m; i++)
+            for (int k = rowptr[i]; k < rowptr[i + 1]; k++) {
+                if (colind[k] < 0 || colind[k] >= n)
+                    throw bad("'VALUE': column index " + colind[k] + " out of range [0, " + n + ") in row " + i);
+                if (k > rowptr[i] && colind[k - 1] >= colind[k])
+                    throw bad("'VALUE': columns of row " + i + " are "
+                            + (colind[k - 1] == colind[k] ? "duplicated" : "not sorted"));
+            }
+    }
+
     private Value readValue(long length, ColumnVector into) throws IOException, SILCException {
-        if (length < DESCRIPTOR_BYTES) throw new IOException("a VALUE reply shorter than its descriptor");
+        if (length < DESCRIPTOR_BYTES) throw bad("VALUE reply shorter than its descriptor");
         readFully(DESCRIPTOR_BYTES);
         int format = buf.getInt();
-        buf.getInt();
+        int namelen = buf.getInt();
         long m = buf.getLong(), n = buf.getLong(), nnz = buf.getLong(), kl = buf.getLong(), ku = buf.getLong();
-        long arrays = (format == CSR_FORMAT ? 8 * (m + 1) + 8 * nnz : 0) + 8 * nnz;
-        boolean sane = m >= 0 && n >= 0 && nnz >= 0 && m <= (1L << 40) && n <= (1L << 40) && nnz <= (1L << 40)
-                && (format == DENSE && nnz == m * n || format == CSR_FORMAT
-                    || format == BAND && kl >= 0 && ku >= 0 && nnz == (kl + ku + 1) * n)
-                && length == DESCRIPTOR_BYTES + arrays;
-        if (!sane) throw new IOException("a malformed VALUE descriptor");
+        if (namelen != 0) throw bad("VALUE reply with a name length");
+        long arrays = layout(format, m, n, nnz, kl, ku);
+        if (length - DESCRIPTOR_BYTES != arrays)
+            throw bad("VALUE reply carries " + Long.toUnsignedString(length - DESCRIPTOR_BYTES)
+                    + " bytes of arrays, its descriptor needs " + arrays);
         String shape = m + "x" + n;
+        String name = format == CSR_FORMAT ? "csr" : format == BAND ? "band" : "dense";
         String refuse = null;
-        if (into != null && (format != DENSE || n != 1 || m != into.v.length))
+        if (arrays > maxValueBytes || format == BAND && 8.0 * m * n > maxValueBytes)
+            refuse = "silc server " + url + ": reply refused: a " + shape + " " + name + " value of "
+                    + (format == BAND ? (long) (8.0 * m * n) + " bytes as a DenseMatrix" : arrays + " bytes")
+                    + ", over the client's limit of " + maxValueBytes
+                    + " bytes per value (SILC_MAX_REPLY_BYTES, setMaxValueBytes)";
+        else if (into != null && (format != DENSE || n != 1 || m != into.v.length))
             refuse = "GET: the value is " + shape + (format == CSR_FORMAT ? " sparse" : "")
                     + ", the ColumnVector has " + into.v.length + " rows";
         else if (nnz > Integer.MAX_VALUE - 8 || m > Integer.MAX_VALUE - 8
@@ -468,6 +687,7 @@ public final class SILC implements AutoCloseable {
             readInts(rowptr, m + 1);
             readInts(colind, nnz);
             readDoubles(val, nnz);
+            checkCsr(rowptr, colind, (int) m, (int) n, (int) nnz);
             return new CRS((int) m, (int) n, rowptr, colind, val);
         }
         if (format == DENSE) {
@@ -479,7 +699,7 @@ public final class SILC implements AutoCloseable {
             readDoubles(a, nnz);
             return new DenseMatrix((int) m, (int) n, a);
         }
-        // Band, LAPACK layout: A(i, j) = band[ku + i - j + j * ld].
+        // Band, LAPACK layout: A(i, j) = band[ku + i - j + j * ld], dense under the cap (checked above).
         double[] band = new double[(int) nnz];
         readDoubles(band, nnz);
         DenseMatrix d = new DenseMatrix((int) m, (int) n);
