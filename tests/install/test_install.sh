@@ -131,6 +131,16 @@ print("python: embedded session from", silc.__file__, "with", e._lib._name)
 ' >"$TOP/python.log" 2>&1 || { cat "$TOP/python.log"; fail "the installed Python package"; }
   cat "$TOP/python.log"
   grep -q "with $PREFIX/lib/libsilc.so.1\$" "$TOP/python.log" || fail "the Python package did not load the prefix's libsilc"
+  # Without an install beside it (the source tree's package), by soname on
+  # the loader's path.
+  env -i PYTHONPATH="$SRC/bindings/python" LD_LIBRARY_PATH="$PREFIX/lib" /usr/bin/python3 -B -c '
+import silc, silc._embedded as e
+with silc.Session() as s:
+    s.exec("x = 2 * 21")
+print("python: by soname:", e._lib._name)
+' >"$TOP/python2.log" 2>&1 || { cat "$TOP/python2.log"; fail "the Python package finding libsilc by soname"; }
+  cat "$TOP/python2.log"
+  grep -q "by soname: libsilc.so.1\$" "$TOP/python2.log" || fail "the Python package did not load libsilc by soname"
 else
   echo "test_install: no Python package installed (no /usr/bin/python3 at configure)"
 fi
