@@ -196,6 +196,13 @@ static void test_csr_errors(void)
     CHECK(silc_envelope_csr(&e, 2, 2, rp_bad0, ci_ok, v) != 0, "rowptr[0] = 1 accepted");
     CHECK(contains(silc_errmsg(), "rowptr[0]"), "message: %s", silc_errmsg());
     CHECK(e.values == NULL && e.rowptr == NULL, "failed constructor left arrays behind");
+    /* SILC_PUT of that envelope (the README's sequence without its checks)
+     * is an error naming why, and binds nothing, not a 0x0 value. */
+    CHECK(SILC_PUT("failed_env", &e) != 0, "SILC_PUT of a failed constructor's envelope succeeded");
+    CHECK(contains(silc_errmsg(), "envelope 'failed_env' was not constructed: silc_envelope_csr: rowptr[0]"),
+          "message: %s", silc_errmsg());
+    CHECK(silc_get(silc_default_context(), &e, "failed_env") != 0,
+          "failed_env is bound after the refused SILC_PUT");
     CHECK(silc_envelope_csr(&e, 2, 2, rp_dec, ci_ok, v) != 0, "decreasing rowptr accepted");
     CHECK(contains(silc_errmsg(), "rowptr decreases at row 1"), "message: %s", silc_errmsg());
     CHECK(silc_envelope_csr32(&e, 2, 2, rp32_dec, (const int32_t *)NULL, v) != 0, "csr32 bad rowptr");

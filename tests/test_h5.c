@@ -3,14 +3,17 @@
  * (silc_save, silc_load) and the statements: every value kind comes back
  * bit for bit (dense, vector, scalar, empty, CSR, band); names choose what
  * is saved and loaded; and every failure is a message that names what is
- * wrong, with nothing changed: a missing file, a file that is not HDF5, an
- * object that is not a SILC layout (a load of all then binds none), a name
- * the file lacks, an undefined name to save (the old file stays).
+ * wrong, with nothing changed: a missing file, an unreadable one, a file
+ * that is not HDF5 (each with its reason), an object that is not a SILC
+ * layout asked for by name, a name the file lacks, an undefined name to
+ * save (the old file stays); a load of the whole file skips another
+ * program's objects and names them in a warning.
  * tests/test_h5.py checks the files against h5py and scipy.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -82,10 +85,16 @@ static void test_failures(void)
     double *before;
     int64_t m = 0, n = 0;
     CHECK(silc_exec(c, "D = [9, 9]") == 0, "D");
-    expect(silc_load(c, "/nonexistent/x.h5", NULL), "load: cannot read '/nonexistent/x.h5'", "missing file");
+    expect(silc_load(c, "/nonexistent/x.h5", NULL), "load: cannot read '/nonexistent/x.h5': No such file or directory",
+           "missing file");
     f = fopen(other, "w");
     if (f) fputs("not hdf5\n", f), fclose(f);
     expect(silc_load(c, other, NULL), "is not an HDF5 file", "a text file");
+    if (geteuid() != 0) { /* root reads any file */
+        chmod(other, 0);
+        expect(silc_load(c, other, NULL), "Permission denied", "an unreadable file");
+        chmod(other, 0600);
+    }
     expect(silc_load(c, path, "nosuch"), "load: 'nosuch' is not in", "a name the file lacks");
     expect(silc_save(c, path, "D nosuch"), "save: undefined name 'nosuch'", "an undefined name");
     CHECK(silc_load(c, path, "D") == 0, "the old file stays after a failed save: %s", silc_context_errmsg(c));
@@ -93,18 +102,28 @@ static void test_failures(void)
            "an unwritable place");
     expect(silc_exec(c, "load x"), "load needs a file name in quotes", "parse");
     expect(silc_load(c, "a\"b", NULL), "without '\"'", "a quote in the path");
-    /* A file with an object of no SILC layout: a load of all binds nothing. */
+    /* A file with an object of no SILC layout: a load of all binds the rest
+     * and names what it skipped; a load of that object by name fails and
+     * changes nothing. */
     CHECK(silc_exec(c, "D = [9, 9]") == 0, "D again");
     before = entries("D", &m, &n);
     if (system("/usr/bin/python3 -c \"import h5py; f = h5py.File('/tmp/silc-test-h5-bad.h5', 'w'); "
                "f['D'] = [[1.0, 2.0]]; g = f.create_group('G'); g['x'] = [1.0]\" 2>/dev/null") == 0) {
         double *after;
-        expect(silc_load(c, "/tmp/silc-test-h5-bad.h5", NULL), "load: 'G' in '/tmp/silc-test-h5-bad.h5' is not a SILC value",
-               "a group that is not CSR");
+        expect(silc_load(c, "/tmp/silc-test-h5-bad.h5", "D G"),
+               "load: 'G' in '/tmp/silc-test-h5-bad.h5' is not a SILC value", "a group that is not CSR, by name");
         after = entries("D", &m, &n);
         CHECK(before && after && m == 1 && n == 2 && after[0] == 9 && after[1] == 9,
               "D keeps its value after the failed load");
         free(after);
+        CHECK(silc_load(c, "/tmp/silc-test-h5-bad.h5", NULL) == 0, "a load of all skips G: %s", silc_context_errmsg(c));
+        after = entries("D", &m, &n);
+        CHECK(after && m == 1 && n == 2 && after[0] == 1 && after[1] == 2, "D is the file's [1, 2]");
+        free(after);
+        CHECK(tl_contains(silc_context_warnings(c), "load: skipped 1 object of '/tmp/silc-test-h5-bad.h5' that is "
+                                                    "not a SILC value: 'G' (not a SILC value: a group needs"),
+              "the warning names G: %s", silc_context_warnings(c));
+        CHECK(!strstr(tl_out_exec(c, "who"), "\nG "), "G is not bound:\n%s", tl_out());
         remove("/tmp/silc-test-h5-bad.h5");
     } else {
         printf("test_h5: no h5py: the foreign-layout case skipped\n");

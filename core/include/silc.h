@@ -164,7 +164,9 @@ SILC_API int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
 SILC_API int silc_exec(silc_context *ctx, const char *statements);
 /* The statements `save "path" names` and `load "path" names` (HDF5; README
  * "Saving and loading"): names is a space-separated list, NULL or "" for
- * every name (save) or every object of the file (load).  A failed save
+ * every name (save) or every SILC value of the file (load: other objects
+ * are skipped, and a warning names them; a name given must be a SILC value).
+ * Layouts, dense orientation included: docs/hdf5.md.  A failed save
  * leaves the old file, a failed load changes no name.  load reads a file as
  * untrusted input: no external link is followed, datasets with external
  * storage and virtual datasets are refused, index datasets must be integers,

@@ -3,7 +3,13 @@
  * session's values in HDF5, in the layouts other tools read without SILC
  * (h5py, scipy, anndata):
  *
- *   dense m x n   a 2-D float64 dataset of shape (m, n), row i = row i
+ *   dense m x n   a 2-D float64 dataset of HDF5 shape (n, m) holding the
+ *                 column-major array, with attribute MATLAB_class = "double":
+ *                 MATLAB -v7.3's layout, which Octave's load -hdf5 (it
+ *                 reverses HDF5's dimensions) reads as m x n; h5py/numpy
+ *                 read it as (n, m), and the attribute says to transpose
+ *                 (docs/hdf5.md).  A dataset without the attribute (h5py's,
+ *                 scipy's) is read row-major: shape (m, n), row i = row i
  *   CSR           a group with datasets data (float64), indices and indptr
  *                 (int64, 0-based) and an attribute shape = (m, n); also
  *                 encoding-type = "csr_matrix", as anndata writes it
@@ -16,7 +22,10 @@
  * with O_EXCL | O_NOFOLLOW, so a link planted beside it redirects nothing, and
  * a link at the name itself is replaced, not written through); load reads every value first and binds
  * them only when all were read, so a failed load changes nothing.  An
- * object that is none of the layouts is an error naming it.  Built only
+ * object that is none of the layouts is an error naming it when it was
+ * asked for by name; a load of the whole file skips it (a file may hold
+ * other programs' groups and strings) and warns with the list of what it
+ * skipped and why.  Built only
  * with HDF5 (SILC_HAVE_HDF5); without it both statements say so.
  *
  * Which file a name means is the options database's (cfg_file_read,
@@ -150,6 +159,9 @@ static double *row_major(const double *a, int64_t m, int64_t n, int64_t ld)
     return t;
 }
 
+/* The attribute that marks a column-major dense dataset (MATLAB -v7.3's). */
+#define H5_COLUMN_MAJOR_ATTR "MATLAB_class"
+
 static int save_one(silc_engine *E, hid_t file, const char *name, const silc_value *v)
 {
     int64_t shape[2] = {v->m, v->n};
@@ -175,16 +187,20 @@ static int save_one(silc_engine *E, hid_t file, const char *name, const silc_val
     } else {
         int band = v->format == SILC_FMT_BAND;
         int64_t rows = band ? v->ld : v->m;
-        hsize_t dims[2] = {(hsize_t)rows, (hsize_t)v->n};
-        double *t = row_major(v->val, rows, v->n, rows);
-        if (!t) return eng_error(E, "save: out of memory writing '%s'", name);
-        obj = write_dataset(file, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, dims, t);
+        /* band: LAPACK's storage row-major, (kl+ku+1, n); dense: the
+         * column-major array as HDF5 shape (n, m) (see the top) */
+        hsize_t dims[2] = {(hsize_t)(band ? rows : v->n), (hsize_t)(band ? v->n : rows)};
+        double *t = band ? row_major(v->val, rows, v->n, rows) : NULL;
+        if (band && !t) return eng_error(E, "save: out of memory writing '%s'", name);
+        obj = write_dataset(file, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, dims,
+                            band ? t : v->val ? v->val : (const double[1]){0});
         free(t);
         if (obj < 0) return eng_error(E, "save: H5Dcreate2/H5Dwrite failed for '%s'", name);
         rc = 0;
         if (band && (put_attr_str(obj, "silc-format", "band") || put_attr_i64(obj, "kl", &v->kl, 1) ||
                      put_attr_i64(obj, "ku", &v->ku, 1) || put_attr_i64(obj, "shape", shape, 2)))
             rc = -1;
+        if (!band && put_attr_str(obj, H5_COLUMN_MAJOR_ATTR, "double")) rc = -1;
     }
     if (v->format == SILC_FMT_CSR) H5Gclose(obj);
     else H5Dclose(obj);
@@ -343,8 +359,11 @@ static int claim_allowed(silc_engine *E, const val_parts *p, const char *name, c
     return eng_error(E, "load: '%s' in '%s': %s", name, path, why);
 }
 
-/* CSR: the group g holding data, indices, indptr and a shape attribute. */
-static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const char *path, const char *name)
+/* CSR: the group g holding data, indices, indptr and a shape attribute.
+ * *foreign is set when g is not laid out as a SILC value at all (another
+ * program's group), as opposed to a SILC value that is broken. */
+static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const char *path, const char *name,
+                            int *foreign)
 {
     static const char *const parts[3] = {"data", "indices", "indptr"};
     hid_t d[3] = {-1, -1, -1};
@@ -355,6 +374,7 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
     char what[3][300], why[512];
     int k, rc = 0;
     if (get_attr_i64(g, "shape", shape, 2) != 2 || shape[0] < 0 || shape[1] < 0) {
+        *foreign = 1;
         eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, indptr "
                      "and an integer shape attribute (m, n)", name, path);
         return NULL;
@@ -363,6 +383,7 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
         hid_t sp;
         snprintf(what[k], sizeof what[k], "'%s/%s'", name, parts[k]);
         if (H5Lexists(g, parts[k], acc->link) <= 0) {
+            *foreign = 1;
             rc = eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, "
                               "indptr and a shape attribute (%s is missing)", name, path, what[k]);
             break;
@@ -415,8 +436,10 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
     return v;
 }
 
-/* Dense (a 1-D or 2-D dataset of numbers) or band (silc-format = "band"). */
-static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const char *name)
+/* Dense (a 1-D or 2-D dataset of numbers: row-major, or column-major with
+ * the MATLAB_class attribute) or band (silc-format = "band"); *foreign is
+ * set when d is no array of numbers. */
+static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const char *name, int *foreign)
 {
     hid_t sp = H5Dget_space(d);
     hsize_t dims[2] = {0, 1};
@@ -425,11 +448,11 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
     silc_value *v = NULL;
     val_parts claim;
     double *buf = NULL;
-    int rc = 0;
+    int rc = 0, column_major = 0;
     if (sp >= 0) H5Sclose(sp);
     snprintf(what, sizeof what, "'%s'", name);
     if (rank < 1 || rank > 2 || (cls != H5T_FLOAT && cls != H5T_INTEGER))
-        return eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or 2-D array of numbers",
+        return *foreign = 1, eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or 2-D array of numbers",
                          name, path), NULL;
     if (storage_allowed(E, d, what, path)) return NULL;
     sp = H5Dget_space(d);
@@ -448,7 +471,10 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
                                 "attributes and kl+ku+1 rows of n columns", name, path), NULL;
         claim.format = SILC_FMT_BAND, claim.m = shape[0], claim.n = shape[1], claim.kl = kl, claim.ku = ku;
     } else {
-        claim.format = SILC_FMT_DENSE, claim.m = (int64_t)dims[0], claim.n = (int64_t)dims[1];
+        char order[16];
+        get_attr_str(d, H5_COLUMN_MAJOR_ATTR, order, sizeof order);
+        column_major = rank == 2 && order[0];
+        claim.format = SILC_FMT_DENSE, claim.m = (int64_t)dims[column_major], claim.n = (int64_t)dims[!column_major];
     }
     /* The claim (band: its rows too) before anything is allocated or read;
      * band storage is then stored diagonals times columns. */
@@ -458,7 +484,9 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
         rc = eng_error(E, "load: out of memory reading '%s'", name);
     if (!rc && dims[0] * dims[1] > 0 && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
         rc = eng_error(E, "load: reading '%s' in '%s' failed (H5Dread)", name, path);
-    if (!rc) { /* row-major (rows, n) into column-major */
+    if (!rc && column_major) { /* HDF5's (n, m) is the column-major m x n array */
+        if (dims[0] * dims[1] > 0) memcpy(v->val, buf, (size_t)(dims[0] * dims[1]) * sizeof *buf);
+    } else if (!rc) { /* row-major (rows, n) into column-major */
         int64_t i, j, r = (int64_t)dims[0], c = (int64_t)dims[1];
         for (i = 0; i < r; i++)
             for (j = 0; j < c; j++) v->val[i + j * r] = buf[i * c + j];
@@ -471,8 +499,9 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
     return v;
 }
 
-/* The value of the object name of file, or NULL with E->err naming it. */
-static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const char *name)
+/* The value of the object name of file, or NULL with E->err naming it
+ * (*foreign set when the object is none of SILC's layouts). */
+static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const char *name, int *foreign)
 {
     H5O_info_t info;
     h5_access acc = {-1, -1, -1};
@@ -492,14 +521,15 @@ static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const 
         } else if (info.type == H5O_TYPE_GROUP) {
             hid_t g = H5Gopen2(file, name, acc.group);
             if (g < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
-            else v = load_csr(E, &acc, g, path, name);
+            else v = load_csr(E, &acc, g, path, name, foreign);
             if (g >= 0) H5Gclose(g);
         } else if (info.type == H5O_TYPE_DATASET) {
             hid_t d = H5Dopen2(file, name, acc.dataset);
             if (d < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
-            else v = load_dataset(E, d, path, name);
+            else v = load_dataset(E, d, path, name, foreign);
             if (d >= 0) H5Dclose(d);
         } else {
+            *foreign = 1;
             eng_error(E, "load: '%s' in '%s' is not a SILC value (neither a dataset nor a group)", name, path);
         }
     }
@@ -529,9 +559,29 @@ static herr_t add_name(hid_t g, const char *name, const H5L_info_t *info, void *
     return 0;
 }
 
+/* What a load of the whole file skipped, for its warning: the first
+ * SKIP_LISTED names with the reason, then a count. */
+#define SKIP_LISTED 16
+typedef struct skip_list {
+    size_t count;
+    strbuf list;
+} skip_list;
+
+static void note_skipped(skip_list *s, const char *name, const char *err)
+{
+    /* err is "load: 'x' in 'f.h5' is not a SILC value: why" or "... is
+     * not a name SILC can bind (...)": the part from "not" on says why */
+    const char *why = strstr(err, "is not ");
+    why = why ? why + 3 : err;
+    if (s->count < SKIP_LISTED) sb_printf(&s->list, "%s'%s' (%s)", s->count ? "; " : "", name, why);
+    else if (s->count == SKIP_LISTED) sb_printf(&s->list, "; and more");
+    s->count++;
+}
+
 int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n)
 {
     root_names all = {NULL, 0, 0, 0};
+    skip_list skipped;
     silc_value **got = NULL, **olds = NULL;
     char fdpath[64];
     cfg_file in;
@@ -539,6 +589,8 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
     size_t i, k, count = n;
     int rc = 0;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    skipped.count = 0;
+    sb_init(&skipped.list);
     if (cfg_file_read(E, "load", path, &in)) return -1;
     util_fd_path(in.fd, fdpath, sizeof fdpath);
     if (H5Fis_hdf5(fdpath) <= 0) {
@@ -554,25 +606,41 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
         names = (const char *const *)all.names;
         count = all.n;
     }
-    for (i = 0; !rc && i < count; i++)
-        if (!util_is_name(names[i]))
-            rc = eng_error(E, "load: '%s' in '%s' is not a name SILC can bind (a letter or '_', then letters, "
-                              "digits and '_')", names[i], path);
     if (!rc && (!(got = calloc(count ? count : 1, sizeof *got)) || !(olds = calloc(count ? count : 1, sizeof *olds))))
         rc = eng_error(E, "load: out of memory");
-    for (i = 0; !rc && i < count; i++)
-        if (!(got[i] = load_one(E, file, path, names[i]))) rc = -1;
+    /* A load of the whole file skips what is not SILC's (another program's
+     * groups, strings, names SILC cannot bind) and says so below; a name
+     * asked for must load.  A SILC value that is broken or refused fails
+     * either way. */
+    for (i = 0; !rc && i < count; i++) {
+        int foreign = 0;
+        if (!util_is_name(names[i])) {
+            foreign = 1;
+            rc = eng_error(E, "load: '%s' in '%s' is not a name SILC can bind (a letter or '_', then letters, "
+                              "digits and '_')", names[i], path);
+        } else if (!(got[i] = load_one(E, file, path, names[i], &foreign))) {
+            rc = -1;
+        }
+        if (rc && foreign && !n) {
+            note_skipped(&skipped, names[i], E->err);
+            E->err[0] = '\0';
+            rc = 0;
+        }
+    }
     H5Fclose(file);
     /* Every value read: now they are bound.  Only a new name can fail to
      * bind (out of memory); then the names bound so far get back what they
      * held (rebinding never allocates) or go. */
     for (i = 0; !rc && i < count; i++) {
-        silc_value *old = store_get(&E->store, names[i]);
+        silc_value *old;
+        if (!got[i]) continue; /* skipped */
+        old = store_get(&E->store, names[i]);
         if (old) val_retain(old);
         if (store_set(&E->store, names[i], got[i])) {
             val_release(old);
             while (i-- > 0) {
                 silc_value *prev = olds[i];
+                if (!got[i]) continue;
                 if (prev) store_set(&E->store, names[i], prev);
                 else store_remove(&E->store, names[i]);
             }
@@ -581,7 +649,12 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
         }
         olds[i] = old;
     }
-    for (i = 0; !rc && i < count; i++) eng_info_remove(E, names[i]);
+    for (i = 0; !rc && i < count; i++)
+        if (got[i]) eng_info_remove(E, names[i]);
+    if (!rc && skipped.count)
+        eng_warn(E, "load: skipped %zu object%s of '%s' that %s: %s", skipped.count, skipped.count == 1 ? "" : "s",
+                 path, skipped.count == 1 ? "is not a SILC value" : "are not SILC values", sb_str(&skipped.list));
+    sb_free(&skipped.list);
     for (k = 0; olds && k < count; k++) val_release(olds[k]);
     free(olds);
     for (k = 0; got && k < count; k++) val_release(got[k]);

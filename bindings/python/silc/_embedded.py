@@ -1,8 +1,8 @@
 """silc._embedded -- a session inside this process, through libsilc with
 ctypes (no compiler at import): the engine, its plugins and the values live
 here, as for a C program.  libsilc is found by SILC_LIBRARY (a path), else
-the one the package was installed with (_paths.py, written by cmake
---install), else the system's (ctypes.util.find_library).  One of the
+relative to this package in its install (_paths.py, written by CMake), else
+by its soname (_candidates says why in that order).  One of the
 package's two back ends (_remote.py the other).
 """
 import ctypes
@@ -26,24 +26,47 @@ _OUTPUT = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
 _lib = None
 
 
+def _candidates():
+    """Where libsilc may be, in the order tried: SILC_LIBRARY (a path the user
+    names), then the libsilc of the install this package belongs to, found
+    relative to the package itself (_paths.py, written by CMake: no absolute
+    path, so a staged or moved prefix works), then the soname through the
+    dynamic loader's own search (LD_LIBRARY_PATH, ld.so.cache), then
+    ctypes.util.find_library."""
+    path = os.environ.get("SILC_LIBRARY")
+    if path:
+        return [path]
+    found = []
+    try:
+        from . import _paths
+        here = os.path.dirname(os.path.abspath(__file__))
+        beside = os.path.normpath(os.path.join(here, _paths.LIBSILC_DIR, _paths.LIBSILC_SONAME))
+        if os.path.exists(beside):
+            found.append(beside)
+        found.append(_paths.LIBSILC_SONAME)
+    except ImportError:  # the source tree's package: no install beside it
+        found.append("libsilc.so.1")
+    system = ctypes.util.find_library("silc")
+    if system:
+        found.append(system)
+    return found
+
+
 def _library():
     global _lib
     if _lib is not None:
         return _lib
-    path = os.environ.get("SILC_LIBRARY")
-    if not path:
+    lib, tried = None, []
+    for path in _candidates():
         try:
-            from . import _paths
-            path = _paths.LIBSILC
-        except ImportError:
-            path = ctypes.util.find_library("silc")
-    if not path:
-        raise SilcError("libsilc not found: set SILC_LIBRARY to its path, or install SILC "
-                        "(cmake --install), or pass a server address for a remote session")
-    try:
-        lib = ctypes.CDLL(path)
-    except OSError as e:
-        raise SilcError("cannot load libsilc from %s: %s" % (path, e))
+            lib = ctypes.CDLL(path)
+            break
+        except OSError as e:
+            tried.append("%s (%s)" % (path, e))
+    if lib is None:
+        raise SilcError("libsilc not found: tried " + "; ".join(tried) + ". Set SILC_LIBRARY to its path "
+                        "(build/core/libsilc.so.1 in a build tree), install SILC (cmake --install), or "
+                        "pass a server address for a remote session")
     vp, cp, env = ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(_Envelope)
     for name, res, args in (("silc_open", ctypes.c_int, [ctypes.POINTER(vp), cp]),
                             ("silc_close", None, [ctypes.POINTER(vp)]),
