@@ -302,6 +302,10 @@ static void test_missing_plugin(void)
     for (int i = 0; i < 3; i++) {
         rc = silc_open(&c, conf);
         CHECK(rc == 0, "open %d with a bogus plugin file: %s", i, c ? silc_context_errmsg(c) : silc_errmsg());
+        /* Plugins open at first need: a misspelt backend's suggestions
+         * list every backend, which opens every file (the bogus one too). */
+        CHECK(c && silc_exec(c, "set dispatch.solve.sparse = nosuch_backend") != 0,
+              "open %d: a misspelt backend was accepted", i);
         silc_close(&c);
     }
     unsetenv("SILC_PLUGIN_PATH");
