@@ -128,6 +128,15 @@ void val_array_free(void *p);
 void val_budget_set(int64_t exempt, uint64_t limit, const char *source);
 /* 1 if a constructor was refused by the budget since it was last set. */
 int val_budget_refused(void);
+/* The budget's check for bytes claimed before any value is made (a file's
+ * shapes, summed over everything a `load` would bind): 0 if they fit what
+ * the budget has left (or no budget is set); else -1, val_refusal() says
+ * "<what> would bring the values held at once ... (<source>)" as a refused
+ * constructor's, and val_budget_refused() becomes 1. */
+int val_budget_claim(double bytes, const char *what);
+/* What the budget has left, in bytes (negative when over; INT64_MAX when
+ * no budget is set). */
+int64_t val_budget_room(void);
 /* Bytes of the arrays of every value alive in this process. */
 int64_t val_live_bytes(void);
 /* The bytes a value of this claim costs, the one formula every limit uses:

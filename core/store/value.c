@@ -171,18 +171,30 @@ int64_t val_live_bytes(void)
     return live_value_bytes;
 }
 
-static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
+int64_t val_budget_room(void)
+{
+    return budget_limit ? (int64_t)budget_limit - (live_value_bytes - budget_exempt) : INT64_MAX;
+}
+
+int val_budget_claim(double bytes, const char *what)
 {
     double held = (double)(live_value_bytes - budget_exempt);
-    char what[96], over[200];
+    char over[200];
     if (!budget_limit || held + bytes <= (double)budget_limit) return 0;
-    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
-             val_format_name(format));
     util_fmt_over_limit(over, sizeof over, held + bytes, (double)budget_limit);
     snprintf(refusal, sizeof refusal, "%s would bring the values held at once (bound and "
              "temporary) to %s (%s)", what, over, budget_source);
     budget_refusals++;
     return -1;
+}
+
+static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
+{
+    char what[96];
+    if (!budget_limit) return 0;
+    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
+             val_format_name(format));
+    return val_budget_claim(bytes, what);
 }
 
 /* Counts a value's arrays as alive (budget above), once they are made. */
