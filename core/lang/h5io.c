@@ -580,6 +580,7 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
         char what[400];
         if (count == 1) snprintf(what, sizeof what, "'%.300s' (%.0f bytes)", names[0], claimed);
         else snprintf(what, sizeof what, "its %zu values (%.0f bytes)", count, claimed);
+        memo_make_room(E, claimed); /* the memo's kept results go first */
         if (val_budget_claim(claimed, what))
             rc = eng_error(E, "load: '%s': %s", path, val_refusal());
     }

@@ -33,6 +33,7 @@ typedef struct val_attachment {
     char *key;
     void *data;
     void (*destroy)(void *);
+    int64_t bytes;              /* the memory it holds, as charged (val_attach_charge); 0 = not known */
     struct val_attachment *next;
 } val_attachment;
 
@@ -78,6 +79,8 @@ struct silc_value {
     double scan_maxabs;
     val_attachment *attach;
     val_dist *dist;          /* NULL: the value is whole here (val_dist, below) */
+    int64_t bindings;        /* names of a store bound to it (store_set, store_remove): a
+                                cache holding a value no name holds pays for its arrays */
 };
 
 /* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
@@ -193,6 +196,13 @@ void val_set_dist_hooks(const val_dist_hooks *h);
 
 void *val_attach_get(const silc_value *v, const char *key);
 int val_attach_set(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
+/* The memory an attachment holds, as measured by whoever made it (the
+ * dispatcher, around the plugin call that attached it: disp_run): 0, or -1
+ * if v has no attachment key.  A replaced attachment keeps its charge. */
+int val_attach_charge(const silc_value *v, const char *key, int64_t bytes);
+/* The charges of all of v's attachments: what a cache keeping v holds
+ * beyond its arrays (the memo's session charge, memo.c). */
+int64_t val_attach_bytes(const silc_value *v);
 
 /* ---- the store ------------------------------------------------------------- */
 typedef struct store_entry {

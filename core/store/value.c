@@ -521,9 +521,30 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
     }
     a->data = data;
     a->destroy = destroy;
+    a->bytes = 0;
     a->next = v->attach;
     v->attach = a;
     return 0;
+}
+
+int val_attach_charge(const silc_value *cv, const char *key, int64_t bytes)
+{
+    val_attachment *a;
+    if (!cv || !key) return -1;
+    for (a = cv->attach; a; a = a->next)
+        if (strcmp(a->key, key) == 0) {
+            a->bytes = bytes > 0 ? bytes : 0;
+            return 0;
+        }
+    return -1;
+}
+
+int64_t val_attach_bytes(const silc_value *v)
+{
+    const val_attachment *a;
+    int64_t total = 0;
+    for (a = v ? v->attach : NULL; a; a = a->next) total += a->bytes;
+    return total;
 }
 
 /* ---- structural properties ------------------------------------------------ */
@@ -1113,6 +1134,7 @@ void store_clear(silc_store *s)
         store_entry *e = s->buckets[b], *next;
         for (; e; e = next) {
             next = e->next;
+            e->value->bindings--;
             val_release(e->value);
             free(e->name);
             free(e);
@@ -1175,6 +1197,8 @@ int store_set(silc_store *s, const char *name, silc_value *v)
     if (*pe) {
         silc_value *old = (*pe)->value;
         (*pe)->value = val_retain(v);
+        v->bindings++;
+        old->bindings--;
         val_release(old);
         return 0;
     }
@@ -1186,6 +1210,7 @@ int store_set(silc_store *s, const char *name, silc_value *v)
         return -1;
     }
     e->value = val_retain(v);
+    v->bindings++;
     e->next = NULL;
     *pe = e;
     if (++s->count > s->nbuckets) store_grow(s);
@@ -1200,6 +1225,7 @@ int store_remove(silc_store *s, const char *name)
     if (!*pe) return 1;
     e = *pe;
     *pe = e->next;
+    e->value->bindings--;
     val_release(e->value);
     free(e->name);
     free(e);
