@@ -36,7 +36,9 @@
 #endif
 #endif
 #ifdef SILC_HEAP_FROM_SANITIZER
-#include <sanitizer/allocator_interface.h>
+/* The sanitizer runtime's (sanitizer/allocator_interface.h, which gcc does
+ * not ship). */
+size_t __sanitizer_get_current_allocated_bytes(void);
 #elif defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
 #define SILC_HEAP_FROM_MALLINFO2 1
 #include <malloc.h>

@@ -20,8 +20,8 @@
  * directory, --max-session-bytes 12M), a load is checked against what the
  * session has left from the files' shapes, summed over everything it would
  * bind, before anything is read: two 8 MB values in one file are refused
- * together (nothing bound, the session process's peak RSS not grown by
- * either), one of them alone loads and holds its fill value exactly, and
+ * together (nothing bound, the session process's peak RSS grown by less
+ * than reading either would cost), one of them alone loads and holds its fill value exactly, and
  * then the other is refused beside it.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -198,9 +198,13 @@ static void session_budget_cases(void)
     CHECK(!strcmp(silc_context_errmsg(ctx), two_refused), "load of both:\n   got  '%s'\n   want '%s'",
           silc_context_errmsg(ctx), two_refused);
     CHECK(!bound(ctx, "P") && !bound(ctx, "Q"), "a refused load bound something");
+    /* Reading even one of them costs 16 MB (the value, and the row-major
+     * buffer it is read through); the refusal costs a few (HDF5's file
+     * handle; more under AddressSanitizer, whose allocator keeps its own). */
     after = proc_status_bytes(session, "VmHWM:");
-    CHECK(after - before < (4LL << 20), "the session's peak RSS grew by %lld bytes refusing the load",
+    CHECK(after - before < (12LL << 20), "the session's peak RSS grew by %lld bytes refusing the load",
           after - before);
+    printf("refusing the load grew the session's peak RSS by %.1f MiB\n", (after - before) / 1048576.0);
 
     /* One fits, and holds its fill value exactly. */
     CHECK(silc_exec(ctx, "load \"two.h5\" P; s = sum(sum(P))") == 0, "load of P alone: %s",
