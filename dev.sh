@@ -15,7 +15,8 @@ cd "$(dirname "$0")"
 PACKAGES=(cmake make gcc gfortran pkg-config libinih-dev libreadline-dev
           libopenblas-dev liblapacke-dev libsuitesparse-dev libmumps-seq-dev libmumps-dev
           petsc-dev openmpi-bin libopenmpi-dev python3-numpy python3-scipy clang libpng-dev
-          default-jdk-headless libhdf5-dev python3-h5py iproute2)
+          default-jdk-headless libhdf5-dev python3-h5py iproute2
+          openssh-server openssh-client)
 
 install_missing() {
     local missing=()

@@ -9,8 +9,9 @@
  * session's slot (server.h): if this process dies, the parent then knows
  * whether the client can still be told why.
  *
- * Session memory (the val_bytes of every bound value) is kept under
- * max_session_bytes.  A PUT is checked from its descriptor before its arrays
+ * Session memory (the val_bytes of every bound value, and what the memo
+ * keeps without a name: memo_charge) is kept under max_session_bytes; the
+ * memo gives way first (memo_shrink).  A PUT is checked from its descriptor before its arrays
  * are read; an EXEC runs against a snapshot of the bindings (names to
  * retained values, which is cheap because values are immutable) and is rolled
  * back whole if it leaves the session over the limit.
@@ -31,6 +32,7 @@
 #include "dispatch.h"
 #include "dist.h"
 #include "engine.h"
+#include "lang.h"
 
 /* Frames an EXEC produces (who, info, explain), sent with its reply. */
 typedef struct outbuf {
@@ -89,7 +91,7 @@ static void capture_output(void *user, const char *text)
     out_frame(&((session *)user)->out, PROTO_TEXT, text);
 }
 
-static uint64_t session_bytes(const silc_engine *E)
+static uint64_t bound_bytes(const silc_engine *E)
 {
     uint64_t total = 0;
     size_t b;
@@ -97,6 +99,22 @@ static uint64_t session_bytes(const silc_engine *E)
     for (b = 0; b < E->store.nbuckets; b++)
         for (e = E->store.buckets[b]; e; e = e->next) total += val_bytes(e->value);
     return total;
+}
+
+/* What the session holds: its bound values, and what the memo keeps for it
+ * (results no name holds, factorizations hung on results: memo.c). */
+static uint64_t session_bytes(const silc_engine *E)
+{
+    return bound_bytes(E) + memo_charge(E, NULL);
+}
+
+/* At the limit the memo goes first: it is trimmed to what the bound values
+ * and more bytes about to be bound leave. */
+static void memo_give_way(silc_engine *E, double more)
+{
+    double left = (double)srv_cfg.max_session_bytes - (double)bound_bytes(E) - more;
+    if (!srv_cfg.max_session_bytes) return;
+    memo_shrink(E, left > 0 ? (uint64_t)left : 0);
 }
 
 static void infos_free(eng_info_entry *e)
@@ -226,11 +244,15 @@ static int exec_guarded(void)
  * session's under silcd --mpi, the engine's caches). */
 static void exec_budget(const silc_engine *E, int on)
 {
+    uint64_t memo_arrays;
     if (!on || !srv_cfg.max_session_bytes) {
         val_budget_set(0, 0, NULL);
         return;
     }
-    val_budget_set(val_live_bytes() - (int64_t)session_bytes(E), srv_cfg.max_session_bytes,
+    /* The memo's results are values alive: the budget counts them (what
+     * hangs off them it cannot see: memo_make_room adds that). */
+    memo_charge(E, &memo_arrays);
+    val_budget_set(val_live_bytes() - (int64_t)(bound_bytes(E) + memo_arrays), srv_cfg.max_session_bytes,
                    "the session's limit, silcd --max-session-bytes");
 }
 
@@ -261,6 +283,7 @@ static int do_exec(session *S, const char *text)
         srv_log(LOG_INFO, "session %lu: %s", S->id, S->watch.why);
     }
     if (guarded) {
+        memo_give_way(E, 0);
         used = session_bytes(E);
         /* A value refused at the peak fails the request like a limit
          * crossed at its end: rolled back whole. */
@@ -328,9 +351,10 @@ static int put_refusal(session *S, const proto_request *q)
     cost = val_parts_bytes(&claim);
     if (cost < (double)q->layout.total) cost = (double)q->layout.total;
     if (srv_cfg.max_session_bytes > 0) {
-        used = session_bytes(S->E);
         old = store_get(&S->E->store, q->text);
         old_bytes = old ? val_bytes(old) : 0;
+        memo_give_way(S->E, cost - (double)old_bytes);
+        used = session_bytes(S->E);
         if ((double)(used - old_bytes) + cost > (double)srv_cfg.max_session_bytes) {
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
                      "(%.0f bytes) would bring the session to %.0f bytes, the limit is %llu "

@@ -7,6 +7,7 @@
 #define SILC_REMOTE_UTIL_H
 
 #include <arpa/inet.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -294,6 +295,51 @@ static inline int test_token_file(char *path, size_t len)
         return -1;
     }
     return close(fd);
+}
+
+/* The one child process of parent (a forking silcd with one session open:
+ * that session's process), or -1 if it has none or more than one. */
+static inline pid_t only_child_of(pid_t parent)
+{
+    char path[300], line[512];
+    pid_t found = -1;
+    int count = 0;
+    struct dirent *e;
+    DIR *proc = opendir("/proc");
+    if (!proc) return -1;
+    /* /proc/N/stat: "N (comm) S PPID ...", comm may hold anything but ends
+     * at the last ')'. */
+    while ((e = readdir(proc)) && count < 2) {
+        char *close_paren;
+        long ppid;
+        FILE *f;
+        if (e->d_name[0] < '1' || e->d_name[0] > '9') continue;
+        snprintf(path, sizeof path, "/proc/%s/stat", e->d_name);
+        if (!(f = fopen(path, "r"))) continue;
+        if (fgets(line, sizeof line, f) && (close_paren = strrchr(line, ')')) &&
+            sscanf(close_paren + 1, " %*c %ld", &ppid) == 1 && ppid == (long)parent) {
+            found = (pid_t)atol(e->d_name);
+            count++;
+        }
+        fclose(f);
+    }
+    closedir(proc);
+    return count == 1 ? found : -1;
+}
+
+/* A "Vm...:" line of /proc/PID/status in bytes (field "VmHWM:" is the peak
+ * resident set), or -1. */
+static inline long long proc_status_bytes(pid_t pid, const char *field)
+{
+    char path[64], line[256];
+    long long kb = -1;
+    FILE *f;
+    snprintf(path, sizeof path, "/proc/%ld/status", (long)pid);
+    if (!(f = fopen(path, "r"))) return -1;
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, field, strlen(field))) kb = atoll(line + strlen(field));
+    fclose(f);
+    return kb < 0 ? -1 : kb * 1024;
 }
 
 #endif

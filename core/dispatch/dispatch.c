@@ -28,6 +28,22 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__SANITIZE_ADDRESS__)
+#define SILC_HEAP_FROM_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SILC_HEAP_FROM_SANITIZER 1
+#endif
+#endif
+#ifdef SILC_HEAP_FROM_SANITIZER
+/* The sanitizer runtime's (sanitizer/allocator_interface.h, which gcc does
+ * not ship). */
+size_t __sanitizer_get_current_allocated_bytes(void);
+#elif defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+#define SILC_HEAP_FROM_MALLINFO2 1
+#include <malloc.h>
+#endif
+
 const char *const disp_class_names[] = {
     "solve.diag", "solve.triangular", "solve.band", "solve.dense", "solve.dense.spd",
     "solve.sparse", "solve.sparse.spd", "solve.sparse.mmatrix.spd", "solve.rect", "matmul.sparse_sparse",
@@ -468,16 +484,89 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
 
 /* ---- running --------------------------------------------------------------- */
 
+/* ---- what a solve leaves attached --------------------------------------------
+ * A plugin's factorization hangs off its matrix (an attachment) and lives
+ * as long as the value; the plugin ABI does not say how large it is, and
+ * UMFPACK, MUMPS or PETSc allocate it with their own malloc.  So it is
+ * measured: the heap in use (glibc's mallinfo2: the main arena, where the
+ * engine's thread allocates, and every mmapped block; under AddressSanitizer
+ * its allocator's count) grows across the call by what the call kept,
+ * less the value arrays it made (its result, counted by the store); that
+ * growth is charged to the attachments the call added (val_attach_charge),
+ * shared if it added several.  What else the call kept for itself (a
+ * plugin's pattern cache) is charged with them: an overestimate, on the
+ * safe side.  The memo counts these charges against silcd's session limit
+ * (memo.c).  Elsewhere (no mallinfo2) nothing is charged. */
+static int64_t heap_in_use(void)
+{
+#if defined(SILC_HEAP_FROM_SANITIZER)
+    return (int64_t)__sanitizer_get_current_allocated_bytes();
+#elif defined(SILC_HEAP_FROM_MALLINFO2)
+    struct mallinfo2 mi = mallinfo2();
+    return (int64_t)(mi.uordblks + mi.hblkhd);
+#else
+    return -1;
+#endif
+}
+
+typedef struct attach_watch {
+    int on;
+    int64_t heap, live;
+    const val_attachment *before[3];   /* each operand's attachment list before the call */
+} attach_watch;
+
+static void watch_begin(attach_watch *w, const silc_call *call)
+{
+    int i;
+    w->on = 0;
+    if (call->op != SILC_OP_SOLVE || (w->heap = heap_in_use()) < 0) return;
+    for (i = 0; i < 3; i++) w->before[i] = i < call->nin && call->in[i] ? call->in[i]->attach : NULL;
+    w->live = val_live_bytes();
+    w->on = 1;
+}
+
+/* New attachments are put first in a value's list: those before the old
+ * head are the call's.  One that owns nothing (no destructor: a marker) is
+ * not charged. */
+static int new_attachments(const silc_value *v, const val_attachment *before, int charge_them, int64_t bytes)
+{
+    const val_attachment *a;
+    int count = 0;
+    for (a = v ? v->attach : NULL; a && a != before; a = a->next)
+        if (a->destroy) {
+            if (charge_them) val_attach_charge(v, a->key, bytes);
+            count++;
+        }
+    return count;
+}
+
+static void watch_end(attach_watch *w, const silc_call *call)
+{
+    int64_t kept;
+    int i, count = 0;
+    if (!w->on) return;
+    kept = heap_in_use() - w->heap - (val_live_bytes() - w->live);
+    for (i = 0; i < 3 && i < call->nin; i++)
+        if (!(i > 0 && call->in[i] == call->in[0])) count += new_attachments(call->in[i], w->before[i], 0, 0);
+    if (!count) return;
+    for (i = 0; i < 3 && i < call->nin; i++)
+        if (!(i > 0 && call->in[i] == call->in[0]))
+            new_attachments(call->in[i], w->before[i], 1, kept > 0 ? kept / count : 0);
+}
+
 /* One attempt of backend b; the report is reset for every attempt so nothing
  * of a failed backend leaks into the one that succeeds. */
 static int run_one(silc_engine *E, silc_call *call, const ld_backend *b)
 {
     double t0;
+    attach_watch watch;
     int rc;
     call->out = NULL;
     if (call->op == SILC_OP_SOLVE) report_reset(E, call->report);
+    watch_begin(&watch, call);
     t0 = util_now();
     rc = b->backend->ops[call->op].run(call);
+    watch_end(&watch, call);
     if (rc == SILC_OK) rc = host_check_result(call);
     if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
         call->report->seconds = util_now() - t0;

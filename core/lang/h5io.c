@@ -263,7 +263,8 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
  *   - claims: the shape an object announces (its dataspace, its shape, kl
  *     and ku attributes) is checked by the checker every value passes
  *     (val_parts_claim: overflow, the value limit) before anything is
- *     allocated or read;
+ *     allocated or read, and the claims of everything the load binds,
+ *     summed, against what silcd's session has left (val_budget_claim);
  *   - indices: indptr and indices must be integer datasets (a float index
  *     would be truncated) and attributes integers;
  *   - CSR arrays are read into the value itself and checked as a PUT's
@@ -361,9 +362,11 @@ static int claim_allowed(silc_engine *E, const val_parts *p, const char *name, c
 
 /* CSR: the group g holding data, indices, indptr and a shape attribute.
  * *foreign is set when g is not laid out as a SILC value at all (another
- * program's group), as opposed to a SILC value that is broken. */
-static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const char *path, const char *name,
-                            int *foreign)
+ * program's group), as opposed to a SILC value that is broken.  Its checked
+ * claim goes to *claim_out; the value to *out, unless out is NULL (the claim
+ * alone: nothing allocated or read).  0, or -1 with E->err. */
+static int load_csr(silc_engine *E, const h5_access *acc, hid_t g, const char *path, const char *name,
+                    int *foreign, val_parts *claim_out, silc_value **out)
 {
     static const char *const parts[3] = {"data", "indices", "indptr"};
     hid_t d[3] = {-1, -1, -1};
@@ -375,9 +378,8 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
     int k, rc = 0;
     if (get_attr_i64(g, "shape", shape, 2) != 2 || shape[0] < 0 || shape[1] < 0) {
         *foreign = 1;
-        eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, indptr "
-                     "and an integer shape attribute (m, n)", name, path);
-        return NULL;
+        return eng_error(E, "load: '%s' in '%s' is not a SILC value: a group needs datasets data, indices, "
+                            "indptr and an integer shape attribute (m, n)", name, path);
     }
     for (k = 0; !rc && k < 3; k++) {
         hid_t sp;
@@ -417,8 +419,10 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
     claim.format = SILC_FMT_CSR, claim.m = shape[0], claim.n = shape[1], claim.nnz = len[0];
     /* The claim is checked before anything is allocated or read. */
     if (!rc) rc = claim_allowed(E, &claim, name, path);
-    if (!rc && !(v = val_new_unset(SILC_FMT_CSR, claim.m, claim.n, claim.nnz, 0, 0)))
+    if (!rc) *claim_out = claim;
+    if (!rc && out && !(v = val_new_unset(SILC_FMT_CSR, claim.m, claim.n, claim.nnz, 0, 0)))
         rc = eng_error(E, "load: out of memory for '%s'", name);
+    if (!out) goto done;
     if (!rc && ((claim.nnz > 0 && (H5Dread(d[0], H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->val) < 0 ||
                                    H5Dread(d[1], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->colind) < 0)) ||
                 H5Dread(d[2], H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->rowptr) < 0))
@@ -427,19 +431,19 @@ static silc_value *load_csr(silc_engine *E, const h5_access *acc, hid_t g, const
         claim.rowptr = v->rowptr, claim.colind = v->colind, claim.values = v->val;
         if (val_parts_fill(v, &claim, why, sizeof why)) rc = eng_error(E, "load: '%s' in '%s': %s", name, path, why);
     }
+done:
     for (k = 0; k < 3; k++)
         if (d[k] >= 0) H5Dclose(d[k]);
-    if (rc) {
-        val_release(v);
-        return NULL;
-    }
-    return v;
+    if (rc) val_release(v);
+    else if (out) *out = v;
+    return rc;
 }
 
 /* Dense (a 1-D or 2-D dataset of numbers: row-major, or column-major with
  * the MATLAB_class attribute) or band (silc-format = "band"); *foreign is
- * set when d is no array of numbers. */
-static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const char *name, int *foreign)
+ * set when d is no array of numbers; claim and out as load_csr's. */
+static int load_dataset(silc_engine *E, hid_t d, const char *path, const char *name, int *foreign,
+                        val_parts *claim_out, silc_value **out)
 {
     hid_t sp = H5Dget_space(d);
     hsize_t dims[2] = {0, 1};
@@ -452,14 +456,14 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
     if (sp >= 0) H5Sclose(sp);
     snprintf(what, sizeof what, "'%s'", name);
     if (rank < 1 || rank > 2 || (cls != H5T_FLOAT && cls != H5T_INTEGER))
-        return *foreign = 1, eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or 2-D array of numbers",
-                         name, path), NULL;
-    if (storage_allowed(E, d, what, path)) return NULL;
+        return *foreign = 1, eng_error(E, "load: '%s' in '%s' is not a SILC value: a dataset must be a 1-D or "
+                                          "2-D array of numbers", name, path);
+    if (storage_allowed(E, d, what, path)) return -1;
     sp = H5Dget_space(d);
     H5Sget_simple_extent_dims(sp, dims, NULL);
     H5Sclose(sp);
     if (dims[0] > INT64_MAX || dims[1] > INT64_MAX)
-        return eng_error(E, "load: '%s' in '%s' has more rows or columns than SILC can index", name, path), NULL;
+        return eng_error(E, "load: '%s' in '%s' has more rows or columns than SILC can index", name, path);
     get_attr_str(d, "silc-format", fmt, sizeof fmt);
     memset(&claim, 0, sizeof claim);
     if (!strcmp(fmt, "band")) {
@@ -468,7 +472,7 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
             get_attr_i64(d, "shape", shape, 2) != 2 || kl < 0 || ku < 0 || kl > INT32_MAX || ku > INT32_MAX ||
             rank != 2 || dims[0] != (hsize_t)(kl + ku + 1) || dims[1] != (hsize_t)shape[1] || shape[0] < 0)
             return eng_error(E, "load: '%s' in '%s' is not a SILC band value: it needs integer kl, ku and shape "
-                                "attributes and kl+ku+1 rows of n columns", name, path), NULL;
+                                "attributes and kl+ku+1 rows of n columns", name, path);
         claim.format = SILC_FMT_BAND, claim.m = shape[0], claim.n = shape[1], claim.kl = kl, claim.ku = ku;
     } else {
         char order[16];
@@ -478,7 +482,9 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
     }
     /* The claim (band: its rows too) before anything is allocated or read;
      * band storage is then stored diagonals times columns. */
-    if (claim_allowed(E, &claim, name, path)) return NULL;
+    if (claim_allowed(E, &claim, name, path)) return -1;
+    *claim_out = claim;
+    if (!out) return 0;
     if (!(v = val_new_unset(claim.format, claim.m, claim.n, 0, claim.kl, claim.ku)) ||
         !(buf = malloc((size_t)(dims[0] * dims[1] > 0 ? dims[0] * dims[1] : 1) * sizeof *buf)))
         rc = eng_error(E, "load: out of memory reading '%s'", name);
@@ -492,26 +498,26 @@ static silc_value *load_dataset(silc_engine *E, hid_t d, const char *path, const
             for (j = 0; j < c; j++) v->val[i + j * r] = buf[i * c + j];
     }
     free(buf);
-    if (rc) {
-        val_release(v);
-        return NULL;
-    }
-    return v;
+    if (rc) val_release(v);
+    else *out = v;
+    return rc;
 }
 
-/* The value of the object name of file, or NULL with E->err naming it
- * (*foreign set when the object is none of SILC's layouts). */
-static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const char *name, int *foreign)
+/* The checked claim of the object name of file, and its value in *out
+ * unless out is NULL (the claim alone, nothing read).  0, or -1 with
+ * E->err naming it (*foreign set when the object is none of SILC's
+ * layouts). */
+static int load_one(silc_engine *E, hid_t file, const char *path, const char *name, int *foreign,
+                    val_parts *claim, silc_value **out)
 {
     H5O_info_t info;
     h5_access acc = {-1, -1, -1};
-    silc_value *v = NULL;
+    int rc = -1;
     char what[300];
     snprintf(what, sizeof what, "'%s'", name);
     if (access_open(&acc)) {
         access_close(&acc);
-        eng_error(E, "load: out of memory (HDF5 property lists)");
-        return NULL;
+        return eng_error(E, "load: out of memory (HDF5 property lists)");
     }
     if (H5Lexists(file, name, acc.link) <= 0) {
         eng_error(E, "load: '%s' is not in '%s'", name, path);
@@ -521,12 +527,12 @@ static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const 
         } else if (info.type == H5O_TYPE_GROUP) {
             hid_t g = H5Gopen2(file, name, acc.group);
             if (g < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
-            else v = load_csr(E, &acc, g, path, name, foreign);
+            else rc = load_csr(E, &acc, g, path, name, foreign, claim, out);
             if (g >= 0) H5Gclose(g);
         } else if (info.type == H5O_TYPE_DATASET) {
             hid_t d = H5Dopen2(file, name, acc.dataset);
             if (d < 0) eng_error(E, "load: cannot open '%s' in '%s'", name, path);
-            else v = load_dataset(E, d, path, name, foreign);
+            else rc = load_dataset(E, d, path, name, foreign, claim, out);
             if (d >= 0) H5Dclose(d);
         } else {
             *foreign = 1;
@@ -534,7 +540,7 @@ static silc_value *load_one(silc_engine *E, hid_t file, const char *path, const 
         }
     }
     access_close(&acc);
-    return v;
+    return rc;
 }
 
 /* The names of file's root, for a load of everything. */
@@ -583,10 +589,12 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
     root_names all = {NULL, 0, 0, 0};
     skip_list skipped;
     silc_value **got = NULL, **olds = NULL;
+    unsigned char *wanted = NULL; /* loaded, not skipped */
     char fdpath[64];
     cfg_file in;
     hid_t file;
     size_t i, k, count = n;
+    double claimed = 0;
     int rc = 0;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     skipped.count = 0;
@@ -606,26 +614,52 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
         names = (const char *const *)all.names;
         count = all.n;
     }
-    if (!rc && (!(got = calloc(count ? count : 1, sizeof *got)) || !(olds = calloc(count ? count : 1, sizeof *olds))))
+    if (!rc && (!(got = calloc(count ? count : 1, sizeof *got)) || !(olds = calloc(count ? count : 1, sizeof *olds)) ||
+                !(wanted = calloc(count ? count : 1, 1))))
         rc = eng_error(E, "load: out of memory");
-    /* A load of the whole file skips what is not SILC's (another program's
-     * groups, strings, names SILC cannot bind) and says so below; a name
-     * asked for must load.  A SILC value that is broken or refused fails
-     * either way. */
+    /* Every object's claim first, then their sum against what the session
+     * has left (silcd's --max-session-bytes: the values a load binds are
+     * held together), before anything is allocated or read.  A load of the
+     * whole file skips what is not SILC's (another program's groups,
+     * strings, names SILC cannot bind) and says so below; a name asked for
+     * must load.  A SILC value that is broken or refused fails either way. */
     for (i = 0; !rc && i < count; i++) {
+        val_parts claim;
         int foreign = 0;
         if (!util_is_name(names[i])) {
             foreign = 1;
             rc = eng_error(E, "load: '%s' in '%s' is not a name SILC can bind (a letter or '_', then letters, "
                               "digits and '_')", names[i], path);
-        } else if (!(got[i] = load_one(E, file, path, names[i], &foreign))) {
+        } else if (load_one(E, file, path, names[i], &foreign, &claim, NULL)) {
             rc = -1;
+        } else {
+            claimed += val_parts_bytes(&claim);
+            wanted[i] = 1;
         }
         if (rc && foreign && !n) {
             note_skipped(&skipped, names[i], E->err);
             E->err[0] = '\0';
             rc = 0;
         }
+    }
+    if (!rc) {
+        char what[400];
+        size_t nwanted = 0;
+        for (i = 0; i < count; i++) nwanted += wanted[i];
+        if (nwanted == 1) {
+            for (i = 0; !wanted[i]; i++) {}
+            snprintf(what, sizeof what, "'%.300s' (%.0f bytes)", names[i], claimed);
+        } else {
+            snprintf(what, sizeof what, "its %zu values (%.0f bytes)", nwanted, claimed);
+        }
+        memo_make_room(E, claimed); /* the memo's kept results go first */
+        if (val_budget_claim(claimed, what))
+            rc = eng_error(E, "load: '%s': %s", path, val_refusal());
+    }
+    for (i = 0; !rc && i < count; i++) {
+        val_parts claim;
+        int foreign = 0;
+        if (wanted[i] && load_one(E, file, path, names[i], &foreign, &claim, &got[i])) rc = -1;
     }
     H5Fclose(file);
     /* Every value read: now they are bound.  Only a new name can fail to
@@ -659,6 +693,7 @@ int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n
     free(olds);
     for (k = 0; got && k < count; k++) val_release(got[k]);
     free(got);
+    free(wanted);
     for (k = 0; k < all.n; k++) free(all.names[k]);
     free(all.names);
     return rc;

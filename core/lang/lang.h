@@ -194,6 +194,17 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call);
 /* After call ran and gave result: remember it (warned: the call warned, so
  * it is never handed out).  Failing to remember loses nothing. */
 void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int warned);
+/* The memory the memo holds for the session: the arrays of results no
+ * name holds (also in *arrays when not NULL) and everything attached to
+ * every result (factorizations of later solves). */
+uint64_t memo_charge(const silc_engine *E, uint64_t *arrays);
+/* Drops kept results, least recently used first, until memo_charge(E) <=
+ * room (silcd: its limit less the bound values). */
+void memo_shrink(silc_engine *E, uint64_t room);
+/* Under a value budget (val_budget_set: inside a silcd request), drops kept
+ * results, least recently used first, until what hangs off them and need
+ * more bytes fit what the budget has left.  Nothing without a budget. */
+void memo_make_room(silc_engine *E, double need);
 /* At the engine's end. */
 void memo_free(silc_engine *E);
 

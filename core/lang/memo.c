@@ -16,7 +16,19 @@
  * its result is kept only when the same key comes again: most operations of
  * a loop have an operand that changes every step and would only fill the
  * table.  The table is small and bounded (MEMO_SLOTS entries, MEMO_BYTES of
- * results), least recently used first out.  Not used: for solves (their
+ * results with what hangs off them), least recently used first out.
+ *
+ * A kept result is memory the session holds without a name: its arrays
+ * (unless a name holds it too) and, above all, what later calls attached
+ * to it -- a solve with it leaves its factorization there, often many
+ * times the matrix (issue 33: 30 rounds of `B = A * c` kept, solved and
+ * cleared grew a 16 MiB silcd session to 629 MiB).  So it counts against
+ * silcd's --max-session-bytes (memo_charge, session.c) and is the first
+ * thing to go when the limit is reached: at the end of every request and
+ * before a PUT (memo_shrink), before every call of a request and before a
+ * load (memo_make_room), least recently used first.  An attachment's bytes
+ * are what the dispatcher measured the plugin call that made it keep
+ * (val_attach_charge, disp_run).  Not used: for solves (their
  * report and warnings belong to each statement), in explain, for calls
  * that warned, on SPMD engines (ranks number values differently, and every
  * rank must take the same path).  A result handed out is shared, so an
@@ -47,8 +59,22 @@ typedef struct memo_slot {
 struct eng_memo {
     memo_slot slot[MEMO_SLOTS];
     int n;
-    uint64_t clock, bytes;
+    uint64_t clock;
 };
+
+/* A kept result with everything attached to it: what MEMO_BYTES bounds. */
+static uint64_t result_bytes(const silc_value *v)
+{
+    return v ? (uint64_t)val_bytes(v) + (uint64_t)val_attach_bytes(v) : 0;
+}
+
+static uint64_t table_bytes(const eng_memo *M)
+{
+    uint64_t total = 0;
+    int i;
+    for (i = 0; i < M->n; i++) total += result_bytes(M->slot[i].result);
+    return total;
+}
 
 /* The call's key; -1 for a call never kept: a solve (its report and
  * warnings belong to each statement), one with per-call options, or one on
@@ -91,11 +117,17 @@ static memo_slot *find(eng_memo *M, const memo_key *k)
 
 static void drop(eng_memo *M, memo_slot *s)
 {
-    if (s->result) {
-        M->bytes -= val_bytes(s->result);
-        val_release(s->result);
-    }
+    val_release(s->result);
     *s = M->slot[--M->n];
+}
+
+/* The least recently used slot holding a result, but not keep; -1 if none. */
+static int oldest_result(const eng_memo *M, const memo_slot *keep)
+{
+    int i, old = -1;
+    for (i = 0; i < M->n; i++)
+        if (M->slot[i].result && &M->slot[i] != keep && (old < 0 || M->slot[i].used < M->slot[old].used)) old = i;
+    return old;
 }
 
 /* A free slot, evicting the least recently used when the table is full. */
@@ -113,7 +145,15 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call)
 {
     memo_key k;
     memo_slot *s;
-    if (!E->memo || key_of(E, call, &k)) return NULL;
+    double need = 0;
+    int i;
+    if (!E->memo) return NULL;
+    /* Before a call under a session's limit: room for what is kept and,
+     * as a guess at what the call makes, its largest operand. */
+    for (i = 0; i < call->nin && i < 3; i++)
+        if (call->in[i] && (double)val_bytes(call->in[i]) > need) need = (double)val_bytes(call->in[i]);
+    memo_make_room(E, need);
+    if (key_of(E, call, &k)) return NULL;
     s = find(E->memo, &k);
     if (!s || !s->result) return NULL;
     s->used = ++E->memo->clock;
@@ -143,18 +183,51 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
     }
     s->used = ++M->clock;
     if (s->result) return;
-    bytes = val_bytes(result);
-    while (M->bytes + bytes > MEMO_BYTES) {
-        int i, old = -1;
-        for (i = 0; i < M->n; i++)
-            if (M->slot[i].result && &M->slot[i] != s && (old < 0 || M->slot[i].used < M->slot[old].used)) old = i;
+    bytes = result_bytes(result);
+    while (table_bytes(M) + bytes > MEMO_BYTES) {
+        int old = oldest_result(M, s);
         if (old < 0) return; /* larger than the whole table: not kept */
         /* drop() moves the last slot into the freed one: keep s pointing at our key. */
         if (s == &M->slot[M->n - 1]) s = &M->slot[old];
         drop(M, &M->slot[old]);
     }
     s->result = val_retain(result);
-    M->bytes += bytes;
+}
+
+uint64_t memo_charge(const silc_engine *E, uint64_t *arrays)
+{
+    const eng_memo *M = E->memo;
+    uint64_t own = 0, attached = 0;
+    int i;
+    for (i = 0; M && i < M->n; i++) {
+        const silc_value *v = M->slot[i].result;
+        if (!v) continue;
+        if (v->bindings <= 0) own += val_bytes(v);
+        attached += (uint64_t)val_attach_bytes(v);
+    }
+    if (arrays) *arrays = own;
+    return own + attached;
+}
+
+void memo_shrink(silc_engine *E, uint64_t room)
+{
+    eng_memo *M = E->memo;
+    int old;
+    while (M && memo_charge(E, NULL) > room && (old = oldest_result(M, NULL)) >= 0) drop(M, &M->slot[old]);
+}
+
+void memo_make_room(silc_engine *E, double need)
+{
+    eng_memo *M = E->memo;
+    int old;
+    /* The budget counts the results' arrays already (they are values
+     * alive, and silcd's budget does not exempt them); what hangs off them
+     * it cannot see. */
+    while (M && val_budget_room() != INT64_MAX) {
+        uint64_t arrays, attached = memo_charge(E, &arrays) - arrays;
+        if ((double)attached + need <= (double)val_budget_room() || (old = oldest_result(M, NULL)) < 0) return;
+        drop(M, &M->slot[old]);
+    }
 }
 
 void memo_free(silc_engine *E)

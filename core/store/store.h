@@ -33,6 +33,7 @@ typedef struct val_attachment {
     char *key;
     void *data;
     void (*destroy)(void *);
+    int64_t bytes;              /* the memory it holds, as charged (val_attach_charge); 0 = not known */
     struct val_attachment *next;
 } val_attachment;
 
@@ -78,6 +79,8 @@ struct silc_value {
     double scan_maxabs;
     val_attachment *attach;
     val_dist *dist;          /* NULL: the value is whole here (val_dist, below) */
+    int64_t bindings;        /* names of a store bound to it (store_set, store_remove): a
+                                cache holding a value no name holds pays for its arrays */
 };
 
 /* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
@@ -128,6 +131,15 @@ void val_array_free(void *p);
 void val_budget_set(int64_t exempt, uint64_t limit, const char *source);
 /* 1 if a constructor was refused by the budget since it was last set. */
 int val_budget_refused(void);
+/* The budget's check for bytes claimed before any value is made (a file's
+ * shapes, summed over everything a `load` would bind): 0 if they fit what
+ * the budget has left (or no budget is set); else -1, val_refusal() says
+ * "<what> would bring the values held at once ... (<source>)" as a refused
+ * constructor's, and val_budget_refused() becomes 1. */
+int val_budget_claim(double bytes, const char *what);
+/* What the budget has left, in bytes (negative when over; INT64_MAX when
+ * no budget is set). */
+int64_t val_budget_room(void);
 /* Bytes of the arrays of every value alive in this process. */
 int64_t val_live_bytes(void);
 /* The bytes a value of this claim costs, the one formula every limit uses:
@@ -184,6 +196,13 @@ void val_set_dist_hooks(const val_dist_hooks *h);
 
 void *val_attach_get(const silc_value *v, const char *key);
 int val_attach_set(const silc_value *v, const char *key, void *data, void (*destroy)(void *));
+/* The memory an attachment holds, as measured by whoever made it (the
+ * dispatcher, around the plugin call that attached it: disp_run): 0, or -1
+ * if v has no attachment key.  A replaced attachment keeps its charge. */
+int val_attach_charge(const silc_value *v, const char *key, int64_t bytes);
+/* The charges of all of v's attachments: what a cache keeping v holds
+ * beyond its arrays (the memo's session charge, memo.c). */
+int64_t val_attach_bytes(const silc_value *v);
 
 /* ---- the store ------------------------------------------------------------- */
 typedef struct store_entry {

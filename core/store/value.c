@@ -171,18 +171,30 @@ int64_t val_live_bytes(void)
     return live_value_bytes;
 }
 
-static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
+int64_t val_budget_room(void)
+{
+    return budget_limit ? (int64_t)budget_limit - (live_value_bytes - budget_exempt) : INT64_MAX;
+}
+
+int val_budget_claim(double bytes, const char *what)
 {
     double held = (double)(live_value_bytes - budget_exempt);
-    char what[96], over[200];
+    char over[200];
     if (!budget_limit || held + bytes <= (double)budget_limit) return 0;
-    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
-             val_format_name(format));
     util_fmt_over_limit(over, sizeof over, held + bytes, (double)budget_limit);
     snprintf(refusal, sizeof refusal, "%s would bring the values held at once (bound and "
              "temporary) to %s (%s)", what, over, budget_source);
     budget_refusals++;
     return -1;
+}
+
+static int budget_refuses(int format, int64_t m, int64_t n, double bytes)
+{
+    char what[96];
+    if (!budget_limit) return 0;
+    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)m, (long long)n,
+             val_format_name(format));
+    return val_budget_claim(bytes, what);
 }
 
 /* Counts a value's arrays as alive (budget above), once they are made. */
@@ -509,9 +521,30 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
     }
     a->data = data;
     a->destroy = destroy;
+    a->bytes = 0;
     a->next = v->attach;
     v->attach = a;
     return 0;
+}
+
+int val_attach_charge(const silc_value *cv, const char *key, int64_t bytes)
+{
+    val_attachment *a;
+    if (!cv || !key) return -1;
+    for (a = cv->attach; a; a = a->next)
+        if (strcmp(a->key, key) == 0) {
+            a->bytes = bytes > 0 ? bytes : 0;
+            return 0;
+        }
+    return -1;
+}
+
+int64_t val_attach_bytes(const silc_value *v)
+{
+    const val_attachment *a;
+    int64_t total = 0;
+    for (a = v ? v->attach : NULL; a; a = a->next) total += a->bytes;
+    return total;
 }
 
 /* ---- structural properties ------------------------------------------------ */
@@ -1176,6 +1209,7 @@ void store_clear(silc_store *s)
         store_entry *e = s->buckets[b], *next;
         for (; e; e = next) {
             next = e->next;
+            e->value->bindings--;
             val_release(e->value);
             free(e->name);
             free(e);
@@ -1238,6 +1272,8 @@ int store_set(silc_store *s, const char *name, silc_value *v)
     if (*pe) {
         silc_value *old = (*pe)->value;
         (*pe)->value = val_retain(v);
+        v->bindings++;
+        old->bindings--;
         val_release(old);
         return 0;
     }
@@ -1249,6 +1285,7 @@ int store_set(silc_store *s, const char *name, silc_value *v)
         return -1;
     }
     e->value = val_retain(v);
+    v->bindings++;
     e->next = NULL;
     *pe = e;
     if (++s->count > s->nbuckets) store_grow(s);
@@ -1263,6 +1300,7 @@ int store_remove(silc_store *s, const char *name)
     if (!*pe) return 1;
     e = *pe;
     *pe = e->next;
+    e->value->bindings--;
     val_release(e->value);
     free(e->name);
     free(e);

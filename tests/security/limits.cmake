@@ -1,5 +1,5 @@
 # The limits a session cannot pass (docs/security.md, "Limits"): memory of
-# hostile PUTs and of a statement's temporaries, the statement text cap,
+# hostile PUTs, of a statement's temporaries and of the memo, the statement text cap,
 # --max-request-seconds (cooperative and forced), --max-cpu, a client gone
 # during a runaway, --max-clients against orphaned runaways, SIGTERM and
 # SIGKILL of silcd with runaways; the cases that apply again under
@@ -21,6 +21,13 @@ foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_
                    ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
   set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endforeach()
+# The memo's kept results and their UMFPACK factorizations (issue 33).
+if(TARGET silc_plugin_suitesparse)
+  add_test(NAME security_limits_memo
+           COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
+                   ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} memo $<TARGET_FILE:silcd>)
+  set_tests_properties(security_limits_memo PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+endif()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
   foreach(case request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
                admission_mpi announce_mpi)

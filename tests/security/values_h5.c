@@ -15,6 +15,14 @@
  * before anything is read: peak RSS may not grow by more than 32 MiB.  A
  * well-formed CSR group loads bit for bit, so the refusals are not a
  * blanket one.
+ *
+ * Against a silcd of its own (--data-dir, a Unix socket in the build
+ * directory, --max-session-bytes 12M), a load is checked against what the
+ * session has left from the files' shapes, summed over everything it would
+ * bind, before anything is read: two 8 MB values in one file are refused
+ * together (nothing bound, the session process's peak RSS grown by less
+ * than reading either would cost), one of them alone loads and holds its fill value exactly, and
+ * then the other is refused beside it.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <hdf5.h>
@@ -28,6 +36,10 @@
 #include "store.h"
 
 static char dir[400];
+
+#ifdef SILCD_PATH
+#include "remote_util.h"
+#endif
 
 /* The process's peak resident set (VmHWM), in bytes. */
 static long long peak_rss(void)
@@ -119,6 +131,103 @@ static void refused(silc_context *ctx, const char *path, const char *names, cons
     CHECK(a_intact(ctx), "%s: A changed by a refused load", what);
     CHECK(!bound(ctx, absent), "%s: '%s' was bound", what, absent);
 }
+
+#ifdef SILCD_PATH
+/* A 1000 x 1000 dense dataset of unallocated chunks whose fill value is
+ * 0.5: 8 MB to load, a few hundred bytes in the file. */
+static void filled_dense(hid_t file, const char *name)
+{
+    hsize_t dims[2] = {1000, 1000}, chunk[2] = {100, 100};
+    double half = 0.5;
+    hid_t sp = H5Screate_simple(2, dims, NULL), dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 2, chunk);
+    H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &half);
+    H5Dclose(H5Dcreate2(file, name, H5T_IEEE_F64LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+    H5Pclose(dcpl);
+    H5Sclose(sp);
+}
+
+static void session_budget_cases(void)
+{
+    static const char two_refused[] =
+        "session memory limit exceeded: load: 'two.h5': its 2 values (16000000 bytes) would bring the values held "
+        "at once (bound and temporary) to 16000000 bytes (15.3 MiB), over the limit of 12582912 bytes (12.0 MiB) "
+        "by 3.3 MiB (the session's limit, silcd --max-session-bytes); the whole request was rolled back";
+    static const char q_refused[] =
+        "session memory limit exceeded: load: 'two.h5': 'Q' (8000000 bytes) would bring the values held at once "
+        "(bound and temporary) to 16000008 bytes (15.3 MiB), over the limit of 12582912 bytes (12.0 MiB) by "
+        "3.3 MiB (the session's limit, silcd --max-session-bytes); the whole request was rolled back";
+    char data[300], file_path[320], sock[250], listen[300];
+    const char *opts[] = {"--max-session-bytes", "12M", "--data-dir", data, "--shared-data-dir", NULL};
+    silc_context *ctx = NULL;
+    test_server srv;
+    silc_envelope_t e;
+    pid_t session;
+    long long before, after;
+    hid_t file;
+
+    snprintf(data, sizeof data, "%s/tests/values_h5_data", SILC_BINARY_DIR);
+    snprintf(file_path, sizeof file_path, "%s/two.h5", data);
+    snprintf(sock, sizeof sock, "%s/tests/values_h5.sock", SILC_BINARY_DIR);
+    snprintf(listen, sizeof listen, "unix:%s", sock);
+    {
+        char cmd[900];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -m 700 '%s'", data, data);
+        CHECK(system(cmd) == 0, "cannot make %s", data);
+    }
+    file = H5Fcreate(file_path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    filled_dense(file, "P");
+    filled_dense(file, "Q");
+    H5Fclose(file);
+    remove(sock);
+    if (server_start(&srv, listen, opts) != 0) {
+        CHECK(0, "silcd did not start");
+        return;
+    }
+    CHECK(silc_open_remote(&ctx, listen) == 0, "remote open: %s", silc_errmsg());
+    if (!ctx) {
+        server_stop(&srv);
+        return;
+    }
+    session = only_child_of(srv.pid);
+    before = session > 0 ? proc_status_bytes(session, "VmHWM:") : -1;
+    CHECK(before > 0, "cannot read the session process's VmHWM");
+
+    /* Both: 16 MB from the shapes, over 12 MiB: refused before reading. */
+    CHECK(silc_exec(ctx, "load \"two.h5\"") != 0, "two 8 MB values loaded under a 12 MiB session limit");
+    CHECK(!strcmp(silc_context_errmsg(ctx), two_refused), "load of both:\n   got  '%s'\n   want '%s'",
+          silc_context_errmsg(ctx), two_refused);
+    CHECK(!bound(ctx, "P") && !bound(ctx, "Q"), "a refused load bound something");
+    /* Reading even one of them costs 16 MB (the value, and the row-major
+     * buffer it is read through); the refusal costs a few (HDF5's file
+     * handle; more under AddressSanitizer, whose allocator keeps its own). */
+    after = proc_status_bytes(session, "VmHWM:");
+    CHECK(after - before < (12LL << 20), "the session's peak RSS grew by %lld bytes refusing the load",
+          after - before);
+    printf("refusing the load grew the session's peak RSS by %.1f MiB\n", (after - before) / 1048576.0);
+
+    /* One fits, and holds its fill value exactly. */
+    CHECK(silc_exec(ctx, "load \"two.h5\" P; s = sum(sum(P))") == 0, "load of P alone: %s",
+          silc_context_errmsg(ctx));
+    CHECK(silc_get(ctx, &e, "s") == 0 && e.m == 1 && e.n == 1 && e.values[0] == 500000.0,
+          "sum(sum(P)) is not 1e6 * 0.5");
+    silc_envelope_free(&e);
+
+    /* Beside it, the other is over: refused, P and s kept. */
+    CHECK(silc_exec(ctx, "load \"two.h5\" Q") != 0, "Q loaded beside P under a 12 MiB session limit");
+    CHECK(!strcmp(silc_context_errmsg(ctx), q_refused), "load of Q:\n   got  '%s'\n   want '%s'",
+          silc_context_errmsg(ctx), q_refused);
+    CHECK(!bound(ctx, "Q") && bound(ctx, "P") && bound(ctx, "s"), "the refused load of Q changed the names");
+    silc_close(&ctx);
+    CHECK(server_stop(&srv) == 0, "silcd did not stop cleanly");
+    remove(sock);
+    {
+        char cmd[900];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", data);
+        CHECK(system(cmd) == 0, "cannot remove %s", data);
+    }
+}
+#endif
 
 int main(void)
 {
@@ -284,5 +393,8 @@ int main(void)
     remove(path);
     remove(src);
     remove(canary);
+#ifdef SILCD_PATH
+    session_budget_cases();
+#endif
     return check_done();
 }

@@ -157,6 +157,18 @@ int main(void)
                       "(silcd --max-value-bytes)"),
               "remote: 250e6 x 1 band: %s", silc_context_errmsg(ctx));
         CHECK(holds_good(ctx), "remote: 250e6 band: A changed");
+        /* The claim's point: the session process never came near the
+         * 2 GB.  Its peak resident set (VmHWM, from its start: plugins,
+         * the good A, the refusal) stays under an eighth of the claim. */
+        {
+            pid_t session = only_child_of(srv.pid);
+            long long hwm = session > 0 ? proc_status_bytes(session, "VmHWM:") : -1;
+            CHECK(hwm > 0, "remote: cannot read the session process's VmHWM (pid %ld)", (long)session);
+            CHECK(hwm < 2000000016LL / 8, "remote: the session's peak RSS reached %lld bytes for a refused "
+                  "2000000016-byte band claim", hwm);
+            printf("session process %ld: VmHWM %.1f MiB after the refused 1.9 GiB band claim\n", (long)session,
+                   hwm / 1048576.0);
+        }
         silc_envelope_free(&band);
         silc_close(&ctx);
     }
