@@ -18,6 +18,7 @@
 #include "accuracy.h"
 #include "dist.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -587,6 +588,98 @@ static int scalar_whole(lang_ev *V, int rc, silc_value **out)
     return rc;
 }
 
+/* ---- ranges ------------------------------------------------------------------- */
+
+/* Octave's tolerant floor (Hagerty's FL5, liboctave Range.cc): x within ct
+ * (relative) below an integer counts as that integer, so 0:0.1:1 has 11
+ * elements although (1 - 0) / 0.1 is 9.999999999999998. */
+static double tolerant_floor(double x, double ct)
+{
+    double q = x < 0 ? 1 - ct : 1, rmax = q / (2 - ct), t1 = 1 + floor(x);
+    t1 = (ct / q) * (t1 < 0 ? -t1 : t1);
+    t1 = rmax < t1 ? rmax : t1;
+    t1 = ct > t1 ? ct : t1;
+    t1 = floor(x + t1);
+    return (x <= 0 || t1 - x < rmax) ? t1 : t1 - 1;
+}
+
+static int tolerant_equal(double u, double v, double ct)
+{
+    double tu = fabs(u), tv = fabs(v);
+    return fabs(u - v) < (tu > tv ? tu : tv) * ct;
+}
+
+/* The elements of base:inc:limit as Octave counts them (its numel and
+ * final value): 0 when inc is 0 or points away from limit. */
+static double range_count(double base, double inc, double limit)
+{
+    double ct = 3 * DBL_EPSILON, n;
+    if (inc == 0 || (limit > base && inc < 0) || (limit < base && inc > 0)) return 0;
+    n = tolerant_floor((limit - base + inc) / inc, ct);
+    if (n < 0) n = 0;
+    if (n > 0 && !tolerant_equal(base + (n - 1) * inc, limit, ct)) {
+        if (n > 1 && tolerant_equal(base + (n - 2) * inc, limit, ct)) n--;
+        else if (tolerant_equal(base + n * inc, limit, ct)) n++;
+    }
+    return n;
+}
+
+/* Element k (0-based) of a range of count elements: the last one is held
+ * to the limit, and made whole when every element is (Octave's final value). */
+static double range_at(double base, double inc, double limit, double count, double k)
+{
+    double x = base + k * inc;
+    if (k > 0 && k == count - 1) {
+        if ((inc > 0 && x >= limit) || (inc < 0 && x <= limit)) x = limit;
+        if (base == floor(base) && inc == floor(inc)) x = floor(x + 0.5);
+    }
+    return x;
+}
+
+typedef struct range_spec {
+    double base, inc, limit, count;
+} range_spec;
+
+/* Evaluates the ends (and step) of a range node: each must be a finite scalar. */
+static int range_of(lang_ev *V, const ast_node *n, range_spec *r)
+{
+    double x[3] = {0, 0, 0};
+    size_t i;
+    for (i = 0; i < n->nkids; i++) {
+        silc_value *v;
+        if (ev_expr(V, n->kids[i], &v)) return -1;
+        if (!val_is_scalar(v)) {
+            char shape[48];
+            ev_shape(v, shape, sizeof shape);
+            val_release(v);
+            return eng_error(V->E, "a range's %s must be a scalar, got %s",
+                             i == 0 ? "start" : i + 1 == n->nkids ? "end" : "step", shape);
+        }
+        x[i] = val_scalar(v);
+        val_release(v);
+        if (!isfinite(x[i]))
+            return eng_error(V->E, "a range needs finite ends and step, got %g", x[i]);
+    }
+    r->base = x[0];
+    r->inc = n->nkids == 3 ? x[1] : 1;
+    r->limit = x[n->nkids - 1];
+    r->count = range_count(r->base, r->inc, r->limit);
+    return 0;
+}
+
+/* base:inc:limit as a 1xN dense row, as Octave's range is. */
+static int eval_range(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    range_spec r;
+    int64_t k, count;
+    if (range_of(V, n, &r)) return -1;
+    if (val_claim(r.count * sizeof(double), "the range")) return eng_error(V->E, "%s", val_refusal());
+    count = (int64_t)r.count;
+    if (!(*out = val_dense_new(1, count))) return eng_oom(V->E);
+    for (k = 0; k < count; k++) (*out)->val[k] = range_at(r.base, r.inc, r.limit, r.count, (double)k);
+    return 0;
+}
+
 static int expr_any(lang_ev *V, const ast_node *n, silc_value **out);
 
 int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out)
@@ -610,8 +703,9 @@ static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
     case AST_STRING:
         return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
     case AST_COLON_ALL:
+        return eng_error(E, "':' alone is only allowed as a subscript (A[:, j])");
     case AST_RANGE:
-        return eng_error(E, "a range is only allowed inside a subscript");
+        return eval_range(V, n, out);
     case AST_BINARY:
         return eval_binary(V, n, out);
     case AST_UNARY:
@@ -1164,6 +1258,8 @@ static int exec_block(lang_ev *V, const ast_node *b, int *flow)
 }
 
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
+static int empty_loop_cancelled(lang_ev *V);
+static int exec_for(lang_ev *V, const ast_node *s, int *flow);
 
 /* One statement; on a communicator every rank learns whether every rank
  * ran it (dist.h): a statement that failed on one rank alone (out of
@@ -1266,6 +1362,8 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         if (condition(V, s->cond, &truth)) return -1;
         if (truth) return exec_block(V, s->kids[0], flow);
         return s->els ? exec_stmt(V, s->els, flow) : 0;
+    case ST_FOR:
+        return exec_for(V, s, flow);
     case ST_WHILE: {
         /* An iteration of the outermost loop is a time step to the tuner
          * (a script's loop is the program's time loop; tuner_loop_step). */
@@ -1291,6 +1389,63 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
     default:
         return eng_error(V->E, "internal error: expression where a statement was expected");
     }
+}
+
+/* The column k of the values a for loop walks: a range's element k (the
+ * range is never built whole: `for i = 1:1e9` needs no 8 GB), or column k
+ * of a value (a scalar when it has one row). */
+static int for_value(lang_ev *V, const range_spec *r, const silc_value *all, int64_t k,
+                     silc_value **out)
+{
+    int64_t i;
+    if (!all) {
+        *out = val_scalar_new(range_at(r->base, r->inc, r->limit, r->count, (double)k));
+        return *out ? 0 : eng_oom(V->E);
+    }
+    if (!(*out = val_dense_new(all->m, 1))) return eng_oom(V->E);
+    for (i = 0; i < all->m; i++) (*out)->val[i] = val_get(all, i, k);
+    return 0;
+}
+
+/* for name = e: binds name to each column of e in turn and runs the body.
+ * The loop budget, the tuner's time steps and the cancel checks are those
+ * of `while`. */
+static int exec_for(lang_ev *V, const ast_node *s, int *flow)
+{
+    range_spec r = {0, 0, 0, 0};
+    silc_value *all = NULL;
+    int64_t k, count;
+    int rc = 0, outer;
+    uint64_t key;
+    if (s->cond->kind == AST_RANGE) {
+        if (range_of(V, s->cond, &r)) return -1;
+        count = (int64_t)r.count;
+    } else {
+        if (ev_expr(V, s->cond, &all)) return -1;
+        count = all->m > 0 ? all->n : 0;
+    }
+    outer = V->loop_depth++ == 0 && !V->explain;
+    key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
+    for (k = 0; k < count; k++) {
+        double ti = util_now();
+        silc_value *v;
+        if (V->E->loop_budget && ++V->loops > V->E->loop_budget) {
+            rc = eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
+                           (unsigned long long)V->E->loop_budget);
+            break;
+        }
+        if ((rc = for_value(V, &r, all, k, &v))) break;
+        if ((rc = bind(V, s, s->name, v, ti))) break;
+        if (!s->kids[0]->nkids && !V->explain && (rc = empty_loop_cancelled(V))) break;
+        if ((rc = exec_block(V, s->kids[0], flow))) break;
+        if (outer) tuner_loop_step(V->E, key, util_now() - ti);
+        if (*flow == FLOW_BREAK) break;
+        if (V->explain) break;   /* explain describes one pass */
+    }
+    V->loop_depth--;
+    val_release(all);
+    if (!rc) *flow = FLOW_NEXT;
+    return rc;
 }
 
 int lang_exec(silc_engine *E, const char *text)

@@ -39,6 +39,8 @@ typedef struct lx_token {
     int line, col;         /* 1-based */
     size_t start, len;     /* span in the source text */
     double num;            /* TK_NUMBER */
+    int space_before;      /* white space precedes it: in a matrix literal `[1 -2]` is two
+                              elements and `[1 - 2]` one, as in Octave (parser.c) */
 } lx_token;
 
 typedef struct lx_tokens {
@@ -47,6 +49,9 @@ typedef struct lx_tokens {
 } lx_tokens;
 
 /* Tokenizes text; the `set` keyword's argument becomes one TK_RAW token.
+ * Inside a matrix literal a line break separates rows, so it becomes a
+ * TK_SEMI (none after `[`, `,` or `;`); inside ( ) and subscripts it is
+ * dropped, so an expression may span lines.
  * Returns 0, or -1 with "L:C: message" in err. */
 int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen);
 void lx_free(lx_tokens *toks);
@@ -63,6 +68,8 @@ enum ast_kind {
     /* statements (after every expression kind: parser.c tests kind < ST_EXPR) */
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
+    ST_FOR,                /* for name = cond: kids[0] the body block; each column of the
+                              value of cond in turn (a range is never built whole) */
     ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
     ST_TUNE,               /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
                               pairs); els unused; an AST_STRING kid names a file */
@@ -76,11 +83,12 @@ struct ast_node {
     int op;                /* operator token kind (BINARY, UNARY, OPASSIGN) */
     int line, col;
     int height;            /* 1 + the tallest kid's: bounds every walk of the tree */
+    int quiet;             /* a statement followed by ';': its value is not shown */
     size_t start, end;     /* source span [start, end) */
     double num;            /* AST_NUM */
     char *name;            /* NAME, CALL, STRING (unquoted text), assignment target, SET raw text */
     /* kids: BINARY/UNARY/TRANSPOSE operands; INDEX base then subscripts; CALL
-     * arguments; RANGE from, to; EXPR/ASSIGN/OPASSIGN the expression;
+     * arguments; RANGE from, to or from, step, to; EXPR/ASSIGN/OPASSIGN the expression;
      * INDEX_ASSIGN the value then the subscripts; CLEAR names; EXPLAIN the
      * statement; IF/WHILE the body block; BLOCK the statements */
     ast_node **kids;
