@@ -511,7 +511,9 @@ int main(int argc, char **argv)
         fail("%s", ctx ? silc_context_errmsg(ctx) : silc_errmsg());
         status = 1;
     } else {
-        status = load_puts(ctx, &o);
+        /* Values show as in Octave: a statement without ';' prints its value
+         * (core.display; an embedded SILC_EXEC never prints). */
+        status = load_puts(ctx, &o) || run_text(ctx, "set core.display = on");
         if (!status && o.script) {
             char *text = read_file(o.script);
             status = !text || run_text(ctx, text);

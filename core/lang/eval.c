@@ -1080,19 +1080,20 @@ static int exec_set(lang_ev *V, const ast_node *s)
         strbuf b;
         sb_init(&b);
         cfg_list(E, &b);
-        if (!b.len && !b.failed) sb_puts(&b, "no settings\n");
         return print_whole(E, &b, "set");
     }
     eq = strchr(s->name, '=');
     key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
     if (!key) return eng_oom(E);
     if (!eq) {
-        const char *v = cfg_get(E, key);
         strbuf b;
         sb_init(&b);
-        if (v) sb_printf(&b, "%s = %s\n", key, v);
-        else sb_printf(&b, "%s is not set\n", key);
+        rc = cfg_show_key(E, key, &b, 0);
         free(key);
+        if (rc) {
+            sb_free(&b);
+            return -1;
+        }
         return print_whole(E, &b, "set");
     }
     value = trimmed(eq + 1, strlen(eq + 1));
@@ -1189,6 +1190,74 @@ static int exec_info(lang_ev *V, const ast_node *s)
 }
 
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
+
+/* ---- display ----------------------------------------------------------------- */
+
+/* Whether a statement without ';' shows its value: core.display = on, which
+ * the silc command sets (an embedded program's SILC_EXEC never prints
+ * values), and never under explain. */
+static int displaying(const lang_ev *V, const ast_node *s)
+{
+    const char *d;
+    if (s->quiet || V->explain) return 0;
+    d = cfg_get(V->E, "core.display");
+    return d && !strcmp(d, "on");
+}
+
+static int show(lang_ev *V, const char *name, const silc_value *v)
+{
+    strbuf b;
+    sb_init(&b);
+    dp_show(V->E, &b, name, v);
+    return print_whole(V->E, &b, "the display");
+}
+
+/* disp(x): shows x without its name, whatever core.display says (it is
+ * asked for); a statement of its own, since it has no value. */
+static int exec_disp(lang_ev *V, const ast_node *call)
+{
+    silc_value *v;
+    int rc;
+    if (call->nkids != 1) return eng_error(V->E, "disp takes one argument, got %zu", call->nkids);
+    if (ev_expr(V, call->kids[0], &v)) return -1;
+    rc = V->explain ? 0 : show(V, NULL, v);
+    val_release(v);
+    return rc;
+}
+
+/* An expression statement: a name shows as itself (`x = 3`), any other
+ * value as Octave's `ans = ...`, and binds ans when it is shown. */
+static int exec_expr(lang_ev *V, const ast_node *s, double t0)
+{
+    const ast_node *e = s->kids[0];
+    silc_value *v;
+    if (e->kind == AST_CALL && !strcmp(e->name, "disp")) return exec_disp(V, e);
+    if (ev_expr(V, e, &v)) return -1;
+    if (V->explain) {
+        char shape[48];
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
+                  val_format_name(v->format));
+    }
+    if (V->E->warnings.failed) {
+        val_release(v);
+        return eng_error(V->E, "out of memory recording a warning");
+    }
+    if (!displaying(V, s)) {
+        val_release(v);
+        return 0;
+    }
+    if (e->kind == AST_NAME && store_get(&V->E->store, e->name)) {
+        int rc = show(V, e->name, v);
+        val_release(v);
+        return rc;
+    }
+    if (show(V, "ans", v)) {
+        val_release(v);
+        return -1;
+    }
+    return bind(V, s, "ans", v, t0);
+}
 
 static int exec_tune(lang_ev *V, const ast_node *s)
 {
@@ -1303,23 +1372,13 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
     }
     eng_pending_release(&V->pending);
     switch (s->kind) {
-    case ST_EXPR: {
-        silc_value *v;
-        if (ev_expr(V, s->kids[0], &v)) return -1;
-        if (V->explain) {
-            char shape[48];
-            ev_shape(v, shape, sizeof shape);
-            sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
-                      val_format_name(v->format));
-        }
-        val_release(v);
-        if (V->E->warnings.failed) return eng_error(V->E, "out of memory recording a warning");
-        return 0;
-    }
+    case ST_EXPR:
+        return exec_expr(V, s, t0);
     case ST_ASSIGN:
     case ST_OPASSIGN:
     case ST_INDEX_ASSIGN:
-        return exec_assign(V, s, t0);
+        if (exec_assign(V, s, t0)) return -1;
+        return displaying(V, s) ? show(V, s->name, store_get(&V->E->store, s->name)) : 0;
     case ST_CLEAR:
         return exec_clear(V, s);
     case ST_WHO:
@@ -1344,6 +1403,15 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         strbuf b;
         char err[200];
         sb_init(&b);
+        /* help KEY (a setting) and help PLUGIN (its options) ask the options database */
+        if (s->name && strchr(s->name, '.')) {
+            if (cfg_show_key(V->E, s->name, &b, 1)) {
+                sb_free(&b);
+                return -1;
+            }
+            return print_whole(V->E, &b, "help");
+        }
+        if (s->name && !cfg_describe_plugin(V->E, s->name, &b)) return print_whole(V->E, &b, "help");
         if (lang_help(&b, s->name, err, sizeof err)) {
             sb_free(&b);
             return eng_error(V->E, "%s", err);

@@ -174,6 +174,10 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out);
  * ev_expr gathers such a value to every rank first. */
 int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out);
 
+/* display.c: v as Octave shows it, `name = ...` (name NULL: as disp(v)
+ * shows it, without the name), into b; core.format says short or long. */
+void dp_show(silc_engine *E, strbuf *b, const char *name, const silc_value *v);
+
 /* help.c: `help` (every statement and built-in word) or `help NAME` (its
  * usage and what it does) into out; -1 with err for an unknown name.  The
  * README's statement (statements = 1) and built-in tables, as markdown. */

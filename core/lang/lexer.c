@@ -11,7 +11,8 @@
  * double quotes and only appear as option arguments.  The argument of a `set`
  * keyword statement is not an expression but "key = value" with free-form
  * value text (backend option strings such as "-i cg -p ilu"), so the lexer
- * hands the rest of that statement over as one raw token.
+ * hands the rest of that statement over as one raw token; so does `help`,
+ * whose word may be a setting's key (`help solve.verify`).
  */
 #include "lang.h"
 
@@ -260,7 +261,11 @@ int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen)
             int line = L.line, col = L.col, kw = at_statement_start(&L);
             while (isalnum((unsigned char)text[L.pos]) || text[L.pos] == '_') advance(&L, 1);
             rc = push(&L, TK_NAME, start, line, col, 0);
-            if (!rc && kw && L.pos - start == 3 && !strncmp(text + start, "set", 3) &&
+            /* set's argument is "key = value"; help's a word that may be a
+             * key (help solve.verify) */
+            if (!rc && kw &&
+                ((L.pos - start == 3 && !strncmp(text + start, "set", 3)) ||
+                 (L.pos - start == 4 && !strncmp(text + start, "help", 4))) &&
                 !name_is_assigned(text + L.pos))
                 rc = lex_raw(&L);
         } else if (c == '"') {

@@ -1036,12 +1036,18 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
     if (tok_is_text(P, kw, "load")) return parse_file_names(P, kw, ST_LOAD, "load");
     if (tok_is_text(P, kw, "help")) {
         n = node_new(P, ST_HELP, kw);
-        if (n && peek(P)->kind == TK_NAME) {
+        if (n && peek(P)->kind == TK_RAW) {
             const lx_token *w = next(P);
-            if (!(n->name = tok_text(P, w))) {
+            size_t len = w->len;
+            while (len && (P->src[w->start + len - 1] == ' ' || P->src[w->start + len - 1] == '\t' ||
+                           P->src[w->start + len - 1] == '\r'))
+                len--;
+            if (!(n->name = malloc(len + 1))) {
                 node_free(n);
                 return fail(P, w, "out of memory while parsing");
             }
+            memcpy(n->name, P->src + w->start, len);
+            n->name[len] = 0;
             n->end = w->start + w->len;
         }
         return n;
