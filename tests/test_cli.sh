@@ -135,6 +135,15 @@ check "--complete covers keys" [ "$(cat out)" = "solve.verify" ]
 run "$SILC" -e 'alpha = 1; alpah'
 check "did-you-mean takes a transposition" has err "undefined name 'alpah' (did you mean 'alpha'?)"
 
+# ---- --profile: per statement and per plugin call, as PETSc's -log_view -------------
+run "$SILC" --profile -e 'A = [4 1; 1 3]; b = [1; 2]; for i = 1:3
+  x = A \ b;
+end'
+check "--profile status" status_is 0
+check "--profile: statements" has err "for i = 1:3 ..."
+check "--profile: three solves counted" grep -q '^  solve: [^ ]* *3 ' err
+check "--profile: the table header" has err "bytes in"
+
 run "$SILC" run no-such-file.silc
 check "run missing file status" status_is 1
 check "run missing file message" has err "silc: cannot open 'no-such-file.silc'"
@@ -208,7 +217,7 @@ check "--complete: bound names" [ "$(cat out)" = "$(printf 'alpha\nalps')" ]
 run "$SILC" -e 'x = 1;' --complete spa
 check "--complete: built-ins" [ "$(cat out)" = "sparse" ]
 run "$SILC" --complete e
-check "--complete: keywords, built-ins and commands" [ "$(tr '\n' ' ' <out)" = "else explain eye exp eps exit " ]
+check "--complete: keywords, built-ins and commands" [ "$(tr '\n' ' ' <out)" = "elseif else end explain eye exp eps exit " ]
 run "$SILC" -e 'help solve'
 check "help solve" has out 'solve(A, b, "options")'
 run "$SILC" -e 'help sparce'

@@ -52,11 +52,15 @@ static const char usage_text[] =
     "  --config FILE        configuration file (default: $SILC_CONFIG, else ./silc.conf)\n"
     "  -h, --help           show this text\n"
     "  --version            show the version\n"
+    "  --profile            time every statement and plugin call (bytes in and out,\n"
+    "                       reused factorizations) and print the tables to standard\n"
+    "                       error at the end, as PETSc's -log_view (core.profile)\n"
     "  --complete WORD      after running, print the names, statements, built-ins and\n"
     "                       settings (plugin options too) that start with WORD, one a\n"
     "                       line (what Tab completes)\n"
     "In the interactive session a line that ends inside an unclosed ( [ or {, or an\n"
-    "if, while or for without its end, continues on the next line; 'quit', 'exit' or end of input leaves.  Warnings go to standard\n"
+    "if, while or for without its end, continues on the next line; 'quit', 'exit' or\n"
+    "end of input leaves.  Warnings go to standard\n"
     "error as \"warning: ...\"; who, info and explain print to standard output.\n";
 
 typedef struct {
@@ -69,6 +73,7 @@ typedef struct {
     int nget;
     char *tune_text;        /* statement built from `tune ...` arguments */
     const char *complete;   /* --complete WORD */
+    int profile;            /* --profile */
 } cli_options;
 
 static void fail(const char *fmt, ...)
@@ -144,6 +149,8 @@ static int parse_args(int argc, char **argv, cli_options *o)
         } else if (take_option(argc, argv, &i, "--get", &v)) {
             if (!v || !*v) return fail("--get needs a name"), 2;
             o->get_names[o->nget++] = v;
+        } else if (!strcmp(a, "--profile")) {
+            o->profile = 1;
         } else if (take_option(argc, argv, &i, "--complete", &v)) {
             if (!v) return fail("--complete needs a word (it may be empty)"), 2;
             o->complete = v;
@@ -573,7 +580,8 @@ int main(int argc, char **argv)
     } else {
         /* Values show as in Octave: a statement without ';' prints its value
          * (core.display; an embedded SILC_EXEC never prints). */
-        status = load_puts(ctx, &o) || run_text(ctx, "set core.display = on");
+        status = load_puts(ctx, &o) || run_text(ctx, "set core.display = on") ||
+                 (o.profile && run_text(ctx, "set core.profile = on"));
         if (!status && o.script) {
             char *text = read_file(o.script);
             status = !text || run_text(ctx, text);
@@ -584,6 +592,12 @@ int main(int argc, char **argv)
             status = repl(ctx);
         }
         if (!status) status = print_gets(ctx, &o);
+        if (o.profile) {   /* after a failure too: where the time went is still worth seeing */
+            char *table = output_of(ctx, "profile");
+            fflush(stdout);
+            if (table) fputs(table, stderr);
+            free(table);
+        }
         if (!status && o.complete) {
             char **c = completions(ctx, o.complete);
             for (size_t k = 0; c && c[k]; k++) puts(c[k]);

@@ -58,7 +58,7 @@ struct cfg_db {
 
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
-static const char *const core_keys[] = {"plugin_path", "threads", "display", "format"};
+static const char *const core_keys[] = {"plugin_path", "threads", "display", "format", "profile"};
 static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess",
                                          "verify"};
 
@@ -403,9 +403,9 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
     if (strcmp(section, "core") == 0) {
         if (strcmp(name, "threads") == 0) {
             if (check_threads(E, "core.threads", value)) return -1;
-        } else if (strcmp(name, "display") == 0) {
+        } else if (strcmp(name, "display") == 0 || strcmp(name, "profile") == 0) {
             if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
-                return eng_error(E, "core.display expects 'on' or 'off', got '%s'", value);
+                return eng_error(E, "core.%s expects 'on' or 'off', got '%s'", name, value);
         } else if (strcmp(name, "format") == 0) {
             if (strcmp(value, "short") != 0 && strcmp(value, "long") != 0)
                 return eng_error(E, "core.format expects 'short' or 'long', got '%s'", value);
@@ -532,6 +532,9 @@ static const key_rule key_rules[] = {
     {"core.display", KEY_SESSION, "off",
      "on: a statement without ';' shows its value (the silc command turns it on; SILC_EXEC never prints)"},
     {"core.format", KEY_SESSION, "short", "short or long: 5 or 16 significant digits when values are shown"},
+    {"core.profile", KEY_SESSION, "off",
+     "on: time every statement and plugin call, with bytes in and out and reused factorizations; "
+     "the statement 'profile' prints the tables (silc --profile: at exit)"},
     {"<plugin>.<option>", KEY_SESSION, NULL, "a plugin's typed options (other than those above): help PLUGIN"},
 };
 

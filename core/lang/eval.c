@@ -35,10 +35,51 @@ typedef struct cache_entry {
     struct cache_entry *next;
 } cache_entry;
 
+/* ---- the profile (core.profile = on, `profile`, silc --profile) ---------------
+ * Like PETSc's -log_view: per statement and per plugin call, the count, the
+ * time, the bytes handed in and out, the factorizations reused.  Rows are
+ * keyed by their text; a bounded table (PROF_ROWS each), whose last row
+ * gathers what does not fit. */
+#define PROF_ROWS 48
+
+typedef struct prof_row {
+    char name[80];
+    uint64_t count, reused;
+    double seconds, bytes_in, bytes_out;
+} prof_row;
+
+typedef struct prof_table {
+    prof_row rows[PROF_ROWS];
+    size_t n;
+} prof_table;
+
 typedef struct lang_cache {
     cache_entry *b[CACHE_BUCKETS];
     size_t count;
+    prof_table statements, calls;
 } lang_cache;
+
+/* The row named name (made when new; the last row takes the overflow). */
+static prof_row *prof_row_of(prof_table *t, const char *name)
+{
+    size_t i;
+    for (i = 0; i < t->n; i++)
+        if (!strcmp(t->rows[i].name, name)) return &t->rows[i];
+    if (t->n == PROF_ROWS) return &t->rows[PROF_ROWS - 1];
+    memset(&t->rows[t->n], 0, sizeof t->rows[0]);
+    snprintf(t->rows[t->n].name, sizeof t->rows[0].name, "%s", t->n == PROF_ROWS - 1 ? "(the rest)" : name);
+    return &t->rows[t->n++];
+}
+
+/* The bytes of a value's arrays. */
+static double value_bytes(const silc_value *v)
+{
+    if (!v) return 0;
+    if (v->format == SILC_FMT_CSR)
+        return (double)v->nnz * (sizeof(double) + sizeof(silc_index)) + (double)(v->m + 1) * sizeof(silc_index);
+    if (v->format == SILC_FMT_BAND) return (double)v->ld * (double)v->n * sizeof(double);
+    return (double)v->m * (double)v->n * sizeof(double);
+}
 
 static size_t text_hash(const char *s)
 {
@@ -144,12 +185,33 @@ static void indent_into(strbuf *b, const char *text)
     }
 }
 
+/* A plugin call's row of the profile: a solve by its backend, another
+ * operation by the class it ran under. */
+static void profile_call(lang_ev *V, const silc_call *call, const silc_report *rep, double seconds)
+{
+    lang_cache *c = V->E->lang_cache;
+    char name[80];
+    prof_row *r;
+    int i;
+    if (call->op == SILC_OP_SOLVE)
+        snprintf(name, sizeof name, "solve: %s", rep->backend[0] ? rep->backend : "?");
+    else
+        snprintf(name, sizeof name, "%s", call->op_class ? call->op_class : "operation");
+    r = prof_row_of(&c->calls, name);
+    r->count++;
+    r->seconds += seconds;
+    for (i = 0; i < call->nin; i++) r->bytes_in += value_bytes(call->in[i]);
+    r->bytes_out += value_bytes(call->out);
+    if (call->op == SILC_OP_SOLVE && rep->reused_factor) r->reused++;
+}
+
 int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
 {
     silc_engine *E = V->E;
     silc_report rep;
     size_t warned;
     int i, rc;
+    double t0;
     *out = NULL;
     call->out = NULL;
     if (call->op == SILC_OP_SOLVE) {
@@ -200,8 +262,10 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
+    t0 = V->profile ? util_now() : 0;
     rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
+    if (V->profile && !rc && call->out) profile_call(V, call, &rep, util_now() - t0);
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
         call->out = NULL;
@@ -1329,6 +1393,7 @@ static int exec_block(lang_ev *V, const ast_node *b, int *flow)
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
 static int empty_loop_cancelled(lang_ev *V);
 static int exec_for(lang_ev *V, const ast_node *s, int *flow);
+static int exec_profile(lang_ev *V, const ast_node *s);
 
 /* One statement; on a communicator every rank learns whether every rank
  * ran it (dist.h): a statement that failed on one rank alone (out of
@@ -1432,6 +1497,8 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         return s->els ? exec_stmt(V, s->els, flow) : 0;
     case ST_FOR:
         return exec_for(V, s, flow);
+    case ST_PROFILE:
+        return exec_profile(V, s);
     case ST_WHILE: {
         /* An iteration of the outermost loop is a time step to the tuner
          * (a script's loop is the program's time loop; tuner_loop_step). */
@@ -1457,6 +1524,56 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
     default:
         return eng_error(V->E, "internal error: expression where a statement was expected");
     }
+}
+
+/* A top-level statement's row of the profile, by its first line of text. */
+static void profile_statement(lang_ev *V, const ast_node *s, double seconds)
+{
+    lang_cache *c = V->E->lang_cache;
+    char name[80];
+    size_t len = s->end - s->start;
+    const char *nl = memchr(V->src + s->start, '\n', len);
+    prof_row *r;
+    if (nl) len = (size_t)(nl - (V->src + s->start));
+    if (len > 60) len = 60;
+    snprintf(name, sizeof name, "%.*s%s", (int)len, V->src + s->start, nl || s->end - s->start > 60 ? " ..." : "");
+    r = prof_row_of(&c->statements, name);
+    r->count++;
+    r->seconds += seconds;
+}
+
+static void put_profile_table(strbuf *b, const char *title, const prof_table *t, int calls)
+{
+    size_t i;
+    sb_printf(b, "%-44s %8s %11s", title, "count", "time (s)");
+    if (calls) sb_printf(b, " %12s %12s %7s", "bytes in", "bytes out", "reused");
+    sb_puts(b, "\n");
+    if (!t->n) sb_puts(b, "  (none)\n");
+    for (i = 0; i < t->n; i++) {
+        const prof_row *r = &t->rows[i];
+        sb_printf(b, "  %-42s %8llu %11.4g", r->name, (unsigned long long)r->count, r->seconds);
+        if (calls) sb_printf(b, " %12.4g %12.4g %7llu", r->bytes_in, r->bytes_out, (unsigned long long)r->reused);
+        sb_puts(b, "\n");
+    }
+}
+
+/* profile: the tables; profile clear: empties them. */
+static int exec_profile(lang_ev *V, const ast_node *s)
+{
+    lang_cache *c = V->E->lang_cache;
+    const char *p = cfg_get(V->E, "core.profile");
+    strbuf b;
+    if (s->name) {   /* clear */
+        memset(&c->statements, 0, sizeof c->statements);
+        memset(&c->calls, 0, sizeof c->calls);
+        return 0;
+    }
+    sb_init(&b);
+    sb_printf(&b, "profile (core.profile = %s; time is wall time, a statement's includes its calls; "
+                  "reused = solves that reused a factorization)\n", p ? p : "off");
+    put_profile_table(&b, "statement", &c->statements, 0);
+    put_profile_table(&b, "plugin call (solve: backend; else the class)", &c->calls, 1);
+    return print_whole(V->E, &b, "profile");
 }
 
 /* The column k of the values a for loop walks: a range's element k (the
@@ -1503,6 +1620,10 @@ static int exec_for(lang_ev *V, const ast_node *s, int *flow)
             break;
         }
         if ((rc = for_value(V, &r, all, k, &v))) break;
+        /* the loop variable's record is its own, not the last solve's of the body */
+        V->has_solve = 0;
+        V->backends[0] = 0;
+        eng_pending_release(&V->pending);
         if ((rc = bind(V, s, s->name, v, ti))) break;
         if (!s->kids[0]->nkids && !V->explain && (rc = empty_loop_cancelled(V))) break;
         if ((rc = exec_block(V, s->kids[0], flow))) break;
@@ -1534,10 +1655,17 @@ int lang_exec(silc_engine *E, const char *text)
     memset(&V, 0, sizeof V);
     V.E = E;
     V.src = prog->text;
+    {
+        const char *p = cfg_get(E, "core.profile");
+        V.profile = p && !strcmp(p, "on");
+    }
     for (i = 0; i < prog->nstmts; i++) {
-        int flow;
+        int flow, rc;
+        double ts = V.profile ? util_now() : 0;
         E->err[0] = 0;
-        if (exec_stmt(&V, prog->stmts[i], &flow)) {
+        rc = exec_stmt(&V, prog->stmts[i], &flow);
+        if (V.profile && prog->stmts[i]->kind != ST_PROFILE) profile_statement(&V, prog->stmts[i], util_now() - ts);
+        if (rc) {
             eng_pending_release(&V.pending);
             free(V.bind_text);
             if (prog->nstmts > 1) {

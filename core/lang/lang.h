@@ -74,6 +74,7 @@ enum ast_kind {
     ST_TUNE,               /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
                               pairs); els unused; an AST_STRING kid names a file */
     ST_HELP,               /* help [NAME]: name is NULL or the word asked about */
+    ST_PROFILE,            /* profile [clear]: name is NULL or "clear" */
     ST_SAVE, ST_LOAD       /* save/load "file" [names]: name is the file, kids AST_NAME */
 };
 
@@ -126,6 +127,7 @@ typedef struct lang_ev {
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
     int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
     const silc_value *warm; /* initial guess for the statement's solve (solve.initial_guess), or NULL */
+    int profile;           /* core.profile = on when the exec began: time statements and calls */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

@@ -1053,6 +1053,18 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
         return n;
     }
     if (tok_is_text(P, kw, "tune")) return parse_tune(P, kw);
+    if (tok_is_text(P, kw, "profile")) {
+        n = node_new(P, ST_PROFILE, kw);
+        if (n && tok_is_text(P, peek(P), "clear")) {
+            const lx_token *w = next(P);
+            if (!(n->name = tok_text(P, w))) {
+                node_free(n);
+                return fail(P, w, "out of memory while parsing");
+            }
+            n->end = w->start + w->len;
+        }
+        return n;
+    }
     if (tok_is_text(P, kw, "clear")) {
         n = node_new(P, ST_CLEAR, kw);
         while (n && peek(P)->kind == TK_NAME)
@@ -1106,7 +1118,7 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
 
 static const char *const keywords[] = {"if", "while", "for", "break", "continue", "who", "clear",
                                        "info", "set", "explain", "tune", "help", "save", "load",
-                                       "format", "end", "endif", "endwhile", "endfor", "else",
+                                       "format", "profile", "end", "endif", "endwhile", "endfor", "else",
                                        "elseif"};
 
 static ast_node *parse_statement_body(ps_state *P);
