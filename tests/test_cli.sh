@@ -130,6 +130,10 @@ run "$SILC" -e 'set solve.sparse = reference'
 check "an unknown key names the real one" has err "did you mean 'dispatch.solve.sparse'?"
 run "$SILC" -e 'help solve.verify'
 check "help KEY describes it" has out "solve.verify: auto, off or a bound"
+run "$SILC" -e 'help lapack'
+check "help PLUGIN lists its options with defaults" has out "lapack.precision [double] (text): "
+run "$SILC" --complete lapack.pre
+check "--complete covers plugin options" [ "$(cat out)" = "lapack.precision" ]
 run "$SILC" --complete solve.ver
 check "--complete covers keys" [ "$(cat out)" = "solve.verify" ]
 run "$SILC" -e 'alpha = 1; alpah'

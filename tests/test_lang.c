@@ -428,7 +428,7 @@ static const lang_case cases[] = {
     ERR("for 3 = 1:2\nend", "1:5: for needs 'name = values', as in 'for i = 1:n', near '3'"),
     ERR("x = 1:v", "a range's end must be a scalar, got 3x1"),
     ERR("x = 1:inf", "a range needs finite ends and step, got inf"),
-    ERR("x = 1:1e300", "the range needs 8e+300 bytes, over the limit"),
+    ERR("x = 1:1e300", "a range of 1e+300 elements is larger than one value may be"),
     ERR("x = [1 2", "1:9: expected ']' (to close '[' at 1:5) near end of input"),
     ERR("alpha = 1; y = alpah", "statement 2: undefined name 'alpah' (did you mean 'alpha'?)"),
     ERR("x = disp(1)", "disp(x) shows x and has no value: write it as a statement of its own"),

@@ -737,7 +737,8 @@ static int eval_range(lang_ev *V, const ast_node *n, silc_value **out)
     range_spec r;
     int64_t k, count;
     if (range_of(V, n, &r)) return -1;
-    if (val_claim(r.count * sizeof(double), "the range")) return eng_error(V->E, "%s", val_refusal());
+    if (val_claim(r.count * sizeof(double), "the range"))
+        return eng_error(V->E, "a range of %.4g elements is larger than one value may be", r.count);
     count = (int64_t)r.count;
     if (!(*out = val_dense_new(1, count))) return eng_oom(V->E);
     for (k = 0; k < count; k++) (*out)->val[k] = range_at(r.base, r.inc, r.limit, r.count, (double)k);
