@@ -1536,8 +1536,8 @@ static void profile_statement(lang_ev *V, const ast_node *s, double seconds)
     const char *nl = memchr(V->src + s->start, '\n', len);
     prof_row *r;
     if (nl) len = (size_t)(nl - (V->src + s->start));
-    if (len > 60) len = 60;
-    snprintf(name, sizeof name, "%.*s%s", (int)len, V->src + s->start, nl || s->end - s->start > 60 ? " ..." : "");
+    if (len > 38) len = 38;   /* the table's column */
+    snprintf(name, sizeof name, "%.*s%s", (int)len, V->src + s->start, nl || s->end - s->start > 38 ? " ..." : "");
     r = prof_row_of(&c->statements, name);
     r->count++;
     r->seconds += seconds;
