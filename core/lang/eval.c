@@ -1272,9 +1272,24 @@ static int displaying(const lang_ev *V, const ast_node *s)
 static int show(lang_ev *V, const char *name, const silc_value *v)
 {
     strbuf b;
+    silc_value *whole = NULL;
+    int rc;
+    /* A small value distributed by rows is gathered to be shown (every rank
+     * runs this alike: core.display is the same on all); a large one is
+     * described without moving it. */
+    if (dist_is(v) && v->m <= 40 && v->n <= 40) {
+        whole = val_retain((silc_value *)v);
+        if (dist_make_whole(V->E, &whole)) {
+            val_release(whole);
+            return -1;
+        }
+        v = whole;
+    }
     sb_init(&b);
     dp_show(V->E, &b, name, v);
-    return print_whole(V->E, &b, "the display");
+    rc = print_whole(V->E, &b, "the display");
+    val_release(whole);
+    return rc;
 }
 
 /* disp(x): shows x without its name, whatever core.display says (it is

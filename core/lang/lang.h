@@ -2,8 +2,9 @@
  * lang.h -- the command language (core/lang/): tokens (lexer.c), the
  * syntax tree (parser.c), the evaluator's state shared with the built-in
  * functions (builtins.c), subscripts (index.c) and matrix literals
- * (concat.c), `help` (help.c), save/load (h5io.c) and the memo of repeated
- * operations (memo.c), all driven by lang_exec() in eval.c.  The language
+ * (concat.c), `help` (help.c), save/load (h5io.c), the memo of repeated
+ * operations (memo.c) and how values are shown (display.c), all driven by
+ * lang_exec() in eval.c.  The language
  * calls down into the tuner, the dispatcher, the accuracy machinery and the
  * distributed layer; only the engine and the client call it.
  *
