@@ -18,3 +18,11 @@ add_test(NAME test_configs
   COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/test_configs.sh $<TARGET_FILE:silc_cli>
           ${SILC_SHARED_MATRICES} ${CMAKE_CURRENT_SOURCE_DIR}/conformance)
 set_tests_properties(test_configs PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
+
+# The Octave comparison (tests/conformance/octave/README.md): suite.m through
+# `silc run` must print what Octave 7.3 printed for it (suite.out).
+if(TARGET silc_cli)
+  add_test(NAME test_octave
+    COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/conformance/octave/run.sh $<TARGET_FILE:silc_cli>)
+  set_tests_properties(test_octave PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 60)
+endif()

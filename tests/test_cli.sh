@@ -42,13 +42,13 @@ same_numbers() {
 }
 
 # ---- -e and --get ----------------------------------------------------------------
-run "$SILC" -e 'x = 2 + 3' --get x
+run "$SILC" -e 'x = 2 + 3;' --get x
 check "-e exit status" status_is 0
 check "-e --get banner" starts out "%%MatrixMarket matrix array real general"
 check "-e --get value" same_numbers out "5"
 check "-e nothing on stderr" empty err
 
-run "$SILC" -e 'a = 1; b = 2' --get b --get a
+run "$SILC" -e 'a = 1; b = 2;' --get b --get a
 check "two --get in order" same_numbers out "2 1"
 
 run "$SILC" -e 'x = 1; who'
@@ -65,7 +65,7 @@ cat >a.mtx <<'MTX'
 3 2 1e-300
 3 3 3.141592653589793
 MTX
-run "$SILC" --put A=a.mtx -e 'B = A' --get B
+run "$SILC" --put A=a.mtx -e 'B = A;' --get B
 check "sparse round trip status" status_is 0
 check "sparse comes back as coordinate" starts out "%%MatrixMarket matrix coordinate real general"
 check "sparse round trip values" same_numbers out "1 1 0.1  2 1 -2.5  3 2 1e-300  3 3 3.141592653589793"
@@ -78,28 +78,84 @@ cat >d.mtx <<'MTX'
 3
 4.5
 MTX
-run "$SILC" --put=D=d.mtx -e 'E = 2 * D' --get=E
+run "$SILC" --put=D=d.mtx -e 'E = 2 * D;' --get=E
 check "dense put, compute, get" same_numbers out "2 4 6 9"
 
 # ---- run FILE: control flow across lines -------------------------------------------
 cat >loop.silc <<'SILC'
 # sum 1..5 with a loop
-i = 0
-s = 0
+i = 0;
+s = 0;
 while (i < 5) {
-  i = i + 1
-  s = s + i
+  i = i + 1;
+  s = s + i;
 }
 SILC
 run "$SILC" run loop.silc --get s
 check "run FILE with while" same_numbers out "15"
+
+# ---- display: as Octave shows values -------------------------------------------------
+run "$SILC" -e 'x = 2 + 3'
+check "-e shows an assignment without ';'" [ "$(cat out)" = "x = 5" ]
+run "$SILC" -e 'x = 2 + 3;'
+check "';' keeps it quiet" empty out
+run "$SILC" -e 'A = [1 2; 3 4]'
+check "a matrix as Octave shows it" [ "$(cat out)" = "$(printf 'A =\n\n   1   2\n   3   4\n')" ]
+run "$SILC" -e 'x = 1:3; x * 2'
+check "an expression shows as ans" [ "$(tr '\n' '|' <out)" = "ans =||   2   4   6||" ]
+run "$SILC" -e 'p = pi; format long; p, format short; p'
+check "format long / short" [ "$(tr '\n' '|' <out)" = "p = 3.141592653589793|p = 3.1416|" ]
+run "$SILC" -e 'disp(0.5); B = rand(500, 300);  B'
+check "disp shows the value alone" [ "$(head -1 out)" = "0.5000" ]
+check "a large value is summarised" has out "B = 500x300 dense, nnz 150000 (100%); the top-left corner:"
+check "the summary is short" [ "$(wc -l <out)" -lt 12 ]
+printf 'for i = 1:3\n  i\nend\n' >for.silc
+run "$SILC" run for.silc
+check "run FILE shows values in a for loop" [ "$(tr '\n' ' ' <out)" = "i = 1 i = 2 i = 3 " ]
+
+printf 'k = 0;\nfor i = 1:3\n  k = k + i;\nend\nk\nif k > 5\n  big = 1\nend\n' >in
+run "$SILC" <in
+check "REPL waits for the end of a block" [ "$(tr '\n' ' ' <out)" = "k = 6 big = 1 " ]
+
+# ---- settings: discoverable ----------------------------------------------------------
+printf '[solve]\nrefine = 2\n' >s.conf
+run "$SILC" --config s.conf -e 'set'
+check "set lists a default with its origin" grep -q '^solve.verify  *= auto  (default)$' out
+if [ -z "${SILC_SERVER:-}" ]; then   # remote, the server's configuration applies
+    check "set lists a file setting with file:line" grep -q '^solve.refine  *= 2  (s.conf:2)$' out
+fi
+check "set lists the session's own setting" grep -q '^core.display  *= on  (session)$' out
+check "set lists plugin options" grep -q '^lapack.precision  *= double  (default)$' out
+run "$SILC" -e 'set solve.verify'
+check "set KEY shows the value in force" grep -q '^solve.verify  *= auto  (default)$' out
+run "$SILC" -e 'set solve.sparse = reference'
+check "an unknown key names the real one" has err "did you mean 'dispatch.solve.sparse'?"
+run "$SILC" -e 'help solve.verify'
+check "help KEY describes it" has out "solve.verify: auto, off or a bound"
+run "$SILC" -e 'help lapack'
+check "help PLUGIN lists its options with defaults" has out "lapack.precision [double] (text): "
+run "$SILC" --complete lapack.pre
+check "--complete covers plugin options" [ "$(cat out)" = "lapack.precision" ]
+run "$SILC" --complete solve.ver
+check "--complete covers keys" [ "$(cat out)" = "solve.verify" ]
+run "$SILC" -e 'alpha = 1; alpah'
+check "did-you-mean takes a transposition" has err "undefined name 'alpah' (did you mean 'alpha'?)"
+
+# ---- --profile: per statement and per plugin call, as PETSc's -log_view -------------
+run "$SILC" --profile -e 'A = [4 1; 1 3]; b = [1; 2]; for i = 1:3
+  x = A \ b;
+end'
+check "--profile status" status_is 0
+check "--profile: statements" has err "for i = 1:3 ..."
+check "--profile: three solves counted" grep -q '^  solve: [^ ]* *3 ' err
+check "--profile: the table header" has err "bytes in"
 
 run "$SILC" run no-such-file.silc
 check "run missing file status" status_is 1
 check "run missing file message" has err "silc: cannot open 'no-such-file.silc'"
 
 # ---- the REPL on a pipe (no readline, no prompts) ------------------------------------
-printf 'a = (1 +\n2)\nb = a * 2\n' >in
+printf 'a = (1 +\n2);\nb = a * 2;\n' >in
 run "$SILC" --get b <in
 check "REPL continues unclosed brackets" same_numbers out "6"
 printf 'y = nosuch\nz = 7\nwho\n' >in
@@ -162,12 +218,12 @@ check "--version" grep -q '^silc [0-9]' out
 
 # Completion (what Tab completes in the REPL): bound names, statements and
 # built-ins, the REPL's own commands; help and help NAME.
-run "$SILC" -e 'alpha = 1; alps = [1; 2]; beta = 3' --complete al
+run "$SILC" -e 'alpha = 1; alps = [1; 2]; beta = 3;' --complete al
 check "--complete: bound names" [ "$(cat out)" = "$(printf 'alpha\nalps')" ]
-run "$SILC" -e 'x = 1' --complete spa
+run "$SILC" -e 'x = 1;' --complete spa
 check "--complete: built-ins" [ "$(cat out)" = "sparse" ]
 run "$SILC" --complete e
-check "--complete: keywords, built-ins and commands" [ "$(tr '\n' ' ' <out)" = "else explain eye exp eps exit " ]
+check "--complete: keywords, built-ins and commands" [ "$(tr '\n' ' ' <out)" = "elseif else end explain eye exp eps exit " ]
 run "$SILC" -e 'help solve'
 check "help solve" has out 'solve(A, b, "options")'
 run "$SILC" -e 'help sparce'

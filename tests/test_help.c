@@ -42,6 +42,14 @@ static char *slurp(const char *path)
     return s;
 }
 
+static char heard[16384];
+
+static void hear(void *user, const char *text)
+{
+    (void)user;
+    strncat(heard, text, sizeof heard - strlen(heard) - 1);
+}
+
 int main(void)
 {
     char *readme = slurp(SILC_SOURCE_DIR "/README.md"), err[256];
@@ -90,6 +98,32 @@ int main(void)
             CHECK(lang_exec(E, "help solve") == 0, "help solve: %s", E->err);
             CHECK(lang_exec(E, "help nosuch") != 0 && strstr(E->err, "no statement or built-in 'nosuch'"),
                   "help nosuch: %s", E->err);
+            /* issue 29: settings and plugin options are discoverable */
+            E->output = hear;
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help set") == 0 && strstr(heard, "  solve.verify           auto, off or a bound") &&
+                      strstr(heard, "; default auto\n") && strstr(heard, "core.plugin_path"),
+                  "help set: %s", heard);
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help solve.verify") == 0 &&
+                      !strncmp(heard, "solve.verify: auto, off or a bound: the backward error above which the next "
+                                      "listed backend takes over\n  default: auto\n  now: solve.verify", 120),
+                  "help KEY: %s", heard);
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help core.plugin_path") == 0 && strstr(heard, "a server setting"),
+                  "help of a server setting: %s", heard);
+            CHECK(lang_exec(E, "help solve.verfy") != 0 &&
+                      !strcmp(E->err, "unknown key 'solve.verfy'; did you mean 'solve.verify'?"),
+                  "help of a misspelt key: %s", E->err);
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help reference") == 0 && strstr(heard, "plugin reference") &&
+                      strstr(heard, "no options"),
+                  "help PLUGIN: %s", heard);
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help for") == 0 && strstr(heard, "for i = 1:n ... end"), "help for: %s", heard);
+            heard[0] = 0;
+            CHECK(lang_exec(E, "help :") == 0 && strstr(heard, "0:0.1:1"), "help ':': %s", heard);
+            E->output = NULL;
             eng_destroy(&E);
         }
     }

@@ -358,19 +358,81 @@ static const lang_case cases[] = {
     ERR("if (1) { continue }", "1:10: 'continue' outside a loop"),
     ERR("x = \"abc\"", "1:5: unexpected '\"abc\"'"),
     ERR("x = 1 < 2 < 3", "1:11: comparisons do not chain: use '&&' near '<'"),
-    ERR("if (1) x = 2", "1:8: expected '{' near 'x'"),
+    ERR("if (1) x = 2", "1:13: expected 'end' (to close 'if' at 1:1) near end of input"),
     ERR("x = 1.5e", "1:5: malformed number near '1.5e'"),
     ERR("x = \"abc", "1:5: unfinished string"),
     ERR("v + 1 = 3", "1:7: cannot assign to this expression near '='"),
     ERR("x = 1\ny = 2 +\n", "2:8: unexpected end of line"),
     ERR("while (1) { x = 1", "1:18: expected '}' (to close '{' at 1:11) near end of input"),
-    ERR("if 1 { x = 1 }", "1:4: expected '(' near '1'"),
+    OK("if 1 { x = 1 }", "x", 1, 1, 1),
+    ERR("if { x = 1 }", "1:4: expected a condition near '{'"),
     ERR("x = v[1, ]", "1:10: unexpected ']'"),
     ERR("x = a b c", "1:7: unexpected 'b'"),
     ERR("x = 1 @ 2", "1:7: unexpected character '@'"),
     ERR("explain", "1:8: explain needs a statement, as in 'explain x = A \\ b'"),
     ERR("explain who", "1:9: explain takes an assignment or an expression"),
     ERR("info", "1:5: expected a name near end of input"),
+
+    /* issue 29: ranges are values (counted as Octave counts them: 0:0.1:1 has 11
+     * elements, the last exactly 1; 0:0.1:0.3 has 4) */
+    OK("x = 1:5", "x", 1, 5, 1, 2, 3, 4, 5),
+    OK("x = 5:-2:1", "x", 1, 3, 5, 3, 1),
+    OK("x = size(0:0.1:1, 2)", "x", 1, 1, 11),
+    OK("x = max(0:0.1:1)", "x", 1, 1, 1),
+    OK("x = size(0:0.1:0.3, 2)", "x", 1, 1, 4),
+    OK("x = size(1:0, 2)", "x", 1, 1, 0),
+    OK("x = size(1:0.5:1, 2)", "x", 1, 1, 1),
+    OK("x = 1:3 + 1", "x", 1, 4, 1, 2, 3, 4),
+    OK("x = [1:3; 4:6]", "x", 2, 3, 1, 4, 2, 5, 3, 6),
+    OK("x = sparse(1:3, 1:3, 2, 3, 3) * v", "x", 3, 1, 2, 4, 6),
+    OK("x = v[1:2:3]", "x", 2, 1, 1, 3),
+    OK("x = v[end:-1:1]", "x", 3, 1, 3, 2, 1),
+    OK("x = (0:2)' + 1", "x", 3, 1, 1, 2, 3),
+    /* rows separated by white space and line breaks, as in Octave */
+    OK("x = [1 -2]", "x", 1, 2, 1, -2),
+    OK("x = [1 - 2]", "x", 1, 1, -1),
+    OK("x = [1-2]", "x", 1, 1, -1),
+    OK("x = [1 -2 + 3]", "x", 1, 2, 1, 1),
+    OK("x = [1 2 3; 4 5 6]", "x", 2, 3, 1, 4, 2, 5, 3, 6),
+    OK("x = [v' 7]", "x", 1, 4, 1, 2, 3, 7),
+    OK("x = [r (1)]", "x", 1, 4, 1, 2, 3, 1),
+    OK("x = [r [5 6]]", "x", 1, 5, 1, 2, 3, 5, 6),
+    OK("x = [r[2] 9]", "x", 1, 2, 2, 9),
+    OK("x = [abs(-1) -1]", "x", 1, 2, 1, -1),
+    OK("x = [max(v[1], -4) 2]", "x", 1, 2, 1, 2),
+    OK("x = [1 2\n3 4]", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = [\n1 2\n3 4\n]", "x", 2, 2, 1, 3, 2, 4),
+    OK("x = [1 2;]", "x", 1, 2, 1, 2),
+    OK("x = [1, 2, ]", "x", 1, 2, 1, 2),
+    /* for, and blocks closed by end */
+    OK("x = 0; for i = 1:4\n  x += i\nend", "x", 1, 1, 10),
+    OK("x = 0; for (i = 1:4) { x += i }", "x", 1, 1, 10),
+    OK("x = 0; for c = M\n x += c[1] * c[2]\nend", "x", 1, 1, 11),
+    OK("x = 0; for i = 1:10\n if i == 3, continue, end\n if i > 5, break, end\n x += i\nend", "x", 1, 1, 12),
+    OK("x = 0; for i = zeros(1, 0)\n x = 1\nend", "x", 1, 1, 0),
+    OK("x = 0; for i = 1:3\n for j = 1:3\n x += 1\n end\nend", "x", 1, 1, 9),
+    OK("x = 0; for i = 3:-1:1, x = 10 * x + i; endfor", "x", 1, 1, 321),
+    OK("for i = 1:3\nend\nx = i", "x", 1, 1, 3),
+    OK("i = 0; while i < 5\n i += 2\nend\nx = i", "x", 1, 1, 6),
+    OK("i = 0; while i < 5, i += 2; endwhile; x = i", "x", 1, 1, 6),
+    OK("x = 0; if x == 1\n x = 5\nelseif x == 0\n x = 7\nelse\n x = 9\nend", "x", 1, 1, 7),
+    OK("x = 2; if x == 1\n x = 5\nelseif x == 0\n x = 7\nelse\n x = 9\nendif", "x", 1, 1, 9),
+    OK("if 1, x = 1, end", "x", 1, 1, 1),
+    OK("x = 1; if x > 1 x = 3; else x = 4; end", "x", 1, 1, 4),
+    OK("x = 0; while (x < 3) {\n x += 1 }\nif (x == 3) { y = 1 } else if (x == 4) { y = 2 }", "x", 1, 1, 3),
+    ERR("for i = 1:3\n  x = i", "2:8: expected 'end' (to close 'for' at 1:1) near end of input"),
+    ERR("if 1\n x = 1\nelse\n x = 2\nelse\n x = 3\nend", "5:1: expected 'end' (to close 'if' at 1:1) near 'else'"),
+    ERR("end", "1:1: 'end' with no open if, while or for"),
+    ERR("x = 1; endwhile", "1:8: 'endwhile' with no open if, while or for"),
+    ERR("while 1\n x = 1\n}", "3:1: unexpected '}'"),
+    ERR("for 3 = 1:2\nend", "1:5: for needs 'name = values', as in 'for i = 1:n', near '3'"),
+    ERR("x = 1:v", "a range's end must be a scalar, got 3x1"),
+    ERR("x = 1:inf", "a range needs finite ends and step, got inf"),
+    ERR("x = 1:1e300", "a range of 1e+300 elements is larger than one value may be"),
+    ERR("x = [1 2", "1:9: expected ']' (to close '[' at 1:5) near end of input"),
+    ERR("alpha = 1; y = alpah", "statement 2: undefined name 'alpah' (did you mean 'alpha'?)"),
+    ERR("x = disp(1)", "disp(x) shows x and has no value: write it as a statement of its own"),
+    ERR("format wide", "1:8: format takes 'long' or 'short', not 'wide'"),
 
     /* runtime errors */
     ERR("x = vv + 1", "undefined name 'vv' (did you mean 'v'?)"),
@@ -742,13 +804,69 @@ static void test_set(void)
     CHECK(silc_exec(c, "set tune.accuracy = 1e-8") == 0, "set: %s", silc_context_errmsg(c));
     captured[0] = 0;
     CHECK(silc_exec(c, "set tune.accuracy") == 0, "set key: %s", silc_context_errmsg(c));
-    CHECK(!strcmp(captured, "tune.accuracy = 1e-8\n"), "set key output: %s", captured);
+    CHECK(!strcmp(captured, "tune.accuracy                  = 1e-8  (session)\n"), "set key output: %s", captured);
+    /* issue 29: the value in force and its origin, never "is not set" */
+    captured[0] = 0;
+    CHECK(silc_exec(c, "set solve.verify") == 0 && !strcmp(captured, "solve.verify                   = auto  (default)\n"),
+          "set of a default: %s", captured);
+    CHECK(silc_exec(c, "set solve.sparse = reference") != 0 &&
+          !strcmp(silc_context_errmsg(c), "unknown key 'solve.sparse'; did you mean 'dispatch.solve.sparse'?"),
+          "unknown key suggestion: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(c, "set solve.verfy") != 0 &&
+          !strcmp(silc_context_errmsg(c), "unknown key 'solve.verfy'; did you mean 'solve.verify'?"),
+          "unknown key shown: %s", silc_context_errmsg(c));
+    captured[0] = 0;
+    CHECK(silc_exec(c, "set") == 0 && strstr(captured, "\ndispatch.solve.sparse          = ") &&
+              strstr(captured, "\naccuracy.condest               = on  (default)\n"),
+          "set lists defaults: %s", captured);
     captured[0] = 0;
     CHECK(silc_exec(c, "set") == 0 && strstr(captured, "tune.accuracy") != NULL, "set list: %s", captured);
     CHECK(silc_exec(c, "set x = 1") != 0, "set of an unknown key must fail");
     CHECK(silc_exec(c, "x = 1; set tune.accuracy = 1e-9; y = 2") == 0, "set between statements: %s",
           silc_context_errmsg(c));
     CHECK(is_defined(c, "y"), "statement after set ran");
+    silc_close(&c);
+}
+
+/* issue 29: values shown as Octave shows them, only when core.display is
+ * on (the silc command's setting): an embedded SILC_EXEC never prints. */
+static void test_display(void)
+{
+    silc_context *c = fixture();
+    int64_t m, n;
+    double *x;
+    if (!c) return;
+    silc_set_output(c, capture, NULL);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = 3\n1 + 1") == 0 && captured[0] == 0, "embedded printed: %s", captured);
+    CHECK(!is_defined(c, "ans"), "ans bound while not displaying");
+    CHECK(silc_exec(c, "disp(2)") == 0 && !strcmp(captured, "2\n"), "disp: %s", captured);
+    CHECK(silc_exec(c, "set core.display = on") == 0, "set core.display: %s", silc_context_errmsg(c));
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = 3; z = 4\nM\n1 + 1\nq = [0.5 -1.25]") == 0, "display: %s", silc_context_errmsg(c));
+    CHECK(!strcmp(captured, "z = 4\nM =\n\n   1   2\n   3   4\n\nans = 2\nq =\n\n   0.5000  -1.2500\n\n"),
+          "display text: [%s]", captured);
+    CHECK(fetch(c, "ans", &m, &n, &x) == 1 && x && x[0] == 2, "ans is bound to the shown value");
+    free(x);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "format long; p = pi; p\nformat short\np") == 0 &&
+              !strcmp(captured, "p = 3.141592653589793\np = 3.1416\n"),
+          "format long/short: [%s]", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "t = [1e-3 1]\nu = [1 NaN]\nw = zeros(0, 3)\nbig = 12345678") == 0 &&
+              !strcmp(captured, "t =\n\n   1.0000e-03   1.0000e+00\n\nu =\n\n     1   NaN\n\nw = [](0x3)\n"
+                                "big = 1.2346e+07\n"),
+          "e-format, NaN, empty: [%s]", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "E = sparse([1 3], [2 1], [7 8], 3, 3)") == 0 &&
+              !strcmp(captured, "E =\n\nCompressed Column Sparse (rows = 3, cols = 3, nnz = 2 [22%])\n\n"
+                                "  (3, 1) -> 8\n  (1, 2) -> 7\n\n"),
+          "sparse: [%s]", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "G = ones(50, 60);") == 0 && captured[0] == 0, "';' is quiet");
+    CHECK(silc_exec(c, "G") == 0 && !strncmp(captured, "G = 50x60 dense, nnz 3000 (100%); the top-left corner:\n\n"
+                                            "   1   1   1   1   1   1\n", 80),
+          "summary: [%s]", captured);
     silc_close(&c);
 }
 
@@ -1094,6 +1212,7 @@ int main(void)
     test_symmetry_detection();
     test_explain();
     test_set();
+    test_display();
     test_atomicity();
     test_cache();
     test_clear();

@@ -16,10 +16,14 @@
  * other tools through files and pipes.  Uses only the public API (silc.h), as
  * any other client would.  Exit status: 0 success, 1 failure (message on stderr
  * as "silc: ..."), 2 usage error.
+ *
+ * Values show as Octave shows them: the command turns core.display on, so a
+ * statement without ';' prints its value (run, -e and the REPL alike).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <stdarg.h>
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,10 +53,15 @@ static const char usage_text[] =
     "  --config FILE        configuration file (default: $SILC_CONFIG, else ./silc.conf)\n"
     "  -h, --help           show this text\n"
     "  --version            show the version\n"
-    "  --complete WORD      after running, print the names, statements and built-ins\n"
-    "                       that start with WORD, one a line (what Tab completes)\n"
-    "In the interactive session a line that ends inside an unclosed ( [ or { continues\n"
-    "on the next line; 'quit', 'exit' or end of input leaves.  Warnings go to standard\n"
+    "  --profile            time every statement and plugin call (bytes in and out,\n"
+    "                       reused factorizations) and print the tables to standard\n"
+    "                       error at the end, as PETSc's -log_view (core.profile)\n"
+    "  --complete WORD      after running, print the names, statements, built-ins and\n"
+    "                       settings (plugin options too) that start with WORD, one a\n"
+    "                       line (what Tab completes)\n"
+    "In the interactive session a line that ends inside an unclosed ( [ or {, or an\n"
+    "if, while or for without its end, continues on the next line; 'quit', 'exit' or\n"
+    "end of input leaves.  Warnings go to standard\n"
     "error as \"warning: ...\"; who, info and explain print to standard output.\n";
 
 typedef struct {
@@ -65,6 +74,7 @@ typedef struct {
     int nget;
     char *tune_text;        /* statement built from `tune ...` arguments */
     const char *complete;   /* --complete WORD */
+    int profile;            /* --profile */
 } cli_options;
 
 static void fail(const char *fmt, ...)
@@ -140,6 +150,8 @@ static int parse_args(int argc, char **argv, cli_options *o)
         } else if (take_option(argc, argv, &i, "--get", &v)) {
             if (!v || !*v) return fail("--get needs a name"), 2;
             o->get_names[o->nget++] = v;
+        } else if (!strcmp(a, "--profile")) {
+            o->profile = 1;
         } else if (take_option(argc, argv, &i, "--complete", &v)) {
             if (!v) return fail("--complete needs a word (it may be empty)"), 2;
             o->complete = v;
@@ -309,18 +321,21 @@ static char *output_of(silc_context *ctx, const char *stmt)
 }
 
 /* Every completion of prefix: the session's names (from `who`), the
- * statements and built-ins (from `help`), quit and exit; a malloc'd array
- * of malloc'd strings ending in NULL, in that order, without repeats. */
+ * statements and built-ins (from `help`), the settings' keys with every
+ * loaded plugin's options (from `set`), quit and exit; a malloc'd array of
+ * malloc'd strings ending in NULL, in that order, without repeats. */
 static char **completions(silc_context *ctx, const char *prefix)
 {
     char *who = output_of(ctx, "who"), *help = output_of(ctx, "help"), *p;
+    char *keys = output_of(ctx, "set");
     size_t n = 0, cap = 16, plen = strlen(prefix), k;
     char **out = malloc(cap * sizeof *out);
     const char *fixed = "quit exit";
-    for (int src = 0; src < 3 && out; src++) {
+    for (int src = 0; src < 4 && out; src++) {
         /* who: the first word of each line after the header; help: every
-         * word after the first line; then the REPL's own commands */
-        p = src == 0 ? who : src == 1 ? help : (char *)fixed;
+         * word after the first line; set: the first word of every line;
+         * then the REPL's own commands */
+        p = src == 0 ? who : src == 1 ? help : src == 2 ? keys : (char *)fixed;
         if (!p) continue;
         if (src < 2) p = strchr(p, '\n');
         while (p && *p && out) {
@@ -339,12 +354,13 @@ static char **completions(silc_context *ctx, const char *prefix)
                 }
             }
             p += wl;
-            if (src == 0) p = strchr(p, '\n'); /* the rest of a who line is its shape */
+            if (src == 0 || src == 2) p = strchr(p, '\n'); /* the rest of the line: shape, value */
         }
     }
     if (out) out[n] = NULL;
     free(who);
     free(help);
+    free(keys);
     return out;
 }
 
@@ -404,6 +420,54 @@ static long open_brackets(const char *s)
     return depth;
 }
 
+/* Net number of Octave-style blocks a line opens: `if`, `while` or `for`
+ * first in a statement, without a `{` later on the line (the brace form,
+ * counted by open_brackets), opens one; `end` (endif, endwhile, endfor)
+ * first in a statement closes one; a line starting with `{` is the brace
+ * of the block the line before opened.  A heuristic for when to run what
+ * was typed: the parser says what is wrong with the text. */
+static long open_blocks(const char *s)
+{
+    long n = 0;
+    int at_start = 1, opened = 0;
+    s += strspn(s, " \t");
+    if (*s == '{') n--;
+    for (; *s; s++) {
+        if (*s == '"') {
+            s++;
+            while (*s && *s != '"' && *s != '\n') s++;
+            if (!*s) break;
+            at_start = 0;
+        } else if (*s == '#') {
+            break;
+        } else if (*s == ';' || *s == ',') {
+            at_start = 1;
+        } else if (*s == '{') {
+            if (opened) n--, opened--;
+            at_start = 1;
+        } else if (isalpha((unsigned char)*s) || *s == '_') {
+            size_t len = 1;
+            while (isalnum((unsigned char)s[len]) || s[len] == '_') len++;
+            if (at_start) {
+                const char *after = s + len + strspn(s + len, " \t");
+                int assigned = after[0] == '=' && after[1] != '=';
+                if (!assigned && ((len == 2 && !strncmp(s, "if", 2)) || (len == 5 && !strncmp(s, "while", 5)) ||
+                                  (len == 3 && !strncmp(s, "for", 3))))
+                    n++, opened++;
+                else if (!assigned && ((len == 3 && !strncmp(s, "end", 3)) || (len == 5 && !strncmp(s, "endif", 5)) ||
+                                       (len == 8 && !strncmp(s, "endwhile", 8)) ||
+                                       (len == 6 && !strncmp(s, "endfor", 6))))
+                    n--;
+            }
+            at_start = (len == 4 && !strncmp(s, "else", 4));
+            s += len - 1;
+        } else if (*s != ' ' && *s != '\t') {
+            at_start = 0;
+        }
+    }
+    return n;
+}
+
 static int is_command(const char *line, const char *word)
 {
     line += strspn(line, " \t");
@@ -452,6 +516,7 @@ static int repl(silc_context *ctx)
     int interactive = isatty(STDIN_FILENO), failed = 0;
     size_t len = 0, cap = 0;
     long open = 0;     /* brackets the buffered lines leave open */
+    long blocks = 0;   /* Octave-style blocks they leave open (open_blocks) */
     char *buf = NULL;
 #ifdef SILC_HAVE_READLINE
     char *hist = interactive ? history_path() : NULL;
@@ -494,14 +559,16 @@ static int repl(silc_context *ctx)
         buf[len++] = '\n';
         buf[len] = '\0';
         open += open_brackets(line);
+        blocks += open_blocks(line);
         free(line);
         /* Past the language's nesting limit no closing line can make the text
          * valid: run it now, so the parser names the limit, rather than
          * buffering forever. */
-        if (open > 0 && open <= SILC_MAX_NESTING) continue;
+        if ((open > 0 || blocks > 0) && open <= SILC_MAX_NESTING && blocks <= SILC_MAX_NESTING) continue;
         if (buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
         len = 0;
         open = 0;
+        blocks = 0;
     }
     /* Input ended inside open brackets: run it anyway so the parser says what
      * is unclosed. */
@@ -534,7 +601,10 @@ int main(int argc, char **argv)
         fail("%s", ctx ? silc_context_errmsg(ctx) : silc_errmsg());
         status = 1;
     } else {
-        status = load_puts(ctx, &o);
+        /* Values show as in Octave: a statement without ';' prints its value
+         * (core.display; an embedded SILC_EXEC never prints). */
+        status = load_puts(ctx, &o) || run_text(ctx, "set core.display = on") ||
+                 (o.profile && run_text(ctx, "set core.profile = on"));
         if (!status && o.script) {
             char *text = read_file(o.script);
             status = !text || run_text(ctx, text);
@@ -545,6 +615,12 @@ int main(int argc, char **argv)
             status = repl(ctx);
         }
         if (!status) status = print_gets(ctx, &o);
+        if (o.profile) {   /* after a failure too: where the time went is still worth seeing */
+            char *table = output_of(ctx, "profile");
+            fflush(stdout);
+            if (table) fputs(table, stderr);
+            free(table);
+        }
         if (!status && o.complete) {
             char **c = completions(ctx, o.complete);
             for (size_t k = 0; c && c[k]; k++) puts(c[k]);

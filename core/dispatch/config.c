@@ -44,18 +44,21 @@
 typedef struct cfg_entry {
     char *key;
     char *value;
+    char *origin;        /* "silc.conf:3", "session", "call": what `set` shows */
     struct cfg_entry *next;
 } cfg_entry;
 
 struct cfg_db {
     cfg_entry *scope[3]; /* indexed by enum cfg_scope, each in insertion order */
+    const char *file;    /* the config file being read (cfg_load_file), for origins */
+    int file_line;
     int serving;         /* a silcd session's engine (cfg_serve) */
     int data_fd;         /* its folder under --data-dir, -1 = file statements refused */
 };
 
 static const char *const scope_names[3] = {"file", "session", "call"};
 static const char *const tune_keys[] = {"threads", "accuracy", "budget", "wisdom", "max_threads"};
-static const char *const core_keys[] = {"plugin_path", "threads"};
+static const char *const core_keys[] = {"plugin_path", "threads", "display", "format", "profile"};
 static const char *const solve_keys[] = {"refine", "refine_residual", "backward_error", "initial_guess",
                                          "verify"};
 
@@ -230,10 +233,20 @@ static int unknown_section(silc_engine *E, const char *section)
                      section);
 }
 
+static const char *suggest_key(const silc_engine *E, const char *key, char *out, size_t outlen);
+
+/* An unknown section.name: the suggestion is the nearest real key of any
+ * section (`solve.sparse` means `dispatch.solve.sparse`), else the nearest
+ * name of this section. */
 static int unknown_key(silc_engine *E, const char *section, const char *name,
                        const char *const *keys, size_t nkeys)
 {
-    const char *best = util_closest(name, keys, nkeys);
+    char full[256], near[256];
+    const char *best;
+    snprintf(full, sizeof full, "%s.%s", section, name);
+    if (suggest_key(E, full, near, sizeof near))
+        return eng_error(E, "unknown key '%s'; did you mean '%s'?", full, near);
+    best = util_closest(name, keys, nkeys);
     if (best) return eng_error(E, "unknown key '%s.%s'; did you mean '%s.%s'?", section, name,
                                section, best);
     return eng_error(E, "unknown key '%s.%s'", section, name);
@@ -390,8 +403,14 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
     if (strcmp(section, "core") == 0) {
         if (strcmp(name, "threads") == 0) {
             if (check_threads(E, "core.threads", value)) return -1;
+        } else if (strcmp(name, "display") == 0 || strcmp(name, "profile") == 0) {
+            if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
+                return eng_error(E, "core.%s expects 'on' or 'off', got '%s'", name, value);
+        } else if (strcmp(name, "format") == 0) {
+            if (strcmp(value, "short") != 0 && strcmp(value, "long") != 0)
+                return eng_error(E, "core.format expects 'short' or 'long', got '%s'", value);
         } else if (strcmp(name, "plugin_path") != 0) {
-            return unknown_key(E, section, name, core_keys, 2);
+            return unknown_key(E, section, name, core_keys, sizeof core_keys / sizeof core_keys[0]);
         }
         return keep_value(E, norm, section, name, value);
     }
@@ -447,6 +466,7 @@ static void free_list(cfg_entry *e)
         cfg_entry *next = e->next;
         free(e->key);
         free(e->value);
+        free(e->origin);
         free(e);
         e = next;
     }
@@ -473,32 +493,49 @@ enum key_kind {
 typedef struct key_rule {
     const char *key;   /* a key, or a pattern shown as such ("dispatch.<class>") */
     enum key_kind kind;
+    const char *dflt;  /* the value in force when nothing sets it; NULL: a pattern, or a
+                          plugin's option (its own table gives the default) */
     const char *why;
 } key_rule;
 
-/* THE table of which key is whose (docs/security.md, `help set`).  A key not
- * listed is a session setting: dispatch.<class>, solve.*, a plugin's typed
- * options. */
+/* THE table of settings: which key is whose (docs/security.md, `help
+ * set`), its default and what it does (`set`, `help KEY`).  A key not
+ * listed is a session setting: dispatch.<class> (default: the built-in
+ * list, disp_default_list) and a plugin's typed options (its own table). */
 static const key_rule key_rules[] = {
-    {"core.plugin_path", KEY_SERVER, "folders whose plugins are loaded: loads code"},
-    {"core.threads", KEY_SERVER, "the thread budget of one operation"},
-    {"tune.wisdom", KEY_SERVER, "the wisdom file: names a path the tuner writes"},
-    {"tune.max_threads", KEY_SERVER, "the tuner's thread cap (may exceed the cores)"},
-    {"mumps.icntl_1", KEY_SERVER, "MUMPS error output unit: a Fortran unit writes a file"},
-    {"mumps.icntl_2", KEY_SERVER, "MUMPS diagnostics unit: a Fortran unit writes a file"},
-    {"mumps.icntl_3", KEY_SERVER, "MUMPS global information unit: a Fortran unit writes a file"},
-    {"mumps.icntl_22", KEY_SERVER, "MUMPS out-of-core factorization: writes the factors to files"},
-    {"tune.threads", KEY_THREADS, "threads of the solves, or 'auto' for the tuner; in silcd at most "
-                                  "tune.max_threads (else the cores)"},
-    {"petsc.options", KEY_FREEFORM, "PETSc's option string; in silcd no option that views, monitors, "
-                                    "logs, dumps, names a file, loads code or sets threads"},
-    {"lis-style.options", KEY_FREEFORM, "the Lis-style option string; sanitized as petsc.options"},
-    {"dispatch.<class>", KEY_SESSION, "the backends a class of operation tries, in order"},
-    {"tune.accuracy", KEY_SESSION, "the accuracy the tuner's backend choice must reach"},
-    {"tune.budget", KEY_SESSION, "the share of the run the tuner may spend measuring"},
-    {"accuracy.condest", KEY_SESSION, "on or off: the condition estimate of every solve"},
-    {"solve.<option>", KEY_SESSION, "refine, refine_residual, backward_error, initial_guess, verify"},
-    {"<plugin>.<option>", KEY_SESSION, "a plugin's typed options (other than those above)"},
+    {"core.plugin_path", KEY_SERVER, "(none)", "folders whose plugins are loaded: loads code"},
+    {"core.threads", KEY_SERVER, "1", "the thread budget of one operation"},
+    {"tune.wisdom", KEY_SERVER, "(SILC_WISDOM, else ~/.silc_wisdom)",
+     "the wisdom file: names a path the tuner writes"},
+    {"tune.max_threads", KEY_SERVER, "auto", "the tuner's thread cap (may exceed the cores)"},
+    {"mumps.icntl_1", KEY_SERVER, NULL, "MUMPS error output unit: a Fortran unit writes a file"},
+    {"mumps.icntl_2", KEY_SERVER, NULL, "MUMPS diagnostics unit: a Fortran unit writes a file"},
+    {"mumps.icntl_3", KEY_SERVER, NULL, "MUMPS global information unit: a Fortran unit writes a file"},
+    {"mumps.icntl_22", KEY_SERVER, NULL, "MUMPS out-of-core factorization: writes the factors to files"},
+    {"tune.threads", KEY_THREADS, "(core.threads; the tuner's choice after 'tune on')",
+     "threads of the solves, or 'auto' for the tuner; in silcd at most tune.max_threads (else the cores)"},
+    {"petsc.options", KEY_FREEFORM, NULL, "PETSc's option string; in silcd no option that views, monitors, "
+                                          "logs, dumps, names a file, loads code or sets threads"},
+    {"lis-style.options", KEY_FREEFORM, NULL, "the Lis-style option string; sanitized as petsc.options"},
+    {"dispatch.<class>", KEY_SESSION, NULL, "the backends a class of operation tries, in order"},
+    {"tune.accuracy", KEY_SESSION, "1e-10", "the accuracy the tuner's backend choice must reach"},
+    {"tune.budget", KEY_SESSION, "0.05", "the share of the run the tuner may spend measuring"},
+    {"accuracy.condest", KEY_SESSION, "on", "on or off: the condition estimate of every solve"},
+    {"solve.refine", KEY_SESSION, "(up to 3 steps when a direct result misses solve.verify)",
+     "steps of iterative refinement after a direct solve (0 to 100)"},
+    {"solve.refine_residual", KEY_SESSION, "double", "double or extended: the refinement's residual"},
+    {"solve.backward_error", KEY_SESSION, "deferred",
+     "deferred, always or on_request: when a solve's backward error is computed"},
+    {"solve.initial_guess", KEY_SESSION, "auto", "auto, previous or zero: warm starts of iterative solves"},
+    {"solve.verify", KEY_SESSION, "auto",
+     "auto, off or a bound: the backward error above which the next listed backend takes over"},
+    {"core.display", KEY_SESSION, "off",
+     "on: a statement without ';' shows its value (the silc command turns it on; SILC_EXEC never prints)"},
+    {"core.format", KEY_SESSION, "short", "short or long: 5 or 16 significant digits when values are shown"},
+    {"core.profile", KEY_SESSION, "off",
+     "on: time every statement and plugin call, with bytes in and out and reused factorizations; "
+     "the statement 'profile' prints the tables (silc --profile: at exit)"},
+    {"<plugin>.<option>", KEY_SESSION, NULL, "a plugin's typed options (other than those above): help PLUGIN"},
 };
 
 static const key_rule *rule_of(const char *key)
@@ -519,8 +556,216 @@ void cfg_describe_keys(strbuf *b)
                           : "session settings (set, or solve(A, b, \"key = value\")):\n");
         for (i = 0; i < sizeof key_rules / sizeof key_rules[0]; i++)
             if ((key_rules[i].kind == KEY_SERVER) == server)
-                sb_printf(b, "  %-20s %s\n", key_rules[i].key, key_rules[i].why);
+                sb_printf(b, "  %-22s %s%s%s\n", key_rules[i].key, key_rules[i].why,
+                          key_rules[i].dflt ? "; default " : "", key_rules[i].dflt ? key_rules[i].dflt : "");
     }
+    sb_puts(b, "'set' lists every key with the value in force and where it came from; 'help KEY' "
+               "describes one; 'help PLUGIN' lists a plugin's options\n");
+}
+
+/* ---- every key, for listing and suggestions ----------------------------------- */
+
+/* One key SILC knows here: its default and what it does. */
+typedef struct key_info {
+    char key[160];
+    const char *dflt;
+    const char *why;
+} key_info;
+
+/* Calls visit for every concrete key: the table's, each dispatch class's,
+ * and each loaded plugin's options; stops when visit returns nonzero. */
+static int each_key(const silc_engine *E, int (*visit)(void *u, const key_info *k), void *u)
+{
+    key_info k;
+    size_t i, p, np = ld_plugin_count(E);
+    for (i = 0; i < sizeof key_rules / sizeof key_rules[0]; i++) {
+        if (!key_rules[i].dflt) continue;   /* a pattern, or a plugin's (below) */
+        snprintf(k.key, sizeof k.key, "%s", key_rules[i].key);
+        k.dflt = key_rules[i].dflt;
+        k.why = key_rules[i].why;
+        if (visit(u, &k)) return 1;
+    }
+    for (i = 0; disp_class_names[i]; i++) {
+        snprintf(k.key, sizeof k.key, "dispatch.%s", disp_class_names[i]);
+        k.dflt = disp_default_list(disp_class_names[i]);
+        k.why = "the backends this class of operation tries, in order (the built-in list when unset)";
+        if (visit(u, &k)) return 1;
+    }
+    for (p = 0; p < np; p++) {
+        const silc_plugin *pl = ld_plugin_at(E, p)->table;
+        int o;
+        for (o = 0; o < pl->n_options; o++) {
+            snprintf(k.key, sizeof k.key, "%s.%s", pl->name, pl->options[o].key);
+            k.dflt = pl->options[o].default_value && pl->options[o].default_value[0]
+                         ? pl->options[o].default_value
+                         : "(the library's own default)";
+            k.why = pl->options[o].help ? pl->options[o].help : "";
+            if (visit(u, &k)) return 1;
+        }
+    }
+    return 0;
+}
+
+typedef struct key_search {
+    const char *want;
+    key_info found;
+    int hit;
+    const char **names;   /* every key, for the nearest one */
+    size_t n, cap;
+    char (*store)[160];
+} key_search;
+
+static int find_visit(void *u, const key_info *k)
+{
+    key_search *s = u;
+    if (strcmp(s->want, k->key) != 0) return 0;
+    s->found = *k;
+    s->hit = 1;
+    return 1;
+}
+
+static int collect_visit(void *u, const key_info *k)
+{
+    key_search *s = u;
+    if (s->n < s->cap) {
+        memcpy(s->store[s->n], k->key, sizeof s->store[0]);
+        s->names[s->n] = s->store[s->n];
+        s->n++;
+    }
+    return 0;
+}
+
+static int find_key(const silc_engine *E, const char *key, key_info *out)
+{
+    key_search s;
+    memset(&s, 0, sizeof s);
+    s.want = key;
+    each_key(E, find_visit, &s);
+    if (s.hit) *out = s.found;
+    return s.hit;
+}
+
+/* The real key nearest to key, into out: "dispatch." + key when that is one
+ * (`solve.sparse`), else the nearest by edit distance.  NULL when none is
+ * near (or memory ran out). */
+static const char *suggest_key(const silc_engine *E, const char *key, char *out, size_t outlen)
+{
+    key_search s;
+    key_info k;
+    const char *best = NULL;
+    char with[200];
+    snprintf(with, sizeof with, "dispatch.%s", key);
+    if (find_key(E, with, &k)) {
+        snprintf(out, outlen, "%s", with);
+        return out;
+    }
+    memset(&s, 0, sizeof s);
+    s.cap = 4096;
+    s.names = malloc(s.cap * sizeof *s.names);
+    s.store = malloc(s.cap * sizeof *s.store);
+    if (s.names && s.store) {
+        each_key(E, collect_visit, &s);
+        if ((best = util_closest(key, s.names, s.n))) snprintf(out, outlen, "%s", best);
+    }
+    free(s.names);
+    free(s.store);
+    return best ? out : NULL;
+}
+
+/* The entry in force for key (the narrowest scope that has it), or NULL. */
+static const cfg_entry *entry_in_force(const silc_engine *E, const char *key)
+{
+    int s;
+    for (s = CFG_SCOPE_CALL; s >= CFG_SCOPE_FILE; s--) {
+        cfg_entry *e = *find_slot(E->cfg, s, key);
+        if (e) return e;
+    }
+    return NULL;
+}
+
+static void put_setting(const silc_engine *E, strbuf *b, const char *key, const char *dflt)
+{
+    const cfg_entry *e = entry_in_force(E, key);
+    sb_printf(b, "%-30s = %s  (%s)\n", key, e ? e->value : dflt, e ? e->origin : "default");
+}
+
+typedef struct list_ctx {
+    const silc_engine *E;
+    strbuf *b;
+} list_ctx;
+
+static int list_visit(void *u, const key_info *k)
+{
+    list_ctx *c = u;
+    put_setting(c->E, c->b, k->key, k->dflt);
+    return 0;
+}
+
+void cfg_list(const silc_engine *E, strbuf *b)
+{
+    list_ctx c;
+    int s;
+    key_info k;
+    if (!E || !E->cfg) return;
+    c.E = E;
+    c.b = b;
+    each_key(E, list_visit, &c);
+    /* set keys no table lists: a known plugin's options while it is not installed */
+    for (s = CFG_SCOPE_FILE; s <= CFG_SCOPE_CALL; s++) {
+        const cfg_entry *e;
+        for (e = E->cfg->scope[s]; e; e = e->next)
+            if (!find_key(E, e->key, &k) && entry_in_force(E, e->key) == e)
+                sb_printf(b, "%-30s = %s  (%s; its plugin is not loaded)\n", e->key, e->value, e->origin);
+    }
+}
+
+int cfg_show_key(silc_engine *E, const char *key, strbuf *b, int describe)
+{
+    key_info k;
+    char near[256];
+    const cfg_entry *e;
+    if (find_key(E, key, &k)) {
+        if (describe) {
+            const key_rule *r = rule_of(key);
+            sb_printf(b, "%s: %s\n  default: %s\n", key, k.why, k.dflt);
+            if (r && r->kind == KEY_SERVER) sb_puts(b, "  a server setting: silcd's config file only\n");
+            if (r && r->kind == KEY_FREEFORM) sb_printf(b, "  in silcd: %s\n", r->why);
+            sb_puts(b, "  now: ");
+        }
+        put_setting(E, b, key, k.dflt);
+        return 0;
+    }
+    if ((e = entry_in_force(E, key))) {   /* a key of a known plugin that is not loaded */
+        sb_printf(b, "%-30s = %s  (%s; its plugin is not loaded)\n", key, e->value, e->origin);
+        return 0;
+    }
+    if (suggest_key(E, key, near, sizeof near))
+        return eng_error(E, "unknown key '%s'; did you mean '%s'?", key, near);
+    return eng_error(E, "unknown key '%s' ('set' lists every key)", key);
+}
+
+int cfg_describe_plugin(const silc_engine *E, const char *name, strbuf *b)
+{
+    const ld_plugin *lp = ld_find_plugin(E, name);
+    const silc_plugin *pl;
+    int o, i;
+    if (!lp) return -1;
+    pl = lp->table;
+    sb_printf(b, "plugin %s %s\n", pl->name, pl->version ? pl->version : "");
+    for (i = 0; i < pl->n_backends; i++)
+        sb_printf(b, "  backend %s%s%s: %s\n", pl->name, pl->backends[i].name ? "." : "",
+                  pl->backends[i].name ? pl->backends[i].name : "",
+                  pl->backends[i].description ? pl->backends[i].description : "");
+    if (pl->n_options == 0) sb_puts(b, "  no options\n");
+    else sb_printf(b, "  options (set %s.KEY = VALUE; default in brackets):\n", pl->name);
+    for (o = 0; o < pl->n_options; o++) {
+        static const char *const types[] = {"integer", "number", "text", "true/false"};
+        const silc_option_spec *sp = &pl->options[o];
+        sb_printf(b, "    %s.%s [%s] (%s): %s\n", pl->name, sp->key,
+                  sp->default_value && sp->default_value[0] ? sp->default_value : "library default",
+                  sp->type >= 0 && sp->type < 4 ? types[sp->type] : "?", sp->help ? sp->help : "");
+    }
+    return 0;
 }
 
 /* Words in a free-form option's name that make it a server's business: what
@@ -604,20 +849,34 @@ static int session_refusal(silc_engine *E, int scope, const char *key, const cha
 static int store_value(silc_engine *E, int scope, const char *key, const char *value)
 {
     cfg_entry **pe = find_slot(E->cfg, scope, key), *e;
-    char *v = util_strdup(value);
-    if (!v) return eng_error(E, "out of memory setting '%s'", key);
+    char where[300];
+    char *v = util_strdup(value), *o;
+    if (scope == CFG_SCOPE_FILE && E->cfg->file)
+        snprintf(where, sizeof where, "%s:%d", E->cfg->file, E->cfg->file_line);
+    else
+        snprintf(where, sizeof where, "%s", scope_names[scope]);
+    o = util_strdup(where);
+    if (!v || !o) {
+        free(v);
+        free(o);
+        return eng_error(E, "out of memory setting '%s'", key);
+    }
     if (*pe) {
         free((*pe)->value);
+        free((*pe)->origin);
         (*pe)->value = v;
+        (*pe)->origin = o;
         return 0;
     }
     e = calloc(1, sizeof *e);
     if (!e || !(e->key = util_strdup(key))) {
         free(e);
         free(v);
+        free(o);
         return eng_error(E, "out of memory setting '%s'", key);
     }
     e->value = v;
+    e->origin = o;
     *pe = e;
     return 0;
 }
@@ -725,23 +984,6 @@ const char *cfg_get(const silc_engine *E, const char *key)
     return NULL;
 }
 
-void cfg_list(const silc_engine *E, strbuf *b)
-{
-    int s;
-    if (!E || !E->cfg) return;
-    for (s = CFG_SCOPE_FILE; s <= CFG_SCOPE_CALL; s++) {
-        const cfg_entry *e;
-        for (e = E->cfg->scope[s]; e; e = e->next) {
-            /* A key shadowed by a narrower scope is shown but marked. */
-            int t, shadowed = 0;
-            for (t = s + 1; t <= CFG_SCOPE_CALL; t++)
-                if (*find_slot(E->cfg, t, e->key)) shadowed = 1;
-            sb_printf(b, "%s = %s  (%s%s)\n", e->key, e->value, scope_names[s],
-                      shadowed ? ", overridden" : "");
-        }
-    }
-}
-
 /* ---- the INI file ---------------------------------------------------------- */
 
 /* inih (as packaged) does not pass line numbers to the handler, so the reader
@@ -813,6 +1055,14 @@ static int file_handler(void *user, const char *section, const char *name, const
     return 0;
 }
 
+/* The line a value of the file came from, for its origin in `set`. */
+static int file_handler_at(void *user, const char *section, const char *name, const char *value)
+{
+    file_ctx *c = user;
+    c->E->cfg->file_line = c->line;
+    return file_handler(user, section, name, value);
+}
+
 /* The null device: "no settings", as `--config /dev/null` is often meant. */
 static int is_null_device(const struct stat *st)
 {
@@ -855,7 +1105,9 @@ int cfg_load_file(silc_engine *E, const char *path)
     c.E = E;
     c.path = path;
     if (!(c.fp = open_config(E, path))) return -1;
-    rc = ini_parse_stream(file_reader, &c, file_handler, &c);
+    E->cfg->file = path;
+    rc = ini_parse_stream(file_reader, &c, file_handler_at, &c);
+    E->cfg->file = NULL;
     fclose(c.fp);
     if (rc < 0) return eng_error(E, "%s: out of memory reading the config file", path);
     /* the first error wins: inih's syntax errors are numbered as ours */

@@ -77,6 +77,14 @@ static const struct {
     {"solve.rect", "suitesparse.spqr, lapack, reference"},
 };
 
+const char *disp_default_list(const char *cls)
+{
+    size_t i;
+    for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
+        if (!strcmp(default_lists[i].cls, cls)) return default_lists[i].list;
+    return "reference";
+}
+
 /* For a solve whose operands are distributed (dist.h), the built-in lists
  * start with the backends that solve on the row blocks where they lie --
  * MUMPS (AMF ordering, the fastest of PETSc's direct packages here:

@@ -37,8 +37,19 @@ int cfg_set_call_options(silc_engine *E, const char *text);
 void cfg_clear_call_options(silc_engine *E);
 /* Value of key, the narrowest scope first; NULL if unset anywhere. */
 const char *cfg_get(const silc_engine *E, const char *key);
-/* Appends every set key with its value and scope to b (for `set` with no args). */
+/* Appends every key SILC knows here (the settings table, each dispatch
+ * class, each loaded plugin's options) with the value in force and where it
+ * came from -- default, FILE:LINE, session, call -- to b (`set`). */
 void cfg_list(const silc_engine *E, strbuf *b);
+/* One key's line of that listing (`set KEY`), and with describe set what it
+ * does and its default first (`help KEY`).  An unknown key: -1 with E->err
+ * naming the nearest real key. */
+int cfg_show_key(silc_engine *E, const char *key, strbuf *b, int describe);
+/* A loaded plugin's backends and options with their types, defaults and
+ * help, from its own option table (`help mumps`); -1 if no such plugin. */
+int cfg_describe_plugin(const silc_engine *E, const char *name, strbuf *b);
+/* The built-in backend list of a dispatch class ("reference" for most). */
+const char *disp_default_list(const char *cls);
 /* Appends the table of server and session settings (for `help set`). */
 void cfg_describe_keys(strbuf *b);
 

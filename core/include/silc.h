@@ -179,8 +179,11 @@ SILC_API const char *silc_context_errmsg(const silc_context *ctx);
  * computed but deserve distrust, e.g. "matrix is singular to working precision
  * (1-norm condition estimate 3.2e+17)".  Valid until the next call. */
 SILC_API const char *silc_context_warnings(const silc_context *ctx);
-/* Where `who`, `info` and `explain` print (default: stdout).  The callback gets
- * one complete piece of text at a time; NULL restores stdout. */
+/* Where `who`, `info`, `explain`, `help`, `set`, `profile` and `disp(x)` print
+ * (default: stdout).  The callback gets one complete piece of text at a
+ * time; NULL restores stdout.  silc_exec / SILC_EXEC never print a value on
+ * their own: a statement without ';' shows its value (as Octave does) only
+ * after `set core.display = on`, which the silc command sets. */
 typedef void (*silc_output_fn)(void *user, const char *text);
 SILC_API void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
 

@@ -507,7 +507,7 @@ static const bi_entry table[] = {
 const char *const bi_names[] = {
     "zeros", "ones", "eye", "rand", "size", "rows", "cols", "nnz", "sparse", "dense", "band",
     "diag", "diagvec", "sum", "max", "min", "dot", "norm", "abs", "sqrt", "exp", "log", "sin",
-    "cos", "trans", "solve", "pi", "inf", "nan", "eps", NULL};
+    "cos", "trans", "solve", "disp", "pi", "inf", "nan", "eps", "Inf", "NaN", NULL};
 
 static const bi_entry *lookup(const char *name)
 {
@@ -525,8 +525,8 @@ int bi_is_function(const char *name)
 int bi_constant(const char *name, double *x)
 {
     if (!strcmp(name, "pi")) *x = 3.14159265358979323846;
-    else if (!strcmp(name, "inf")) *x = INFINITY;
-    else if (!strcmp(name, "nan")) *x = NAN;
+    else if (!strcmp(name, "inf") || !strcmp(name, "Inf")) *x = INFINITY;   /* Octave spells both */
+    else if (!strcmp(name, "nan") || !strcmp(name, "NaN")) *x = NAN;
     else if (!strcmp(name, "eps")) *x = DBL_EPSILON;
     else return 0;
     return 1;
@@ -539,6 +539,8 @@ static int unknown_function(lang_ev *V, const char *name)
     if (store_get(&V->E->store, name))
         return eng_error(V->E, "unknown function '%s' ('%s' is a variable: subscripts use %s[...])",
                          name, name, name);
+    if (!strcmp(name, "disp"))   /* eval.c runs disp(x) as a statement */
+        return eng_error(V->E, "disp(x) shows x and has no value: write it as a statement of its own");
     for (i = 0; i < NTABLE; i++) fn[i] = table[i].name;
     best = util_closest(name, fn, NTABLE);
     if (best) return eng_error(V->E, "unknown function '%s' (did you mean '%s'?)", name, best);

@@ -18,6 +18,7 @@
 #include "accuracy.h"
 #include "dist.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,10 +35,51 @@ typedef struct cache_entry {
     struct cache_entry *next;
 } cache_entry;
 
+/* ---- the profile (core.profile = on, `profile`, silc --profile) ---------------
+ * Like PETSc's -log_view: per statement and per plugin call, the count, the
+ * time, the bytes handed in and out, the factorizations reused.  Rows are
+ * keyed by their text; a bounded table (PROF_ROWS each), whose last row
+ * gathers what does not fit. */
+#define PROF_ROWS 48
+
+typedef struct prof_row {
+    char name[80];
+    uint64_t count, reused;
+    double seconds, bytes_in, bytes_out;
+} prof_row;
+
+typedef struct prof_table {
+    prof_row rows[PROF_ROWS];
+    size_t n;
+} prof_table;
+
 typedef struct lang_cache {
     cache_entry *b[CACHE_BUCKETS];
     size_t count;
+    prof_table statements, calls;
 } lang_cache;
+
+/* The row named name (made when new; the last row takes the overflow). */
+static prof_row *prof_row_of(prof_table *t, const char *name)
+{
+    size_t i;
+    for (i = 0; i < t->n; i++)
+        if (!strcmp(t->rows[i].name, name)) return &t->rows[i];
+    if (t->n == PROF_ROWS) return &t->rows[PROF_ROWS - 1];
+    memset(&t->rows[t->n], 0, sizeof t->rows[0]);
+    snprintf(t->rows[t->n].name, sizeof t->rows[0].name, "%s", t->n == PROF_ROWS - 1 ? "(the rest)" : name);
+    return &t->rows[t->n++];
+}
+
+/* The bytes of a value's arrays. */
+static double value_bytes(const silc_value *v)
+{
+    if (!v) return 0;
+    if (v->format == SILC_FMT_CSR)
+        return (double)v->nnz * (sizeof(double) + sizeof(silc_index)) + (double)(v->m + 1) * sizeof(silc_index);
+    if (v->format == SILC_FMT_BAND) return (double)v->ld * (double)v->n * sizeof(double);
+    return (double)v->m * (double)v->n * sizeof(double);
+}
 
 static size_t text_hash(const char *s)
 {
@@ -143,12 +185,33 @@ static void indent_into(strbuf *b, const char *text)
     }
 }
 
+/* A plugin call's row of the profile: a solve by its backend, another
+ * operation by the class it ran under. */
+static void profile_call(lang_ev *V, const silc_call *call, const silc_report *rep, double seconds)
+{
+    lang_cache *c = V->E->lang_cache;
+    char name[80];
+    prof_row *r;
+    int i;
+    if (call->op == SILC_OP_SOLVE)
+        snprintf(name, sizeof name, "solve: %s", rep->backend[0] ? rep->backend : "?");
+    else
+        snprintf(name, sizeof name, "%s", call->op_class ? call->op_class : "operation");
+    r = prof_row_of(&c->calls, name);
+    r->count++;
+    r->seconds += seconds;
+    for (i = 0; i < call->nin; i++) r->bytes_in += value_bytes(call->in[i]);
+    r->bytes_out += value_bytes(call->out);
+    if (call->op == SILC_OP_SOLVE && rep->reused_factor) r->reused++;
+}
+
 int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
 {
     silc_engine *E = V->E;
     silc_report rep;
     size_t warned;
     int i, rc;
+    double t0;
     *out = NULL;
     call->out = NULL;
     if (call->op == SILC_OP_SOLVE) {
@@ -199,8 +262,10 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
+    t0 = V->profile ? util_now() : 0;
     rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
+    if (V->profile && !rc && call->out) profile_call(V, call, &rep, util_now() - t0);
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
         call->out = NULL;
@@ -587,6 +652,99 @@ static int scalar_whole(lang_ev *V, int rc, silc_value **out)
     return rc;
 }
 
+/* ---- ranges ------------------------------------------------------------------- */
+
+/* Octave's tolerant floor (Hagerty's FL5, liboctave Range.cc): x within ct
+ * (relative) below an integer counts as that integer, so 0:0.1:1 has 11
+ * elements although (1 - 0) / 0.1 is 9.999999999999998. */
+static double tolerant_floor(double x, double ct)
+{
+    double q = x < 0 ? 1 - ct : 1, rmax = q / (2 - ct), t1 = 1 + floor(x);
+    t1 = (ct / q) * (t1 < 0 ? -t1 : t1);
+    t1 = rmax < t1 ? rmax : t1;
+    t1 = ct > t1 ? ct : t1;
+    t1 = floor(x + t1);
+    return (x <= 0 || t1 - x < rmax) ? t1 : t1 - 1;
+}
+
+static int tolerant_equal(double u, double v, double ct)
+{
+    double tu = fabs(u), tv = fabs(v);
+    return fabs(u - v) < (tu > tv ? tu : tv) * ct;
+}
+
+/* The elements of base:inc:limit as Octave counts them (its numel and
+ * final value): 0 when inc is 0 or points away from limit. */
+static double range_count(double base, double inc, double limit)
+{
+    double ct = 3 * DBL_EPSILON, n;
+    if (inc == 0 || (limit > base && inc < 0) || (limit < base && inc > 0)) return 0;
+    n = tolerant_floor((limit - base + inc) / inc, ct);
+    if (n < 0) n = 0;
+    if (n > 0 && !tolerant_equal(base + (n - 1) * inc, limit, ct)) {
+        if (n > 1 && tolerant_equal(base + (n - 2) * inc, limit, ct)) n--;
+        else if (tolerant_equal(base + n * inc, limit, ct)) n++;
+    }
+    return n;
+}
+
+/* Element k (0-based) of a range of count elements: the last one is held
+ * to the limit, and made whole when every element is (Octave's final value). */
+static double range_at(double base, double inc, double limit, double count, double k)
+{
+    double x = base + k * inc;
+    if (k > 0 && k == count - 1) {
+        if ((inc > 0 && x >= limit) || (inc < 0 && x <= limit)) x = limit;
+        if (base == floor(base) && inc == floor(inc)) x = floor(x + 0.5);
+    }
+    return x;
+}
+
+typedef struct range_spec {
+    double base, inc, limit, count;
+} range_spec;
+
+/* Evaluates the ends (and step) of a range node: each must be a finite scalar. */
+static int range_of(lang_ev *V, const ast_node *n, range_spec *r)
+{
+    double x[3] = {0, 0, 0};
+    size_t i;
+    for (i = 0; i < n->nkids; i++) {
+        silc_value *v;
+        if (ev_expr(V, n->kids[i], &v)) return -1;
+        if (!val_is_scalar(v)) {
+            char shape[48];
+            ev_shape(v, shape, sizeof shape);
+            val_release(v);
+            return eng_error(V->E, "a range's %s must be a scalar, got %s",
+                             i == 0 ? "start" : i + 1 == n->nkids ? "end" : "step", shape);
+        }
+        x[i] = val_scalar(v);
+        val_release(v);
+        if (!isfinite(x[i]))
+            return eng_error(V->E, "a range needs finite ends and step, got %g", x[i]);
+    }
+    r->base = x[0];
+    r->inc = n->nkids == 3 ? x[1] : 1;
+    r->limit = x[n->nkids - 1];
+    r->count = range_count(r->base, r->inc, r->limit);
+    return 0;
+}
+
+/* base:inc:limit as a 1xN dense row, as Octave's range is. */
+static int eval_range(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    range_spec r;
+    int64_t k, count;
+    if (range_of(V, n, &r)) return -1;
+    if (val_claim(r.count * sizeof(double), "the range"))
+        return eng_error(V->E, "a range of %.4g elements is larger than one value may be", r.count);
+    count = (int64_t)r.count;
+    if (!(*out = val_dense_new(1, count))) return eng_oom(V->E);
+    for (k = 0; k < count; k++) (*out)->val[k] = range_at(r.base, r.inc, r.limit, r.count, (double)k);
+    return 0;
+}
+
 static int expr_any(lang_ev *V, const ast_node *n, silc_value **out);
 
 int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out)
@@ -610,8 +768,9 @@ static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
     case AST_STRING:
         return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
     case AST_COLON_ALL:
+        return eng_error(E, "':' alone is only allowed as a subscript (A[:, j])");
     case AST_RANGE:
-        return eng_error(E, "a range is only allowed inside a subscript");
+        return eval_range(V, n, out);
     case AST_BINARY:
         return eval_binary(V, n, out);
     case AST_UNARY:
@@ -986,19 +1145,20 @@ static int exec_set(lang_ev *V, const ast_node *s)
         strbuf b;
         sb_init(&b);
         cfg_list(E, &b);
-        if (!b.len && !b.failed) sb_puts(&b, "no settings\n");
         return print_whole(E, &b, "set");
     }
     eq = strchr(s->name, '=');
     key = trimmed(s->name, eq ? (size_t)(eq - s->name) : strlen(s->name));
     if (!key) return eng_oom(E);
     if (!eq) {
-        const char *v = cfg_get(E, key);
         strbuf b;
         sb_init(&b);
-        if (v) sb_printf(&b, "%s = %s\n", key, v);
-        else sb_printf(&b, "%s is not set\n", key);
+        rc = cfg_show_key(E, key, &b, 0);
         free(key);
+        if (rc) {
+            sb_free(&b);
+            return -1;
+        }
         return print_whole(E, &b, "set");
     }
     value = trimmed(eq + 1, strlen(eq + 1));
@@ -1096,6 +1256,89 @@ static int exec_info(lang_ev *V, const ast_node *s)
 
 static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
 
+/* ---- display ----------------------------------------------------------------- */
+
+/* Whether a statement without ';' shows its value: core.display = on, which
+ * the silc command sets (an embedded program's SILC_EXEC never prints
+ * values), and never under explain. */
+static int displaying(const lang_ev *V, const ast_node *s)
+{
+    const char *d;
+    if (s->quiet || V->explain) return 0;
+    d = cfg_get(V->E, "core.display");
+    return d && !strcmp(d, "on");
+}
+
+static int show(lang_ev *V, const char *name, const silc_value *v)
+{
+    strbuf b;
+    silc_value *whole = NULL;
+    int rc;
+    /* A small value distributed by rows is gathered to be shown (every rank
+     * runs this alike: core.display is the same on all); a large one is
+     * described without moving it. */
+    if (dist_is(v) && v->m <= 40 && v->n <= 40) {
+        whole = val_retain((silc_value *)v);
+        if (dist_make_whole(V->E, &whole)) {
+            val_release(whole);
+            return -1;
+        }
+        v = whole;
+    }
+    sb_init(&b);
+    dp_show(V->E, &b, name, v);
+    rc = print_whole(V->E, &b, "the display");
+    val_release(whole);
+    return rc;
+}
+
+/* disp(x): shows x without its name, whatever core.display says (it is
+ * asked for); a statement of its own, since it has no value. */
+static int exec_disp(lang_ev *V, const ast_node *call)
+{
+    silc_value *v;
+    int rc;
+    if (call->nkids != 1) return eng_error(V->E, "disp takes one argument, got %zu", call->nkids);
+    if (ev_expr(V, call->kids[0], &v)) return -1;
+    rc = V->explain ? 0 : show(V, NULL, v);
+    val_release(v);
+    return rc;
+}
+
+/* An expression statement: a name shows as itself (`x = 3`), any other
+ * value as Octave's `ans = ...`, and binds ans when it is shown. */
+static int exec_expr(lang_ev *V, const ast_node *s, double t0)
+{
+    const ast_node *e = s->kids[0];
+    silc_value *v;
+    if (e->kind == AST_CALL && !strcmp(e->name, "disp")) return exec_disp(V, e);
+    if (ev_expr(V, e, &v)) return -1;
+    if (V->explain) {
+        char shape[48];
+        ev_shape(v, shape, sizeof shape);
+        sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
+                  val_format_name(v->format));
+    }
+    if (V->E->warnings.failed) {
+        val_release(v);
+        return eng_error(V->E, "out of memory recording a warning");
+    }
+    if (!displaying(V, s)) {
+        val_release(v);
+        return 0;
+    }
+    if (e->kind == AST_NAME && store_get(&V->E->store, e->name)) {
+        int rc = show(V, e->name, v);
+        val_release(v);
+        return rc;
+    }
+    if (show(V, "ans", v)) {
+        val_release(v);
+        return -1;
+    }
+    return bind(V, s, "ans", v, t0);
+}
+
 static int exec_tune(lang_ev *V, const ast_node *s)
 {
     double xs[128];
@@ -1164,6 +1407,9 @@ static int exec_block(lang_ev *V, const ast_node *b, int *flow)
 }
 
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow);
+static int empty_loop_cancelled(lang_ev *V);
+static int exec_for(lang_ev *V, const ast_node *s, int *flow);
+static int exec_profile(lang_ev *V, const ast_node *s);
 
 /* One statement; on a communicator every rank learns whether every rank
  * ran it (dist.h): a statement that failed on one rank alone (out of
@@ -1207,23 +1453,13 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
     }
     eng_pending_release(&V->pending);
     switch (s->kind) {
-    case ST_EXPR: {
-        silc_value *v;
-        if (ev_expr(V, s->kids[0], &v)) return -1;
-        if (V->explain) {
-            char shape[48];
-            ev_shape(v, shape, sizeof shape);
-            sb_printf(V->explain_out, "  result: a %s %s value (not run)\n", shape,
-                      val_format_name(v->format));
-        }
-        val_release(v);
-        if (V->E->warnings.failed) return eng_error(V->E, "out of memory recording a warning");
-        return 0;
-    }
+    case ST_EXPR:
+        return exec_expr(V, s, t0);
     case ST_ASSIGN:
     case ST_OPASSIGN:
     case ST_INDEX_ASSIGN:
-        return exec_assign(V, s, t0);
+        if (exec_assign(V, s, t0)) return -1;
+        return displaying(V, s) ? show(V, s->name, store_get(&V->E->store, s->name)) : 0;
     case ST_CLEAR:
         return exec_clear(V, s);
     case ST_WHO:
@@ -1248,6 +1484,15 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         strbuf b;
         char err[200];
         sb_init(&b);
+        /* help KEY (a setting) and help PLUGIN (its options) ask the options database */
+        if (s->name && strchr(s->name, '.')) {
+            if (cfg_show_key(V->E, s->name, &b, 1)) {
+                sb_free(&b);
+                return -1;
+            }
+            return print_whole(V->E, &b, "help");
+        }
+        if (s->name && !cfg_describe_plugin(V->E, s->name, &b)) return print_whole(V->E, &b, "help");
         if (lang_help(&b, s->name, err, sizeof err)) {
             sb_free(&b);
             return eng_error(V->E, "%s", err);
@@ -1266,6 +1511,10 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
         if (condition(V, s->cond, &truth)) return -1;
         if (truth) return exec_block(V, s->kids[0], flow);
         return s->els ? exec_stmt(V, s->els, flow) : 0;
+    case ST_FOR:
+        return exec_for(V, s, flow);
+    case ST_PROFILE:
+        return exec_profile(V, s);
     case ST_WHILE: {
         /* An iteration of the outermost loop is a time step to the tuner
          * (a script's loop is the program's time loop; tuner_loop_step). */
@@ -1293,6 +1542,117 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
     }
 }
 
+/* A top-level statement's row of the profile, by its first line of text. */
+static void profile_statement(lang_ev *V, const ast_node *s, double seconds)
+{
+    lang_cache *c = V->E->lang_cache;
+    char name[80];
+    size_t len = s->end - s->start;
+    const char *nl = memchr(V->src + s->start, '\n', len);
+    prof_row *r;
+    if (nl) len = (size_t)(nl - (V->src + s->start));
+    if (len > 38) len = 38;   /* the table's column */
+    snprintf(name, sizeof name, "%.*s%s", (int)len, V->src + s->start, nl || s->end - s->start > 38 ? " ..." : "");
+    r = prof_row_of(&c->statements, name);
+    r->count++;
+    r->seconds += seconds;
+}
+
+static void put_profile_table(strbuf *b, const char *title, const prof_table *t, int calls)
+{
+    size_t i;
+    sb_printf(b, "%-44s %8s %11s", title, "count", "time (s)");
+    if (calls) sb_printf(b, " %12s %12s %7s", "bytes in", "bytes out", "reused");
+    sb_puts(b, "\n");
+    if (!t->n) sb_puts(b, "  (none)\n");
+    for (i = 0; i < t->n; i++) {
+        const prof_row *r = &t->rows[i];
+        sb_printf(b, "  %-42s %8llu %11.4g", r->name, (unsigned long long)r->count, r->seconds);
+        if (calls) sb_printf(b, " %12.4g %12.4g %7llu", r->bytes_in, r->bytes_out, (unsigned long long)r->reused);
+        sb_puts(b, "\n");
+    }
+}
+
+/* profile: the tables; profile clear: empties them. */
+static int exec_profile(lang_ev *V, const ast_node *s)
+{
+    lang_cache *c = V->E->lang_cache;
+    const char *p = cfg_get(V->E, "core.profile");
+    strbuf b;
+    if (s->name) {   /* clear */
+        memset(&c->statements, 0, sizeof c->statements);
+        memset(&c->calls, 0, sizeof c->calls);
+        return 0;
+    }
+    sb_init(&b);
+    sb_printf(&b, "profile (core.profile = %s; time is wall time, a statement's includes its calls; "
+                  "reused = solves that reused a factorization)\n", p ? p : "off");
+    put_profile_table(&b, "statement", &c->statements, 0);
+    put_profile_table(&b, "plugin call (solve: backend; else the class)", &c->calls, 1);
+    return print_whole(V->E, &b, "profile");
+}
+
+/* The column k of the values a for loop walks: a range's element k (the
+ * range is never built whole: `for i = 1:1e9` needs no 8 GB), or column k
+ * of a value (a scalar when it has one row). */
+static int for_value(lang_ev *V, const range_spec *r, const silc_value *all, int64_t k,
+                     silc_value **out)
+{
+    int64_t i;
+    if (!all) {
+        *out = val_scalar_new(range_at(r->base, r->inc, r->limit, r->count, (double)k));
+        return *out ? 0 : eng_oom(V->E);
+    }
+    if (!(*out = val_dense_new(all->m, 1))) return eng_oom(V->E);
+    for (i = 0; i < all->m; i++) (*out)->val[i] = val_get(all, i, k);
+    return 0;
+}
+
+/* for name = e: binds name to each column of e in turn and runs the body.
+ * The loop budget, the tuner's time steps and the cancel checks are those
+ * of `while`. */
+static int exec_for(lang_ev *V, const ast_node *s, int *flow)
+{
+    range_spec r = {0, 0, 0, 0};
+    silc_value *all = NULL;
+    int64_t k, count;
+    int rc = 0, outer;
+    uint64_t key;
+    if (s->cond->kind == AST_RANGE) {
+        if (range_of(V, s->cond, &r)) return -1;
+        count = (int64_t)r.count;
+    } else {
+        if (ev_expr(V, s->cond, &all)) return -1;
+        count = all->m > 0 ? all->n : 0;
+    }
+    outer = V->loop_depth++ == 0 && !V->explain;
+    key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
+    for (k = 0; k < count; k++) {
+        double ti = util_now();
+        silc_value *v;
+        if (V->E->loop_budget && ++V->loops > V->E->loop_budget) {
+            rc = eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
+                           (unsigned long long)V->E->loop_budget);
+            break;
+        }
+        if ((rc = for_value(V, &r, all, k, &v))) break;
+        /* the loop variable's record is its own, not the last solve's of the body */
+        V->has_solve = 0;
+        V->backends[0] = 0;
+        eng_pending_release(&V->pending);
+        if ((rc = bind(V, s, s->name, v, ti))) break;
+        if (!s->kids[0]->nkids && !V->explain && (rc = empty_loop_cancelled(V))) break;
+        if ((rc = exec_block(V, s->kids[0], flow))) break;
+        if (outer) tuner_loop_step(V->E, key, util_now() - ti);
+        if (*flow == FLOW_BREAK) break;
+        if (V->explain) break;   /* explain describes one pass */
+    }
+    V->loop_depth--;
+    val_release(all);
+    if (!rc) *flow = FLOW_NEXT;
+    return rc;
+}
+
 int lang_exec(silc_engine *E, const char *text)
 {
     lang_program *prog;
@@ -1311,10 +1671,17 @@ int lang_exec(silc_engine *E, const char *text)
     memset(&V, 0, sizeof V);
     V.E = E;
     V.src = prog->text;
+    {
+        const char *p = cfg_get(E, "core.profile");
+        V.profile = p && !strcmp(p, "on");
+    }
     for (i = 0; i < prog->nstmts; i++) {
-        int flow;
+        int flow, rc;
+        double ts = V.profile ? util_now() : 0;
         E->err[0] = 0;
-        if (exec_stmt(&V, prog->stmts[i], &flow)) {
+        rc = exec_stmt(&V, prog->stmts[i], &flow);
+        if (V.profile && prog->stmts[i]->kind != ST_PROFILE) profile_statement(&V, prog->stmts[i], util_now() - ts);
+        if (rc) {
             eng_pending_release(&V.pending);
             free(V.bind_text);
             if (prog->nstmts > 1) {

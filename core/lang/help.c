@@ -31,15 +31,25 @@ static const help_entry entries[] = {
      "same updates. The numbers are those of the copying path, bit for bit"},
     {"[]=", 1, "`x[i, j] = e`, `x[a:b] = e`", "assign into a block of an existing `x` (same shape, or a scalar)"},
     {"()", 1, "`f(args)`", "procedure call (value discarded)"},
-    {"if else while break continue", 1,
-     "`if (c) { ... } else { ... }`, `while (c) { ... }`, `break`, `continue`",
-     "control flow; `c` must be 1x1, nonzero is true; each iteration of a top-level `while` is a time step "
-     "to the tuner"},
+    {"if elseif else while for end break continue", 1,
+     "`if c ... elseif c ... else ... end`, `while c ... end`, `for i = 1:n ... end`; or with braces "
+     "`if (c) { ... } else { ... }`, `while (c) { ... }`, `for (i = v) { ... }`; `break`, `continue`",
+     "control flow; `c` must be 1x1, nonzero is true; `for` binds `i` to each column of the value in turn (a "
+     "range is never built whole); each iteration of a top-level `while` or `for` is a time step to the tuner; "
+     "`,` separates statements as `;` does, but without hiding the value"},
+    {"display format disp ans", 1, "`x`, `x = e` (no `;`), `disp(x)`, `format long`, `format short`",
+     "with `core.display = on` (the `silc` command's setting; an embedded `SILC_EXEC` never prints) a "
+     "statement without `;` shows its value as Octave does: small values in full, larger ones (over 40 rows or "
+     "columns, sparse over 100 entries) summarised by size, format, nnz and top-left corner; an expression's "
+     "value is shown and bound as `ans`. `disp(x)` always shows `x` without its name; `format long` shows 16 "
+     "significant digits (`core.format`)"},
     {"clear", 1, "`clear`, `clear a b`", "remove names"},
     {"who", 1, "`who`", "names, shapes, formats"},
     {"set", 1, "`set key = value`, `set key`, `set`",
-     "session option (same keys as the config file), show one, list all; in silcd a server setting "
-     "(core.plugin_path, tune.wisdom, ...: `help set` lists them) is refused"},
+     "session option (same keys as the config file); `set key` shows the value in force and where it came "
+     "from (default, file:line, session), `set` lists every key so, plugin options included; `help key` "
+     "describes one and `help PLUGIN` lists a plugin's options with their defaults; in silcd a server "
+     "setting (core.plugin_path, tune.wisdom, ...: `help set` lists them) is refused"},
     {"info", 1, "`info x`",
      "how `x` was last computed: statement, backend, method, time, backward error, condition estimate, "
      "iterations, factor reuse, warm start, earlier attempts of the fallback chain"},
@@ -55,9 +65,14 @@ static const help_entry entries[] = {
      "storage with `kl`, `ku`; a failed save keeps the old file, a failed load changes no name; in silcd the "
      "file is beneath the session's folder under `silcd --data-dir` (no absolute path, `..` or symbolic "
      "link), refused without it"},
-    {"[", 0, "`[1, 2; 3, 4]`, `[A, b; c', d]`",
-     "matrix literal / concatenation: `,` side by side, `;` stacks; `[]` is 0×0 and is skipped in "
-     "concatenation; CSR if any block is CSR"},
+    {"[", 0, "`[1 2; 3 4]`, `[1, 2; 3, 4]`, `[A, b; c', d]`",
+     "matrix literal / concatenation: `,` or white space side by side (`[1 -2]` is two entries, `[1 - 2]` "
+     "one, as in Octave), `;` or a line break stacks; `[]` is 0×0 and is skipped in concatenation; CSR if "
+     "any block is CSR"},
+    {":", 0, "`a:b`, `a:s:b`",
+     "row vector from a to b in steps of s (default 1), counted as Octave counts (`0:0.1:1` has 11 entries, "
+     "the last exactly 1); empty when s points away from b; looser than `+ -`, tighter than comparisons "
+     "(`1:n+1`); in a subscript the indices it lists"},
     {"zeros ones", 0, "`zeros(m[,n])`, `ones(m[,n])`", "dense; one argument gives m×m"},
     {"eye", 0, "`eye(n[,m])`", "CSR identity (sparse: this is a sparse-solver tool)"},
     {"rand", 0, "`rand(m[,n])`", "dense uniform [0,1), reproducible per context (xorshift64*)"},
@@ -75,7 +90,8 @@ static const help_entry entries[] = {
     {"trans", 0, "`trans(A)`", "`A'`"},
     {"solve", 0, "`solve(A, b, \"options\")`",
      "`A \\ b` with per-call options, e.g. `\"backend = suitesparse.klu\"` or `\"mumps.icntl_7 = 5\"`"},
-    {"pi inf nan eps", 0, "`pi`, `inf`, `nan`, `eps`", "constants (a variable of the same name shadows them)"},
+    {"pi inf nan eps Inf NaN", 0, "`pi`, `inf` (`Inf`), `nan` (`NaN`), `eps`",
+     "constants (a variable of the same name shadows them)"},
 };
 enum { NENTRIES = sizeof entries / sizeof entries[0] };
 

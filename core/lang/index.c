@@ -87,7 +87,7 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *
     if (sub->kind == AST_COLON_ALL) {
         if (!(out->ix = ix_alloc(V, extent))) rc = -1;
         for (k = 0; !rc && k < extent; k++) out->ix[out->n++] = k;
-    } else if (sub->kind == AST_RANGE) {
+    } else if (sub->kind == AST_RANGE && sub->nkids == 2) {   /* a:s:b is a value like any other */
         double a, b, x;
         if (range_end(V, sub->kids[0], &a) || range_end(V, sub->kids[1], &b)) {
             rc = -1;

@@ -2,8 +2,9 @@
  * lang.h -- the command language (core/lang/): tokens (lexer.c), the
  * syntax tree (parser.c), the evaluator's state shared with the built-in
  * functions (builtins.c), subscripts (index.c) and matrix literals
- * (concat.c), `help` (help.c), save/load (h5io.c) and the memo of repeated
- * operations (memo.c), all driven by lang_exec() in eval.c.  The language
+ * (concat.c), `help` (help.c), save/load (h5io.c), the memo of repeated
+ * operations (memo.c) and how values are shown (display.c), all driven by
+ * lang_exec() in eval.c.  The language
  * calls down into the tuner, the dispatcher, the accuracy machinery and the
  * distributed layer; only the engine and the client call it.
  *
@@ -39,6 +40,8 @@ typedef struct lx_token {
     int line, col;         /* 1-based */
     size_t start, len;     /* span in the source text */
     double num;            /* TK_NUMBER */
+    int space_before;      /* white space precedes it: in a matrix literal `[1 -2]` is two
+                              elements and `[1 - 2]` one, as in Octave (parser.c) */
 } lx_token;
 
 typedef struct lx_tokens {
@@ -47,6 +50,9 @@ typedef struct lx_tokens {
 } lx_tokens;
 
 /* Tokenizes text; the `set` keyword's argument becomes one TK_RAW token.
+ * Inside a matrix literal a line break separates rows, so it becomes a
+ * TK_SEMI (none after `[`, `,` or `;`); inside ( ) and subscripts it is
+ * dropped, so an expression may span lines.
  * Returns 0, or -1 with "L:C: message" in err. */
 int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen);
 void lx_free(lx_tokens *toks);
@@ -63,10 +69,13 @@ enum ast_kind {
     /* statements (after every expression kind: parser.c tests kind < ST_EXPR) */
     ST_EXPR, ST_ASSIGN, ST_OPASSIGN, ST_INDEX_ASSIGN, ST_CLEAR, ST_WHO, ST_SET,
     ST_INFO, ST_EXPLAIN, ST_IF, ST_WHILE, ST_BREAK, ST_CONTINUE,
+    ST_FOR,                /* for name = cond: kids[0] the body block; each column of the
+                              value of cond in turn (a range is never built whole) */
     ST_BLOCK,              /* { statements } of IF / WHILE: kids are the statements */
     ST_TUNE,               /* tune WORD: name the word; kids AST_NUM arguments (fit: p, t
                               pairs); els unused; an AST_STRING kid names a file */
     ST_HELP,               /* help [NAME]: name is NULL or the word asked about */
+    ST_PROFILE,            /* profile [clear]: name is NULL or "clear" */
     ST_SAVE, ST_LOAD       /* save/load "file" [names]: name is the file, kids AST_NAME */
 };
 
@@ -76,11 +85,12 @@ struct ast_node {
     int op;                /* operator token kind (BINARY, UNARY, OPASSIGN) */
     int line, col;
     int height;            /* 1 + the tallest kid's: bounds every walk of the tree */
+    int quiet;             /* a statement followed by ';': its value is not shown */
     size_t start, end;     /* source span [start, end) */
     double num;            /* AST_NUM */
     char *name;            /* NAME, CALL, STRING (unquoted text), assignment target, SET raw text */
     /* kids: BINARY/UNARY/TRANSPOSE operands; INDEX base then subscripts; CALL
-     * arguments; RANGE from, to; EXPR/ASSIGN/OPASSIGN the expression;
+     * arguments; RANGE from, to or from, step, to; EXPR/ASSIGN/OPASSIGN the expression;
      * INDEX_ASSIGN the value then the subscripts; CLEAR names; EXPLAIN the
      * statement; IF/WHILE the body block; BLOCK the statements */
     ast_node **kids;
@@ -118,6 +128,7 @@ typedef struct lang_ev {
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
     int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
     const silc_value *warm; /* initial guess for the statement's solve (solve.initial_guess), or NULL */
+    int profile;           /* core.profile = on when the exec began: time statements and calls */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,
@@ -165,6 +176,10 @@ int ev_expr(lang_ev *V, const ast_node *n, silc_value **out);
  * consumers that hand it to ev_run or bind it, never read its arrays.
  * ev_expr gathers such a value to every rank first. */
 int ev_expr_dist(lang_ev *V, const ast_node *n, silc_value **out);
+
+/* display.c: v as Octave shows it, `name = ...` (name NULL: as disp(v)
+ * shows it, without the name), into b; core.format says short or long. */
+void dp_show(silc_engine *E, strbuf *b, const char *name, const silc_value *v);
 
 /* help.c: `help` (every statement and built-in word) or `help NAME` (its
  * usage and what it does) into out; -1 with err for an unknown name.  The

@@ -1,12 +1,18 @@
 /*
  * lexer.c -- turns statement text into tokens with 1-based line:column.
  *
- * Newlines separate statements, so they are tokens, except inside () and []
- * where an expression may span lines.  `'` is always the transpose: strings use
+ * Newlines separate statements, so they are tokens, except inside () and
+ * subscripts [], where an expression may span lines, and inside a matrix
+ * literal, where a newline separates rows as `;` does (Octave's
+ * `[1 2\n 3 4]` is 2x2).  A `[` opens a subscript when it follows what can
+ * be subscripted (a name, a number, `)`, `]`, `'`) with no space between, or
+ * with a space outside a literal; otherwise it opens a literal: the parser
+ * (parse_postfix) makes the same choice from the same token facts.  `'` is always the transpose: strings use
  * double quotes and only appear as option arguments.  The argument of a `set`
  * keyword statement is not an expression but "key = value" with free-form
  * value text (backend option strings such as "-i cg -p ilu"), so the lexer
- * hands the rest of that statement over as one raw token.
+ * hands the rest of that statement over as one raw token; so does `help`,
+ * whose word may be a setting's key (`help solve.verify`).
  */
 #include "lang.h"
 
@@ -15,11 +21,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Brackets deeper than this are past the parser's nesting limit anyway
+ * (SILC_MAX_NESTING), so their kind no longer matters. */
+#define LX_MAX_OPEN (2 * SILC_MAX_NESTING + 8)
+
 typedef struct lx_state {
     const char *s;
     size_t pos;
     int line, col;
     int depth;             /* open ( and [ */
+    char open[LX_MAX_OPEN]; /* what the innermost LX_MAX_OPEN of them are: '(' ,
+                               's' a subscript, 'l' a literal */
+    int space;             /* white space since the last token */
     lx_tokens *out;
     char *err;
     size_t errlen;
@@ -44,6 +57,8 @@ static int push(lx_state *L, int kind, size_t start, int line, int col, double n
     o->t[o->n].start = start;
     o->t[o->n].len = L->pos - start;
     o->t[o->n].num = num;
+    o->t[o->n].space_before = L->space;
+    L->space = 0;
     o->n++;
     return 0;
 }
@@ -156,6 +171,24 @@ static const struct { const char *text; int kind; } ops[] = {
     {":", TK_COLON}, {"=", TK_ASSIGN}, {"<", TK_LT}, {">", TK_GT}, {"!", TK_NOT},
 };
 
+/* The kind of the innermost open bracket: '(' , 's', 'l', or 0 at the top. */
+static char innermost(const lx_state *L)
+{
+    if (L->depth == 0) return 0;
+    return L->depth <= LX_MAX_OPEN ? L->open[L->depth - 1] : '(';
+}
+
+/* Whether a `[` here opens a subscript (see the head of the file). */
+static int opens_subscript(const lx_state *L)
+{
+    int k;
+    if (L->out->n == 0) return 0;
+    k = L->out->t[L->out->n - 1].kind;
+    if (k != TK_NAME && k != TK_NUMBER && k != TK_RPAREN && k != TK_RBRACKET && k != TK_QUOTE)
+        return 0;
+    return !(L->space && innermost(L) == 'l');
+}
+
 static int lex_operator(lx_state *L)
 {
     size_t i, start = L->pos;
@@ -163,7 +196,11 @@ static int lex_operator(lx_state *L)
     for (i = 0; i < sizeof ops / sizeof ops[0]; i++) {
         size_t k = strlen(ops[i].text);
         if (strncmp(L->s + L->pos, ops[i].text, k) != 0) continue;
-        if (ops[i].kind == TK_LPAREN || ops[i].kind == TK_LBRACKET) L->depth++;
+        if (ops[i].kind == TK_LPAREN || ops[i].kind == TK_LBRACKET) {
+            if (L->depth < LX_MAX_OPEN)
+                L->open[L->depth] = ops[i].kind == TK_LPAREN ? '(' : opens_subscript(L) ? 's' : 'l';
+            L->depth++;
+        }
         if ((ops[i].kind == TK_RPAREN || ops[i].kind == TK_RBRACKET) && L->depth > 0) L->depth--;
         advance(L, k);
         return push(L, ops[i].kind, start, line, col, 0);
@@ -185,6 +222,7 @@ int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen)
     L.pos = 0;
     L.line = L.col = 1;
     L.depth = 0;
+    L.space = 0;
     L.out = out;
     L.err = err;
     L.errlen = errlen;
@@ -196,6 +234,7 @@ int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen)
         if (c == 0) break;
         if (c == ' ' || c == '\t' || c == '\r') {
             advance(&L, 1);
+            L.space = 1;
             continue;
         }
         if (c == '#') {
@@ -206,7 +245,14 @@ int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen)
             size_t start = L.pos;
             int line = L.line, col = L.col;
             advance(&L, 1);
-            if (L.depth == 0) rc = push(&L, TK_NEWLINE, start, line, col, 0);
+            if (L.depth == 0) {
+                rc = push(&L, TK_NEWLINE, start, line, col, 0);
+            } else if (innermost(&L) == 'l') {
+                int k = out->t[out->n - 1].kind; /* a literal's '[' is a token before */
+                if (k != TK_LBRACKET && k != TK_COMMA && k != TK_SEMI)
+                    rc = push(&L, TK_SEMI, start, line, col, 0);
+            }
+            L.space = 1;
         } else if (isdigit((unsigned char)c) ||
                    (c == '.' && isdigit((unsigned char)text[L.pos + 1]))) {
             rc = lex_number(&L);
@@ -215,7 +261,11 @@ int lx_tokenize(const char *text, lx_tokens *out, char *err, size_t errlen)
             int line = L.line, col = L.col, kw = at_statement_start(&L);
             while (isalnum((unsigned char)text[L.pos]) || text[L.pos] == '_') advance(&L, 1);
             rc = push(&L, TK_NAME, start, line, col, 0);
-            if (!rc && kw && L.pos - start == 3 && !strncmp(text + start, "set", 3) &&
+            /* set's argument is "key = value"; help's a word that may be a
+             * key (help solve.verify) */
+            if (!rc && kw &&
+                ((L.pos - start == 3 && !strncmp(text + start, "set", 3)) ||
+                 (L.pos - start == 4 && !strncmp(text + start, "help", 4))) &&
                 !name_is_assigned(text + L.pos))
                 rc = lex_raw(&L);
         } else if (c == '"') {

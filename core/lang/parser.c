@@ -12,9 +12,13 @@
  * left-associative chain (`1+1+...+1`) reaches without recursing here but
  * which the evaluator and node_free() would walk recursively.
  *
- * Keywords (clear who set info explain tune if while else break continue) are
- * keywords only at the start of a statement and only when not followed by an
- * assignment, so `info = 3` still binds a variable.  The first syntax error
+ * Keywords (clear who set info explain tune if while for else break continue
+ * format help save load, and the block words end endif endwhile endfor
+ * elseif) are keywords only at the start of a statement and only when not
+ * followed by an assignment, so `info = 3` still binds a variable.  Blocks
+ * are written with braces, `while (c) { ... }`, or as in Octave, `while c
+ * ... end`; a condition is any expression.  Inside a matrix literal white
+ * space separates elements as Octave does (starts_new_element).  The first syntax error
  * stops parsing; its message is Lua-style, "L:C: expected ')' (to close '('
  * at 1:5) near ';'".
  */
@@ -32,6 +36,8 @@ typedef struct ps_state {
     int depth;             /* nested expressions: enter() bounds it */
     int block_depth;       /* nested statements (blocks, else if, explain): the same */
     int bracket_depth;     /* inside [ ]: `end` and `:` are subscripts */
+    int in_literal;        /* directly inside a matrix literal's row (not within ( ) or a
+                              subscript there): white space may separate elements */
     char *err;
     size_t errlen;
     int failed;
@@ -207,6 +213,8 @@ static int close_with(ps_state *P, int kind, const char *what, const lx_token *o
 }
 
 static ast_node *parse_expr(ps_state *P);
+static int parse_list_items(ps_state *P, ast_node *n, int closer, const char *closetext,
+                            const lx_token *opener, int subscripts);
 
 static ast_node *binary(ps_state *P, const lx_token *optk, ast_node *l, ast_node *r)
 {
@@ -234,32 +242,40 @@ static ast_node *binary(ps_state *P, const lx_token *optk, ast_node *l, ast_node
     return n;
 }
 
-/* Subscript item: ':' alone, a:b, or an expression. */
+/* Inside a matrix literal, does the token here start the next element
+ * rather than continue this one?  As in Octave: a `+` or `-` with space
+ * before it and none after is a sign (`[1 -2]` is two elements, `[1 - 2]`
+ * and `[1 -  2]`... one), and a `(` or `[` after a space opens a new
+ * element (`[a (1)]`, `[x [1 2]]`). */
+static int starts_new_element(const ps_state *P)
+{
+    const lx_token *tk = peek(P);
+    if (!P->in_literal || !tk->space_before) return 0;
+    if (tk->kind == TK_PLUS || tk->kind == TK_MINUS) return !peek_at(P, 1)->space_before;
+    return tk->kind == TK_LPAREN || tk->kind == TK_LBRACKET;
+}
+
+/* Subscript item: ':' alone, or an expression (a range a:b or a:s:b among them). */
 static ast_node *parse_subscript(ps_state *P)
 {
-    ast_node *a, *r;
-    const lx_token *tk;
     if (is(P, TK_COLON) && (peek_at(P, 1)->kind == TK_COMMA || peek_at(P, 1)->kind == TK_RBRACKET))
         return node_new(P, AST_COLON_ALL, next(P));
-    a = parse_expr(P);
-    if (!a || !is(P, TK_COLON)) return a;
-    tk = next(P);
-    r = node_new(P, AST_RANGE, tk);
-    if (!r || add_kid(P, r, a)) {
-        if (!r) node_free(a);
-        node_free(r);
-        return NULL;
-    }
-    if (add_kid(P, r, parse_expr(P))) {
-        node_free(r);
-        return NULL;
-    }
-    return r;
+    return parse_expr(P);
 }
 
 /* Comma-separated items up to the closer; items go to n->kids. */
 static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetext,
                       const lx_token *opener, int subscripts)
+{
+    int saved = P->in_literal, rc;
+    P->in_literal = 0;     /* `[f(1, -2) 3]`: white space means nothing inside the call */
+    rc = parse_list_items(P, n, closer, closetext, opener, subscripts);
+    P->in_literal = saved;
+    return rc;
+}
+
+static int parse_list_items(ps_state *P, ast_node *n, int closer, const char *closetext,
+                            const lx_token *opener, int subscripts)
 {
     if (is(P, closer) && !subscripts) return close_with(P, closer, closetext, opener, n);
     for (;;) {
@@ -287,36 +303,59 @@ static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetex
     return close_with(P, closer, closetext, opener, n);
 }
 
-/* [a, b; c, d]: rows separated by ';', blocks by ','.  Newlines inside the
- * brackets are ignored by the lexer, so a literal may span lines. */
+/* Whether a token can begin an expression: in a literal's row such a token
+ * after an element, with no comma between, begins the next element. */
+static int can_start_expr(int k)
+{
+    return k == TK_NUMBER || k == TK_NAME || k == TK_LPAREN || k == TK_LBRACKET || k == TK_MINUS ||
+           k == TK_PLUS || k == TK_NOT;
+}
+
+/* One row of a literal: elements separated by ',' or by white space. */
+static int parse_row(ps_state *P, ast_node *row)
+{
+    for (;;) {
+        if (add_kid(P, row, parse_expr(P))) return -1;
+        if (is(P, TK_COMMA)) {
+            next(P);
+            if (is(P, TK_RBRACKET) || is(P, TK_SEMI)) return 0;   /* [1, 2, ] */
+            continue;
+        }
+        if (!can_start_expr(peek(P)->kind)) return 0;
+    }
+}
+
+/* [a, b; c, d] or [a b; c d]: rows separated by ';' or a line break (the
+ * lexer turns it into ';'), elements by ',' or white space; an empty row
+ * (`[1 2;]`, a trailing line break) adds nothing. */
 static ast_node *parse_matrix(ps_state *P)
 {
     const lx_token *open = next(P);
     ast_node *m = node_new(P, AST_MATRIX, open), *row = NULL;
+    int saved = P->in_literal, saved_brackets = P->bracket_depth;
     if (!m) return NULL;
-    if (is(P, TK_RBRACKET)) {
-        if (close_with(P, TK_RBRACKET, "]", open, m)) goto fail;
-        return m;
-    }
-    for (;;) {
+    P->in_literal = 1;
+    P->bracket_depth = 0;  /* `end` in a literal inside a subscript is not the subscript's */
+    while (is(P, TK_SEMI)) next(P);
+    while (!is(P, TK_RBRACKET)) {
         row = node_new(P, AST_ROW, peek(P));
-        if (!row) goto fail;
-        for (;;) {
-            if (add_kid(P, row, parse_expr(P))) goto fail;
-            if (!is(P, TK_COMMA)) break;
-            next(P);
-        }
+        if (!row || parse_row(P, row)) goto fail;
         if (add_kid(P, m, row)) {
             row = NULL;
             goto fail;
         }
         row = NULL;
         if (!is(P, TK_SEMI)) break;
-        next(P);
+        while (is(P, TK_SEMI)) next(P);
     }
-    if (close_with(P, TK_RBRACKET, "]", open, m)) goto fail;
+    P->in_literal = saved;
+    P->bracket_depth = saved_brackets;
+    if (close_with(P, TK_RBRACKET, "]", open, m)) goto fail_restored;
     return m;
 fail:
+    P->in_literal = saved;
+    P->bracket_depth = saved_brackets;
+fail_restored:
     node_free(row);
     node_free(m);
     return NULL;
@@ -342,8 +381,11 @@ static ast_node *parse_primary(ps_state *P)
     case TK_LBRACKET:
         return parse_matrix(P);
     case TK_LPAREN: {
+        int saved = P->in_literal;
         next(P);
+        P->in_literal = 0;
         n = parse_expr(P);
+        P->in_literal = saved;
         if (!n) return NULL;
         if (close_with(P, TK_RPAREN, ")", tk, NULL)) {
             node_free(n);
@@ -362,7 +404,7 @@ static ast_node *parse_primary(ps_state *P)
 static ast_node *parse_postfix(ps_state *P)
 {
     ast_node *n = parse_primary(P);
-    while (n) {
+    while (n && !starts_new_element(P)) {
         const lx_token *tk = peek(P);
         ast_node *w;
         if (tk->kind == TK_QUOTE) {
@@ -469,7 +511,7 @@ static ast_node *parse_mul(ps_state *P)
 static ast_node *parse_add(ps_state *P)
 {
     ast_node *l = parse_mul(P);
-    while (l && (is(P, TK_PLUS) || is(P, TK_MINUS))) {
+    while (l && (is(P, TK_PLUS) || is(P, TK_MINUS)) && !starts_new_element(P)) {
         const lx_token *op = next(P);
         l = binary(P, op, l, parse_mul(P));
     }
@@ -481,12 +523,41 @@ static int is_comparison(int k)
     return k == TK_EQ || k == TK_NE || k == TK_LT || k == TK_LE || k == TK_GT || k == TK_GE;
 }
 
+/* a:b and a:s:b, between the comparisons and + - as in Octave (1:n+1 is
+ * 1:(n+1)); kids from, to or from, step, to.  A value everywhere: a row
+ * vector, or inside a subscript the indices it lists. */
+static ast_node *parse_range(ps_state *P)
+{
+    ast_node *l = parse_add(P), *r;
+    const lx_token *op;
+    if (!l || !is(P, TK_COLON)) return l;
+    op = next(P);
+    r = node_new(P, AST_RANGE, op);
+    if (!r || add_kid(P, r, l)) {
+        if (!r) node_free(l);
+        node_free(r);
+        return NULL;
+    }
+    if (add_kid(P, r, parse_add(P))) {
+        node_free(r);
+        return NULL;
+    }
+    if (is(P, TK_COLON)) {
+        next(P);
+        if (add_kid(P, r, parse_add(P))) {
+            node_free(r);
+            return NULL;
+        }
+    }
+    return r;
+}
+
 static ast_node *parse_cmp(ps_state *P)
 {
-    ast_node *l = parse_add(P);
+    ast_node *l = parse_range(P);
     if (l && is_comparison(peek(P)->kind)) {
         const lx_token *op = next(P);
-        l = binary(P, op, l, parse_add(P));
+        l = binary(P, op, l, parse_range(P));
         if (l && is_comparison(peek(P)->kind)) {
             node_free(l);
             return fail(P, peek(P), "comparisons do not chain: use '&&' near '%.*s'",
@@ -531,9 +602,16 @@ static ast_node *parse_expr(ps_state *P)
 
 static ast_node *parse_statement(ps_state *P);
 
+static int is_assign_op(int k)
+{
+    return k == TK_ASSIGN || k == TK_PLUSEQ || k == TK_MINUSEQ || k == TK_STAREQ || k == TK_SLASHEQ;
+}
+
+/* A statement ends at ';' (which also keeps its value from being shown),
+ * ',' or a line break, as in Octave. */
 static int is_separator(int k)
 {
-    return k == TK_SEMI || k == TK_NEWLINE;
+    return k == TK_SEMI || k == TK_NEWLINE || k == TK_COMMA;
 }
 
 static void skip_separators(ps_state *P)
@@ -541,18 +619,41 @@ static void skip_separators(ps_state *P)
     while (is_separator(peek(P)->kind)) next(P);
 }
 
-/* Statements until closer (TK_RBRACE or TK_EOF), into n->kids. */
+/* The words that close or continue an Octave-style block. */
+static const char *const block_words[] = {"end", "endif", "endwhile", "endfor", "else", "elseif"};
+
+static int is_block_word(const ps_state *P, const lx_token *tk)
+{
+    size_t i;
+    for (i = 0; i < sizeof block_words / sizeof block_words[0]; i++)
+        if (tok_is_text(P, tk, block_words[i])) return 1;
+    return 0;
+}
+
+/* Statement lists end at '}' (a brace block), at the end of the text, or at
+ * one of block_words (an Octave-style block, closer CLOSE_WORD). */
+#define CLOSE_WORD (-1)
+
+static int at_closer(const ps_state *P, int closer)
+{
+    if (closer == CLOSE_WORD) return is_block_word(P, peek(P)) && !is_assign_op(peek_at(P, 1)->kind);
+    return is(P, closer);
+}
+
+/* Statements until closer, into n->kids.  A statement followed by ';' is
+ * marked quiet: its value is not shown (core.display). */
 static int parse_statements(ps_state *P, ast_node *n, int closer)
 {
     skip_separators(P);
-    while (!is(P, closer) && !is(P, TK_EOF)) {
+    while (!at_closer(P, closer) && !is(P, TK_EOF)) {
         ast_node *s = parse_statement(P);
         int k;
         if (!s || add_kid(P, n, s)) return -1;
         k = peek(P)->kind;
+        if (k == TK_SEMI) s->quiet = 1;
         /* a block ends a statement by itself: `if (c) { } x = 1` */
-        if (!is_separator(k) && k != closer && k != TK_EOF &&
-            s->kind != ST_IF && s->kind != ST_WHILE) {
+        if (!is_separator(k) && !at_closer(P, closer) && k != TK_EOF && s->kind != ST_IF &&
+            s->kind != ST_WHILE && s->kind != ST_FOR) {
             unexpected(P, peek(P));
             return -1;
         }
@@ -583,32 +684,117 @@ static ast_node *parse_block(ps_state *P, ast_node *owner)
     return b;
 }
 
-static ast_node *parse_condition(ps_state *P)
+/* The statements of an Octave-style block, up to (not past) the word that
+ * ends them; kw is the keyword that opened it, for the message when the
+ * text ends first. */
+static ast_node *parse_word_block(ps_state *P, ast_node *owner, const lx_token *kw)
 {
-    const lx_token *open = peek(P);
-    ast_node *c;
-    if (!is(P, TK_LPAREN)) {
-        char d[64];
-        lx_describe(P->src, open, d, sizeof d);
-        return fail(P, open, "expected '(' near %s", d);
-    }
-    next(P);
-    c = parse_expr(P);
-    if (c && close_with(P, TK_RPAREN, ")", open, NULL)) {
-        node_free(c);
+    ast_node *b = node_new(P, ST_BLOCK, peek(P));
+    if (!b) return NULL;
+    if (parse_statements(P, b, CLOSE_WORD)) {
+        node_free(b);
         return NULL;
     }
-    return c;
+    if (is(P, TK_EOF)) {
+        node_free(b);
+        return fail(P, peek(P), "expected 'end' (to close '%.*s' at %d:%d) near end of input",
+                    (int)kw->len, P->src + kw->start, kw->line, kw->col);
+    }
+    if (b->end > owner->end) owner->end = b->end;
+    return b;
 }
 
+/* Consumes the `end` (or endif / endwhile / endfor, matching kw) of an
+ * Octave-style block. */
+static int close_word_block(ps_state *P, ast_node *owner, const lx_token *kw)
+{
+    const lx_token *tk = peek(P);
+    char want[16];
+    if (tok_is_text(P, kw, "elseif")) snprintf(want, sizeof want, "endif");
+    else snprintf(want, sizeof want, "end%.*s", (int)(kw->len < 8 ? kw->len : 8), P->src + kw->start);
+    if (tok_is_text(P, tk, "end") || tok_is_text(P, tk, want)) {
+        next(P);
+        owner->end = tk->start + tk->len;
+        return 0;
+    }
+    {
+        char d[64];
+        lx_describe(P->src, tk, d, sizeof d);
+        fail(P, tk, "expected 'end' (to close '%.*s' at %d:%d) near %s", (int)kw->len,
+             P->src + kw->start, kw->line, kw->col, d);
+    }
+    return -1;
+}
+
+/* After the condition or the for header: a brace block `{ ... }` (the brace
+ * may be on the next line), or statements up to the closing word.
+ * *braced tells which. */
+static ast_node *parse_body(ps_state *P, ast_node *owner, const lx_token *kw, int *braced)
+{
+    size_t save = P->pos;
+    while (is(P, TK_NEWLINE)) next(P);
+    *braced = is(P, TK_LBRACE);
+    if (*braced) return parse_block(P, owner);
+    P->pos = save;
+    return parse_word_block(P, owner, kw);
+}
+
+/* A condition: any expression (Octave's `if x > 1`), parenthesised or not. */
+static ast_node *parse_condition(ps_state *P)
+{
+    const lx_token *at = peek(P);
+    if (at->kind == TK_EOF || is_separator(at->kind) || at->kind == TK_LBRACE) {
+        char d[64];
+        lx_describe(P->src, at, d, sizeof d);
+        return fail(P, at, "expected a condition near %s", d);
+    }
+    return parse_expr(P);
+}
+
+/* if: kw is `if` (or `elseif`, continuing an Octave-style chain whose one
+ * `end` closes it all). */
 static ast_node *parse_if(ps_state *P, const lx_token *kw)
 {
     ast_node *n = node_new(P, ST_IF, kw), *b;
+    const lx_token *opener = kw;
     size_t save;
+    int braced;
     if (!n) return NULL;
-    if (!(n->cond = parse_condition(P)) || !(b = parse_block(P, n)) || add_kid(P, n, b)) {
+    if (!(n->cond = parse_condition(P)) || !(b = parse_body(P, n, opener, &braced)) ||
+        add_kid(P, n, b)) {
         node_free(n);
         return NULL;
+    }
+    if (!braced) {
+        const lx_token *w = peek(P);
+        if (tok_is_text(P, w, "elseif")) {
+            next(P);
+            if (enter_block(P)) {           /* an elseif chain recurses */
+                node_free(n);
+                return NULL;
+            }
+            n->els = parse_if(P, w);
+            leave_block(P);
+            if (!n->els) {
+                node_free(n);
+                return NULL;
+            }
+            if (n->els->end > n->end) n->end = n->els->end;
+            return n;
+        }
+        if (tok_is_text(P, w, "else")) {
+            next(P);
+            if (!(n->els = parse_word_block(P, n, kw))) {
+                node_free(n);
+                return NULL;
+            }
+        }
+        /* `elseif` ends its chain with the `end` of the first `if` */
+        if (close_word_block(P, n, kw)) {
+            node_free(n);
+            return NULL;
+        }
+        return n;
     }
     save = P->pos;
     while (is(P, TK_NEWLINE)) next(P);
@@ -639,15 +825,52 @@ static ast_node *parse_if(ps_state *P, const lx_token *kw)
 static ast_node *parse_while(ps_state *P, const lx_token *kw)
 {
     ast_node *n = node_new(P, ST_WHILE, kw), *b;
+    int braced;
     if (!n) return NULL;
     if (!(n->cond = parse_condition(P))) {
         node_free(n);
         return NULL;
     }
     P->loop_depth++;
-    b = parse_block(P, n);
+    b = parse_body(P, n, kw, &braced);
     P->loop_depth--;
-    if (!b || add_kid(P, n, b)) {
+    if (!b || add_kid(P, n, b) || (!braced && close_word_block(P, n, kw))) {
+        node_free(n);
+        return NULL;
+    }
+    return n;
+}
+
+static ast_node *parse_for(ps_state *P, const lx_token *kw)
+{
+    ast_node *n = node_new(P, ST_FOR, kw), *b;
+    const lx_token *open = NULL, *var;
+    int braced;
+    if (!n) return NULL;
+    /* for i = e  or  for (i = e) */
+    if (is(P, TK_LPAREN) && peek_at(P, 1)->kind == TK_NAME && peek_at(P, 2)->kind == TK_ASSIGN)
+        open = next(P);
+    var = peek(P);
+    if (var->kind != TK_NAME || peek_at(P, 1)->kind != TK_ASSIGN) {
+        char d[64];
+        lx_describe(P->src, var, d, sizeof d);
+        node_free(n);
+        return fail(P, var, "for needs 'name = values', as in 'for i = 1:n', near %s", d);
+    }
+    if (!(n->name = tok_text(P, var))) {
+        node_free(n);
+        return fail(P, var, "out of memory while parsing");
+    }
+    next(P);
+    next(P);
+    if (!(n->cond = parse_expr(P)) || (open && close_with(P, TK_RPAREN, ")", open, NULL))) {
+        node_free(n);
+        return NULL;
+    }
+    P->loop_depth++;
+    b = parse_body(P, n, kw, &braced);
+    P->loop_depth--;
+    if (!b || add_kid(P, n, b) || (!braced && close_word_block(P, n, kw))) {
         node_free(n);
         return NULL;
     }
@@ -777,6 +1000,32 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
     ast_node *n;
     if (tok_is_text(P, kw, "if")) return parse_if(P, kw);
     if (tok_is_text(P, kw, "while")) return parse_while(P, kw);
+    if (tok_is_text(P, kw, "for")) return parse_for(P, kw);
+    if (is_block_word(P, kw))
+        return fail(P, kw, "'%.*s' with no open if, while or for", (int)kw->len, P->src + kw->start);
+    if (tok_is_text(P, kw, "format")) {
+        /* format long | short (Octave's), a shorthand for set core.format */
+        const lx_token *w = peek(P);
+        const char *style = "short";
+        n = node_new(P, ST_SET, kw);
+        if (!n) return NULL;
+        if (w->kind == TK_NAME) {
+            next(P);
+            if (tok_is_text(P, w, "long")) style = "long";
+            else if (!tok_is_text(P, w, "short")) {
+                node_free(n);
+                return fail(P, w, "format takes 'long' or 'short', not '%.*s'", (int)w->len,
+                            P->src + w->start);
+            }
+            n->end = w->start + w->len;
+        }
+        if (!(n->name = malloc(32))) {
+            node_free(n);
+            return fail(P, kw, "out of memory while parsing");
+        }
+        snprintf(n->name, 32, "core.format = %s", style);
+        return n;
+    }
     if (tok_is_text(P, kw, "break") || tok_is_text(P, kw, "continue")) {
         if (P->loop_depth == 0)
             return fail(P, kw, "'%.*s' outside a loop", (int)kw->len, P->src + kw->start);
@@ -787,7 +1036,26 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
     if (tok_is_text(P, kw, "load")) return parse_file_names(P, kw, ST_LOAD, "load");
     if (tok_is_text(P, kw, "help")) {
         n = node_new(P, ST_HELP, kw);
-        if (n && peek(P)->kind == TK_NAME) {
+        if (n && peek(P)->kind == TK_RAW) {
+            const lx_token *w = next(P);
+            size_t len = w->len;
+            while (len && (P->src[w->start + len - 1] == ' ' || P->src[w->start + len - 1] == '\t' ||
+                           P->src[w->start + len - 1] == '\r'))
+                len--;
+            if (!(n->name = malloc(len + 1))) {
+                node_free(n);
+                return fail(P, w, "out of memory while parsing");
+            }
+            memcpy(n->name, P->src + w->start, len);
+            n->name[len] = 0;
+            n->end = w->start + w->len;
+        }
+        return n;
+    }
+    if (tok_is_text(P, kw, "tune")) return parse_tune(P, kw);
+    if (tok_is_text(P, kw, "profile")) {
+        n = node_new(P, ST_PROFILE, kw);
+        if (n && tok_is_text(P, peek(P), "clear")) {
             const lx_token *w = next(P);
             if (!(n->name = tok_text(P, w))) {
                 node_free(n);
@@ -797,7 +1065,6 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
         }
         return n;
     }
-    if (tok_is_text(P, kw, "tune")) return parse_tune(P, kw);
     if (tok_is_text(P, kw, "clear")) {
         n = node_new(P, ST_CLEAR, kw);
         while (n && peek(P)->kind == TK_NAME)
@@ -848,13 +1115,11 @@ static ast_node *parse_keyword(ps_state *P, const lx_token *kw)
     return n;
 }
 
-static int is_assign_op(int k)
-{
-    return k == TK_ASSIGN || k == TK_PLUSEQ || k == TK_MINUSEQ || k == TK_STAREQ || k == TK_SLASHEQ;
-}
 
-static const char *const keywords[] = {"if", "while", "break", "continue", "who", "clear",
-                                       "info", "set", "explain", "tune", "help", "save", "load"};
+static const char *const keywords[] = {"if", "while", "for", "break", "continue", "who", "clear",
+                                       "info", "set", "explain", "tune", "help", "save", "load",
+                                       "format", "profile", "end", "endif", "endwhile", "endfor", "else",
+                                       "elseif"};
 
 static ast_node *parse_statement_body(ps_state *P);
 

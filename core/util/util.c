@@ -82,20 +82,25 @@ const char *sb_str(const strbuf *b)
     return b->s ? b->s : "";
 }
 
-/* Levenshtein distance with two rolling rows; names are short, so the rows
- * live on the stack unless a name is unusually long. */
+/* Damerau-Levenshtein distance in its optimal-string-alignment form, with
+ * three rolling rows: an adjacent transposition ("alpah" for "alpha") costs
+ * 1, as a typo does, where plain Levenshtein counts 2 and, for a five-letter
+ * name, misses the suggestion.  Names are short, so the rows live on the
+ * stack unless a name is unusually long. */
 static size_t edit_distance(const char *a, const char *b)
 {
     size_t la = strlen(a), lb = strlen(b), i, j, d;
-    size_t stack[2][64], *prev, *cur, *heap = NULL;
+    size_t stack[3][64], *prev2, *prev, *cur, *heap = NULL;
     if (lb + 1 <= 64) {
-        prev = stack[0];
-        cur = stack[1];
+        prev2 = stack[0];
+        prev = stack[1];
+        cur = stack[2];
     } else {
-        heap = malloc(2 * (lb + 1) * sizeof *heap);
+        heap = malloc(3 * (lb + 1) * sizeof *heap);
         if (!heap) return (size_t)-1;
-        prev = heap;
-        cur = heap + lb + 1;
+        prev2 = heap;
+        prev = heap + lb + 1;
+        cur = heap + 2 * (lb + 1);
     }
     for (j = 0; j <= lb; j++) prev[j] = j;
     for (i = 1; i <= la; i++) {
@@ -105,9 +110,14 @@ static size_t edit_distance(const char *a, const char *b)
             size_t sub = prev[j - 1] + (a[i - 1] != b[j - 1]);
             size_t del = prev[j] + 1, ins = cur[j - 1] + 1;
             d = sub < del ? sub : del;
-            cur[j] = d < ins ? d : ins;
+            if (ins < d) d = ins;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                prev2[j - 2] + 1 < d)
+                d = prev2[j - 2] + 1;
+            cur[j] = d;
         }
-        t = prev;
+        t = prev2;
+        prev2 = prev;
         prev = cur;
         cur = t;
     }

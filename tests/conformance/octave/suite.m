@@ -1,0 +1,74 @@
+# The statement suite that SILC and Octave must print alike
+# (tests/conformance/octave/README.md).  Every line is valid in both languages.
+x = 3
+y = pi
+z = 0.031416
+w = 0.0031416
+a = 31415.9
+b = 314.159
+k = -0.5
+n = -2
+big = 1e10
+q = 1e-10
+A = [1 2; 3 4]
+B = [1.5 2.25; -3 4]
+C = [100.5 2.25]
+D = [0.01 1]
+E = [0.001 1]
+M = [1 -2]
+M2 = [1 - 2]
+M3 = [1 , 2
+3 4]
+N = [NaN 1 Inf]
+e = [];
+e
+v = 1:5
+v2 = [0:0.25:1];
+v2
+r = 10:-3:1
+r0 = 5:1
+c = size(0:0.1:1, 2)
+lastv = max(0:0.1:1)
+s = sum(1:100)
+t = (1:3)'
+u = [1:3; 4:6]
+uw = [(1:20) * 2]
+S = sparse([1 2 3], [1 2 3], [4 5 6], 3, 3)
+S2 = sparse(1:4, 1:4, 2, 4, 4);
+nnz(S2)
+k2 = 0;
+for i = 1:10
+  k2 = k2 + i;
+end
+k2
+j = 0;
+while j < 7
+  j = j + 2;
+end
+j
+if j > 5
+  big2 = 1;
+else
+  big2 = 0;
+end
+big2
+if j < 5, w2 = 1; elseif j == 8, w2 = 2; else, w2 = 3; end
+w2
+acc = 0;
+for col = [1 2; 3 4]
+  acc = acc + col' * col;
+end
+acc
+f = 2 * (1:4) + 1
+g = (1:4) .^ 2
+h = [1 2 3] * [4 5 6]'
+abs([-1.5 2])
+1 + 1;
+disp(pi)
+disp([1 2; 3 4])
+format long
+p = pi
+P = [pi 1]
+r3 = 1/3
+format short
+p = pi
