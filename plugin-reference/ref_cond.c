@@ -82,19 +82,18 @@ static void top_insert(int64_t *top, int *len, int t, const double *h, int64_t i
     if (*len < t) (*len)++;
 }
 
-/* One pass over h (n entries): its largest value, the t largest entries
- * (top, *ntop) and the t largest not yet used (fresh, *nfresh). */
-static double select_top(int64_t n, int t, const double *h, const unsigned char *used, int64_t *top, int *ntop,
-                         int64_t *fresh, int *nfresh)
+/* One pass over h (n entries): the t largest entries (top, *ntop; top[0]
+ * is the largest) and the t largest not yet used (fresh, *nfresh).  Most
+ * entries fail the first compare with the smallest kept, so the pass costs
+ * about what one "largest" pass did. */
+static void select_top(int64_t n, int t, const double *h, const unsigned char *used, int64_t *top, int *ntop,
+                       int64_t *fresh, int *nfresh)
 {
-    double hmax = -1.0;
     *ntop = *nfresh = 0;
     for (int64_t i = 0; i < n; i++) {
-        if (h[i] > hmax) hmax = h[i];
-        top_insert(top, ntop, t, h, i);
-        if (!used[i]) top_insert(fresh, nfresh, t, h, i);
+        if (*ntop < t || h[i] > h[top[t - 1]]) top_insert(top, ntop, t, h, i);
+        if (!used[i] && (*nfresh < t || h[i] > h[fresh[t - 1]])) top_insert(fresh, nfresh, t, h, i);
     }
-    return hmax;
 }
 
 /* The bookkeeping between solves is a few O(n t) passes (the column sums,
@@ -128,7 +127,7 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
     }
     for (int k = 1;; k++) {
         /* X holds Y = M^{-1} X_k: its largest column 1-norm is a lower bound. */
-        double cur = -1.0, hmax;
+        double cur = -1.0;
         int jbest = 0, ntop, nfresh, any_fresh = 0;
         for (int j = 0; j < t; j++) {
             double s = sum_abs(n, X + (size_t)j * n);
@@ -153,9 +152,9 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
                 if (fabs(X[i + (size_t)j * n]) > m) m = fabs(X[i + (size_t)j * n]);
             h[i] = m;
         }
-        hmax = select_top(n, t, h, used, top, &ntop, ind, &nfresh);
+        select_top(n, t, h, used, top, &ntop, ind, &nfresh);
         /* The gradient points at the unit vector already best: converged. */
-        if (ind_best >= 0 && hmax == h[ind_best]) break;
+        if (ind_best >= 0 && h[top[0]] == h[ind_best]) break;
         /* The t most promising unit vectors; if all were tried, converged. */
         for (int j = 0; j < ntop; j++) any_fresh |= !used[top[j]];
         if (!any_fresh) break;
