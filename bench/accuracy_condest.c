@@ -181,16 +181,15 @@ int main(int argc, char **argv)
     }
     fclose(idx);
     printf("\n%d of %d rows above %.0f %% of the factorization ('!')\n", over, rows, 100 * CE_BUDGET);
-    printf("median ratio per backend:");
+    printf("median ratio per backend:\n");
     for (size_t k = 0; k < NB; k++) {
         if (!nratio[k]) continue;
         qsort(ratios[k], (size_t)nratio[k], sizeof(double), by_value);
-        printf("  %s %.0f %% (%d of %d over)", backends[k].name,
+        printf("  %-20s %4.0f %%  (%d of %d rows over)\n", backends[k].name,
                100 * (nratio[k] % 2 ? ratios[k][nratio[k] / 2]
                                     : 0.5 * (ratios[k][nratio[k] / 2 - 1] + ratios[k][nratio[k] / 2])),
                nover[k], nratio[k]);
     }
-    printf("\n");
     silc_close(&c);
     return 0;
 }
