@@ -105,23 +105,39 @@ static int ch_fail(silc_call *call, const char *fn, int status)
     return ss_host->error(call, SILC_ELIB, "%s: failed (status %d)", fn, status);
 }
 
-/* For the condition estimate (A symmetric: A^{-T} = A^{-1}). */
+/* For the condition estimate (A symmetric: A^{-T} = A^{-1}): the solution
+ * and CHOLMOD's workspace are kept from one solve to the next
+ * (cholmod_l_solve2), where cholmod_l_solve allocated and freed them on
+ * every call. */
+typedef struct ch_est {
+    ch_factor *F;
+    cholmod_dense *X, *Y, *E;
+} ch_est;
+
 static int ch_apply_inv(void *ctx, double *x, int t, int trans)
 {
-    ch_factor *F = ctx;
+    ch_est *e = ctx;
     cholmod_common *cc = ss_cholmod_common();
-    cholmod_dense B, *X;
-    int64_t n = (int64_t)F->L->n;
+    cholmod_dense B;
+    int64_t n = (int64_t)e->F->L->n;
     int ok;
     (void)trans;
     ch_dense(n, t, x, &B);
     ss_lock();
-    X = cholmod_l_solve(CHOLMOD_A, F->L, &B, cc);
-    ok = X != NULL;
-    if (ok) memcpy(x, X->x, (size_t)(n * t) * sizeof(double));
-    cholmod_l_free_dense(&X, cc);
+    ok = cholmod_l_solve2(CHOLMOD_A, e->F->L, &B, NULL, &e->X, NULL, &e->Y, &e->E, cc);
     ss_unlock();
+    if (ok) memcpy(x, e->X->x, (size_t)(n * t) * sizeof(double));
     return ok ? 0 : -1;
+}
+
+static void ch_est_free(ch_est *e)
+{
+    cholmod_common *cc = ss_cholmod_common();
+    ss_lock();
+    cholmod_l_free_dense(&e->X, cc);
+    cholmod_l_free_dense(&e->Y, cc);
+    cholmod_l_free_dense(&e->E, cc);
+    ss_unlock();
 }
 
 static const char *ch_ordering_name(int ordering)
@@ -254,8 +270,11 @@ int ss_cholmod_solve(silc_call *call)
     if (owned) ss_host->free(B);
     if (!X) return ch_fail(call, "cholmod_l_solve", status);
     call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
-    if (fold && (int64_t)X->d == n)
-        ss_square_cond(call, condest, n, ch_apply_inv, F, &F->info, (const double *)X->x + n * k);
+    if (fold && (int64_t)X->d == n) {
+        ch_est e = {F, NULL, NULL, NULL};
+        ss_square_cond(call, condest, n, ch_apply_inv, &e, &F->info, (const double *)X->x + n * k);
+        ch_est_free(&e);
+    }
     ss_lock();
     cholmod_l_free_dense(&X, cc);
     ss_unlock();

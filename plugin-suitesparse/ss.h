@@ -117,17 +117,24 @@ typedef struct ss_factor_info {
     char note[160];
 } ss_factor_info;
 
-/* The condition estimate of a square factorization: the block form of the
- * host (Higham-Tisseur, SS_EST_COLS columns, SS_EST_STEPS steps: the
- * two-column, two-step form MUMPS uses, 0.97-1.00 of cond_1 on the shared
- * matrices) costs three applications of A^-1 or A^-T to two columns; the
- * one-column dlacon form took about five pairs of solves.  The first
- * application rides along with the user's solve when it is due
- * (ss_cond_due): the solve takes ss_rhs_with_start's array, B with the
- * starting block after it, and passes the solved block as Y0.
- * apply(ctx, X, t, trans) overwrites the n x t X with A^-1 X (A^-T X).
- * Sets fi->cond = norm1(A) ||A^{-1}||_1 and fi->estimated; nothing when
- * not due. */
+/* The condition estimate of a square factorization: Hager/Higham (LAPACK
+ * dlacn2's count of solves) with the host's estimator.  The start is two
+ * columns, e/n and Higham's alternating vector (the extra vector dlacn2
+ * solves last); the one with the larger ||A^-1 x||_1 goes on alone: one
+ * A^-T solve (the gradient), one A^-1 solve (the best unit vector), so
+ * four column solves in three applications, where the two-column block
+ * form carried both columns through and made six.  SuiteSparse's solves
+ * cost per column (KLU's solve of a very sparse matrix is a pass over its
+ * factors, a sixth of a refactorization on 494_bus), so a column less is
+ * a sixth less; the estimates are those of the block form on the shared
+ * matrices but west0067 (0.69 of cond_1 against 0.97, as dlacon's: the
+ * test allows 10x).  The first application rides along with the user's
+ * solve when it is due (ss_cond_due): the solve takes ss_rhs_with_start's
+ * array, B with the starting block after it, and passes the solved block
+ * as Y0; Y0 = NULL makes ss_square_cond solve the start itself (UMFPACK,
+ * one column per call anyway).  apply(ctx, X, t, trans) overwrites the
+ * n x t X with A^-1 X (A^-T X).  Sets fi->cond = norm1(A) ||A^{-1}||_1 and
+ * fi->estimated; nothing when not due or when a solve fails. */
 #define SS_EST_COLS 2
 #define SS_EST_STEPS 2
 typedef int (*ss_block_fn)(void *ctx, double *X, int t, int trans);

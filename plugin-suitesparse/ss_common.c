@@ -191,20 +191,44 @@ int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi)
     return !fi->estimated && ss_condest_wanted(call, mode);
 }
 
+/* The column of the solved starting block Y (n x SS_EST_COLS) with the
+ * largest 1-norm (a NaN or Inf one wins: the estimate then says so). */
+static const double *best_start(int64_t n, const double *Y)
+{
+    const double *best = Y;
+    double s_best = 0;
+    for (int j = 0; j < SS_EST_COLS; j++) {
+        double s = 0;
+        for (int64_t i = 0; i < n; i++) s += fabs(Y[i + j * n]);
+        if (j == 0 || (!(s <= s_best) && !isnan(s_best))) best = Y + j * n, s_best = s;
+    }
+    return best;
+}
+
 void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi,
                     const double *Y0)
 {
-    double inv;
+    double inv = -1, *start = NULL;
     size_t len;
     if (!ss_cond_due(call, mode, fi)) return;
-    inv = ss_host->inv_norm1_est_block(n, SS_EST_COLS, SS_EST_STEPS, apply, ctx, Y0);
+    if (!Y0) { /* not folded into the user's solve: the start is solved here */
+        if (!(start = ss_host->alloc((size_t)n * SS_EST_COLS * sizeof *start))) return;
+        ss_host->inv_norm1_start(n, SS_EST_COLS, start);
+        if (apply(ctx, start, SS_EST_COLS, 0)) {
+            ss_host->free(start);
+            return; /* a solve failed: no estimate */
+        }
+    }
+    /* The better start goes on alone: one column per solve from here. */
+    inv = ss_host->inv_norm1_est_block(n, 1, SS_EST_STEPS, apply, ctx, best_start(n, Y0 ? Y0 : start));
+    ss_host->free(start);
     if (inv < 0) return; /* a solve failed: no estimate */
     fi->cond = silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
     fi->estimated = 1;
     len = strlen(fi->note);
     snprintf(fi->note + len, sizeof fi->note - len,
-             "%s1-norm condition estimate: block Hager/Higham through the factors (%d columns, %d steps%s)",
-             len ? "; " : "", SS_EST_COLS, SS_EST_STEPS, Y0 ? ", the first with this solve" : "");
+             "%s1-norm condition estimate: Hager/Higham through the factors (e/n and alternating start%s, %d steps)",
+             len ? "; " : "", Y0 ? " with this solve" : "", SS_EST_STEPS);
 }
 
 double *ss_rhs_with_start(const silc_view *b, int64_t n)

@@ -56,7 +56,7 @@ static const silc_backend ss_backends[] = {
 
 static const silc_option_spec ss_options[] = {
     {"condest", SILC_OPT_STRING, "true",
-     "1-norm condition estimate by block Hager/Higham (2 columns, 2 steps, once per factorization): "
+     "1-norm condition estimate by Hager/Higham (4 column solves, once per factorization): "
      "true (auto means the same), false (none; the libraries' cheap pivot ratio is shown, "
      "labelled, never as the estimate)"},
     {"umfpack_irstep", SILC_OPT_INT, "2", "UMFPACK: maximum steps of iterative refinement"},

@@ -20,7 +20,9 @@
  *     the caller makes anyway) returns what it returns when it applies X0
  *     itself, with one application of B fewer;
  *   - a failing apply gives -1, a non-finite one a non-finite estimate,
- *     n = 1 and t > n work.
+ *     n = 1 and t > n work;
+ *   - ties in the gradient (B = 2 I: every unit vector as promising) pick
+ *     the first indices, as a stable sort would, and the estimate is exact.
  */
 #include "check.h"
 
@@ -40,6 +42,7 @@ typedef struct op {
     int applies;   /* applications of B (trans = 0) */
     int fail_at;   /* apply number that fails (0 = never) */
     int poison;    /* put an Inf into the result */
+    double *seen;  /* when set: receives the block of the second application of B */
 } op;
 
 static int apply_block(void *ctx, double *X, int t, int trans)
@@ -52,6 +55,7 @@ static int apply_block(void *ctx, double *X, int t, int trans)
         free(y);
         return -1;
     }
+    if (!trans && o->applies == 2 && o->seen) memcpy(o->seen, X, (size_t)(n * t) * sizeof *X);
     for (k = 0; k < t; k++) {
         double *x = X + k * n;
         for (i = 0; i < n; i++) {
@@ -112,7 +116,7 @@ static void test_bidiagonal_inverse(const silc_host_api *h)
 {
     const int64_t n = 30;
     const double c = 0.9;
-    op o = {n, calloc((size_t)(n * n), sizeof(double)), 0, 0, 0};
+    op o = {n, calloc((size_t)(n * n), sizeof(double)), 0, 0, 0, NULL};
     double exact, est;
     int64_t i, j;
     for (j = 0; j < n; j++)
@@ -132,7 +136,7 @@ static void test_random(const silc_host_api *h)
     } forms[] = {{1, 5}, {2, 2}, {2, 5}, {4, 2}};
     const int64_t n = 100;
     const int trials = 40;
-    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0};
+    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0, NULL};
     double sum[4] = {0}, worst[4] = {1, 1, 1, 1};
     int kind, trial, f;
     for (kind = 0; kind < 3; kind++)
@@ -165,7 +169,7 @@ static void test_folded_start(const silc_host_api *h)
 {
     const int64_t n = 60;
     const int t = 2;
-    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0};
+    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0, NULL};
     double *Y0 = malloc((size_t)(n * t) * sizeof *Y0), a, b;
     int applies;
     fill(&o, 0);
@@ -190,9 +194,9 @@ static void test_folded_start(const silc_host_api *h)
 static void test_edges(const silc_host_api *h)
 {
     const int64_t n = 20;
-    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0};
+    op o = {n, malloc((size_t)(n * n) * sizeof(double)), 0, 0, 0, NULL};
     double one[1] = {-4}, est;
-    op single = {1, one, 0, 0, 0};
+    op single = {1, one, 0, 0, 0, NULL};
     fill(&o, 0);
     o.fail_at = 2;
     CHECK(h->inv_norm1_est_block(n, 2, 2, apply_block, &o, NULL) == -1, "a failing apply gives -1 (block)");
@@ -212,6 +216,24 @@ static void test_edges(const silc_host_api *h)
     free(o.B);
 }
 
+static void test_tied_gradient(const silc_host_api *h)
+{
+    const int64_t n = 6;
+    const int t = 2;
+    op o = {n, calloc((size_t)(n * n), sizeof(double)), 0, 0, 0, NULL};
+    double seen[12], est;
+    int64_t i;
+    for (i = 0; i < n; i++) o.B[i + i * n] = 2;
+    o.seen = seen;
+    est = h->inv_norm1_est_block(n, t, 5, apply_block, &o, NULL);
+    CHECK(est == 2, "B = 2 I: estimate %.17g, exact 2", est);
+    CHECK(o.applies == 2, "B = 2 I: the start and one unit-vector step (%d applications)", o.applies);
+    for (i = 0; i < n * t; i++)
+        CHECK(seen[i] == (i == 0 || i == n + 1 ? 1.0 : 0.0),
+              "tied gradient: unit vectors e_1 and e_2 are tried first (entry %lld is %g)", (long long)i, seen[i]);
+    free(o.B);
+}
+
 int main(void)
 {
     const silc_host_api *h = host_api();
@@ -224,6 +246,7 @@ int main(void)
     test_random(h);
     test_folded_start(h);
     test_edges(h);
+    test_tied_gradient(h);
     rc = check_done();
     silc_close(&c);
     return rc;
