@@ -6,16 +6,18 @@ the package's front; this is one of its two back ends (_embedded.py the
 other).
 """
 import os
+import signal
 import socket
 import struct
 import sys
+import threading
 
 import numpy as np
 
 from ._values import CSR, SilcError, from_parts, to_parts
 
 PROTOCOL_VERSION = 1
-PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE = range(1, 9)
+PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE, CANCEL = range(1, 10)
 OK, ERROR, VALUE, TEXT, WARN = range(128, 133)
 _HEADER = struct.Struct("<IIQ")
 _HELLO = struct.Struct("<4sII")
@@ -49,6 +51,12 @@ class RemoteSession:
         token = token if token is not None else _token_from_env()
         self.url = url
         self.warnings = ""
+        # cancel() writes only while an EXEC waits for its reply (_awaiting),
+        # so its frame never lands inside another; reentrant because a
+        # SIGINT handler runs on the main thread, maybe inside exec's own
+        # critical section.
+        self._cancel_lock = threading.RLock()
+        self._awaiting = False
         self.sock = self._connect(url)
         tok = (token or "").encode()
         self.sock.sendall(_HELLO.pack(b"SILC", PROTOCOL_VERSION, len(tok)) + tok)
@@ -149,10 +157,52 @@ class RemoteSession:
 
     def exec(self, statements, out=None):
         """Runs statements.  Text printed by who/info/explain goes to out (a
-        list) when given, else to stdout; warnings are in self.warnings."""
+        list) when given, else to stdout; warnings are in self.warnings.
+        Ctrl-C (SIGINT, on the main thread) sends CANCEL, waits for the
+        server's reply and raises KeyboardInterrupt; a second Ctrl-C gives
+        up waiting and closes the session."""
         self.warnings = ""
         self._send(EXEC, statements.encode())
-        self._reply(out)
+        presses = []
+
+        def on_sigint(signum, frame):
+            presses.append(signum)
+            if len(presses) > 1:
+                raise KeyboardInterrupt
+            self.cancel()
+
+        previous = None
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+            previous = signal.signal(signal.SIGINT, on_sigint)
+        with self._cancel_lock:
+            self._awaiting = True
+        try:
+            self._reply(out)
+        except KeyboardInterrupt:
+            self.sock.close()  # gave up inside a reply: the stream is lost
+            self.sock = None
+            raise
+        except SilcError:
+            if presses:
+                raise KeyboardInterrupt from None
+            raise
+        finally:
+            with self._cancel_lock:
+                self._awaiting = False
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+        if presses:
+            raise KeyboardInterrupt
+
+    def cancel(self):
+        """Interrupts the exec running on this session (from another thread
+        or a signal handler): the server stops it at its next check and it
+        fails with "interrupted", the store as before the statement.  Does
+        nothing when no exec is waiting for its reply."""
+        with self._cancel_lock:
+            if self._awaiting and self.sock is not None:
+                self.sock.sendall(_HEADER.pack(CANCEL, 0, 0))
 
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""
