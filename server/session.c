@@ -178,6 +178,15 @@ static int do_exec(session *S, const char *text)
         /* The plain reason, not "statement k: " or "rank 0 of N: ". */
         snprintf(S->err, sizeof S->err, "%s", S->watch.why);
         srv_log(LOG_INFO, "session %lu: %s", S->id, S->watch.why);
+    } else if (rc && S->watch.cancelled) {
+        /* Interrupted by the client's CANCEL.  Under silcd --mpi only rank
+         * 0 read it, and the ranks' agreement named it ("statement 2: rank
+         * 0 of 2: interrupted"): the client is told what any other server
+         * says, "statement 2: interrupted". */
+        char *rank = srv_mpi ? strstr(S->err, "rank 0 of ") : NULL, *colon;
+        if (rank && (colon = strstr(rank, ": ")) != NULL && !strcmp(colon + 2, ENG_INTERRUPTED))
+            memmove(rank, colon + 2, strlen(colon + 2) + 1);
+        srv_log(LOG_INFO, "session %lu: %s", S->id, S->err);
     }
     if (guarded) {
         used = session_bytes(E);

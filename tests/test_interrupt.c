@@ -6,6 +6,8 @@
  * embedded context, on a remote one (a private silcd: the CANCEL frame,
  * docs/protocol.md) and inside a plugin call that polls host->cancelled()
  * (the "crash" test plugin, alpha 19, which spins until told to stop).
+ * With SILC_SERVER set, only the remote part, against that server (run so
+ * against silcd --mpi by tests/mpi.cmake).
  *
  * No timing is asserted: only that the EXEC returns while the canceller
  * waits at most a generous bound (5 s, more under a sanitizer) for it, an
@@ -103,6 +105,26 @@ static void check_loop_cancelled(silc_context *ctx, const char *where)
     CHECK_NEAR(scalar(ctx, "i"), 1000, 0);
 }
 
+/* An iterative solve of lis-style (which asks host->cancelled() once an
+ * iteration) that would run 1e8 Jacobi sweeps stops when interrupted, and
+ * the name it was to bind keeps its value. */
+static void check_iterative_cancelled(silc_context *ctx)
+{
+    int rc;
+    if (silc_exec(ctx, "set dispatch.solve.sparse.spd = lis-style")) {
+        printf("skipped the lis-style case: %s\n", silc_context_errmsg(ctx));
+        return;
+    }
+    CHECK(silc_exec(ctx, "set lis-style.options = -i jacobi -tol 1e-300 -maxiter 100000000; "
+                         "n = 3000; E = eye(n); S = [zeros(1, n); E[1:n-1, :]]; "
+                         "A = 2*E - S - S'; x = 5") == 0,
+          "lis-style setup: %s", silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+          "lis-style solve: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "x"), 5, 0);
+}
+
 /* A plugin call that polls host->cancelled() returns when told to, and the
  * next backend of the list does not take over the interrupted operation. */
 static void check_plugin_cancelled(void)
@@ -141,12 +163,26 @@ int main(void)
 {
     silc_context *ctx = NULL;
     test_server srv;
+    const char *server = getenv("SILC_SERVER");
+
+    /* Against a given server (the silcd --mpi fixture, tests/mpi.cmake):
+     * there rank 0 reads the CANCEL and the ranks stop together. */
+    if (server && *server) {
+        if (silc_open_remote(&ctx, server)) {
+            CHECK(0, "silc_open_remote %s: %s", server, silc_errmsg());
+        } else {
+            check_loop_cancelled(ctx, server);
+        }
+        silc_close(&ctx);
+        return check_done();
+    }
 
     CHECK(silc_cancel(NULL) == -1, "silc_cancel(NULL)");
     if (silc_open(&ctx, NULL)) {
         CHECK(0, "silc_open: %s", silc_errmsg());
     } else {
         check_loop_cancelled(ctx, "embedded");
+        check_iterative_cancelled(ctx);
     }
     silc_close(&ctx);
 

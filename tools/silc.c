@@ -20,6 +20,8 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -219,6 +221,9 @@ static silc_context *interrupt_ctx;
 static volatile sig_atomic_t exec_running;      /* a statement runs */
 static volatile sig_atomic_t exec_interrupts;   /* Ctrl-C presses during it */
 static volatile sig_atomic_t line_interrupted;  /* Ctrl-C at the prompt */
+/* Written by the handler at the prompt, so the prompt's wait wakes up
+ * whichever thread the signal landed on and however it raced the wait. */
+static int wake_pipe[2] = {-1, -1};
 
 static void on_sigint(int sig)
 {
@@ -227,7 +232,13 @@ static void on_sigint(int sig)
     ssize_t ignored;
     (void)sig;
     if (!exec_running) {
+        int saved_errno = errno;
         line_interrupted = 1;
+        if (wake_pipe[1] >= 0) {
+            ignored = write(wake_pipe[1], "", 1);
+            (void)ignored;
+        }
+        errno = saved_errno;
         return;
     }
     silc_cancel(interrupt_ctx);
@@ -247,6 +258,14 @@ static void catch_sigint(silc_context *ctx)
 {
     struct sigaction sa;
     interrupt_ctx = ctx;
+    if (pipe(wake_pipe) == 0) {
+        for (int k = 0; k < 2; k++) {
+            fcntl(wake_pipe[k], F_SETFL, O_NONBLOCK);
+            fcntl(wake_pipe[k], F_SETFD, FD_CLOEXEC);
+        }
+    } else {
+        wake_pipe[0] = wake_pipe[1] = -1; /* Ctrl-C at the prompt then waits for a key */
+    }
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
@@ -261,14 +280,29 @@ static void catch_sigint(silc_context *ctx)
 static int read_key(FILE *in)
 {
     for (;;) {
+        struct pollfd p[2];
         unsigned char c;
-        ssize_t n = read(fileno(in), &c, 1);
-        if (n == 1) return c;
-        if (n == 0 || errno != EINTR) return EOF;
+        char drain[64];
+        ssize_t n;
         if (line_interrupted) {
             rl_replace_line("", 0);
             return '\n';
         }
+        p[0].fd = fileno(in);
+        p[1].fd = wake_pipe[0];
+        p[0].events = p[1].events = POLLIN;
+        p[0].revents = p[1].revents = 0;
+        if (poll(p, wake_pipe[0] >= 0 ? 2 : 1, -1) < 0) {
+            if (errno == EINTR) continue;
+            return EOF;
+        }
+        if (p[1].revents) { /* the flag is looked at above */
+            while (read(wake_pipe[0], drain, sizeof drain) > 0) {}
+            continue;
+        }
+        n = read(p[0].fd, &c, 1);
+        if (n == 1) return c;
+        if (n == 0 || errno != EINTR) return EOF;
     }
 }
 #endif

@@ -1322,7 +1322,11 @@ static int exec_top(lang_ev *V, const ast_node *s)
     eng_snapshot snap;
     int flow, rc;
     if (!is_compound(s)) return exec_stmt(V, s, &flow);
-    if (eng_snapshot_take(V->E, &snap)) return eng_error(V->E, "out of memory preparing the statement");
+    rc = eng_snapshot_take(V->E, &snap) ? eng_error(V->E, "out of memory preparing the statement") : 0;
+    if (ranks_agree(V, rc)) { /* every rank runs the statement, or none */
+        if (!rc) eng_snapshot_free(&snap);
+        return -1;
+    }
     rc = exec_stmt(V, s, &flow);
     if (!rc) {
         eng_snapshot_free(&snap);
