@@ -94,13 +94,17 @@ void eng_snapshot_free(eng_snapshot *s)
 {
     size_t i;
     for (i = 0; i < s->n; i++) {
-        free(s->names[i]);
-        val_release(s->values[i]);
+        free(s->bindings[i].name);
+        val_release(s->bindings[i].value);
     }
-    free(s->names);
-    free(s->values);
+    free(s->bindings);
     infos_free(s->infos);
     memset(s, 0, sizeof *s);
+}
+
+static int binding_order(const void *a, const void *b)
+{
+    return strcmp(((const eng_binding *)a)->name, ((const eng_binding *)b)->name);
 }
 
 int eng_snapshot_take(const silc_engine *E, eng_snapshot *s)
@@ -111,14 +115,13 @@ int eng_snapshot_take(const silc_engine *E, eng_snapshot *s)
     eng_info_entry **tail = &s->infos;
     memset(s, 0, sizeof *s);
     s->rand_state = E->rand_state;
-    s->names = calloc(E->store.count + 1, sizeof *s->names);
-    s->values = calloc(E->store.count + 1, sizeof *s->values);
-    if (!s->names || !s->values) goto oom;
+    if (!(s->bindings = calloc(E->store.count + 1, sizeof *s->bindings))) goto oom;
     for (b = 0; b < E->store.nbuckets; b++)
         for (e = E->store.buckets[b]; e; e = e->next) {
-            if (!(s->names[s->n] = util_strdup(e->name))) goto oom;
-            s->values[s->n++] = val_retain(e->value);
+            if (!(s->bindings[s->n].name = util_strdup(e->name))) goto oom;
+            s->bindings[s->n++].value = val_retain(e->value);
         }
+    qsort(s->bindings, s->n, sizeof *s->bindings, binding_order);
     for (ie = E->infos; ie; ie = ie->next) {
         eng_info_entry *c = calloc(1, sizeof *c);
         if (!c) goto oom;
@@ -141,11 +144,26 @@ oom:
 
 int eng_snapshot_restore(silc_engine *E, eng_snapshot *s)
 {
-    size_t i;
+    size_t b, i;
     int rc = 0;
-    store_clear(&E->store);
+    /* Names bound since the snapshot go, and the others get their old
+     * values back; neither allocates (rebinding a bound name reuses its
+     * entry), so a failure cannot leave the store half restored, except
+     * for a name cleared meanwhile, which needs a new entry. */
+    for (b = 0; b < E->store.nbuckets; b++) {
+        store_entry *e = E->store.buckets[b], *next;
+        for (; e; e = next) {
+            eng_binding key;
+            next = e->next;
+            key.name = e->name;
+            if (!bsearch(&key, s->bindings, s->n, sizeof *s->bindings, binding_order))
+                store_remove(&E->store, e->name);
+        }
+    }
     for (i = 0; i < s->n; i++)
-        if (store_set(&E->store, s->names[i], s->values[i])) rc = -1;
+        if (store_get(&E->store, s->bindings[i].name) != s->bindings[i].value &&
+            store_set(&E->store, s->bindings[i].name, s->bindings[i].value))
+            rc = -1;
     eng_info_free_all(E);
     E->infos = s->infos;
     s->infos = NULL;

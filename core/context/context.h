@@ -120,17 +120,20 @@ void eng_interrupt_clear(silc_engine *E);
  * interrupted (eval.c).  Cheap, since values are immutable: the names and
  * references to the values.  An update in place (eval.c) then copies the
  * value once, since the snapshot holds it too. */
+typedef struct eng_binding {
+    char *name;
+    silc_value *value;          /* retained */
+} eng_binding;
 typedef struct eng_snapshot {
     size_t n;
-    char **names;
-    silc_value **values;
+    eng_binding *bindings;      /* sorted by name */
     eng_info_entry *infos;
     uint64_t rand_state;
 } eng_snapshot;
 /* 0, or -1 when out of memory (s is then empty). */
 int eng_snapshot_take(const silc_engine *E, eng_snapshot *s);
-/* Puts everything back as it was and consumes s; -1 if a binding could not
- * be restored (out of memory). */
+/* Puts everything back as it was and consumes s.  Allocates only to bind
+ * again a name that was cleared since: -1 if that ran out of memory. */
 int eng_snapshot_restore(silc_engine *E, eng_snapshot *s);
 void eng_snapshot_free(eng_snapshot *s);
 /* Copies info; takes over its pending references (also on failure). */
