@@ -194,6 +194,7 @@ typedef struct lis_ctx {
     char label[32];             /* "BiCG" for messages */
     char why[160];              /* what broke down */
     double *w1, *w2;            /* double scratch for preconditioning in quad */
+    silc_call *call;            /* the solve, for host->cancelled() (lis_limit); may be NULL */
 } lis_ctx;
 
 /* Scalars are double-double numbers; in double mode each operation rounds

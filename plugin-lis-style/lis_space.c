@@ -181,9 +181,13 @@ void lv_psolve_t(lis_ctx *c, const lis_vec *x, lis_vec *y)
     psolve(c, x, y, 1);
 }
 
+/* The iteration limit, or a request to stop (an interrupt, silcd's time
+ * limit: host->cancelled, ABI 1.7), asked once an iteration: the solver
+ * then ends as at -maxiter, and the host reports why it stopped. */
 int lis_limit(const lis_ctx *c)
 {
-    return c->iter >= c->o->maxiter;
+    if (c->iter >= c->o->maxiter) return 1;
+    return c->call && lis_host->struct_size >= SILC_HOST_NEEDS(cancelled) && lis_host->cancelled(c->call);
 }
 
 int lis_check(lis_ctx *c, dd rnorm)

@@ -448,6 +448,7 @@ static int solve_run(silc_call *call)
     c.pc = pc;
     c.o = &opt;
     c.n = a.n;
+    c.call = call;
     if (opt.conv_cond == LIS_CONV_BACKWARD)
         for (j = 0; j < A.m; j++) {
             double row = 0;

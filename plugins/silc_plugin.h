@@ -334,7 +334,8 @@ typedef struct silc_host_api {
      * result of a collective call (x = A \ b: like = b).  NULL on failure. */
     silc_value *(*dist_dense_new)(const silc_value *like, int64_t n);
 
-    /* ABI 1.7: 1 when the request running this call is to stop (silcd's
+    /* ABI 1.7: 1 when the request running this call is to stop (an
+     * interrupt: Ctrl-C in the REPL, silc_cancel, a CANCEL frame; silcd's
      * --max-request-seconds, its client gone, the server shutting down),
      * else 0.  An iterative method asks between iterations and then returns
      * host->error(call, SILC_ELIB, "stopped on request"); the host reports

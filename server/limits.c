@@ -8,7 +8,9 @@
  *   (PR_SET_PDEATHSIG), so that no session outlives silcd;
  * - the watch over a running request, which the evaluator asks between
  *   statements (silc_engine.cancel): its time limit (--max-request-seconds),
- *   its client hanging up, the server shutting down.  Asking is cooperative;
+ *   its client hanging up, the server shutting down, and the client's
+ *   CANCEL frame, which the watch reads off the socket while the request
+ *   runs (an interrupt: "interrupted", docs/protocol.md).  Asking is cooperative;
  *   a request stuck inside a library call is ended by a timer in the
  *   session's process (the process dies of SIGALRM and silcd tells the
  *   client, silcd.c reap_children) or, when its client has gone, killed by
@@ -30,9 +32,11 @@
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
 
+#include "client.h"
 #include "engine.h"
 
 /* The part of a process's data segment (kB, /proc/self/status VmData) made
@@ -184,6 +188,19 @@ static int client_gone(int fd)
     return poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR));
 }
 
+/* A CANCEL frame is the next thing on the socket: taken off it (1).  The
+ * header is peeked first, so anything else a client sent is left for the
+ * request loop; a header not yet whole is looked at again next poll. */
+static int cancel_arrived(int fd)
+{
+    uint8_t h[PROTO_HEADER_BYTES];
+    ssize_t n = recv(fd, h, sizeof h, MSG_PEEK | MSG_DONTWAIT);
+    if (n != (ssize_t)sizeof h || proto_get_u32(h) != PROTO_CANCEL || proto_get_u32(h + 4) != 0 ||
+        proto_get_u64(h + 8) != 0)
+        return 0;
+    return recv(fd, h, sizeof h, MSG_DONTWAIT) == (ssize_t)sizeof h;
+}
+
 static int shutdown_requested(void)
 {
     struct pollfd p;
@@ -221,11 +238,20 @@ int srv_watch_check(void *user, char *why, size_t whylen)
     srv_watch *w = user;
     double now = util_now();
     if (w->stop) return stop_because(w, w->stop, why, whylen);
+    if (w->cancelled) {
+        snprintf(why, whylen, "%s", ENG_INTERRUPTED);
+        return 1;
+    }
     if (w->deadline > 0 && now >= w->deadline) return stop_because(w, SRV_STOP_TIME, why, whylen);
     /* The clock is cheap (vDSO), system calls are not: poll every 20 ms. */
     if (now < w->next_poll) return 0;
     w->next_poll = now + SRV_WATCH_POLL_S;
     if (client_gone(w->fd)) return stop_because(w, SRV_STOP_GONE, why, whylen);
+    if (cancel_arrived(w->fd)) {
+        w->cancelled = 1;
+        snprintf(why, whylen, "%s", ENG_INTERRUPTED);
+        return 1;
+    }
     if (!w->shutdown_at && shutdown_requested()) w->shutdown_at = now + SRV_SHUTDOWN_GRACE_S;
     if (w->shutdown_at && now >= w->shutdown_at)
         return stop_because(w, SRV_STOP_SHUTDOWN, why, whylen);

@@ -114,11 +114,13 @@ void srv_death_reason(int sig, int state, char *out, size_t outlen);
 enum { SRV_STOP_NONE = 0, SRV_STOP_TIME, SRV_STOP_GONE, SRV_STOP_SHUTDOWN };
 /* One running request's watch: the engine's cancel hook (srv_watch_check,
  * user = the watch) stops it past --max-request-seconds, when the client on
- * fd hangs up, or a grace after shutdown; stop says which. */
+ * fd hangs up, or a grace after shutdown; stop says which.  A CANCEL frame
+ * from the client (read by the watch) interrupts it: cancelled. */
 typedef struct srv_watch {
     int fd;
     double deadline, next_poll, shutdown_at;
     int stop;
+    int cancelled;   /* the client sent CANCEL: "interrupted", an ordinary failure (no stop) */
     char why[256];   /* the client's message once stop is set */
 } srv_watch;
 void srv_watch_begin(srv_watch *w, int fd);

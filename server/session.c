@@ -11,10 +11,11 @@
  *
  * Session memory (the val_bytes of every bound value, and what the memo
  * keeps without a name: memo_charge) is kept under max_session_bytes; the
- * memo gives way first (memo_shrink).  A PUT is checked from its descriptor before its arrays
- * are read; an EXEC runs against a snapshot of the bindings (names to
- * retained values, which is cheap because values are immutable) and is rolled
- * back whole if it leaves the session over the limit.
+ * memo gives way first (memo_shrink).  A PUT is checked from its descriptor
+ * before its arrays are read; an EXEC runs against a snapshot of the
+ * bindings (eng_snapshot: names to retained values, which is cheap because
+ * values are immutable) and is rolled back whole if it leaves the session
+ * over the limit.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "server.h"
@@ -57,14 +58,6 @@ struct session {
 
 srv_ranks *srv_mpi;
 
-/* The bindings and records an EXEC may change, to restore on rollback. */
-typedef struct snapshot {
-    size_t n;
-    char **names;
-    silc_value **values;
-    eng_info_entry *infos;
-    uint64_t rand_state;
-} snapshot;
 
 static void out_frame(outbuf *o, uint32_t op, const char *text)
 {
@@ -115,79 +108,6 @@ static void memo_give_way(silc_engine *E, double more)
     double left = (double)srv_cfg.max_session_bytes - (double)bound_bytes(E) - more;
     if (!srv_cfg.max_session_bytes) return;
     memo_shrink(E, left > 0 ? (uint64_t)left : 0);
-}
-
-static void infos_free(eng_info_entry *e)
-{
-    while (e) {
-        eng_info_entry *next = e->next;
-        free(e->name);
-        free(e->info.statement);
-        free(e);
-        e = next;
-    }
-}
-
-static void snapshot_free(snapshot *s)
-{
-    size_t i;
-    for (i = 0; i < s->n; i++) {
-        free(s->names[i]);
-        val_release(s->values[i]);
-    }
-    free(s->names);
-    free(s->values);
-    infos_free(s->infos);
-    memset(s, 0, sizeof *s);
-}
-
-static int snapshot_take(const silc_engine *E, snapshot *s)
-{
-    size_t b;
-    const store_entry *e;
-    const eng_info_entry *ie;
-    eng_info_entry **tail = &s->infos;
-    memset(s, 0, sizeof *s);
-    s->rand_state = E->rand_state;
-    s->names = calloc(E->store.count + 1, sizeof *s->names);
-    s->values = calloc(E->store.count + 1, sizeof *s->values);
-    if (!s->names || !s->values) goto oom;
-    for (b = 0; b < E->store.nbuckets; b++)
-        for (e = E->store.buckets[b]; e; e = e->next) {
-            if (!(s->names[s->n] = util_strdup(e->name))) goto oom;
-            s->values[s->n++] = val_retain(e->value);
-        }
-    for (ie = E->infos; ie; ie = ie->next) {
-        eng_info_entry *c = calloc(1, sizeof *c);
-        if (!c) goto oom;
-        *tail = c;
-        tail = &c->next;
-        c->info = ie->info;
-        c->info.statement = NULL;
-        if (!(c->name = util_strdup(ie->name))) goto oom;
-        if (ie->info.statement && !(c->info.statement = util_strdup(ie->info.statement)))
-            goto oom;
-    }
-    return 0;
-oom:
-    snapshot_free(s);
-    return -1;
-}
-
-/* Puts the bindings back as they were; the snapshot is consumed. */
-static int snapshot_restore(silc_engine *E, snapshot *s)
-{
-    size_t i;
-    int rc = 0;
-    store_clear(&E->store);
-    for (i = 0; i < s->n; i++)
-        if (store_set(&E->store, s->names[i], s->values[i])) rc = -1;
-    infos_free(E->infos);
-    E->infos = s->infos;
-    s->infos = NULL;
-    E->rand_state = s->rand_state;
-    snapshot_free(s);
-    return rc;
 }
 
 static int reply_text(session *S, uint32_t op, const char *text)
@@ -259,12 +179,12 @@ static void exec_budget(const silc_engine *E, int on)
 static int do_exec(session *S, const char *text)
 {
     silc_engine *E = S->E;
-    snapshot snap;
+    eng_snapshot snap;
     char *warnings;
     uint64_t used;
     int rc, guarded = exec_guarded(), r, stop, refused;
     int64_t over;
-    if (guarded && snapshot_take(E, &snap)) {
+    if (guarded && eng_snapshot_take(E, &snap)) {
         return reply_error(S, "out of memory preparing the statement");
     }
     if (srv_mpi) srv_mpi->command(srv_mpi, SRV_CMD_EXEC, S->id, text);
@@ -281,6 +201,15 @@ static int do_exec(session *S, const char *text)
         /* The plain reason, not "statement k: " or "rank 0 of N: ". */
         snprintf(S->err, sizeof S->err, "%s", S->watch.why);
         srv_log(LOG_INFO, "session %lu: %s", S->id, S->watch.why);
+    } else if (rc && S->watch.cancelled) {
+        /* Interrupted by the client's CANCEL.  Under silcd --mpi only rank
+         * 0 read it, and the ranks' agreement named it ("statement 2: rank
+         * 0 of 2: interrupted"): the client is told what any other server
+         * says, "statement 2: interrupted". */
+        char *rank = srv_mpi ? strstr(S->err, "rank 0 of ") : NULL, *colon;
+        if (rank && (colon = strstr(rank, ": ")) != NULL && !strcmp(colon + 2, ENG_INTERRUPTED))
+            memmove(rank, colon + 2, strlen(colon + 2) + 1);
+        srv_log(LOG_INFO, "session %lu: %s", S->id, S->err);
     }
     if (guarded) {
         memo_give_way(E, 0);
@@ -290,7 +219,7 @@ static int do_exec(session *S, const char *text)
         over = stop || refused || (srv_cfg.max_session_bytes && used > srv_cfg.max_session_bytes);
         if (srv_mpi) srv_mpi->word(srv_mpi, &over); /* rank 0's verdict decides for all */
         if (stop) {
-            if (snapshot_restore(E, &snap))
+            if (eng_snapshot_restore(E, &snap))
                 snprintf(S->err, sizeof S->err, "out of memory restoring the session");
             rc = -1;
         } else if (over && refused) {
@@ -298,7 +227,7 @@ static int do_exec(session *S, const char *text)
             snprintf(why, sizeof why, "%.1000s", S->err);
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: %s; the whole request "
                      "was rolled back", why);
-            if (snapshot_restore(E, &snap))
+            if (eng_snapshot_restore(E, &snap))
                 snprintf(S->err, sizeof S->err, "out of memory restoring the session");
             rc = -1;
         } else if (over) {
@@ -309,11 +238,11 @@ static int do_exec(session *S, const char *text)
                      "--max-session-bytes); the whole request was rolled back%s%.500s",
                      (unsigned long long)used, (unsigned long long)srv_cfg.max_session_bytes,
                      rc ? "; it had also failed: " : "", done);
-            if (snapshot_restore(E, &snap))
+            if (eng_snapshot_restore(E, &snap))
                 snprintf(S->err, sizeof S->err, "out of memory restoring the session");
             rc = -1;
         } else {
-            snapshot_free(&snap);
+            eng_snapshot_free(&snap);
         }
     }
     /* A client that has gone is not answered: the session ends. */
@@ -650,6 +579,12 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
             sb_free(&b);
             break;
         }
+        case PROTO_CANCEL:
+            /* It came after the EXEC it was meant for had ended (the
+             * watch takes one that comes in time, limits.c): nothing to
+             * stop, and no reply, as the client expects none. */
+            rc = 0;
+            break;
         default: /* PROTO_BYE */
             reply_text(S, PROTO_OK, NULL);
             rc = -1;
@@ -815,17 +750,17 @@ int srv_follow(void)
             store_remove(&E->store, text);
             eng_info_remove(E, text);
         } else if (cmd == SRV_CMD_EXEC) {
-            snapshot snap;
+            eng_snapshot snap;
             int guarded = exec_guarded(), have = 0;
             int64_t over = 0;
-            if (guarded) have = snapshot_take(E, &snap) == 0;
+            if (guarded) have = eng_snapshot_take(E, &snap) == 0;
             exec_budget(E, 1);
             api_exec(E, text, err, sizeof err);
             exec_budget(E, 0);
             if (guarded) {
                 srv_mpi->word(srv_mpi, &over);
-                if (over && have) snapshot_restore(E, &snap);
-                else if (have) snapshot_free(&snap);
+                if (over && have) eng_snapshot_restore(E, &snap);
+                else if (have) eng_snapshot_free(&snap);
             }
         }
         free(text);

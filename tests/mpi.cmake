@@ -47,7 +47,7 @@ set_tests_properties(silcd_mpi_start PROPERTIES FIXTURES_SETUP silcd_mpi
                      ENVIRONMENT "${SILC_MPI_ENV};SILC_LAUNCH=${MPIEXEC_EXECUTABLE} -np 2;SILC_WISDOM=${_mpi_state}/wisdom")
 set_tests_properties(silcd_mpi_stop PROPERTIES FIXTURES_CLEANUP silcd_mpi)
 set(_mpi_remote_env "${SILC_TEST_ENV};SILC_SERVER=unix:${SILC_MPI_SOCKET}")
-foreach(t test_api test_lang test_truth test_examples)
+foreach(t test_api test_lang test_truth test_examples test_interrupt)
   if(TARGET ${t})
     add_test(NAME ${t}_mpi_server COMMAND ${t})
     set_tests_properties(${t}_mpi_server PROPERTIES ENVIRONMENT "${_mpi_remote_env}" TIMEOUT 600

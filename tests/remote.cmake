@@ -30,6 +30,15 @@ target_link_libraries(test_server PRIVATE Threads::Threads)
 add_dependencies(test_server silc_test_crash silcd)
 set_tests_properties(test_server PROPERTIES TIMEOUT 300)
 
+# Interrupts (silc_cancel from a thread): embedded, inside a plugin call that
+# polls host->cancelled() (the crash plugin), and over a private silcd.
+silc_add_test(test_interrupt INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_interrupt.c)
+target_compile_definitions(test_interrupt PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>"
+  CRASH_PLUGIN_DIR="${CMAKE_CURRENT_BINARY_DIR}/crash-plugin")
+target_link_libraries(test_interrupt PRIVATE Threads::Threads)
+add_dependencies(test_interrupt silc_test_crash silcd)
+set_tests_properties(test_interrupt PROPERTIES TIMEOUT 120)
+
 # The frame decoder under a deterministic mutation fuzzer (always), and under
 # libFuzzer when clang can build it (a short run; longer runs by hand).
 add_executable(fuzz_frame ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c)
@@ -104,6 +113,18 @@ if(SILC_SYSTEM_PYTHON)
            ${PROJECT_SOURCE_DIR}/bindings/python)
   set_tests_properties(test_python PROPERTIES ENVIRONMENT "${_remote_env}" TIMEOUT 120
                        FIXTURES_REQUIRED silcd)
+  # Ctrl-C in the REPL (through a pseudo-terminal) and cancel from the
+  # Python client, against a silcd of its own; embedded Python too where
+  # the interpreter can load libsilc (not under a sanitizer).
+  if(TARGET silc_cli)
+    set(_interrupt_env "${SILC_TEST_ENV}")
+    if(NOT SILC_SANITIZE)
+      list(APPEND _interrupt_env "SILC_LIBRARY=$<TARGET_FILE:silc>")
+    endif()
+    add_test(NAME test_interrupt_py COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/test_interrupt.py
+             $<TARGET_FILE:silc_cli> $<TARGET_FILE:silcd> ${PROJECT_SOURCE_DIR}/bindings/python)
+    set_tests_properties(test_interrupt_py PROPERTIES ENVIRONMENT "${_interrupt_env}" TIMEOUT 120)
+  endif()
   # The same test embedded: libsilc in the interpreter through ctypes (not
   # in a sanitizer build: an uninstrumented interpreter cannot load ASan's
   # libsilc).

@@ -6,7 +6,8 @@
  *                                    flow (if/while/break/continue) spans lines
  *     silc [options] -e STATEMENTS
  *     silc [options]                 REPL (readline line editing and history in
- *                                    ~/.silc_history when stdin is a terminal)
+ *                                    ~/.silc_history when stdin is a terminal;
+ *                                    Ctrl-C interrupts a statement or clears the line)
  *     silc [options] tune fit P:T...  fit the tuner's model to timings
  *     silc [options] tune report [F]  the tuner's last result from the wisdom file
  *                                    (the `tune` statement, so the same code answers)
@@ -22,6 +23,9 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <ctype.h>
 #include <stdio.h>
@@ -61,8 +65,10 @@ static const char usage_text[] =
     "                       line (what Tab completes)\n"
     "In the interactive session a line that ends inside an unclosed ( [ or {, or an\n"
     "if, while or for without its end, continues on the next line; 'quit', 'exit' or\n"
-    "end of input leaves.  Warnings go to standard\n"
-    "error as \"warning: ...\"; who, info and explain print to standard output.\n";
+    "end of input (Ctrl-D) leaves.  Ctrl-C stops the running statement\n"
+    "(\"interrupted\", the store as before it) or clears the line being typed.\n"
+    "Warnings go to standard error as \"warning: ...\"; who, info and explain print\n"
+    "to standard output.\n";
 
 typedef struct {
     const char *config;
@@ -240,10 +246,110 @@ static void print_warnings(const silc_context *ctx)
     }
 }
 
+/* ---- Ctrl-C in the interactive session ------------------------------------ */
+
+/* SIGINT interrupts the running statement (silc_cancel, which is
+ * async-signal-safe and, on a remote context, sends CANCEL to silcd); at
+ * the prompt it drops the line being typed.  The handler only sets flags
+ * and calls silc_cancel; the REPL acts on them outside the handler. */
+static silc_context *interrupt_ctx;
+static volatile sig_atomic_t exec_running;      /* a statement runs */
+static volatile sig_atomic_t exec_interrupts;   /* Ctrl-C presses during it */
+static volatile sig_atomic_t line_interrupted;  /* Ctrl-C at the prompt */
+/* Written by the handler at the prompt, so the prompt's wait wakes up
+ * whichever thread the signal landed on and however it raced the wait. */
+static int wake_pipe[2] = {-1, -1};
+
+static void on_sigint(int sig)
+{
+    static const char again[] = "\nsilc: still running (inside a library call that does not "
+                                "stop); Ctrl-C once more quits\n";
+    ssize_t ignored;
+    (void)sig;
+    if (!exec_running) {
+        int saved_errno = errno;
+        line_interrupted = 1;
+        if (wake_pipe[1] >= 0) {
+            ignored = write(wake_pipe[1], "", 1);
+            (void)ignored;
+        }
+        errno = saved_errno;
+        return;
+    }
+    silc_cancel(interrupt_ctx);
+    if (++exec_interrupts == 2) {
+        ignored = write(STDERR_FILENO, again, sizeof again - 1);
+        (void)ignored;
+    } else if (exec_interrupts >= 3) {
+        /* A call that never returns: the third press quits, as the
+         * terminal's default would have (history is saved line by line). */
+        signal(SIGINT, SIG_DFL);
+        raise(SIGINT);
+    }
+}
+
+/* Without SA_RESTART, so that a read at the prompt returns EINTR. */
+static void catch_sigint(silc_context *ctx)
+{
+    struct sigaction sa;
+    interrupt_ctx = ctx;
+    if (pipe(wake_pipe) == 0) {
+        for (int k = 0; k < 2; k++) {
+            fcntl(wake_pipe[k], F_SETFL, O_NONBLOCK);
+            fcntl(wake_pipe[k], F_SETFD, FD_CLOEXEC);
+        }
+    } else {
+        wake_pipe[0] = wake_pipe[1] = -1; /* Ctrl-C at the prompt then waits for a key */
+    }
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+}
+
+#ifdef SILC_HAVE_READLINE
+/* readline's reader (rl_getc_function): on Ctrl-C the line typed so far is
+ * dropped and readline returns at once, so the REPL can also drop the lines
+ * of an unfinished statement and show a fresh prompt.  readline's own
+ * SIGINT handling is off (rl_catch_signals = 0): it would end the process. */
+static int read_key(FILE *in)
+{
+    for (;;) {
+        struct pollfd p[2];
+        unsigned char c;
+        char drain[64];
+        ssize_t n;
+        if (line_interrupted) {
+            rl_replace_line("", 0);
+            return '\n';
+        }
+        p[0].fd = fileno(in);
+        p[1].fd = wake_pipe[0];
+        p[0].events = p[1].events = POLLIN;
+        p[0].revents = p[1].revents = 0;
+        if (poll(p, wake_pipe[0] >= 0 ? 2 : 1, -1) < 0) {
+            if (errno == EINTR) continue;
+            return EOF;
+        }
+        if (p[1].revents) { /* the flag is looked at above */
+            while (read(wake_pipe[0], drain, sizeof drain) > 0) {}
+            continue;
+        }
+        n = read(p[0].fd, &c, 1);
+        if (n == 1) return c;
+        if (n == 0 || errno != EINTR) return EOF;
+    }
+}
+#endif
+
 /* Runs statements and reports warnings and any error; returns 0 on success. */
 static int run_text(silc_context *ctx, const char *text)
 {
-    int rc = silc_exec(ctx, text);
+    int rc;
+    exec_interrupts = 0;
+    exec_running = 1;
+    rc = silc_exec(ctx, text);
+    exec_running = 0;
     print_warnings(ctx);
     if (rc) fail("%s", silc_context_errmsg(ctx));
     return rc;
@@ -475,9 +581,12 @@ static int is_command(const char *line, const char *word)
     return !strncmp(line, word, len) && line[len + strspn(line + len, " \t;")] == '\0';
 }
 
-/* One line without its newline, malloc'd; NULL at end of input. */
+/* One line without its newline, malloc'd; NULL at end of input.  After
+ * Ctrl-C at the prompt line_interrupted is set (the line is then "", or
+ * NULL from getline, and means nothing). */
 static char *read_line(int interactive, const char *prompt)
 {
+    line_interrupted = 0;
 #ifdef SILC_HAVE_READLINE
     if (interactive) return readline(prompt);
 #endif
@@ -490,6 +599,10 @@ static char *read_line(int interactive, const char *prompt)
     ssize_t len = getline(&line, &cap, stdin);
     if (len < 0) {
         free(line);
+        if (line_interrupted) {
+            clearerr(stdin); /* EINTR is not the end of input */
+            putchar('\n');
+        }
         return NULL;
     }
     if (len > 0 && line[len - 1] == '\n') line[len - 1] = '\0';
@@ -525,12 +638,26 @@ static int repl(silc_context *ctx)
         rl_attempted_completion_function = complete;
         using_history();
         stifle_history(1000);
-        if (hist) read_history(hist); /* a missing file is a first session */
+        /* Each line is appended to the file as it is entered, so a session
+         * that ends any way at all keeps its lines; a first session makes
+         * the file (append_history does not). */
+        if (hist && read_history(hist) == ENOENT) write_history(hist);
+        rl_catch_signals = 0;
+        rl_getc_function = read_key;
     }
 #endif
+    if (interactive) catch_sigint(ctx);
     if (interactive) printf("silc %s -- 'quit' or Ctrl-D to leave, silc --help for usage\n", SILC_VERSION);
     for (;;) {
         char *line = read_line(interactive, len ? "...> " : "silc> ");
+        if (line_interrupted) {
+            /* Ctrl-C at the prompt: the statement being typed, all its
+             * lines, is dropped; only Ctrl-D or quit/exit leave. */
+            free(line);
+            len = 0;
+            open = 0;
+            continue;
+        }
         if (!line) {
             if (interactive) putchar('\n');
             break;
@@ -540,7 +667,10 @@ static int repl(silc_context *ctx)
             break;
         }
 #ifdef SILC_HAVE_READLINE
-        if (interactive && line[strspn(line, " \t")]) add_history(line);
+        if (interactive && line[strspn(line, " \t")]) {
+            add_history(line);
+            if (hist) append_history(1, hist);
+        }
 #endif
         size_t add = strlen(line);
         if (len + add + 2 > cap) {
@@ -575,7 +705,7 @@ static int repl(silc_context *ctx)
     if (len && buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
     free(buf);
 #ifdef SILC_HAVE_READLINE
-    if (hist) write_history(hist);
+    if (hist) history_truncate_file(hist, 1000);
     free(hist);
 #endif
     return interactive ? 0 : failed;

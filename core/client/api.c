@@ -105,6 +105,7 @@ int api_exec(silc_engine *E, const char *statements, char *err, size_t errlen)
     E->warnings.len = 0;
     E->warnings.failed = 0;
     if (E->warnings.s) E->warnings.s[0] = '\0';
+    eng_interrupt_clear(E); /* an interrupt stops the exec it meets, not the next one */
     if (lang_exec(E, statements) == 0) return 0;
     snprintf(err, errlen, "%s", E->err[0] ? E->err : "statement failed");
     return -1;
@@ -407,6 +408,18 @@ int silc_exec(silc_context *ctx, const char *statements)
                                         &ctx->warnings, ctx->err, sizeof ctx->err));
     if (spmd_enter(ctx, "EXEC", statements, 0)) return ctx_result(ctx, -1);
     return ctx_result(ctx, api_exec(ctx->E, statements, ctx->err, sizeof ctx->err));
+}
+
+/* Touches only the engine's atomic flag or writes one frame (rem_cancel),
+ * so it may run in a signal handler or another thread. */
+int silc_cancel(silc_context *ctx)
+{
+    if (!ctx) return -1;
+    if (ctx->E) {
+        eng_interrupt(ctx->E);
+        return 0;
+    }
+    return rem_cancel(ctx->R);
 }
 
 /* save / load as a statement, so that embedded and remote contexts do the

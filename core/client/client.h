@@ -83,6 +83,7 @@ enum proto_op {
     /* requests */
     PROTO_PUT = 1, PROTO_GET = 2, PROTO_EXEC = 3, PROTO_DELETE = 4,
     PROTO_LIST = 5, PROTO_INFO = 6, PROTO_EXPLAIN = 7, PROTO_BYE = 8,
+    PROTO_CANCEL = 9,   /* no reply of its own: it ends the running EXEC early */
     /* replies */
     PROTO_OK = 128, PROTO_ERROR = 129, PROTO_VALUE = 130, PROTO_TEXT = 131, PROTO_WARN = 132
 };
@@ -236,5 +237,9 @@ int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, char *err, size_t
  * WARN replies are appended to warnings. */
 int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
              strbuf *warnings, char *err, size_t errlen);
+/* Sends CANCEL if an EXEC is waiting for its reply (else nothing); its
+ * reply then comes as usual, ERROR "interrupted" if the server stopped it.
+ * Async-signal-safe and callable from another thread (silc_cancel). */
+int rem_cancel(rem_conn *c);
 
 #endif

@@ -168,6 +168,7 @@ const char *proto_op_name(uint32_t op)
     case PROTO_INFO: return "INFO";
     case PROTO_EXPLAIN: return "EXPLAIN";
     case PROTO_BYE: return "BYE";
+    case PROTO_CANCEL: return "CANCEL";
     case PROTO_OK: return "OK";
     case PROTO_ERROR: return "ERROR";
     case PROTO_VALUE: return "VALUE";
@@ -543,6 +544,7 @@ int proto_read_request(proto_stream *s, const proto_limits *lim, proto_request *
     switch (r->op) {
     case PROTO_LIST:
     case PROTO_BYE:
+    case PROTO_CANCEL:
         if (len != 0) {
             perr(0, err, errlen, "%s frame with a %llu-byte body (must be empty)",
                  proto_op_name(r->op), (unsigned long long)len);

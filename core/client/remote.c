@@ -24,6 +24,8 @@
 #include <errno.h>
 #include <math.h>
 #include <netdb.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
@@ -54,12 +56,18 @@ static void keep_alive(int fd)
 #endif
 }
 
+/* Whether a CANCEL may be written now (rem_cancel): only while an EXEC
+ * waits for its reply, when nothing else is being sent, so its 16 bytes
+ * never land inside another frame. */
+enum { EXEC_IDLE, EXEC_AWAITING, EXEC_CANCELLING };
+
 struct rem_conn {
     int fd;
     int broken;
     int io_timeout_ms;         /* SILC_IO_TIMEOUT: the longest silence inside a reply; -1 none */
     int exec_timeout_ms;       /* SILC_EXEC_TIMEOUT: the longest wait for an EXEC's reply; -1 none */
     proto_limits limits;       /* SILC_MAX_REPLY_BYTES per value; text as silcd's statements */
+    atomic_int exec_state;   /* EXEC_*; lock-free, so rem_cancel is async-signal-safe */
     char url[512];
 };
 
@@ -391,8 +399,39 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
              strbuf *warnings, char *err, size_t errlen)
 {
     char why[512];
+    int rc, state;
     if (usable(c, err, errlen)) return -1;
     if (proto_send_text(c->fd, PROTO_EXEC, statements, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, NULL, fn, user, warnings, 1, err, errlen);
+    atomic_store(&c->exec_state, EXEC_AWAITING);
+    rc = await_reply(c, NULL, fn, user, warnings, 1, err, errlen);
+    /* A CANCEL being written (another thread) finishes before the next
+     * request may be sent; a signal handler's has finished by now. */
+    for (;;) {
+        state = EXEC_AWAITING;
+        if (atomic_compare_exchange_strong(&c->exec_state, &state, EXEC_IDLE)) break;
+        if (state == EXEC_IDLE) break;
+        sched_yield();
+    }
+    return rc;
+}
+
+int rem_cancel(rem_conn *c)
+{
+    uint8_t frame[PROTO_HEADER_BYTES];
+    size_t sent = 0;
+    int state = EXEC_AWAITING, saved_errno = errno;
+    if (!c) return -1;
+    if (!atomic_compare_exchange_strong(&c->exec_state, &state, EXEC_CANCELLING)) return 0;
+    proto_encode_header(frame, PROTO_CANCEL, 0);
+    /* send() is async-signal-safe; proto_send polls and formats messages. */
+    while (sent < sizeof frame) {
+        ssize_t n = send(c->fd, frame + sent, sizeof frame - sent, MSG_NOSIGNAL);
+        if (n > 0) sent += (size_t)n;
+        else if (n < 0 && errno == EINTR) continue;
+        else break; /* the connection is failing: the reply's read says so */
+    }
+    atomic_store(&c->exec_state, EXEC_AWAITING);
+    errno = saved_errno; /* a signal handler must leave errno as it found it */
+    return 0;
 }

@@ -44,11 +44,132 @@ int eng_oom(silc_engine *E)
     return eng_error(E, "%s", *why ? why : "out of memory");
 }
 
+int eng_cancel_pending(silc_engine *E, char *why, size_t whylen)
+{
+    if (atomic_load_explicit(&E->interrupt, memory_order_relaxed)) {
+        snprintf(why, whylen, "%s", ENG_INTERRUPTED);
+        return 1;
+    }
+    return E->cancel && E->cancel(E->cancel_user, why, whylen) != 0;
+}
+
 int eng_cancel_check(silc_engine *E)
 {
     char why[sizeof E->err];
-    if (!E->cancel || !E->cancel(E->cancel_user, why, sizeof why)) return 0;
+    if (!eng_cancel_pending(E, why, sizeof why)) return 0;
     return eng_error(E, "%s", why);
+}
+
+void eng_interrupt(silc_engine *E)
+{
+    atomic_store_explicit(&E->interrupt, 1, memory_order_relaxed);
+}
+
+void eng_interrupt_clear(silc_engine *E)
+{
+    atomic_store_explicit(&E->interrupt, 0, memory_order_relaxed);
+}
+
+/* ---- snapshots ------------------------------------------------------------ */
+
+/* The copy of a record holds its own references to the deferred backward
+ * error's operands, so the record it came from may be replaced meanwhile. */
+static void pending_retain(eng_pending *p)
+{
+    if (p->A) val_retain(p->A);
+    if (p->B) val_retain(p->B);
+    if (p->X) val_retain(p->X);
+}
+
+static void infos_free(eng_info_entry *e)
+{
+    while (e) {
+        eng_info_entry *next = e->next;
+        info_entry_free(e);
+        e = next;
+    }
+}
+
+void eng_snapshot_free(eng_snapshot *s)
+{
+    size_t i;
+    for (i = 0; i < s->n; i++) {
+        free(s->bindings[i].name);
+        val_release(s->bindings[i].value);
+    }
+    free(s->bindings);
+    infos_free(s->infos);
+    memset(s, 0, sizeof *s);
+}
+
+static int binding_order(const void *a, const void *b)
+{
+    return strcmp(((const eng_binding *)a)->name, ((const eng_binding *)b)->name);
+}
+
+int eng_snapshot_take(const silc_engine *E, eng_snapshot *s)
+{
+    size_t b;
+    const store_entry *e;
+    const eng_info_entry *ie;
+    eng_info_entry **tail = &s->infos;
+    memset(s, 0, sizeof *s);
+    s->rand_state = E->rand_state;
+    if (!(s->bindings = calloc(E->store.count + 1, sizeof *s->bindings))) goto oom;
+    for (b = 0; b < E->store.nbuckets; b++)
+        for (e = E->store.buckets[b]; e; e = e->next) {
+            if (!(s->bindings[s->n].name = util_strdup(e->name))) goto oom;
+            s->bindings[s->n++].value = val_retain(e->value);
+        }
+    qsort(s->bindings, s->n, sizeof *s->bindings, binding_order);
+    for (ie = E->infos; ie; ie = ie->next) {
+        eng_info_entry *c = calloc(1, sizeof *c);
+        if (!c) goto oom;
+        *tail = c;
+        tail = &c->next;
+        c->info = ie->info;
+        c->info.statement = NULL;
+        memset(&c->info.pending, 0, sizeof c->info.pending);
+        if (!(c->name = util_strdup(ie->name))) goto oom;
+        if (ie->info.statement && !(c->info.statement = util_strdup(ie->info.statement)))
+            goto oom;
+        c->info.pending = ie->info.pending;
+        pending_retain(&c->info.pending);
+    }
+    return 0;
+oom:
+    eng_snapshot_free(s);
+    return -1;
+}
+
+int eng_snapshot_restore(silc_engine *E, eng_snapshot *s)
+{
+    size_t b, i;
+    int rc = 0;
+    /* Names bound since the snapshot go, and the others get their old
+     * values back; neither allocates (rebinding a bound name reuses its
+     * entry), so a failure cannot leave the store half restored, except
+     * for a name cleared meanwhile, which needs a new entry. */
+    for (b = 0; b < E->store.nbuckets; b++) {
+        store_entry *e = E->store.buckets[b], *next;
+        for (; e; e = next) {
+            eng_binding key;
+            next = e->next;
+            key.name = e->name;
+            if (!bsearch(&key, s->bindings, s->n, sizeof *s->bindings, binding_order))
+                store_remove(&E->store, e->name);
+        }
+    }
+    for (i = 0; i < s->n; i++)
+        if (store_get(&E->store, s->bindings[i].name) != s->bindings[i].value &&
+            store_set(&E->store, s->bindings[i].name, s->bindings[i].value))
+            rc = -1;
+    eng_info_free_all(E);
+    E->infos = s->infos;
+    s->infos = NULL;
+    E->rand_state = s->rand_state;
+    eng_snapshot_free(s);
+    return rc;
 }
 
 void eng_print(silc_engine *E, const char *text)

@@ -12,6 +12,8 @@
 #ifndef SILC_CONTEXT_H
 #define SILC_CONTEXT_H
 
+#include <stdatomic.h>
+
 #include "silc.h"
 #include "silc_plugin.h"
 #include "util.h"
@@ -71,6 +73,10 @@ struct silc_engine {
      * limit and to stop a request whose client has gone. */
     int (*cancel)(void *user, char *why, size_t whylen);
     void *cancel_user;
+    /* Set by eng_interrupt (silc_cancel: a signal handler or another
+     * thread), cleared when an exec starts; asked wherever the hook is.
+     * Lock-free, so setting it is async-signal-safe. */
+    atomic_int interrupt;
     size_t max_statement_bytes;         /* longest statement text an exec parses, 0 = no cap */
     char err[4096];
     strbuf warnings;                    /* warnings of the current/last exec */
@@ -93,9 +99,43 @@ void eng_warn(silc_engine *E, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
-/* 0 to go on; -1 with E->err set when the engine's cancel hook asks to
- * stop the running exec (a request past its time limit, a client gone). */
+/* 0 to go on; -1 with E->err set when the running exec must stop: it was
+ * interrupted (eng_interrupt: "interrupted"), or the engine's cancel hook
+ * asks (a request past its time limit, a client gone, a CANCEL frame). */
 int eng_cancel_check(silc_engine *E);
+/* The same question without touching E->err: 1 (why filled) or 0.  For a
+ * plugin polling host->cancelled() and the dispatcher between backends. */
+int eng_cancel_pending(silc_engine *E, char *why, size_t whylen);
+/* Asks the running exec to stop at its next check; async-signal-safe and
+ * callable from any thread.  eng_interrupt_clear (an exec's start) forgets
+ * an earlier request. */
+void eng_interrupt(silc_engine *E);
+void eng_interrupt_clear(silc_engine *E);
+/* The message of an interrupted statement. */
+#define ENG_INTERRUPTED "interrupted"
+
+/* The bindings, their `info` records and the rand() state, to put back when
+ * a statement or request is undone: a request stopped by silcd's limits
+ * (server/session.c) or a top-level loop or `if` that fails or is
+ * interrupted (eval.c).  Cheap, since values are immutable: the names and
+ * references to the values.  An update in place (eval.c) then copies the
+ * value once, since the snapshot holds it too. */
+typedef struct eng_binding {
+    char *name;
+    silc_value *value;          /* retained */
+} eng_binding;
+typedef struct eng_snapshot {
+    size_t n;
+    eng_binding *bindings;      /* sorted by name */
+    eng_info_entry *infos;
+    uint64_t rand_state;
+} eng_snapshot;
+/* 0, or -1 when out of memory (s is then empty). */
+int eng_snapshot_take(const silc_engine *E, eng_snapshot *s);
+/* Puts everything back as it was and consumes s.  Allocates only to bind
+ * again a name that was cleared since: -1 if that ran out of memory. */
+int eng_snapshot_restore(silc_engine *E, eng_snapshot *s);
+void eng_snapshot_free(eng_snapshot *s);
 /* Copies info; takes over its pending references (also on failure). */
 int eng_info_set(silc_engine *E, const char *name, eng_info *info);
 /* As eng_info_set, but takes over info->statement (malloc'd) too; allocates

@@ -707,6 +707,11 @@ static void chain_error(silc_engine *E, strbuf *attempts)
 static int hand_over(silc_engine *E, const silc_call *call, const blist *L, int i, const ld_backend *b,
                      strbuf *attempts, double seconds, int verification)
 {
+    /* An interrupt (or silcd's stop) ends the chain: no next backend, and
+     * no failure remembered against the matrix, since the attempt may have
+     * failed only because it was told to stop.  Not on a communicator,
+     * where the ranks agree on stops after the statement (eval.c). */
+    if (!E->dist && eng_cancel_check(E)) return 0;
     if (!fallback_left(L, i)) {
         chain_error(E, attempts);
         return 0;

@@ -263,8 +263,10 @@ static int h_cancelled(silc_call *call)
 {
     host_call_ctx *ctx = call ? call->host_private : NULL;
     char why[256];
-    if (!ctx || !ctx->E || !ctx->E->cancel || ctx->collective || ctx->E->dist) return 0;
-    return ctx->E->cancel(ctx->E->cancel_user, why, sizeof why) != 0;
+    /* Not during a collective call or on a communicator: one rank leaving
+     * a collective alone would leave the others waiting in it. */
+    if (!ctx || !ctx->E || ctx->collective || ctx->E->dist) return 0;
+    return eng_cancel_pending(ctx->E, why, sizeof why);
 }
 
 static const silc_host_api host_table = {

@@ -162,6 +162,19 @@ SILC_API void silc_close(silc_context **ctx);
 SILC_API int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
 SILC_API int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
 SILC_API int silc_exec(silc_context *ctx, const char *statements);
+/* Interrupts the silc_exec running on ctx: it fails with "interrupted"
+ * ("statement 2: interrupted" in a text of several statements) at its next
+ * check -- after each statement and loop iteration, before each plugin
+ * call, and inside plugins that poll host->cancelled() -- and the
+ * interrupted statement leaves the store as before it (a whole loop or
+ * `if` is undone); earlier statements of the text stay done.  A library
+ * call that never polls finishes first.  Async-signal-safe and
+ * thread-safe: call it from a SIGINT handler or from another thread while
+ * silc_exec runs (not concurrently with silc_close).  On a remote context
+ * it sends a CANCEL frame (docs/protocol.md) if an exec is waiting for its
+ * reply.  With no exec running it does nothing (the next exec starts
+ * afresh).  Returns 0, or -1 for a NULL context; sets no message. */
+SILC_API int silc_cancel(silc_context *ctx);
 /* The statements `save "path" names` and `load "path" names` (HDF5; README
  * "Saving and loading"): names is a space-separated list, NULL or "" for
  * every name (save) or every SILC value of the file (load: other objects

@@ -259,6 +259,10 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         *out = call->out;
         return 0;
     }
+    /* An interrupt is also asked between plugin calls, so a statement of
+     * many operations stops within one of them; on a communicator only
+     * after statements, where the ranks agree on it (exec_stmt). */
+    if (!E->dist && eng_cancel_check(E)) return -1;
     warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
@@ -1653,6 +1657,49 @@ static int exec_for(lang_ev *V, const ast_node *s, int *flow)
     return rc;
 }
 
+/* A statement that holds other statements (a loop, an `if`, a block),
+ * whose inner bindings must be undone if it fails or is interrupted part
+ * way; any other statement computes its value whole before binding it.
+ * Kinds not listed here count as compound, so a new one is undone too. */
+static int is_compound(const ast_node *s)
+{
+    switch (s->kind) {
+    case ST_EXPR: case ST_ASSIGN: case ST_OPASSIGN: case ST_INDEX_ASSIGN: case ST_CLEAR:
+    case ST_WHO: case ST_SET: case ST_INFO: case ST_EXPLAIN: case ST_BREAK: case ST_CONTINUE:
+    case ST_TUNE: case ST_HELP: case ST_PROFILE: case ST_SAVE: case ST_LOAD:
+        return 0;
+    default:
+        return 1;
+    }
+}
+
+/* One top-level statement.  A compound one runs against a snapshot of the
+ * store (eng_snapshot), put back when it fails -- the same on every rank,
+ * since failures are agreed -- so that an interrupted loop leaves the
+ * store as before it, as any failed statement does. */
+static int exec_top(lang_ev *V, const ast_node *s)
+{
+    eng_snapshot snap;
+    int flow, rc;
+    if (!is_compound(s)) return exec_stmt(V, s, &flow);
+    rc = eng_snapshot_take(V->E, &snap) ? eng_error(V->E, "out of memory preparing the statement") : 0;
+    if (ranks_agree(V, rc)) { /* every rank runs the statement, or none */
+        if (!rc) eng_snapshot_free(&snap);
+        return -1;
+    }
+    rc = exec_stmt(V, s, &flow);
+    if (!rc) {
+        eng_snapshot_free(&snap);
+        return 0;
+    }
+    if (eng_snapshot_restore(V->E, &snap)) {
+        char msg[sizeof V->E->err];
+        memcpy(msg, V->E->err, sizeof msg);
+        eng_error(V->E, "%.2000s; out of memory undoing the statement: some names are unbound", msg);
+    }
+    return -1;
+}
+
 int lang_exec(silc_engine *E, const char *text)
 {
     lang_program *prog;
@@ -1676,10 +1723,10 @@ int lang_exec(silc_engine *E, const char *text)
         V.profile = p && !strcmp(p, "on");
     }
     for (i = 0; i < prog->nstmts; i++) {
-        int flow, rc;
+        int rc;
         double ts = V.profile ? util_now() : 0;
         E->err[0] = 0;
-        rc = exec_stmt(&V, prog->stmts[i], &flow);
+        rc = exec_top(&V, prog->stmts[i]);
         if (V.profile && prog->stmts[i]->kind != ST_PROFILE) profile_statement(&V, prog->stmts[i], util_now() - ts);
         if (rc) {
             eng_pending_release(&V.pending);

@@ -201,6 +201,27 @@ public final class TestClient {
             for (int q = 0; q < n; q++) err = Math.max(err, Math.abs(un.v[q] - Math.exp(-0.5) * Math.sin((q + 1) * h)));
             double bound = 0.5 * h * h * Math.exp(-0.5) / 12 + 0.5 * dt * Math.exp(-0.5);
             check(err < 1.5 * bound, "diffusion error " + err + " vs estimate " + bound);
+
+            // cancel() from another thread: a loop of 1e9 iterations (minutes) ends
+            // "interrupted", the loop's assignments undone, the session going on.
+            s.EXEC("ca = 7; cx = 1; ci = 0");
+            Thread canceller = new Thread(() -> {
+                try {
+                    Thread.sleep(300);
+                    s.cancel();
+                } catch (Exception e) {
+                    check(false, "cancel: " + e);
+                }
+            });
+            canceller.start();
+            expectError(() -> s.EXEC("while (ci < 1e9) { ci = ci + 1; cx = ci }"), "interrupted",
+                        "EXEC cancelled from another thread");
+            canceller.join();
+            check(s.GETScalar("ca") == 7 && s.GETScalar("cx") == 1 && s.GETScalar("ci") == 0,
+                  "the store as before the cancelled loop");
+            s.cancel(); // nothing running: nothing sent
+            s.EXEC("ci = 2");
+            check(s.GETScalar("ci") == 2, "an EXEC after cancel()");
         }
 
         // Names never leak between sessions; FINALIZE twice is harmless.

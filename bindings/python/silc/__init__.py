@@ -192,6 +192,14 @@ class Session:
         """
         self._s.exec(statements, out)
 
+    def cancel(self):
+        """Interrupts the exec running on this session, from another thread
+        (or, remote, a signal handler): it raises silc.Error "interrupted"
+        and the interrupted statement leaves the store as before it.
+        Remote, Ctrl-C during exec does this itself and raises
+        KeyboardInterrupt once the server has answered."""
+        self._s.cancel()
+
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""
         return self._s.explain(statement)

@@ -73,6 +73,7 @@ def _library():
                             ("silc_put", ctypes.c_int, [vp, cp, env]),
                             ("silc_get", ctypes.c_int, [vp, env, cp]),
                             ("silc_exec", ctypes.c_int, [vp, cp]),
+                            ("silc_cancel", ctypes.c_int, [vp]),
                             ("silc_context_errmsg", cp, [vp]),
                             ("silc_context_warnings", cp, [vp]),
                             ("silc_errmsg", cp, []),
@@ -150,6 +151,12 @@ class EmbeddedSession:
         w = self._lib.silc_context_warnings(self._ctx)
         self.warnings = w.decode("utf-8", "replace") if w else ""
         self._check(rc)
+
+    def cancel(self):
+        # silc_cancel only sets the engine's flag: safe while another
+        # thread is inside silc_exec (ctypes released the GIL there).
+        if self._ctx:
+            self._lib.silc_cancel(self._ctx)
 
     def text_of(self, statement):
         out = []

@@ -18,9 +18,11 @@ server; after one that leaves the stream out of step the connection is
 closed and later calls say so.
 """
 import os
+import signal
 import socket
 import struct
 import sys
+import threading
 
 import numpy as np
 
@@ -29,7 +31,7 @@ from ._values import (CSR, DEFAULT_MAX_VALUE_BYTES, Error, ProtocolError, Timeou
 
 SilcError = Error
 PROTOCOL_VERSION = 1
-PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE = range(1, 9)
+PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE, CANCEL = range(1, 10)
 OK, ERROR, VALUE, TEXT, WARN = range(128, 133)
 _HEADER = struct.Struct("<IIQ")
 _HELLO = struct.Struct("<4sII")
@@ -115,6 +117,12 @@ class RemoteSession:
         self.timeout = _seconds(timeout, "SILC_IO_TIMEOUT", DEFAULT_TIMEOUT)
         self.exec_timeout = _seconds(exec_timeout, "SILC_EXEC_TIMEOUT", 0)
         self.max_value_bytes = _size(max_value_bytes)
+        # cancel() writes only while an EXEC waits for its reply (_awaiting),
+        # so its frame never lands inside another; reentrant because a
+        # SIGINT handler runs on the main thread, maybe inside exec's own
+        # critical section.
+        self._cancel_lock = threading.RLock()
+        self._awaiting = False
         try:
             self.sock = self._connect(url)
         except OSError as e:
@@ -324,10 +332,53 @@ class RemoteSession:
 
     def exec(self, statements, out=None):
         """Runs statements.  Text printed by who/info/explain goes to out (a
-        list) when given, else to stdout; warnings are in self.warnings."""
+        list) when given, else to stdout; warnings are in self.warnings.
+        Ctrl-C (SIGINT, on the main thread) sends CANCEL, waits for the
+        server's reply and raises KeyboardInterrupt; a second Ctrl-C gives
+        up waiting and closes the session."""
         self.warnings = ""
         self._send(EXEC, statements.encode())
-        self._reply(out, first_wait=self.exec_timeout)
+        presses = []
+
+        def on_sigint(signum, frame):
+            presses.append(signum)
+            if len(presses) > 1:
+                raise KeyboardInterrupt
+            self.cancel()
+
+        previous = None
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+            previous = signal.signal(signal.SIGINT, on_sigint)
+        with self._cancel_lock:
+            self._awaiting = True
+        try:
+            self._reply(out, first_wait=self.exec_timeout)
+        except KeyboardInterrupt:
+            # gave up inside a reply: the stream is lost
+            self.broken = "interrupted twice while waiting for a reply"
+            self._drop()
+            raise
+        except SilcError:
+            if presses:
+                raise KeyboardInterrupt from None
+            raise
+        finally:
+            with self._cancel_lock:
+                self._awaiting = False
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+        if presses:
+            raise KeyboardInterrupt
+
+    def cancel(self):
+        """Interrupts the exec running on this session (from another thread
+        or a signal handler): the server stops it at its next check and it
+        fails with "interrupted", the store as before the statement.  Does
+        nothing when no exec is waiting for its reply."""
+        with self._cancel_lock:
+            if self._awaiting and self.sock is not None:
+                self.sock.sendall(_HEADER.pack(CANCEL, 0, 0))
 
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""

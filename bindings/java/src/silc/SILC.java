@@ -52,7 +52,8 @@ import java.util.function.Consumer;
 /** One session on a silcd server. */
 public final class SILC implements AutoCloseable {
     static final int PROTOCOL_VERSION = 1;
-    static final int PUT = 1, GET = 2, EXEC = 3, DELETE = 4, LIST = 5, INFO = 6, EXPLAIN = 7, BYE = 8;
+    static final int PUT = 1, GET = 2, EXEC = 3, DELETE = 4, LIST = 5, INFO = 6, EXPLAIN = 7, BYE = 8,
+            CANCEL = 9;
     static final int OK = 128, ERROR = 129, VALUE = 130, TEXT = 131, WARN = 132;
     static final int DENSE = 0, CSR_FORMAT = 1, BAND = 2;
     static final int DESCRIPTOR_BYTES = 48;
@@ -73,6 +74,10 @@ public final class SILC implements AutoCloseable {
     private Consumer<String> output = System.out::print;
     /* One buffer for everything sent and received; values stream through it. */
     private final ByteBuffer buf = ByteBuffer.allocateDirect(BUFFER_BYTES).order(ByteOrder.LITTLE_ENDIAN);
+    /* cancel() writes only while an EXEC waits for its reply, so its frame
+     * never lands inside another request. */
+    private final Object cancelLock = new Object();
+    private boolean awaitingExec;
 
     /* A malformed SILC_* limit variable, reported by INIT. */
     private String envError;
@@ -295,7 +300,36 @@ public final class SILC implements AutoCloseable {
     public void EXEC(String statements) throws SILCException {
         warnings = "";
         request(EXEC, text(statements, "EXEC"));
-        reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT");
+        synchronized (cancelLock) {
+            awaitingExec = true;
+        }
+        try {
+            reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT");
+        } finally {
+            synchronized (cancelLock) {
+                awaitingExec = false;
+            }
+        }
+    }
+
+    /**
+     * Interrupts the EXEC running on this session; call it from another thread.
+     * The server stops the EXEC at its next check, which then throws
+     * SILCException "interrupted" with the store as before the interrupted
+     * statement. Does nothing when no EXEC is waiting for its reply.
+     */
+    public void cancel() throws SILCException {
+        synchronized (cancelLock) {
+            if (!awaitingExec || channel == null) return;
+            ByteBuffer frame = ByteBuffer.allocate(16).order(ByteOrder.LITTLE_ENDIAN);
+            frame.putInt(CANCEL).putInt(0).putLong(0).flip();
+            try {
+                while (frame.hasRemaining()) channel.write(frame);
+            } catch (IOException e) {
+                /* The EXEC's own read meets the broken connection and says so. */
+                throw new SILCException("cancel: cannot write to silc server " + url + ": " + e.getMessage(), e);
+            }
+        }
     }
 
     /** The warnings of the last EXEC, one per line ("" when none). */

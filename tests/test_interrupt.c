@@ -1,0 +1,207 @@
+/*
+ * test_interrupt.c -- silc_cancel from another thread (silc.h): an EXEC
+ * running a loop of 1e9 iterations (minutes of work) comes back with
+ * "interrupted", the loop's own assignments undone and the values bound
+ * before it intact, and the next EXEC runs normally.  The same on an
+ * embedded context, on a remote one (a private silcd: the CANCEL frame,
+ * docs/protocol.md) and inside a plugin call that polls host->cancelled()
+ * (the "crash" test plugin, alpha 19, which spins until told to stop).
+ * With SILC_SERVER set, only the remote part, against that server (run so
+ * against silcd --mpi by tests/mpi.cmake).
+ *
+ * No timing is asserted: only that the EXEC returns while the canceller
+ * waits at most a generous bound (5 s, more under a sanitizer) for it, an
+ * ordering that a loop of 1e9 iterations could not meet by finishing.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <pthread.h>
+#include <stdatomic.h>
+
+#include "check.h"
+#include "remote_util.h"
+#include "silc.h"
+
+#define LONG_LOOP "while (i < 1e9) { i = i + 1; x = i }"
+
+typedef struct canceller {
+    silc_context *ctx;
+    atomic_int exec_done;  /* set by the EXEC's thread when it returns */
+    int returned_in_time;  /* the EXEC returned within the bound after the cancel */
+} canceller;
+
+static double bound_s(void)
+{
+    return getenv("ASAN_OPTIONS") ? 20.0 : 5.0;
+}
+
+/* Waits until the EXEC has surely started (it runs for minutes), cancels
+ * it, and waits for it to return. */
+static void *cancel_later(void *arg)
+{
+    canceller *c = arg;
+    double t0;
+    sleep_ms(300);
+    CHECK(!atomic_load(&c->exec_done), "the EXEC ended before it was cancelled");
+    silc_cancel(c->ctx);
+    t0 = util_now();
+    while (!atomic_load(&c->exec_done) && util_now() - t0 < bound_s()) sleep_ms(10);
+    c->returned_in_time = atomic_load(&c->exec_done);
+    if (!c->returned_in_time) silc_cancel(c->ctx); /* report, do not hang: the loop would */
+    return NULL;
+}
+
+/* Runs text on ctx while a thread cancels it; returns silc_exec's status. */
+static int exec_cancelled(silc_context *ctx, const char *text)
+{
+    canceller c;
+    pthread_t t;
+    int rc;
+    c.ctx = ctx;
+    atomic_init(&c.exec_done, 0);
+    c.returned_in_time = 0;
+    pthread_create(&t, NULL, cancel_later, &c);
+    rc = silc_exec(ctx, text);
+    atomic_store(&c.exec_done, 1);
+    pthread_join(t, NULL);
+    CHECK(c.returned_in_time, "the EXEC did not return within %g s of silc_cancel", bound_s());
+    return rc;
+}
+
+/* The first entry of a dense value (NaN if there is none). */
+static double scalar(silc_context *ctx, const char *name)
+{
+    silc_envelope_t e;
+    double v = NAN;
+    if (silc_get(ctx, &e, name)) return NAN;
+    if (e.format == SILC_DENSE && e.m * e.n >= 1) v = e.values[0];
+    silc_envelope_free(&e);
+    return v;
+}
+
+static void check_loop_cancelled(silc_context *ctx, const char *where)
+{
+    int rc;
+    CHECK(silc_exec(ctx, "a = 7; x = 1; i = 0") == 0, "%s: setup: %s", where, silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, LONG_LOOP);
+    CHECK(rc != 0, "%s: an interrupted EXEC must fail", where);
+    CHECK(!strcmp(silc_context_errmsg(ctx), "interrupted"), "%s: message '%s', want 'interrupted'",
+          where, silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "a"), 7, 0);
+    CHECK_NEAR(scalar(ctx, "x"), 1, 0); /* assigned inside the loop: undone */
+    CHECK_NEAR(scalar(ctx, "i"), 0, 0);
+
+    /* Earlier statements of the same text stay done, as with any failure. */
+    rc = exec_cancelled(ctx, "y = 5; " LONG_LOOP);
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "statement 2: interrupted"),
+          "%s: message '%s', want 'statement 2: interrupted'", where, silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "y"), 5, 0);
+    CHECK_NEAR(scalar(ctx, "x"), 1, 0);
+
+    /* The interrupt was for that EXEC only: the next runs to its end, and
+     * a cancel with nothing running changes nothing. */
+    CHECK(silc_cancel(ctx) == 0, "%s: silc_cancel with nothing running", where);
+    CHECK(silc_exec(ctx, "i = 0; while (i < 1000) { i = i + 1 }") == 0, "%s: next EXEC: %s", where,
+          silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "i"), 1000, 0);
+}
+
+/* An iterative solve of lis-style (which asks host->cancelled() once an
+ * iteration) that would run 1e8 Jacobi sweeps stops when interrupted, and
+ * the name it was to bind keeps its value. */
+static void check_iterative_cancelled(silc_context *ctx)
+{
+    int rc;
+    if (silc_exec(ctx, "set dispatch.solve.sparse.spd = lis-style")) {
+        printf("skipped the lis-style case: %s\n", silc_context_errmsg(ctx));
+        return;
+    }
+    CHECK(silc_exec(ctx, "set lis-style.options = -i jacobi -tol 1e-300 -maxiter 100000000; "
+                         "n = 3000; E = eye(n); S = [zeros(1, n); E[1:n-1, :]]; "
+                         "A = 2*E - S - S'; x = 5") == 0,
+          "lis-style setup: %s", silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+          "lis-style solve: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "x"), 5, 0);
+}
+
+/* A plugin call that polls host->cancelled() returns when told to, and the
+ * next backend of the list does not take over the interrupted operation. */
+static void check_plugin_cancelled(void)
+{
+    char dir[] = "/tmp/silc-int-XXXXXX", conf[600], cmd[700];
+    silc_context *ctx = NULL;
+    FILE *f;
+    int rc;
+    if (!mkdtemp(dir)) {
+        CHECK(0, "mkdtemp");
+        return;
+    }
+    snprintf(conf, sizeof conf, "%s/silc.conf", dir);
+    f = fopen(conf, "w");
+    if (!f) {
+        CHECK(0, "cannot write %s", conf);
+        return;
+    }
+    fprintf(f, "[core]\nplugin_path = %s\n[dispatch]\nadd = crash, reference\n", CRASH_PLUGIN_DIR);
+    fclose(f);
+    if (silc_open(&ctx, conf)) {
+        CHECK(0, "open with the crash plugin: %s", ctx ? silc_context_errmsg(ctx) : silc_errmsg());
+    } else {
+        CHECK(silc_exec(ctx, "y = 3 * [1; 2]") == 0, "crash plugin scale: %s", silc_context_errmsg(ctx));
+        rc = exec_cancelled(ctx, "y = 19 * [1; 2]");
+        CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+              "plugin call: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+        CHECK_NEAR(scalar(ctx, "y"), 3, 0); /* y[1], unchanged */
+    }
+    silc_close(&ctx);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd)) {}
+}
+
+int main(void)
+{
+    silc_context *ctx = NULL;
+    test_server srv;
+    const char *server = getenv("SILC_SERVER");
+
+    /* Against a given server (the silcd --mpi fixture, tests/mpi.cmake):
+     * there rank 0 reads the CANCEL and the ranks stop together. */
+    if (server && *server) {
+        if (silc_open_remote(&ctx, server)) {
+            CHECK(0, "silc_open_remote %s: %s", server, silc_errmsg());
+        } else {
+            check_loop_cancelled(ctx, server);
+        }
+        silc_close(&ctx);
+        return check_done();
+    }
+
+    CHECK(silc_cancel(NULL) == -1, "silc_cancel(NULL)");
+    if (silc_open(&ctx, NULL)) {
+        CHECK(0, "silc_open: %s", silc_errmsg());
+    } else {
+        check_loop_cancelled(ctx, "embedded");
+        check_iterative_cancelled(ctx);
+    }
+    silc_close(&ctx);
+
+    check_plugin_cancelled();
+
+    if (server_start(&srv, NULL, NULL)) {
+        CHECK(0, "silcd did not start");
+    } else {
+        if (silc_open_remote(&ctx, srv.url)) {
+            CHECK(0, "silc_open_remote %s: %s", srv.url, silc_errmsg());
+        } else {
+            check_loop_cancelled(ctx, "remote");
+            /* After the cancels the session is in step (a CANCEL that
+             * came late would have been answered by nothing). */
+            CHECK(silc_exec(ctx, "q = 2") == 0, "after cancels: %s", silc_context_errmsg(ctx));
+            CHECK_NEAR(scalar(ctx, "q"), 2, 0);
+        }
+        silc_close(&ctx);
+        CHECK(server_stop(&srv) == 0, "silcd did not stop cleanly");
+    }
+    return check_done();
+}
