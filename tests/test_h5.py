@@ -87,7 +87,7 @@ with tempfile.TemporaryDirectory() as d:
         f["C"].attrs["MATLAB_class"] = "double"
         f["title"] = "not a matrix"           # another program's objects: skipped, named
         f.create_group("obs")["x"] = np.arange(3.0)
-    r = subprocess.run([silc, "-e", 'load "%s"; Md = dense(M)' % path2, "--get", "Md", "--get", "V", "--get", "w",
+    r = subprocess.run([silc, "-e", 'load "%s"; Md = dense(M);' % path2, "--get", "Md", "--get", "V", "--get", "w",
                         "--get", "C"], capture_output=True, text=True)
     check(r.returncode == 0, "load of a file with foreign objects: %s" % r.stderr)
     check("warning: load: skipped 2 objects of" in r.stderr and "'obs' (not a SILC value: a group needs" in r.stderr

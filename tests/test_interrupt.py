@@ -27,6 +27,8 @@ import struct
 import subprocess
 import sys
 import tempfile
+
+import numpy as np
 import threading
 import time
 
@@ -187,7 +189,7 @@ def check_history(env, home):
 
 
 def values(s, names):
-    return [float(s.get(n).ravel()[0]) for n in names]
+    return [float(np.ravel(s.get(n))[0]) for n in names]  # scalars come back as floats
 
 
 def check_python(s, what, sigint):

@@ -98,7 +98,7 @@ awk -v k=$k 'BEGIN {
     } }' >"$OUT/A.mtx"
 awk -v n=$((k * k)) 'BEGIN { print "%%MatrixMarket matrix array real general"; print n, 1
     for (r = 0; r < n; r++) print (r % 7) + 1 }' >"$OUT/x.mtx"
-STMT='y = A * x; u = A \ y'
+STMT='y = A * x; u = A \ y;'   # ';': silc -e shows what a statement without one binds
 SILC_SERVER= timeout 60 "$SILC" --put A="$OUT/A.mtx" --put x="$OUT/x.mtx" -e "$STMT" --get y --get u \
     >"$OUT/embedded.mtx" 2>"$OUT/embedded.err" || bad "embedded run: $(cat "$OUT/embedded.err")"
 

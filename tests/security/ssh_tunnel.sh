@@ -122,7 +122,7 @@ echo "ok: ssh -L $D/local.sock -> $D/silcd.sock"
 # A = [4 1 0; 1 3 1; 0 1 2], x = [1; -2; 3]: b = A x = [2; -2; 4].  The
 # client names only the tunnel's socket; silcd's socket is never opened by it.
 out=$(SILC_SERVER=unix:$D/local.sock SILC_TOKEN_FILE=$D/token timeout 60 "$CLI" \
-      -e 'A = [4, 1, 0; 1, 3, 1; 0, 1, 2]; b = [2; -2; 4]; x = A \ b; r = norm(x - [1; -2; 3], inf)' \
+      -e 'A = [4, 1, 0; 1, 3, 1; 0, 1, 2]; b = [2; -2; 4]; x = A \ b; r = norm(x - [1; -2; 3], inf);' \
       --get x --get r 2>&1)
 rc=$?
 if [ $rc -ne 0 ]; then
