@@ -34,6 +34,7 @@
 #include <time.h>
 
 #include "diffusion_common.h"
+#include "timing.h"
 #include "silc.h"
 
 #define BATCHES 7
@@ -41,24 +42,6 @@
 static silc_context *ctx;
 static volatile double sink;
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static int check(int rc, const char *what)
 {
@@ -108,20 +91,20 @@ static int spmv_row(int64_t k)
     int reps = (int)(2e7 / (double)(A.nnz > 0 ? A.nnz : 1));
     reps = reps < SPMV_XS ? SPMV_XS : reps / SPMV_XS * SPMV_XS;
     for (int b = 0; !rc && b < BATCHES; b++) {
-        double t0 = now();
+        double t0 = bench_now();
         for (int r = 0; !rc && r < reps; r++) rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
-        ts[b] = (now() - t0) / reps;
-        t0 = now();
+        ts[b] = (bench_now() - t0) / reps;
+        t0 = bench_now();
         for (int r = 0; r < reps; r++) {
             spmv_c(&A, x + (size_t)(r % SPMV_XS) * (size_t)n, y);
             sink = y[r % n];
         }
-        tc[b] = (now() - t0) / reps;
+        tc[b] = (bench_now() - t0) / reps;
         ratio[b] = ts[b] / tc[b];
     }
     if (!rc)
-        printf("%9lld %10lld %12.1f %12.1f %8.3f\n", (long long)A.nnz, (long long)n, median(ts, BATCHES) * 1e6,
-               median(tc, BATCHES) * 1e6, median(ratio, BATCHES));
+        printf("%9lld %10lld %12.1f %12.1f %8.3f\n", (long long)A.nnz, (long long)n, bench_median(ts, BATCHES) * 1e6,
+               bench_median(tc, BATCHES) * 1e6, bench_median(ratio, BATCHES));
     silc_envelope_free(&A);
     free(x);
     free(y);
@@ -150,9 +133,9 @@ static int silc_solve_time(const silc_envelope_t *A, double *t)
 {
     double t0;
     if (check(silc_put(ctx, "A", A), "PUT A")) return 1;
-    t0 = now();
+    t0 = bench_now();
     if (check(silc_exec(ctx, "x = A \\ b"), "x = A \\ b")) return 1;
-    *t = now() - t0;
+    *t = bench_now() - t0;
     return 0;
 }
 
@@ -183,12 +166,12 @@ static int dense_row(int64_t n, int reps)
         memcpy(A.values, a, nn * sizeof *a);
         memcpy(w, a, nn * sizeof *w);
         memcpy(xb, b, (size_t)n * sizeof *xb);
-        t0 = now();
+        t0 = bench_now();
         if (LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, 1, w, (lapack_int)n, ipiv, xb, (lapack_int)n)) {
             fprintf(stderr, "limit: dgesv failed\n");
             rc = 1;
         }
-        t0 = now() - t0;
+        t0 = bench_now() - t0;
         sink = xb[0];
         if (r >= 0) tl[r] = t0;
         rc = rc || check(silc_exec(ctx, "set accuracy.condest = on"), "set") ||
@@ -200,7 +183,7 @@ static int dense_row(int64_t n, int reps)
              silc_solve_time(&A, r >= 0 ? &toff[r] : &t0);
     }
     if (!rc) {
-        double l = median(tl, reps), c = median(tcond, reps), o = median(toff, reps);
+        double l = bench_median(tl, reps), c = bench_median(tcond, reps), o = bench_median(toff, reps);
         printf("%6lld %10.3f %12.3f %12.3f %10.3f %9.3f %9.3f\n", (long long)n, l, o, c, c - o, o / l,
                c / l);
     }

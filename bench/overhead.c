@@ -34,6 +34,7 @@
 #include <time.h>
 
 #include "diffusion_common.h"
+#include "timing.h"
 #include "silc.h"
 
 #define BATCHES 5
@@ -42,23 +43,10 @@ static silc_context *ctx;
 static long serial; /* makes every uncached text unique across the whole run */
 static volatile double sink;
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 static double median(double *v)
 {
-    qsort(v, BATCHES, sizeof *v, cmp_double);
-    return v[BATCHES / 2];
+    return bench_median(v, BATCHES); /* BATCHES is odd: the middle one */
 }
 
 static int exec_or_die(const char *text)
@@ -85,10 +73,10 @@ static int time_cached(const char *stmt, int reps, double *out)
     double t[BATCHES];
     if (exec_or_die(stmt)) return 1;
     for (int b = 0; b < BATCHES; b++) {
-        double t0 = now();
+        double t0 = bench_now();
         for (int r = 0; r < reps; r++)
             if (exec_or_die(stmt)) return 1;
-        t[b] = (now() - t0) / reps;
+        t[b] = (bench_now() - t0) / reps;
     }
     *out = median(t);
     return 0;
@@ -105,10 +93,10 @@ static int time_uncached(const char *stmt, int reps, double *out)
     for (int b = 0; b < BATCHES; b++) {
         for (int r = 0; r < reps; r++)
             snprintf(texts + (size_t)r * width, width, "%s # %ld", stmt, serial++);
-        double t0 = now();
+        double t0 = bench_now();
         for (int r = 0; r < reps; r++)
             if (exec_or_die(texts + (size_t)r * width)) return free(texts), 1;
-        t[b] = (now() - t0) / reps;
+        t[b] = (bench_now() - t0) / reps;
     }
     free(texts);
     *out = median(t);
@@ -123,7 +111,7 @@ static double time_plain(int kind, int reps)
     for (int k = 0; k < 100; k++) A[k] = 1.0 / (k + 1);
     for (int k = 0; k < 10; k++) x[k] = k + 1;
     for (int b = 0; b < BATCHES; b++) {
-        double t0 = now();
+        double t0 = bench_now();
         for (int r = 0; r < reps; r++) {
             if (kind == 0) {
                 for (int i = 0; i < 10; i++) y[i] = x[i] + x[i];
@@ -135,7 +123,7 @@ static double time_plain(int kind, int reps)
             sink = y[r % 10];
             x[r % 10] += 1e-300; /* keeps the compiler from hoisting the loop */
         }
-        t[b] = (now() - t0) / reps;
+        t[b] = (bench_now() - t0) / reps;
     }
     return median(t);
 }
@@ -184,7 +172,7 @@ static int time_sparse(int what, const silc_envelope_t *A, const double *b, int 
     double *y = malloc((size_t)A->m * sizeof *y);
     if (!y) return fprintf(stderr, "overhead: out of memory\n"), 1;
     for (int bt = 0; bt < BATCHES; bt++) {
-        double t0 = now();
+        double t0 = bench_now();
         for (int r = 0; r < reps; r++) {
             int rc = 0;
             switch (what) {
@@ -204,7 +192,7 @@ static int time_sparse(int what, const silc_envelope_t *A, const double *b, int 
             }
             if (rc) return free(y), 1;
         }
-        t[bt] = (now() - t0) / reps;
+        t[bt] = (bench_now() - t0) / reps;
     }
     free(y);
     *out = median(t);
@@ -273,12 +261,12 @@ static int in_place_updates(void)
             if (time_cached(stmts[k], reps, &t[k])) return free(x), free(y), 1;
         for (int64_t i = 0; i < n; i++) y[i] = (double)(i % 13) / 13;
         for (int b = 0; b < BATCHES; b++) {
-            double t0 = now();
+            double t0 = bench_now();
             for (int r = 0; r < reps; r++) {
                 for (int64_t i = 0; i < n; i++) x[i] += y[i];
                 sink = x[r % n]; /* as time_plain: no folding of the repetitions */
             }
-            tc[b] = (now() - t0) / reps;
+            tc[b] = (bench_now() - t0) / reps;
         }
         printf("%-9lld %10.2f %10.2f %10.2f %14.2f %12.2f %14.2f %13.2f\n", (long long)n, t[0] * 1e6,
                t[1] * 1e6, t[2] * 1e6, t[3] * 1e6, t[4] * 1e6, t[5] * 1e6, median(tc) * 1e6);
