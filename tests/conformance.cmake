@@ -20,7 +20,7 @@ add_test(NAME test_configs
 set_tests_properties(test_configs PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
 
 # The Octave comparison (tests/conformance/octave/README.md): suite.m through
-# `silc run` must print what Octave 7.3 printed for it (suite.out).
+# `silc run` must print what Octave 7.3 printed for it (suite.octave-truth.txt).
 if(TARGET silc_cli)
   add_test(NAME test_octave
     COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/conformance/octave/run.sh $<TARGET_FILE:silc_cli>)

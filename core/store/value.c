@@ -576,6 +576,21 @@ typedef struct props_acc {
     double total, sumsq, maxabs;
 } props_acc;
 
+/* What a nonzero at (i, j) off the diagonal says of the shape: not
+ * diagonal, not the triangle it lies outside, and a band at least that
+ * wide. */
+static inline void shape_off_diagonal(silc_props *p, int64_t i, int64_t j)
+{
+    p->diagonal = 0;
+    if (j > i) {
+        p->lower = 0;
+        if (j - i > p->ku) p->ku = j - i;
+    } else {
+        p->upper = 0;
+        if (i - j > p->kl) p->kl = i - j;
+    }
+}
+
 static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
 {
     double x = fabs(a), xs = x * acc->scale;
@@ -587,15 +602,7 @@ static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
         if (i == j && a > 0) acc->pos_diag_count++;
         if (a != 0) {
             p->nnz++;
-            if (i != j) p->diagonal = 0;
-            if (j > i) {
-                p->lower = 0;
-                if (j - i > p->ku) p->ku = j - i;
-            }
-            if (i > j) {
-                p->upper = 0;
-                if (i - j > p->kl) p->kl = i - j;
-            }
+            if (i != j) shape_off_diagonal(p, i, j);
         }
     }
     acc->total += xs;
@@ -704,15 +711,9 @@ static int norms_shape_pass_dense(const silc_value *v, props_acc *acc)
         nnz += nz;
         for (first = 0; c[first] == 0; first++) {}
         for (last = m - 1; c[last] == 0; last--) {}
-        if (first != j || last != j) p->diagonal = 0;
-        if (first < j) {
-            p->lower = 0;
-            if (j - first > p->ku) p->ku = j - first;
-        }
-        if (last > j) {
-            p->upper = 0;
-            if (last - j > p->kl) p->kl = last - j;
-        }
+        /* the column's outermost nonzeros bound everything between */
+        if (first != j) shape_off_diagonal(p, first, j);
+        if (last != j && last != first) shape_off_diagonal(p, last, j);
     }
     if (!isfinite(total) || !isfinite(sumsq)) return 1;
     p->nnz = nnz;

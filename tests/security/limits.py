@@ -56,7 +56,8 @@ def _no_server_left():
 # Under AddressSanitizer (CI's second pass, slow unwinder) a process's exit
 # includes LeakSanitizer's scan of every rank: seconds, not milliseconds.  The
 # claims below are "stops", not "stops fast"; exits get this much more time.
-EXIT_SLACK = 4 if "ASAN_OPTIONS" in os.environ else 1
+SANITIZED = "ASAN_OPTIONS" in os.environ
+EXIT_SLACK = 4 if SANITIZED else 1
 
 
 def wait_until(pred, seconds, step=0.05):
@@ -179,6 +180,19 @@ class Server:
         """stop(), and fail unless silcd exited 0."""
         if self.stop() != 0:
             fail("silcd exited with %s" % self.proc.returncode)
+
+    def expect_job_ended(self, reason, log_text):
+        """The MPI job ends by itself (a rank or rank 0 ended it), with a
+        non-zero status and log_text in the log saying why."""
+        try:
+            self.proc.wait(30 * EXIT_SLACK)
+        except subprocess.TimeoutExpired:
+            fail("the job still runs %s:\n%s" % (reason, self.text()))
+        if self.proc.returncode == 0:
+            fail("mpirun exited 0 %s" % reason)
+        if log_text not in self.text():
+            fail("the log does not say why the job ended:\n" + self.text())
+        self.log.close()
 
 
 def expect_error(fn, text, exact=True):
@@ -452,7 +466,7 @@ def case_memo():
         print("round %2d: charge %.1f MiB, VmRSS %.1f MiB" % (r, charge / MiB, rss[-1] / MiB))
     # Under AddressSanitizer freed memory sits in its quarantine (256 MiB):
     # resident memory says nothing there; the charge above still holds.
-    if "ASAN_OPTIONS" not in os.environ and rss[-1] > rss[2] + 64 * MiB:
+    if not SANITIZED and rss[-1] > rss[2] + 64 * MiB:
         fail("the session grew from %.0f MiB (round 3) to %.0f MiB (round 30)" %
              (rss[2] / MiB, rss[-1] / MiB))
     s.close()
@@ -575,7 +589,7 @@ def case_idle_cpu_mpi():
     t0 = time.monotonic()
     time.sleep(3)
     wall = time.monotonic() - t0
-    bound = 0.2 if "ASAN_OPTIONS" in os.environ else 0.1
+    bound = 0.2 if SANITIZED else 0.1
     for r, p in sorted(ranks.items()):
         share = (cpu_seconds(p) - before[r]) / wall
         print("rank %d idle: %.1f %% of a core" % (r, 100 * share))
@@ -592,7 +606,7 @@ def case_max_cpu_mpi():
     """--max-cpu under --mpi caps each rank over the job's life: resting
     ranks do not reach it, a runaway does, and the rank that dies says why
     before mpirun ends the job."""
-    cap = 5 if "ASAN_OPTIONS" in os.environ else 2   # rank start-up counts too
+    cap = 5 if SANITIZED else 2   # rank start-up counts too
     srv = Server("--max-cpu", str(cap), mpi=True)
     s = srv.session()
     s.exec("a = 1")
@@ -605,15 +619,8 @@ def case_max_cpu_mpi():
         fail("the runaway returned")
     except (SilcError, OSError):
         pass
-    try:
-        srv.proc.wait(30 * EXIT_SLACK)
-    except subprocess.TimeoutExpired:
-        fail("the job still runs after a rank reached --max-cpu:\n" + srv.text())
-    if srv.proc.returncode == 0:
-        fail("mpirun exited 0 after a rank reached --max-cpu")
-    if "s of CPU time a rank may use (silcd --max-cpu): ending the MPI job" not in srv.text():
-        fail("the log does not say why the job ended:\n" + srv.text())
-    srv.log.close()
+    srv.expect_job_ended("after a rank reached --max-cpu",
+                         "s of CPU time a rank may use (silcd --max-cpu): ending the MPI job")
 
 
 def case_stuck_mpi():
@@ -631,16 +638,9 @@ def case_stuck_mpi():
         fail("the stuck call returned")
     except (SilcError, OSError):
         pass
-    try:
-        srv.proc.wait(30 * EXIT_SLACK)
-    except subprocess.TimeoutExpired:
-        fail("the job still runs with a stuck request:\n" + srv.text())
-    if srv.proc.returncode == 0:
-        fail("mpirun exited 0 after a stuck request ended the job")
-    if ("took longer than 3 s and did not stop within 2 s more (it is inside a library "
-            "call) (silcd --max-request-seconds): ending the MPI job" not in srv.text()):
-        fail("the log does not say why the job ended:\n" + srv.text())
-    srv.log.close()
+    srv.expect_job_ended("with a stuck request",
+                         "took longer than 3 s and did not stop within 2 s more (it is inside a library "
+                         "call) (silcd --max-request-seconds): ending the MPI job")
 
 
 HELLO = b"SILC" + struct.pack("<II", 1, 0)
