@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 7
+#define SILC_ABI_MINOR 8
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -56,6 +56,20 @@ enum silc_status {
 };
 
 /* ---- values ---------------------------------------------------------------- */
+
+/* ABI 1.8: a value's field, real or complex.  A complex value stores each
+ * entry as two doubles, the real part then the imaginary part (interleaved:
+ * the layout of LAPACK's complex*16, C99's double complex, UMFPACK's and
+ * KLU's packed complex arrays (Az = NULL), ZMUMPS_COMPLEX, NumPy's
+ * complex128 and MPI_C_DOUBLE_COMPLEX).  Its view's val then holds 2 doubles
+ * per entry (dense 2*m*n, csr 2*nnz, band 2*ld*n); every count in the view
+ * (nnz, ld) still counts entries.  The host hands a complex operand only to
+ * an op its backend lists in silc_plugin.complex_ops (never to a plugin older
+ * than ABI 1.8), and never mixes fields in one call: where an operation
+ * mixes a real and a complex operand, the host promotes the real one first
+ * (or splits the call: a real A solved against a complex b is two real
+ * solves sharing A's factorization).  host->field() tells a value's field. */
+enum silc_field { SILC_FIELD_REAL = 0, SILC_FIELD_COMPLEX = 1 };
 typedef struct silc_value silc_value; /* opaque, owned by the host */
 
 enum silc_format {
@@ -96,6 +110,12 @@ typedef struct silc_props {
     int64_t nnz;            /* numerically nonzero entries */
     int has_nonfinite;      /* a NaN or Inf is stored */
     double norm1, norminf, normfro, maxabs; /* computed with scaling: no overflow */
+    /* ABI 1.8 (SILC_PROPS_SYMMETRY part).  For a complex value, symmetric
+     * means A = A.' (complex symmetric: the matrices COCG and LDL^T take) and
+     * hermitian means A = A' (conjugate transpose: what Cholesky takes);
+     * pos_diag means every diagonal entry is real and > 0.  For a real
+     * value hermitian equals symmetric.  The norms use the modulus. */
+    int hermitian;
 } silc_props;
 
 /* ---- operations ------------------------------------------------------------ */
@@ -108,7 +128,8 @@ enum silc_op {
     SILC_OP_MATMUL = 2,    /* out = in[0] * in[1] (neither is 1x1: host turns that into SCALE) */
     SILC_OP_EWISE = 3,     /* out = in[0] (sub) in[1] element-wise; sub = enum silc_ewise     */
     SILC_OP_MAP = 4,       /* out = f(in[0]) element-wise; sub = enum silc_map                */
-    SILC_OP_TRANSPOSE = 5, /* out = in[0]'                                                    */
+    SILC_OP_TRANSPOSE = 5, /* out = in[0]' (ABI 1.8, complex: sub 0 conjugate transpose ',
+                              sub 1 plain transpose .'; the same for real values)           */
     SILC_OP_SOLVE = 6,     /* out = in[0] \ in[1]; fills call->report; options in call->options;
                               ABI 1.6: nin = 3 gives in[2], an initial guess (dense, the
                               solution's shape) an iterative method may start from (warm
@@ -127,14 +148,25 @@ enum silc_ewise {
 
 enum silc_map {
     SILC_MAP_NEG = 0, SILC_MAP_ABS, SILC_MAP_SQRT, SILC_MAP_EXP, SILC_MAP_LOG,
-    SILC_MAP_SIN, SILC_MAP_COS, SILC_MAP_NOT
+    SILC_MAP_SIN, SILC_MAP_COS, SILC_MAP_NOT,
+    /* ABI 1.8, for complex values (a real operand is handled too: real and
+     * conj copy it, imag gives zeros, angle 0 or pi).  REAL, IMAG, ABS and
+     * ANGLE give a real result; the others keep the operand's field.  SQRT
+     * and LOG of a complex value take the principal branch (C99 csqrt, clog);
+     * a real operand stays real (the host promotes a real operand with
+     * negative entries to complex first, as Octave does). */
+    SILC_MAP_REAL, SILC_MAP_IMAG, SILC_MAP_CONJ, SILC_MAP_ANGLE
 };
 
 /* REDUCE: for a vector (m==1 or n==1) the result is 1x1; for a matrix it is the
  * 1xn row of per-column results (as MATLAB), except NORM, NORM1, NORMINF,
  * NORMFRO and DOT, which always give 1x1.  NORM of a vector is the 2-norm, of a
  * matrix the 2-norm (largest singular value).  DOT takes in[0], in[1] of the
- * same shape and returns sum(in0 .* in1). */
+ * same shape and returns sum(in0 .* in1).  ABI 1.8, complex: SUM and DOT give a
+ * complex result (DOT conjugates nothing: the language's dot() conjugates its
+ * first operand before asking, as Octave's does); MAX and MIN compare by
+ * modulus and return the entry (ties: the larger angle, Octave's rule); the
+ * norms use the modulus and are real. */
 enum silc_reduce {
     SILC_RED_SUM = 0, SILC_RED_MAX, SILC_RED_MIN, SILC_RED_DOT,
     SILC_RED_NORM, SILC_RED_NORM1, SILC_RED_NORMINF, SILC_RED_NORMFRO
@@ -198,6 +230,11 @@ typedef struct silc_call {
     const char *op_class;       /* class being tried, e.g. "solve.sparse.spd": a SOLVE under a
                                    ".spd" class should try Cholesky and return SILC_ENOTSPD on
                                    failure; under the general class it should use LU */
+    /* ABI 1.8: imaginary parts of alpha and beta, for ADD and SCALE on
+     * complex values (0 otherwise; the host promotes a real operand scaled by
+     * a complex alpha first, so a call with a nonzero imaginary part has
+     * complex operands). */
+    double alpha_imag, beta_imag;
 } silc_call;
 
 typedef int (*silc_op_fn)(silc_call *call);
@@ -343,6 +380,20 @@ typedef struct silc_host_api {
      * 0 on a distributed call: its ranks must stop together, which they do
      * after the statement.  Check struct_size >= SILC_HOST_NEEDS(cancelled). */
     int (*cancelled)(silc_call *call);
+
+    /* ABI 1.8: complex values (see enum silc_field).  field(v) is v's field.
+     * The constructors are dense_new/csr_new/band_new for complex values,
+     * zero-filled; their views hold 2 doubles per entry. */
+    int (*field)(const silc_value *v);
+    silc_value *(*dense_new_complex)(int64_t m, int64_t n);
+    silc_value *(*csr_new_complex)(int64_t m, int64_t n, int64_t nnz_capacity);
+    silc_value *(*band_new_complex)(int64_t m, int64_t n, int64_t kl, int64_t ku);
+    /* Hager-Higham for complex A (LAPACK zlacn2's method): as inv_norm1_est,
+     * with x and work n complex entries (2n doubles, interleaved) and trans 1
+     * meaning the conjugate transpose, A^{-H} x.  cond_1(A) ~ props(A)->norm1
+     * (the modulus 1-norm) * estimate. */
+    double (*inv_norm1_est_complex)(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                                    void *ctx, double *work);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */
@@ -373,8 +424,18 @@ typedef struct silc_plugin {
      * the ops it runs collectively on distributed operands, as bits
      * SILC_COLLECTIVE(op); NULL = none.  Only such calls see host->comm. */
     const uint32_t *collective_ops;
+
+    /* ABI 1.8: per backend (n_backends entries), the ops that take complex
+     * operands, as bits SILC_COMPLEX_OPS(op); NULL = none.  The host hands
+     * complex values to no other op: the dispatcher passes over a backend
+     * that lacks the bit ("does not take complex values") to the next of the
+     * list, so a plugin built against a real-only library (PETSc's real
+     * build) simply leaves the bit out, and an accepts() function may still
+     * decline a complex call it cannot take, with its reason. */
+    const uint32_t *complex_ops;
 } silc_plugin;
 #define SILC_COLLECTIVE(op) (1u << (op))
+#define SILC_COMPLEX_OPS(op) (1u << (op))
 
 /* The check every silc_plugin_init starts with: the host table exists, speaks
  * this major version and index width, and is long enough to hold every host
