@@ -20,9 +20,14 @@
  * ranks wait for rank 0's next command without spinning (await_header).
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE   /* getifaddrs, IFF_UP */
 #include "server.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
@@ -73,10 +78,365 @@ static int await_header(MPI_Request *req)
     }
 }
 
-/* The three header words of a command (rank 0 sends, the others wait). */
+static srv_ranks the_ranks;
+static ranks_impl the_impl;
+
+/* ---- waking the resting ranks ------------------------------------------------
+ *
+ * Even MPI_Ibcast tested with naps costs a resting rank a few percent of a
+ * core (Open MPI progresses the request on every test).  So a rank other
+ * than 0 waits outside MPI, in poll() on a TCP socket to rank 0 that rank 0
+ * writes one byte to before each command; only then does it join the
+ * command's broadcast.  At start rank 0 listens on an ephemeral port of
+ * every address, broadcasts over MPI its interface addresses (others first,
+ * loopback last), the port and a random secret; each rank tries the
+ * addresses in turn (WAKE_CONNECT_MS each), proves it holds the first half
+ * of the secret and checks that rank 0 answers with the second half (a
+ * stray listener on another host's address cannot).  Rank 0 keeps only
+ * connections that present the secret (the others are closed and logged),
+ * until every rank has finished trying (an MPI barrier), then closes the
+ * listener.  A rank that could not connect (a firewall) waits by testing
+ * MPI_Ibcast with naps as before, and says so once.  The socket closing
+ * means rank 0 is gone: the rank exits, and with it the job.  docs/
+ * distributed.md ("An idle server rests") gives the measured costs. */
+
+#define WAKE_SECRET_BYTES 32          /* each half */
+#define WAKE_MAX_ADDRS 16
+#define WAKE_CONNECT_MS 1000          /* per address: connect, then rank 0's answer */
+
+typedef struct wake_offer {
+    uint8_t secret[2 * WAKE_SECRET_BYTES];  /* [0, 32): the rank's proof; the rest: rank 0's */
+    int32_t port;                           /* 0: rank 0 could not listen */
+    int32_t count;
+    struct {
+        int32_t family;                     /* AF_INET, AF_INET6 */
+        uint8_t addr[16];
+    } addr[WAKE_MAX_ADDRS];
+} wake_offer;
+
+/* What a rank sends on connecting: the proof, then its rank. */
+#define WAKE_HELLO_BYTES (WAKE_SECRET_BYTES + 4)
+
+static int *wake_fds;      /* rank 0: per rank, the socket, or -1 (that rank polls MPI) */
+static int wake_fd = -1;   /* the other ranks: the socket from rank 0, or -1 */
+
+/* Rank 0's addresses, loopback last; IPv6 link-local ones are left out
+ * (they need an interface the other host would have to name). */
+static void wake_addresses(wake_offer *o)
+{
+    struct ifaddrs *ifs = NULL, *i;
+    int pass;
+    o->count = 0;
+    if (getifaddrs(&ifs) != 0) return;
+    for (pass = 0; pass < 2; pass++)
+        for (i = ifs; i && o->count < WAKE_MAX_ADDRS; i = i->ifa_next) {
+            const struct sockaddr *sa = i->ifa_addr;
+            int loop = (i->ifa_flags & IFF_LOOPBACK) != 0;
+            if (!sa || !(i->ifa_flags & IFF_UP) || loop != pass) continue;
+            if (sa->sa_family == AF_INET) {
+                o->addr[o->count].family = AF_INET;
+                memcpy(o->addr[o->count++].addr, &((const struct sockaddr_in *)sa)->sin_addr, 4);
+            } else if (sa->sa_family == AF_INET6) {
+                const struct in6_addr *a = &((const struct sockaddr_in6 *)sa)->sin6_addr;
+                if (IN6_IS_ADDR_LINKLOCAL(a)) continue;
+                o->addr[o->count].family = AF_INET6;
+                memcpy(o->addr[o->count++].addr, a, 16);
+            }
+        }
+    freeifaddrs(ifs);
+}
+
+/* A listener on an ephemeral port of every address (IPv6 and IPv4 when the
+ * host has IPv6, else IPv4); its port in *port. */
+static int wake_listen(int32_t *port)
+{
+    struct sockaddr_storage ss;
+    socklen_t sl = sizeof ss;
+    int fd = socket(AF_INET6, SOCK_STREAM, 0), off = 0;
+    memset(&ss, 0, sizeof ss);
+    if (fd >= 0) {
+        struct sockaddr_in6 *a = (struct sockaddr_in6 *)&ss;
+        setsockopt(fd, IPPROTO_IPV6, IPV6_V6ONLY, &off, sizeof off);
+        a->sin6_family = AF_INET6;
+        a->sin6_addr = in6addr_any;
+        if (bind(fd, (struct sockaddr *)a, sizeof *a) != 0) {
+            close(fd);
+            fd = -1;
+        }
+    }
+    if (fd < 0) {
+        struct sockaddr_in *a = (struct sockaddr_in *)&ss;
+        memset(&ss, 0, sizeof ss);
+        a->sin_family = AF_INET;
+        a->sin_addr.s_addr = htonl(INADDR_ANY);
+        if ((fd = socket(AF_INET, SOCK_STREAM, 0)) < 0) return -1;
+        if (bind(fd, (struct sockaddr *)a, sizeof *a) != 0) {
+            close(fd);
+            return -1;
+        }
+    }
+    if (listen(fd, 64) != 0 || getsockname(fd, (struct sockaddr *)&ss, &sl) != 0) {
+        close(fd);
+        return -1;
+    }
+    *port = ntohs(ss.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&ss)->sin6_port
+                                           : ((struct sockaddr_in *)&ss)->sin_port);
+    fcntl(fd, F_SETFL, O_NONBLOCK);
+    return fd;
+}
+
+static int same_bytes(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    uint8_t d = 0;
+    size_t i;
+    for (i = 0; i < n; i++) d |= (uint8_t)(a[i] ^ b[i]);
+    return d == 0;
+}
+
+/* Waits up to ms for fd to be ready for events; 1 if it is. */
+static int wait_fd(int fd, short events, int ms)
+{
+    struct pollfd p;
+    double end = util_now() + ms / 1000.0;
+    p.fd = fd;
+    p.events = events;
+    for (;;) {
+        int left = (int)((end - util_now()) * 1000), rc;
+        if (left < 0) return 0;
+        p.revents = 0;
+        rc = poll(&p, 1, left);
+        if (rc > 0) return 1;
+        if (rc == 0 || errno != EINTR) return 0;
+    }
+}
+
+/* A rank other than 0: the first of rank 0's addresses that answers with
+ * its half of the secret; -1 if none does. */
+static int wake_connect(const wake_offer *o, int rank, char *why, size_t whylen)
+{
+    uint8_t hello[WAKE_HELLO_BYTES], answer[WAKE_SECRET_BYTES];
+    int k;
+    memcpy(hello, o->secret, WAKE_SECRET_BYTES);
+    proto_put_u32(hello + WAKE_SECRET_BYTES, (uint32_t)rank);
+    snprintf(why, whylen, "rank 0 offered no address");
+    for (k = 0; k < o->count; k++) {
+        struct sockaddr_storage ss;
+        socklen_t sl;
+        size_t got = 0;
+        int fd, err = 0, one = 1;
+        char host[INET6_ADDRSTRLEN] = "?";
+        memset(&ss, 0, sizeof ss);
+        if (o->addr[k].family == AF_INET) {
+            struct sockaddr_in *a = (struct sockaddr_in *)&ss;
+            a->sin_family = AF_INET;
+            a->sin_port = htons((uint16_t)o->port);
+            memcpy(&a->sin_addr, o->addr[k].addr, 4);
+            sl = sizeof *a;
+            inet_ntop(AF_INET, &a->sin_addr, host, sizeof host);
+        } else {
+            struct sockaddr_in6 *a = (struct sockaddr_in6 *)&ss;
+            a->sin6_family = AF_INET6;
+            a->sin6_port = htons((uint16_t)o->port);
+            memcpy(&a->sin6_addr, o->addr[k].addr, 16);
+            sl = sizeof *a;
+            inet_ntop(AF_INET6, &a->sin6_addr, host, sizeof host);
+        }
+        if ((fd = socket(ss.ss_family, SOCK_STREAM, 0)) < 0) continue;
+        fcntl(fd, F_SETFL, O_NONBLOCK);
+        if (connect(fd, (struct sockaddr *)&ss, sl) != 0 && errno != EINPROGRESS) err = errno;
+        if (!err && !wait_fd(fd, POLLOUT, WAKE_CONNECT_MS)) err = ETIMEDOUT;
+        sl = sizeof err;
+        if (!err && getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &sl) != 0) err = errno;
+        if (!err && send(fd, hello, sizeof hello, MSG_NOSIGNAL) != (ssize_t)sizeof hello)
+            err = errno ? errno : EPIPE;
+        while (!err && got < sizeof answer) {
+            ssize_t r;
+            if (!wait_fd(fd, POLLIN, WAKE_CONNECT_MS)) err = ETIMEDOUT;
+            else if ((r = recv(fd, answer + got, sizeof answer - got, 0)) > 0) got += (size_t)r;
+            else if (r == 0) err = ECONNRESET;
+            else if (errno != EINTR && errno != EAGAIN) err = errno;
+        }
+        if (!err && !same_bytes(answer, o->secret + WAKE_SECRET_BYTES, sizeof answer)) err = EPROTO;
+        if (!err) {
+            fcntl(fd, F_SETFL, 0);
+            setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+            return fd;
+        }
+        snprintf(why, whylen, "%s port %d: %s", host, (int)o->port,
+                 err == EPROTO ? "not rank 0 (wrong answer)" : strerror(err));
+        close(fd);
+    }
+    return -1;
+}
+
+/* A connection to rank 0's wake-up listener, until it has shown its hello. */
+typedef struct wake_pending {
+    int fd;
+    size_t got;
+    uint8_t hello[WAKE_HELLO_BYTES];
+} wake_pending;
+
+/* Rank 0, one pending connection readable: its hello judged once whole.
+ * 1 while incomplete; 0 when judged (kept in wake_fds or closed). */
+static int wake_judge(wake_pending *w, const wake_offer *o, int size)
+{
+    ssize_t r = recv(w->fd, w->hello + w->got, sizeof w->hello - w->got, MSG_DONTWAIT);
+    uint32_t rank;
+    int one = 1;
+    if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return 1;
+    if (r > 0 && (w->got += (size_t)r) < sizeof w->hello) return 1;
+    rank = proto_get_u32(w->hello + WAKE_SECRET_BYTES);
+    if (r <= 0 || !same_bytes(w->hello, o->secret, WAKE_SECRET_BYTES) || rank == 0 ||
+        rank >= (uint32_t)size || wake_fds[rank] >= 0) {
+        char peer[64];
+        srv_peer_of(w->fd, peer, sizeof peer);
+        srv_log(LOG_WARN, "wake-up port: closed a connection from %s that did not present "
+                "the job's secret", *peer ? peer : "?");
+        close(w->fd);
+        return 0;
+    }
+    fcntl(w->fd, F_SETFL, 0);
+    setsockopt(w->fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    if (send(w->fd, o->secret + WAKE_SECRET_BYTES, WAKE_SECRET_BYTES, MSG_NOSIGNAL) !=
+        WAKE_SECRET_BYTES) {
+        close(w->fd);
+        return 0;
+    }
+    wake_fds[rank] = w->fd;
+    return 0;
+}
+
+/* Rank 0: accepts and judges connections until every rank has finished
+ * trying (the barrier req completes), then closes the listener and what
+ * has not shown a hello. */
+static void wake_accept(int lfd, const wake_offer *o, int size, MPI_Request *req)
+{
+    int cap = 2 * size + 8, n = 0, i, done = 0;
+    wake_pending *w = calloc((size_t)cap, sizeof *w);
+    struct pollfd *p = calloc((size_t)cap + 1, sizeof *p);
+    while (w && p && !done) {
+        p[0].fd = lfd;
+        p[0].events = POLLIN;
+        p[0].revents = 0;
+        for (i = 0; i < n; i++) {
+            p[i + 1].fd = w[i].fd;
+            p[i + 1].events = POLLIN;
+            p[i + 1].revents = 0;
+        }
+        poll(p, (nfds_t)n + 1, 10);
+        for (i = n - 1; i >= 0; i--)
+            if (p[i + 1].revents && !wake_judge(&w[i], o, size)) w[i] = w[--n];
+        if (p[0].revents & POLLIN) {
+            int fd = accept(lfd, NULL, NULL);
+            if (fd >= 0 && n == cap) {
+                srv_log(LOG_WARN, "wake-up port: too many connections, one closed");
+                close(fd);
+            } else if (fd >= 0) {
+                fcntl(fd, F_SETFL, O_NONBLOCK);
+                memset(&w[n], 0, sizeof w[n]);
+                w[n++].fd = fd;
+            }
+        }
+        if (MPI_Test(req, &done, MPI_STATUS_IGNORE) != MPI_SUCCESS) break;
+    }
+    if (!done) MPI_Wait(req, MPI_STATUS_IGNORE);   /* out of memory: no socket, but in step */
+    for (i = 0; i < n; i++) {
+        if (w[i].got) srv_log(LOG_WARN, "wake-up port: closed a connection that did not finish "
+                              "presenting the job's secret");
+        close(w[i].fd);
+    }
+    close(lfd);
+    free(w);
+    free(p);
+}
+
+/* Collective, at start: the wake-up sockets (above) on the ranks that can
+ * reach rank 0; the others are told, and say once, that they poll MPI. */
+static void wake_setup(int rank, int size)
+{
+    wake_offer o;
+    MPI_Request req;
+    uint8_t *kept = calloc((size_t)size, 1);
+    int lfd = -1, i, n = 0;
+    char why[256];
+    memset(&o, 0, sizeof o);
+    if (rank == 0) wake_fds = malloc((size_t)size * sizeof *wake_fds);
+    if (!kept || (rank == 0 && !wake_fds)) {  /* the ranks would leave step: the job ends */
+        srv_log(LOG_ERROR, "rank %d: out of memory setting up wake-ups", rank);
+        MPI_Abort(MPI_COMM_WORLD, 70);
+    }
+    if (rank == 0) {
+        int rnd = open("/dev/urandom", O_RDONLY);
+        for (i = 0; i < size; i++) wake_fds[i] = -1;
+        if (rnd >= 0 &&
+            read(rnd, o.secret, sizeof o.secret) == (ssize_t)sizeof o.secret &&
+            (lfd = wake_listen(&o.port)) >= 0)
+            wake_addresses(&o);
+        if (rnd >= 0) close(rnd);
+        if (lfd < 0 || !o.count) {
+            srv_log(LOG_WARN, "rank 0: no wake-up listener (%s): resting ranks will poll MPI",
+                    lfd < 0 ? strerror(errno) : "no address");
+            o.count = 0;
+        }
+    }
+    MPI_Bcast(&o, (int)sizeof o, MPI_BYTE, 0, the_impl.wake);
+    if (rank != 0 && o.count) wake_fd = wake_connect(&o, rank, why, sizeof why);
+    MPI_Ibarrier(the_impl.wake, &req);
+    if (rank == 0 && lfd >= 0) wake_accept(lfd, &o, size, &req);
+    else MPI_Wait(&req, MPI_STATUS_IGNORE);
+    if (rank == 0)
+        for (i = 1; i < size; i++) n += kept[i] = wake_fds[i] >= 0;
+    MPI_Bcast(kept, size, MPI_BYTE, 0, the_impl.wake);
+    if (rank == 0) {
+        srv_log(LOG_INFO, "%d of %d ranks rest on a wake-up socket", n, size - 1);
+    } else if (!kept[rank]) {
+        if (wake_fd >= 0) close(wake_fd);
+        wake_fd = -1;
+        srv_log(LOG_WARN, "rank %d: cannot reach rank 0 for wake-ups (%s): resting by polling "
+                "MPI instead (a few %% of a core; docs/distributed.md)", rank,
+                o.count ? why : "rank 0 has no wake-up listener");
+    }
+    free(kept);
+}
+
+/* Rank 0, before a command: a byte to every rank that rests on a socket
+ * (a full buffer already wakes it; a rank gone is MPI's to notice). */
+static void wake_ranks(int size)
+{
+    int i;
+    for (i = 1; wake_fds && i < size; i++)
+        if (wake_fds[i] >= 0 && send(wake_fds[i], "w", 1, MSG_DONTWAIT | MSG_NOSIGNAL) < 0 &&
+            errno != EAGAIN && errno != EWOULDBLOCK)
+            srv_log(LOG_WARN, "rank 0: waking rank %d: %s", i, strerror(errno));
+}
+
+/* A rank other than 0: rank 0's byte for the next command.  For
+ * AWAIT_SPIN_S it is looked for without sleeping (requests that follow each
+ * other pay no wake-up), then awaited in poll.  The socket closing means
+ * rank 0 has gone (killed, or ended by a limit): this rank ends too. */
+static void await_wake(int rank)
+{
+    double spin_until = util_now() + AWAIT_SPIN_S;
+    for (;;) {
+        char b;
+        ssize_t got = recv(wake_fd, &b, 1, MSG_DONTWAIT);
+        if (got == 1) return;
+        if (got == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+            srv_log(LOG_ERROR, "rank %d: rank 0 is gone (%s): ending this rank", rank,
+                    got == 0 ? "its wake-up socket closed" : strerror(errno));
+            _exit(1);
+        }
+        if (util_now() >= spin_until) wait_fd(wake_fd, POLLIN, 60000);
+    }
+}
+
+/* The three header words of a command (rank 0 sends, the others wait:
+ * on their wake-up socket if they have one, then in the broadcast). */
 static int header_bcast(ranks_impl *I, int64_t h[3], int rank)
 {
     MPI_Request req;
+    if (rank == 0) wake_ranks(the_ranks.size);
+    else if (wake_fd >= 0) await_wake(rank);
     if (MPI_Ibcast(h, 3, MPI_INT64_T, 0, I->wake, &req) != MPI_SUCCESS) return -1;
     if (rank == 0) return MPI_Wait(&req, MPI_STATUS_IGNORE) == MPI_SUCCESS ? 0 : -1;
     return await_header(&req);
@@ -143,9 +503,6 @@ static struct silc_comm_ops *r_engine_comm(srv_ranks *R, char *err, size_t errle
     return silc_mpi_comm_ops(MPI_COMM_WORLD, err, errlen);
 }
 
-static srv_ranks the_ranks;
-static ranks_impl the_impl;
-
 int srv_mpi_init(int *argc, char ***argv, int64_t min_rows)
 {
     char msg[256];
@@ -164,6 +521,7 @@ int srv_mpi_init(int *argc, char ***argv, int64_t min_rows)
     }
     the_ranks.rank = the_impl.ctrl->rank;
     the_ranks.size = the_impl.ctrl->size;
+    wake_setup(the_ranks.rank, the_ranks.size);
     the_ranks.min_rows = min_rows;
     the_ranks.command = r_command;
     the_ranks.receive = r_receive;
@@ -176,8 +534,15 @@ int srv_mpi_init(int *argc, char ***argv, int64_t min_rows)
 
 void srv_mpi_finish(void)
 {
+    int i;
     if (!srv_mpi) return;
     if (srv_mpi->rank == 0) r_command(srv_mpi, SRV_CMD_STOP, 0, NULL);
+    for (i = 0; wake_fds && i < srv_mpi->size; i++)
+        if (wake_fds[i] >= 0) close(wake_fds[i]);
+    free(wake_fds);
+    wake_fds = NULL;
+    if (wake_fd >= 0) close(wake_fd);
+    wake_fd = -1;
     if (the_impl.ctrl->destroy) the_impl.ctrl->destroy(the_impl.ctrl->impl);
     MPI_Comm_free(&the_impl.wake);
     srv_mpi = NULL;
