@@ -311,3 +311,63 @@ int srv_auth_verify(int fd, const char *given, int may_wait, char *why, size_t w
                 "the last)", why, addr, (unsigned)n, (long long)(now - last));
     return -1;
 }
+
+/* ---- admission: --max-clients and --peer-share ------------------------- */
+
+int srv_admit(const char *peer, int nslots, srv_slot_at at, void *user, int *evict, char *why,
+              size_t whylen)
+{
+    int i, free_slot = -1, from_peer = 0, oldest_peer = -1, oldest = -1;
+    int peer_cap = (int)(srv_cfg.peer_share * srv_cfg.max_clients);
+    double t_peer = 0, t_any = 0;
+    if (peer_cap < 1) peer_cap = 1;
+    *evict = 0;
+    for (i = 0; i < nslots; i++) {
+        srv_slot_view v;
+        int mine;
+        at(user, i, &v);
+        if (!v.live) {
+            if (free_slot < 0) free_slot = i;
+            continue;
+        }
+        mine = *peer && strcmp(v.peer, peer) == 0;
+        from_peer += mine;
+        if (!v.handshaking) continue;
+        if (oldest < 0 || v.accepted < t_any) oldest = i, t_any = v.accepted;
+        if (mine && (oldest_peer < 0 || v.accepted < t_peer)) oldest_peer = i, t_peer = v.accepted;
+    }
+    if (*peer && from_peer >= peer_cap) {
+        if (oldest_peer >= 0) {
+            snprintf(why, whylen, "--peer-share %g of --max-clients %d", srv_cfg.peer_share,
+                     srv_cfg.max_clients);
+            *evict = 1;
+            return oldest_peer;
+        }
+        snprintf(why, whylen, "server busy: %s holds %d open sessions, its share of %d (silcd "
+                 "--peer-share %g of --max-clients)", peer, from_peer, peer_cap,
+                 srv_cfg.peer_share);
+        return -1;
+    }
+    if (free_slot >= 0) return free_slot;
+    if (oldest >= 0) {
+        snprintf(why, whylen, "--max-clients %d", srv_cfg.max_clients);
+        *evict = 1;
+        return oldest;
+    }
+    snprintf(why, whylen, "server busy: too many sessions (silcd --max-clients %d)",
+             srv_cfg.max_clients);
+    return -1;
+}
+
+void srv_refuse(int fd, const char *why)
+{
+    uint8_t hello[PROTO_HELLO_BYTES];
+    struct iovec iov;
+    char err[128];
+    proto_encode_hello(hello, PROTO_VERSION, 0);
+    iov.iov_base = hello;
+    iov.iov_len = sizeof hello;
+    if (proto_send(fd, &iov, 1, 1000, err, sizeof err) == 0)
+        proto_send_text(fd, PROTO_ERROR, why, 1000, err, sizeof err);
+    close(fd);
+}

@@ -563,8 +563,14 @@ void srv_mpi_finish(void)
  * the bytes of a refused body are dropped as they come.  Deadlines: the
  * handshake must be done within --handshake-timeout of the accept; a peer
  * that sends nothing for --io-timeout in the middle of a message is dropped.
- * Replies are still written by the session with the forking server's
- * blocking sends (--io-timeout bounds a client that does not read). */
+ * Replies are queued by the session and written by this loop as the socket
+ * takes them (srv_session_flush): a connection whose reply waits is not
+ * read until the reply is out, and is dropped when its client takes no
+ * byte of it for --io-timeout, so a client that does not read its GET
+ * stalls no one.  A session that sends nothing for --idle-timeout between
+ * requests is closed, as by the forking server (srv_session_expire); a
+ * newcomer is admitted by the same rules (srv_admit: --max-clients,
+ * --peer-share, the oldest unauthenticated connection giving way). */
 
 #define READ_CHUNK ((size_t)64 << 10)   /* a buffer grows by at least this, at most doubling */
 
@@ -573,8 +579,9 @@ typedef struct conn {
     unsigned long id;
     session *S;             /* NULL while in the handshake */
     char peer[64];
+    double accepted;
     double handshake_end;   /* while S is NULL */
-    double last_byte;       /* when the peer last sent, for --io-timeout inside a message */
+    double last_byte;       /* when a byte last went either way: --io-timeout, --idle-timeout */
     uint8_t *buf;           /* the message being assembled, as far as kept */
     size_t kept, cap;
     size_t want;            /* bytes_to_keep as last asked (0: ask) */
@@ -641,6 +648,10 @@ static int conn_decide(conn *c)
         c->drop = proto_get_u64(c->buf + 8) - (c->kept - PROTO_HEADER_BYTES);
         rc = srv_session_serve(c->S, c->buf, c->kept);
     }
+    /* The reply goes out now if the socket takes it (a client that reads
+     * pays no poll round), else as the client reads (srv_mpi_serve). */
+    c->last_byte = util_now();
+    if (!rc && c->S && srv_session_flush(c->S) < 0) rc = -1;
     c->kept = c->want = 0;
     if (c->cap > READ_CHUNK) { /* a large message's buffer goes with it */
         free(c->buf);
@@ -701,19 +712,86 @@ static int conn_read(conn *c)
 static int conn_deadline(conn *c, double now, int *over)
 {
     double end = -1;
+    int writing = c->S && srv_session_pending(c->S), idle = 0;
     *over = 0;
     if (!c->S) end = c->handshake_end;
-    else if (c->kept || c->drop) end = c->last_byte + srv_cfg.io_timeout_ms / 1000.0;
+    else if (c->kept || c->drop || writing) end = c->last_byte + srv_cfg.io_timeout_ms / 1000.0;
+    else if (srv_cfg.idle_timeout_ms > 0) {
+        end = c->last_byte + srv_cfg.idle_timeout_ms / 1000.0;
+        idle = 1;
+    }
     if (end < 0) return -1;
     if (now < end) return (int)((end - now) * 1000) + 1;
     if (!c->S)
         srv_log(LOG_INFO, "session %lu: no handshake within %g s, closed (--handshake-timeout)",
                 c->id, srv_cfg.handshake_timeout_ms / 1000.0);
+    else if (idle)
+        srv_session_expire(c->S);   /* says why; conn_end writes it if the socket takes it */
     else
-        srv_log(LOG_INFO, "session %lu: timed out after %d ms waiting for the peer inside a "
-                "request (--io-timeout): closed", c->id, srv_cfg.io_timeout_ms);
+        srv_log(LOG_INFO, "session %lu: timed out after %d ms waiting for the peer %s "
+                "(--io-timeout): closed", c->id, srv_cfg.io_timeout_ms,
+                writing ? "to read a reply" : "inside a request");
     *over = 1;
     return -1;
+}
+
+/* The connection's reply waits: written as far as the socket takes it.
+ * 0, or -1 when the connection is over. */
+static int conn_write(conn *c)
+{
+    uint64_t before = srv_session_pending(c->S);
+    int rc = srv_session_flush(c->S);
+    if (rc < 0) return -1;
+    if (srv_session_pending(c->S) < before) c->last_byte = util_now();
+    return 0;
+}
+
+static conn *admit_cs;   /* srv_mpi_serve's connections, for conn_at */
+static int admit_n;
+
+static void conn_at(void *user, int i, srv_slot_view *v)
+{
+    (void)user;
+    v->live = i < admit_n;
+    v->handshaking = v->live && !admit_cs[i].S;
+    v->peer = admit_cs[i].peer;
+    v->accepted = admit_cs[i].accepted;
+}
+
+/* A new connection: a slot by srv_admit (closing the oldest unauthenticated
+ * connection in the way), or refused with the reason.  Returns the new n. */
+static int conn_admit(conn *cs, int n, int fd, int is_tcp, unsigned long id)
+{
+    char peer[64], why[256];
+    int one = 1, evict, slot;
+    conn *c;
+    srv_peer_of(fd, peer, sizeof peer);
+    admit_cs = cs;
+    admit_n = n;
+    slot = srv_admit(peer, srv_cfg.max_clients, conn_at, NULL, &evict, why, sizeof why);
+    if (slot < 0) {
+        srv_log(LOG_WARN, "refusing a connection%s%s: %s", *peer ? " from " : "", peer, why);
+        srv_refuse(fd, why);
+        return n;
+    }
+    if (evict) {
+        srv_log(LOG_WARN, "session %lu%s%s: closed unauthenticated to make room (%s)", cs[slot].id,
+                *cs[slot].peer ? " from " : "", cs[slot].peer, why);
+        conn_end(&cs[slot]);
+    } else {
+        slot = n++;   /* srv_admit gives the first free slot: n */
+    }
+    if (is_tcp) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    c = &cs[slot];
+    memset(c, 0, sizeof *c);
+    c->fd = fd;
+    c->id = id;
+    c->accepted = util_now();
+    c->handshake_end = c->accepted + srv_cfg.handshake_timeout_ms / 1000.0;
+    /* The peer's entry of the authentication backoff, while it is connected. */
+    snprintf(c->peer, sizeof c->peer, "%s", peer);
+    srv_auth_hold(c->peer);
+    return n;
 }
 
 int srv_mpi_serve(int lfd, int is_tcp)
@@ -746,7 +824,7 @@ int srv_mpi_serve(int lfd, int is_tcp)
         p[1].events = POLLIN;
         for (i = 0; i < n; i++) {
             p[i + 2].fd = cs[i].fd;
-            p[i + 2].events = POLLIN;
+            p[i + 2].events = cs[i].S && srv_session_pending(cs[i].S) ? POLLOUT : POLLIN;
             p[i + 2].revents = 0;
         }
         p[0].revents = p[1].revents = 0;
@@ -757,29 +835,14 @@ int srv_mpi_serve(int lfd, int is_tcp)
         if (p[1].revents) break;
         for (i = n - 1; i >= 0; i--) {
             if (!p[i + 2].revents) continue;
-            if (conn_read(&cs[i]) != 0) {
+            if ((p[i + 2].events == POLLOUT ? conn_write(&cs[i]) : conn_read(&cs[i])) != 0) {
                 conn_end(&cs[i]);
                 cs[i] = cs[--n];
             }
         }
         if (p[0].revents & POLLIN) {
-            int fd = accept(lfd, NULL, NULL), one = 1;
-            conn *c;
-            if (fd < 0) continue;
-            if (n == srv_cfg.max_clients) {
-                srv_log(LOG_WARN, "server busy: too many sessions (silcd --max-clients)");
-                close(fd);
-                continue;
-            }
-            if (is_tcp) setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-            c = &cs[n++];
-            memset(c, 0, sizeof *c);
-            c->fd = fd;
-            c->id = next_id++;
-            c->handshake_end = util_now() + srv_cfg.handshake_timeout_ms / 1000.0;
-            /* The peer's entry of the authentication backoff, while it is connected. */
-            srv_peer_of(fd, c->peer, sizeof c->peer);
-            srv_auth_hold(c->peer);
+            int fd = accept(lfd, NULL, NULL);
+            if (fd >= 0) n = conn_admit(cs, n, fd, is_tcp, next_id++);
         }
     }
     for (i = 0; i < n; i++) conn_end(&cs[i]);

@@ -56,6 +56,11 @@ void srv_log(int level, const char *fmt, ...)
 #endif
     ;
 
+typedef struct session session;
+/* --idle-timeout reached: logs it and tells the client why (its next read
+ * finds the ERROR); the caller then closes the session. */
+void srv_session_expire(session *S);
+
 /* Serves one accepted connection until BYE, disconnect, idle timeout or
  * shutdown, then closes fd.  Runs in the session's own process; id numbers
  * the session in the log; *state is its slot (above).  1 if a session was
@@ -87,6 +92,23 @@ void srv_auth_drop(const char *addr);
  * reset by a success); may_wait 0 (silcd --mpi, one process for every
  * session) refuses such a check unchecked instead of waiting. */
 int srv_auth_verify(int fd, const char *given, int may_wait, char *why, size_t whylen);
+/* Admission (--max-clients, --peer-share), the same for both servers: a
+ * newcomer from peer (its address, "" on a Unix socket) among nslots slots
+ * (at describes slot i).  The slot to give it, free or (*evict = 1, why =
+ * the limit, for the log) held by the oldest connection that has not
+ * completed its handshake, of peer if peer is at its share, else of anyone
+ * when no slot is free: the caller closes that one first.  -1 with why, the
+ * client's message, when every connection in the way is an open session. */
+typedef struct srv_slot_view {
+    int live, handshaking;
+    const char *peer;
+    double accepted;   /* util_now() */
+} srv_slot_view;
+typedef void (*srv_slot_at)(void *user, int i, srv_slot_view *out);
+int srv_admit(const char *peer, int nslots, srv_slot_at at, void *user, int *evict, char *why,
+              size_t whylen);
+/* Refuses a connection with a hello and an ERROR saying why; closes fd. */
+void srv_refuse(int fd, const char *why);
 /* ---- limits.c: what no session may pass (docs/security.md, "Limits") ---- */
 #define SRV_REQUEST_GRACE_S 2.0   /* past --max-request-seconds, before the process is ended */
 #define SRV_SHUTDOWN_GRACE_S 2.0  /* a request in flight at SIGTERM, before it is stopped */
@@ -161,10 +183,14 @@ extern srv_ranks *srv_mpi;       /* NULL unless silcd --mpi */
  * header, descriptor and name are in head, whether its arrays will be read
  * (1) or refused unread (0).  serve: one request, frame = its kept bytes;
  * 0, or -1 when the session is over.  close. */
-typedef struct session session;
 session *srv_session_open_hello(int fd, unsigned long id, const uint8_t *hello, size_t len);
 int srv_session_wants_arrays(session *S, const uint8_t *head, size_t len);
 int srv_session_serve(session *S, const uint8_t *frame, size_t len);
+/* Its replies are queued (one at most): flush writes what the socket takes
+ * now, without blocking: 0 all out, 1 some left (pending bytes), -1 the
+ * connection broke; close writes a last reply if the socket takes it. */
+int srv_session_flush(session *S);
+uint64_t srv_session_pending(const session *S);
 void srv_session_close(session *S);
 /* The other ranks of silcd --mpi: follow rank 0's commands until STOP. */
 int srv_follow(void);

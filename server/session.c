@@ -20,6 +20,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "server.h"
 
+#include <errno.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -34,6 +35,27 @@
 #include "dist.h"
 #include "engine.h"
 #include "lang.h"
+
+/* silcd --mpi: a reply waits here until rank 0's poll loop has written it
+ * as fast as the client reads (srv_session_flush), so that a client that
+ * does not read stalls no other session.  A part is a copy (headers,
+ * texts), or a value's arrays, the value held until they are out.  The loop
+ * reads no further request of a session while its reply waits, so one
+ * reply at most is queued: a GET's value, which the session's limits
+ * already count, and a few headers. */
+typedef struct reply_part {
+    uint8_t *own;            /* a malloc'd copy, or NULL */
+    const uint8_t *p;
+    size_t len;
+    silc_value *hold;        /* released once p[0..len) is out */
+} reply_part;
+
+typedef struct reply_queue {
+    reply_part *parts;
+    size_t first, n, cap;    /* parts[first..n) wait, the first from byte off */
+    size_t off;
+    uint64_t bytes;          /* still to write */
+} reply_queue;
 
 /* Frames an EXEC produces (who, info, explain), sent with its reply. */
 typedef struct outbuf {
@@ -52,6 +74,8 @@ struct session {
     proto_limits lim;
     int slot;              /* the state of a session of silcd --mpi (no parent to share it with) */
     int announced;         /* silcd --mpi: the other ranks made an engine for it */
+    int queued;            /* silcd --mpi: replies go to q, written by srv_session_flush */
+    reply_queue q;
     srv_watch watch;       /* of the running EXEC (limits.c) */
     char err[4096];
 };
@@ -110,15 +134,97 @@ static void memo_give_way(silc_engine *E, double more)
     memo_shrink(E, left > 0 ? (uint64_t)left : 0);
 }
 
-static int reply_text(session *S, uint32_t op, const char *text)
+static void part_done(reply_part *r)
 {
+    free(r->own);
+    val_release(r->hold);
+}
+
+static int queue_part(reply_queue *q, const struct iovec *iov, silc_value *hold)
+{
+    reply_part *r;
+    if (!iov->iov_len) return 0;
+    if (q->n == q->cap) {
+        size_t cap = q->cap ? 2 * q->cap : 8;
+        reply_part *p = realloc(q->parts, cap * sizeof *p);
+        if (!p) return -1;
+        q->parts = p;
+        q->cap = cap;
+    }
+    r = &q->parts[q->n];
+    memset(r, 0, sizeof *r);
+    r->len = iov->iov_len;
+    if (hold) {
+        r->hold = val_retain(hold);
+        r->p = iov->iov_base;
+    } else {
+        if (!(r->own = malloc(r->len))) return -1;
+        memcpy(r->own, iov->iov_base, r->len);
+        r->p = r->own;
+    }
+    q->n++;
+    q->bytes += r->len;
+    return 0;
+}
+
+static void queue_clear(reply_queue *q)
+{
+    size_t k;
+    for (k = q->first; k < q->n; k++) part_done(&q->parts[k]);
+    q->first = q->n = q->off = 0;
+    q->bytes = 0;
+}
+
+/* The parts of a reply to the client: written now (the forking server's
+ * session: its process has nothing else to do, and --io-timeout bounds a
+ * client that does not read), or queued (silcd --mpi).  Parts from index
+ * borrowed on are arrays of hold, the others are copied. */
+static int send_parts(session *S, const struct iovec *iov, int n, silc_value *hold, int borrowed)
+{
+    struct iovec v[8];
     char why[256];
+    int i;
     *S->state = SLOT_REPLYING;
-    if (proto_send_text(S->fd, op, text, srv_cfg.io_timeout_ms, why, sizeof why)) {
+    if (!S->queued) {
+        if (n > 8) return -1;
+        memcpy(v, iov, (size_t)n * sizeof *iov);   /* proto_send consumes its iovecs */
+        if (!proto_send(S->fd, v, n, srv_cfg.io_timeout_ms, why, sizeof why)) return 0;
         srv_log(LOG_INFO, "session %lu: %s", S->id, why);
         return -1;
     }
+    for (i = 0; i < n; i++)
+        if (queue_part(&S->q, &iov[i], i >= borrowed ? hold : NULL)) {
+            srv_log(LOG_ERROR, "session %lu: out of memory queueing a reply: closed", S->id);
+            return -1;
+        }
     return 0;
+}
+
+/* One frame: its header, then body[0..n) (from borrowed on, arrays of hold). */
+static int send_frame(session *S, uint32_t op, const struct iovec *body, int n, silc_value *hold,
+                      int borrowed)
+{
+    uint8_t hdr[PROTO_HEADER_BYTES];
+    struct iovec iov[8];
+    uint64_t len = 0;
+    int i;
+    if (n > 7) return -1;
+    iov[0].iov_base = hdr;
+    iov[0].iov_len = sizeof hdr;
+    for (i = 0; i < n; i++) {
+        iov[i + 1] = body[i];
+        len += body[i].iov_len;
+    }
+    proto_encode_header(hdr, op, len);
+    return send_parts(S, iov, n + 1, hold, borrowed + 1);
+}
+
+static int reply_text(session *S, uint32_t op, const char *text)
+{
+    struct iovec body;
+    body.iov_base = (void *)(uintptr_t)text;
+    body.iov_len = text ? strlen(text) : 0;
+    return send_frame(S, op, &body, 1, NULL, 1);
 }
 
 static int reply_error(session *S, const char *msg)
@@ -131,7 +237,6 @@ static int reply_error(session *S, const char *msg)
 static int finish_exec(session *S, int rc, const char *warnings)
 {
     struct iovec iov;
-    char why[256];
     if (S->out.failed) {
         S->out.failed = 0;
         S->out.len = 0;
@@ -143,11 +248,7 @@ static int finish_exec(session *S, int rc, const char *warnings)
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
     S->out.len = 0;
-    *S->state = SLOT_REPLYING;
-    if (iov.iov_len && proto_send(S->fd, &iov, 1, srv_cfg.io_timeout_ms, why, sizeof why)) {
-        srv_log(LOG_INFO, "session %lu: %s", S->id, why);
-        return -1;
-    }
+    if (iov.iov_len && send_parts(S, &iov, 1, NULL, 1)) return -1;
     if (warnings && *warnings && reply_text(S, PROTO_WARN, warnings)) return -1;
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
 }
@@ -331,7 +432,6 @@ static int do_get(session *S, const char *name)
     proto_desc d;
     uint8_t desc[PROTO_DESC_BYTES];
     struct iovec body[4];
-    char why[256];
     int k, rc;
     v = (silc_value *)api_lookup(S->E, name, S->err, sizeof S->err);
     if (v && dist_is(v)) { /* its blocks, gathered to rank 0 (once: kept with the value) */
@@ -344,11 +444,8 @@ static int do_get(session *S, const char *name)
     proto_encode_desc(desc, &d);
     body[0].iov_base = desc;
     body[0].iov_len = sizeof desc;
-    *S->state = SLOT_REPLYING;
     rc = k < 0 ? reply_error(S, "value too large to send")
-               : proto_send_frame(S->fd, PROTO_VALUE, body, k + 1, srv_cfg.io_timeout_ms, why,
-                                  sizeof why);
-    if (k >= 0 && rc) srv_log(LOG_INFO, "session %lu: %s", S->id, why);
+               : send_frame(S, PROTO_VALUE, body, k + 1, v, 1);
     val_release(v);
     return rc;
 }
@@ -471,7 +568,7 @@ static int handshake(session *S, const proto_stream *in)
     proto_encode_hello(hello, PROTO_VERSION, 0);
     iov.iov_base = hello;
     iov.iov_len = sizeof hello;
-    if (proto_send(S->fd, &iov, 1, srv_cfg.io_timeout_ms, why, sizeof why)) {
+    if (send_parts(S, &iov, 1, NULL, 1)) {
         free(token);
         return -1;
     }
@@ -513,6 +610,16 @@ static int handshake(session *S, const proto_stream *in)
     return reply_text(S, PROTO_OK, "silcd " SILC_VERSION);
 }
 
+void srv_session_expire(session *S)
+{
+    char msg[160];
+    snprintf(msg, sizeof msg, "session closed: idle for %g s (silcd --idle-timeout); "
+             "its values are gone", srv_cfg.idle_timeout_ms / 1000.0);
+    srv_log(LOG_INFO, "session %lu: %s", S->id, msg);
+    reply_text(S, PROTO_ERROR, msg);
+    if (!S->queued) shutdown(S->fd, SHUT_WR);   /* queued: written as the session closes */
+}
+
 /* Waits for the next request; 0 when one is arriving, -1 on shutdown or
  * after --idle-timeout, which the client is told with an ERROR that its
  * next read finds. */
@@ -537,12 +644,7 @@ static int await_request(session *S)
         if (p[1].revents) return -1;
         if (p[0].revents) return 0;
         if (rc == 0 && srv_cfg.idle_timeout_ms > 0 && util_now() >= deadline) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "session closed: idle for %g s (silcd --idle-timeout); "
-                     "its values are gone", srv_cfg.idle_timeout_ms / 1000.0);
-            srv_log(LOG_INFO, "session %lu: %s", S->id, msg);
-            reply_text(S, PROTO_ERROR, msg);
-            shutdown(S->fd, SHUT_WR);
+            srv_session_expire(S);
             return -1;
         }
     }
@@ -596,7 +698,7 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
 }
 
 static session *session_open(int fd, unsigned long id, volatile int *state,
-                             const proto_stream *hello)
+                             const proto_stream *hello, int queued)
 {
     session *S = calloc(1, sizeof *S);
     if (!S) {
@@ -606,6 +708,7 @@ static session *session_open(int fd, unsigned long id, volatile int *state,
     }
     S->fd = fd;
     S->id = id;
+    S->queued = queued;
     S->state = state ? state : &S->slot;
     S->lim.max_value_bytes = srv_cfg.max_value_bytes;
     S->lim.max_text_bytes = srv_cfg.max_text_bytes;
@@ -622,7 +725,7 @@ static session *session_open(int fd, unsigned long id, volatile int *state,
 session *srv_session_open_hello(int fd, unsigned long id, const uint8_t *hello, size_t len)
 {
     proto_stream st = {-1, 0, hello, len, 0};
-    return session_open(fd, id, NULL, &st);
+    return session_open(fd, id, NULL, &st, 1);
 }
 
 int srv_session_wants_arrays(session *S, const uint8_t *head, size_t len)
@@ -651,22 +754,76 @@ static int session_step(session *S)
     return rc;
 }
 
+int srv_session_flush(session *S)
+{
+    reply_queue *q = &S->q;
+    while (q->first < q->n) {
+        struct iovec iov[64];
+        struct msghdr m;
+        size_t k, cnt = 0;
+        ssize_t sent;
+        for (k = q->first; k < q->n && cnt < 64; k++, cnt++) {
+            size_t skip = k == q->first ? q->off : 0;
+            iov[cnt].iov_base = (void *)(uintptr_t)(q->parts[k].p + skip);
+            iov[cnt].iov_len = q->parts[k].len - skip;
+        }
+        memset(&m, 0, sizeof m);
+        m.msg_iov = iov;
+        m.msg_iovlen = cnt;
+        sent = sendmsg(S->fd, &m, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (sent < 0 && errno == EINTR) continue;
+        if (sent < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return 1;
+        if (sent < 0) {
+            srv_log(LOG_INFO, "session %lu: writing a reply: %s", S->id, strerror(errno));
+            return -1;
+        }
+        q->bytes -= (uint64_t)sent;
+        while (sent > 0) {
+            reply_part *r = &q->parts[q->first];
+            size_t left = r->len - q->off;
+            if ((size_t)sent < left) {
+                q->off += (size_t)sent;
+                break;
+            }
+            sent -= (ssize_t)left;
+            part_done(r);
+            q->first++;
+            q->off = 0;
+        }
+    }
+    q->first = q->n = 0;
+    return 0;
+}
+
+uint64_t srv_session_pending(const session *S)
+{
+    return S->q.bytes;
+}
+
 void srv_session_close(session *S)
 {
     if (!S) return;
+    /* A last reply (BYE's OK, a refusal, --idle-timeout's ERROR) goes out
+     * if the socket takes it now; a reply the client is not reading is
+     * dropped. */
+    if (S->queued && srv_session_flush(S) == 1)
+        srv_log(LOG_INFO, "session %lu: closed with %llu bytes of its reply unread", S->id,
+                (unsigned long long)S->q.bytes);
     if (S->announced) srv_mpi->command(srv_mpi, SRV_CMD_CLOSE, S->id, NULL);
     if (S->E) {
         eng_destroy(&S->E);
         srv_log(LOG_INFO, "session %lu: closed", S->id);
     }
     free(S->out.p);
+    queue_clear(&S->q);
+    free(S->q.parts);
     close(S->fd);
     free(S);
 }
 
 int srv_session(int fd, unsigned long id, volatile int *state)
 {
-    session *S = session_open(fd, id, state, NULL);
+    session *S = session_open(fd, id, state, NULL, 0);
     if (!S) return 0;
     while (await_request(S) == 0 && session_step(S) == 0) {}
     srv_session_close(S);

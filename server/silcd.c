@@ -433,79 +433,35 @@ static void on_child(int sig)
     (void)rc;
 }
 
-/* Refuses a connection with a proper hello and an ERROR saying why. */
-static void refuse(int fd, const char *why)
+static void slot_at(void *user, int i, srv_slot_view *v)
 {
-    uint8_t hello[PROTO_HELLO_BYTES];
-    struct iovec iov;
-    char err[128];
-    proto_encode_hello(hello, PROTO_VERSION, 0);
-    iov.iov_base = hello;
-    iov.iov_len = sizeof hello;
-    if (proto_send(fd, &iov, 1, 1000, err, sizeof err) == 0)
-        proto_send_text(fd, PROTO_ERROR, why, 1000, err, sizeof err);
-    close(fd);
+    (void)user;
+    v->live = conns[i].pid != 0;
+    v->handshaking = conn_state[i] == SLOT_HANDSHAKE;
+    v->peer = conns[i].peer;
+    v->accepted = conns[i].accepted;
 }
 
-/* Closes the oldest connection that has not completed its handshake, of
- * peer (or of anyone: peer NULL), to make room; its slot, or -1 if every
- * such connection is an open session.  A client completes its handshake in
- * a millisecond, so connections that never send a byte (or wait out the
- * delay of a failed authentication) cannot lock real clients out. */
-static int evict_unauthenticated(const char *peer, const char *limit)
-{
-    int i, oldest = -1;
-    for (i = 0; i < n_conns; i++)
-        if (conns[i].pid && conn_state[i] == SLOT_HANDSHAKE &&
-            (!peer || strcmp(conns[i].peer, peer) == 0) &&
-            (oldest < 0 || conns[i].accepted < conns[oldest].accepted))
-            oldest = i;
-    if (oldest < 0) return -1;
-    srv_log(LOG_WARN, "session %lu%s%s: closed unauthenticated to make room (%s)", conns[oldest].id,
-            *conns[oldest].peer ? " from " : "", conns[oldest].peer, limit);
-    /* Waited for here, so that it cannot touch the slot's state once reused. */
-    kill(conns[oldest].pid, SIGKILL);
-    waitpid(conns[oldest].pid, NULL, 0);
-    close(conns[oldest].fd);
-    srv_auth_drop(conns[oldest].peer);
-    conns[oldest].pid = 0;
-    conns[oldest].fd = -1;
-    conn_state[oldest] = SLOT_FREE;
-    return oldest;
-}
-
-/* A free slot for a new connection from peer, or -1 with why set.  A peer
- * at its share (--peer-share), or a full server (--max-clients), makes
- * room by closing its oldest unauthenticated connection; only open
- * sessions are never closed for a newcomer. */
+/* A free slot for a new connection from peer, or -1 with why set
+ * (srv_admit).  A connection closed to make room is killed and waited for
+ * here, so that it cannot touch the slot's state once reused.  A client
+ * completes its handshake in a millisecond, so connections that never
+ * send a byte (or wait out the delay of a failed authentication) cannot
+ * lock real clients out. */
 static int take_slot(const char *peer, char *why, size_t whylen)
 {
-    int i, free_slot = -1, from_peer = 0, slot;
-    int peer_cap = (int)(srv_cfg.peer_share * srv_cfg.max_clients);
-    char limit[96];
-    if (peer_cap < 1) peer_cap = 1;
-    for (i = 0; i < n_conns; i++) {
-        if (!conns[i].pid) {
-            if (free_slot < 0) free_slot = i;
-            continue;
-        }
-        if (*peer && strcmp(conns[i].peer, peer) == 0) from_peer++;
-    }
-    if (*peer && from_peer >= peer_cap) {
-        snprintf(limit, sizeof limit, "--peer-share %g of --max-clients %d", srv_cfg.peer_share,
-                 srv_cfg.max_clients);
-        if ((slot = evict_unauthenticated(peer, limit)) >= 0) return slot;
-        snprintf(why, whylen, "server busy: %s holds %d open sessions, its share of %d (silcd "
-                 "--peer-share %g of --max-clients)", peer, from_peer, peer_cap,
-                 srv_cfg.peer_share);
-        return -1;
-    }
-    if (free_slot >= 0) return free_slot;
-    snprintf(limit, sizeof limit, "--max-clients %d", srv_cfg.max_clients);
-    if ((slot = evict_unauthenticated(NULL, limit)) >= 0) return slot;
-    snprintf(why, whylen, "server busy: too many sessions (silcd --max-clients %d)",
-             srv_cfg.max_clients);
-    return -1;
+    int evict, slot = srv_admit(peer, n_conns, slot_at, NULL, &evict, why, whylen);
+    if (slot < 0 || !evict) return slot;
+    srv_log(LOG_WARN, "session %lu%s%s: closed unauthenticated to make room (%s)", conns[slot].id,
+            *conns[slot].peer ? " from " : "", conns[slot].peer, why);
+    kill(conns[slot].pid, SIGKILL);
+    waitpid(conns[slot].pid, NULL, 0);
+    close(conns[slot].fd);
+    srv_auth_drop(conns[slot].peer);
+    conns[slot].pid = 0;
+    conns[slot].fd = -1;
+    conn_state[slot] = SLOT_FREE;
+    return slot;
 }
 
 static void sigmask_session_signals(int how)
@@ -555,7 +511,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     int slot = take_slot(peer, why, sizeof why);
     if (slot < 0) {
         srv_log(LOG_WARN, "refusing a connection%s%s: %s", *peer ? " from " : "", peer, why);
-        refuse(fd, why);
+        srv_refuse(fd, why);
         return;
     }
     conns[slot].fd = fd;
@@ -571,7 +527,7 @@ static void start_session(int lfd, int fd, unsigned long id, const char *peer)
     sigmask_session_signals(SIG_UNBLOCK);
     if (pid < 0) {
         srv_log(LOG_ERROR, "cannot start a session process: %s", strerror(errno));
-        refuse(fd, "server cannot start a session: fork failed");
+        srv_refuse(fd, "server cannot start a session: fork failed");
         srv_auth_drop(peer);
         conn_state[slot] = SLOT_FREE;
         return;

@@ -30,7 +30,7 @@ if(TARGET silc_plugin_suitesparse)
 endif()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
   foreach(case request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
-               admission_mpi announce_mpi)
+               admission_mpi announce_mpi unread_get_mpi idle_timeout_mpi peer_share_mpi)
     add_test(NAME security_limits_${case}
              COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
                      ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case}

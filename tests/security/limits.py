@@ -29,7 +29,7 @@ import numpy as np
 BINDINGS, STATEDIR, CASE, SILCD = sys.argv[1:5]
 MPIRUN = sys.argv[5] if len(sys.argv) > 5 else None
 sys.path.insert(0, BINDINGS)
-from silc._remote import PUT, RemoteSession, _DESC, _HEADER  # noqa: E402
+from silc._remote import GET, OK, PUT, RemoteSession, _DESC, _HEADER, _HELLO  # noqa: E402
 from silc._values import DENSE, SilcError  # noqa: E402
 
 RUNAWAY = "x = 1\nwhile (1) { x = 1 }"
@@ -116,7 +116,7 @@ def descendants(pid):
 class Server:
     """silcd (or mpirun -np 2 silcd --mpi) on a Unix socket of its own."""
 
-    def __init__(self, *args, mpi=False):
+    def __init__(self, *args, mpi=False, listen=None):
         self.mpi = mpi
         os.makedirs(STATEDIR, exist_ok=True)
         self.sock = os.path.join(STATEDIR, CASE + ".sock")
@@ -125,7 +125,7 @@ class Server:
         for p in (self.sock, ready):
             if os.path.exists(p):
                 os.unlink(p)
-        cmd = [SILCD, "--listen", "unix:" + self.sock, "--ready-file", ready,
+        cmd = [SILCD, "--listen", listen or "unix:" + self.sock, "--ready-file", ready,
                "--log-level", "info"] + list(args)
         if mpi:
             cmd = [MPIRUN, "-np", "2"] + cmd[:1] + ["--mpi"] + cmd[1:]
@@ -137,7 +137,7 @@ class Server:
             fail("silcd did not start")
         if self.proc.poll() is not None:
             fail("silcd exited at start:\n" + self.text())
-        self.url = "unix:" + self.sock
+        self.url = open(ready).read().strip() if listen else "unix:" + self.sock
 
     def text(self):
         self.log.flush()
@@ -758,6 +758,167 @@ def case_announce_mpi():
         fail("the session's answer is wrong")
     hostile.sock.close()
     s.close()
+    srv.stop_cleanly()
+
+
+def stall_get(srv, rows):
+    """A session that stores a rows x 1000 matrix, asks for it back and
+    never reads the reply (the raw GET frame on its socket).  The matrix,
+    for the caller to compare."""
+    s = srv.session()
+    x = np.arange(rows * 1000, dtype=np.float64).reshape(rows, 1000)
+    s.put("big", x)
+    s.sock.sendall(_HEADER.pack(GET, 0, 3) + b"big")
+    return s, x
+
+
+def recv_exact(sock, n, seconds):
+    sock.settimeout(seconds)
+    out = bytearray()
+    while len(out) < n:
+        chunk = sock.recv(min(n - len(out), 1 << 20))
+        if not chunk:
+            break
+        out += chunk
+    return bytes(out)
+
+
+def case_unread_get_mpi():
+    """Rank 0 writes replies as clients read them: a client that asks for
+    a 16 MB value and does not read does not stall another client, whose
+    handshake and requests are answered while the first still holds its
+    reply unread; the first then reads its whole value, exact.  A client
+    that never reads is dropped at --io-timeout and the server goes on."""
+    srv = Server("--io-timeout", "60", mpi=True)
+    stalled, x = stall_get(srv, 2000)
+    time.sleep(0.5)                      # rank 0 has written what the socket takes
+    other = RemoteSession(srv.url, timeout=30)
+    other.exec("a = 6 * 7")
+    if other.get("a")[0, 0] != 42:
+        fail("the other client's answer is wrong")
+    if "waiting for the peer to read a reply" in srv.text():
+        fail("the stalled client was dropped before the other was served:\n" + srv.text())
+    head = recv_exact(stalled.sock, _HEADER.size + _DESC.size, 30)
+    op, _, length = _HEADER.unpack(head[:_HEADER.size])
+    _fmt, _nl, m, n, _nnz, _kl, _ku = _DESC.unpack(head[_HEADER.size:])
+    if (op, m, n, length) != (130, 2000, 1000, _DESC.size + x.nbytes):
+        fail("the stalled GET's reply header: op %d, %d x %d, %d bytes" % (op, m, n, length))
+    body = recv_exact(stalled.sock, x.nbytes, 30)
+    got = np.frombuffer(body, dtype=np.float64)
+    if got.size != x.size or not np.array_equal(got.reshape(1000, 2000).T, x):
+        fail("the stalled GET's value, read late, differs from the one stored")
+    stalled.sock.settimeout(30)
+    stalled.exec("b = 1")                # the session goes on in step
+    stalled.close()
+    other.close()
+    srv.stop_cleanly()
+    # --io-timeout: a client that never reads is dropped; the server serves on.
+    srv = Server("--io-timeout", "1", mpi=True)
+    stalled, _ = stall_get(srv, 2000)
+    if not wait_until(lambda: "timed out after 1000 ms waiting for the peer to read a reply "
+                      "(--io-timeout): closed" in srv.text(), 20 * EXIT_SLACK):
+        fail("a client that never read its GET was not dropped at --io-timeout:\n" + srv.text())
+    s = srv.session()
+    s.exec("c = 2 + 3")
+    if s.get("c")[0, 0] != 5:
+        fail("the server's answer after dropping the stalled client is wrong")
+    s.close()
+    stalled.sock.close()
+    srv.stop_cleanly()
+
+
+def case_idle_timeout_mpi():
+    """--idle-timeout under --mpi: a session idle past it is closed (its
+    engine on both ranks) and its client told why; an active session is
+    not; a new one computes."""
+    srv = Server("--idle-timeout", "1", mpi=True)
+    idle = srv.session()
+    idle.exec("x = 1")
+    busy = srv.session()
+    end = time.monotonic() + 2.5
+    k = 0
+    while time.monotonic() < end:        # requests closer than 1 s apart
+        busy.exec("y = %d" % k)
+        k += 1
+        time.sleep(0.2)
+    # What the idle client's next read finds (this client would write
+    # first, into the closed socket): the reason, then the end.
+    head = recv_exact(idle.sock, _HEADER.size, 10)
+    op, _, n = _HEADER.unpack(head) if len(head) == _HEADER.size else (None, 0, 0)
+    msg = recv_exact(idle.sock, n, 10).decode()
+    if (op, msg) != (129, "session closed: idle for 1 s (silcd --idle-timeout); its values are gone"):
+        fail("the idle client read %s %r" % (op, msg))
+    if recv_exact(idle.sock, 1, 10) != b"":
+        fail("the idle session's connection stayed open")
+    if busy.get("y")[0, 0] != k - 1:
+        fail("the active session lost its value")
+    if "session 1: session closed: idle for 1 s (silcd --idle-timeout)" not in srv.text():
+        fail("the log does not say why session 1 was closed:\n" + srv.text())
+    busy.close()
+    s = srv.session()
+    s.exec("z = [1; 2] * 3")
+    if s.get("z")[1, 0] != 6:
+        fail("a new session after the timeout computes wrongly")
+    s.close()
+    srv.stop_cleanly()
+
+
+def tcp_hello(port, token, source="127.0.0.1"):
+    """A raw handshake from source: (socket, reply op, reply text)."""
+    c = socket.create_connection(("127.0.0.1", port), timeout=30, source_address=(source, 0))
+    tok = token.encode()
+    c.sendall(_HELLO.pack(b"SILC", 1, len(tok)) + tok)
+    recv_exact(c, _HELLO.size, 30)
+    head = recv_exact(c, _HEADER.size, 30)
+    if len(head) < _HEADER.size:
+        return c, None, ""
+    op, _, n = _HEADER.unpack(head)
+    return c, op, recv_exact(c, n, 30).decode()
+
+
+def case_peer_share_mpi():
+    """--peer-share under --mpi, by the forking server's rules (srv_admit):
+    300 silent connections from 127.0.0.1 hold at most its share, each
+    newcomer closing the oldest silent one, so a real client from 127.0.0.1
+    gets in; a peer whose share is all open sessions is refused with the
+    reason, and another address still gets in."""
+    tok = os.path.join(STATEDIR, CASE + ".token")
+    if os.path.exists(tok):
+        os.unlink(tok)
+    subprocess.run([SILCD, "--make-token", tok], check=True, stdout=subprocess.DEVNULL)
+    token = open(tok).readline().strip()
+    os.makedirs(STATEDIR, exist_ok=True)
+    srv = Server("--max-clients", "64", "--peer-share", "0.5", "--handshake-timeout", "60",
+                 "--token-file", tok, mpi=True, listen="tcp://127.0.0.1:0")
+    port = int(srv.url.rsplit(":", 1)[1])
+    silent = [socket.create_connection(("127.0.0.1", port), timeout=30) for _ in range(300)]
+    c, op, text = tcp_hello(port, token)
+    if op != OK:
+        fail("a real client behind 300 silent connections from its address: %s %r" % (op, text))
+    c.close()
+    if not wait_until(lambda: "closed unauthenticated to make room (--peer-share 0.5 of "
+                      "--max-clients 64)" in srv.text(), 10 * EXIT_SLACK):
+        fail("the log does not say silent connections made room:\n" + srv.text())
+    open_now = sum(not answered(s) for s in silent[-10:])
+    closed = sum(answered(s) and s.recv(1) == b"" for s in silent[:10])
+    if (open_now, closed) != (10, 10):
+        fail("of 300 silent connections, the newest 10: %d open; the oldest 10: %d closed"
+             % (open_now, closed))
+    for s in silent:
+        s.close()
+    sessions = [RemoteSession(srv.url, token=token, timeout=30) for _ in range(32)]
+    expect_error(lambda: RemoteSession(srv.url, token=token, timeout=30),
+                 "server busy: 127.0.0.1 holds 32 open sessions, its share of 32 (silcd "
+                 "--peer-share 0.5 of --max-clients)", exact=False)
+    c, op, text = tcp_hello(port, token, source="127.0.0.2")
+    if op != OK:
+        fail("127.0.0.2 while 127.0.0.1 holds its share: %s %r" % (op, text))
+    c.close()
+    sessions[0].exec("q = 4 * 4")
+    if sessions[0].get("q")[0, 0] != 16:
+        fail("a session at the share computes wrongly")
+    for s in sessions:
+        s.close()
     srv.stop_cleanly()
 
 
