@@ -1,22 +1,27 @@
 #!/usr/bin/env python3
-"""mpi_wake.py -- what resting ranks cost a request (docs/distributed.md,
-"An idle server rests").
+"""mpi_wake.py -- what resting ranks cost: CPU while idle, and latency added
+to the first request after an idle period (docs/distributed.md, "An idle
+server rests").
 
 The ranks of `mpirun -np 2 silcd --mpi` other than 0 wait for the next
-command without spinning (server/mpi_server.c, await_header): they test an
-MPI_Ibcast in a loop for 2 ms after a command, then nap from 50 us doubling
-to 1 ms.  A request that comes after an idle period therefore waits for a
-napping rank; one that follows another closely does not.  This bench times
-the same small collective request (`n = x' * x` on a vector split between
-the ranks) back to back ("under load") and after 0.2 s of idleness ("after
-idle"), and does the same against the forking silcd in the same run, whose
-difference is the cost of idleness that is not MPI's (the client's and the
-server's caches and scheduler wake-ups).  The table gives medians and the
-added latency after idle, MPI's share being the difference of the two.
+command in poll() on a wake-up socket that rank 0 writes a byte to before
+each command (server/mpi_server.c, await_wake), after looking for it
+without sleeping for 2 ms after the last command.  A request that comes
+after an idle period therefore pays a wake-up of the resting rank; one
+that follows another closely does not.  This bench
+ - reads each rank's CPU time (utime + stime, /proc/PID/stat) over IDLE_S
+   seconds with no request, after one session has computed;
+ - times the same small collective request (`n = x' * x` on a vector split
+   between the ranks) back to back ("under load") and after 0.2 s of
+   idleness ("after idle"), and does the same against the forking silcd in
+   the same run, whose difference is the cost of idleness that is not
+   MPI's (the client's and the server's caches and scheduler wake-ups).
+The table gives medians and the added latency after idle, MPI's share
+being the difference of the two.
 
-    /usr/bin/python3 bench/mpi_wake.py [BUILD_DIR]   (default build; ~40 s)
+    /usr/bin/python3 bench/mpi_wake.py [BUILD_DIR]   (default build; ~50 s)
     env: LOAD (requests back to back, default 400), IDLE (requests after
-         idle, default 40)
+         idle, default 40), IDLE_S (seconds of the CPU reading, default 10)
 """
 import os
 import statistics
@@ -33,6 +38,7 @@ from silc._remote import RemoteSession  # noqa: E402
 
 LOAD = int(os.environ.get("LOAD", "400"))
 IDLE = int(os.environ.get("IDLE", "40"))
+IDLE_S = float(os.environ.get("IDLE_S", "10"))
 for k, v in (("OPENBLAS_NUM_THREADS", "1"), ("OMP_NUM_THREADS", "1"),
              ("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
              ("OMPI_MCA_rmaps_base_oversubscribe", "1")):
@@ -81,20 +87,72 @@ def measure(url):
     return statistics.median(load), statistics.median(idle)
 
 
+def rank_pids(proc):
+    """{rank: pid} of the silcd ranks under mpirun proc."""
+    out, todo = {}, [proc.pid]
+    while todo:
+        parent = todo.pop()
+        for d in os.listdir("/proc"):
+            if not d.isdigit():
+                continue
+            try:
+                with open("/proc/%s/stat" % d) as f:
+                    if int(f.read().rsplit(")", 1)[1].split()[1]) != parent:
+                        continue
+                with open("/proc/%s/environ" % d, "rb") as f:
+                    env = f.read().split(b"\0")
+            except OSError:
+                continue
+            todo.append(int(d))
+            for e in env:
+                if e.startswith(b"OMPI_COMM_WORLD_RANK="):
+                    out[int(e.split(b"=")[1])] = int(d)
+    return out
+
+
+def cpu_seconds(pid):
+    with open("/proc/%d/stat" % pid) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def idle_cpu(proc, url):
+    """Each rank's share of a core over IDLE_S seconds of rest."""
+    s = RemoteSession(url)
+    s.put("x", np.ones((1000, 1)))
+    s.exec("n = x' * x")
+    ranks = rank_pids(proc)
+    time.sleep(0.5)
+    before = {r: cpu_seconds(p) for r, p in ranks.items()}
+    t = time.monotonic()
+    time.sleep(IDLE_S)
+    wall = time.monotonic() - t
+    used = {r: (cpu_seconds(p) - before[r]) / wall for r, p in ranks.items()}
+    s.close()
+    return used
+
+
 def main():
     work = tempfile.mkdtemp(prefix="silc-mpi-wake.")
     rows = {}
     for name, mpi in (("silcd (forking, baseline)", False), ("mpirun -np 2 silcd --mpi", True)):
         proc, url = start(work, mpi)
         try:
+            if mpi:
+                idle = idle_cpu(proc, url)
             rows[name] = measure(url)
         finally:
             proc.terminate()
             proc.wait(60)
+    print("| rank of mpirun -np 2 silcd --mpi | CPU over %g s idle (%% of a core) |" % IDLE_S)
+    print("| --- | --- |")
+    for r in sorted(idle):
+        print("| %d | %.2f |" % (r, 100 * idle[r]))
+    print()
     print("| server | under load, median (ms) | after 0.2 s idle, median (ms) | added after idle (ms) |")
     print("| --- | --- | --- | --- |")
-    for name, (load, idle) in rows.items():
-        print("| %s | %.3f | %.3f | %+.3f |" % (name, load * 1e3, idle * 1e3, (idle - load) * 1e3))
+    for name, (load, idle_t) in rows.items():
+        print("| %s | %.3f | %.3f | %+.3f |" % (name, load * 1e3, idle_t * 1e3, (idle_t - load) * 1e3))
     (fl, fi), (ml, mi) = rows.values()
     print("\nMPI's share of the latency added after idle: %+.3f ms (target < 1 ms); "
           "under load, --mpi / forking: %.2fx (%d and %d requests)"

@@ -17,7 +17,9 @@
  * rank) closes the sessions, tells the others to stop, and finalizes MPI.
  * A rank that dies takes the job with it (Open MPI's default), so the
  * clients see their connection close rather than wait forever.  The other
- * ranks wait for rank 0's next command without spinning (await_header).
+ * ranks wait for rank 0's next command at rest, in poll() on a wake-up
+ * socket from rank 0 (await_wake; await_header where there is none), and
+ * end when that socket closes (rank 0 gone).
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE   /* getifaddrs, IFF_UP */
@@ -35,6 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/syscall.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -50,13 +53,14 @@ typedef struct ranks_impl {
     MPI_Comm wake;             /* commands' headers, awaited without spinning (await_header) */
 } ranks_impl;
 
-/* How a rank other than 0 waits for rank 0's next command.  A blocking
+/* How a rank other than 0 takes rank 0's next command.  A blocking
  * MPI_Bcast would spin in Open MPI's progress engine (99 % of a core per
  * idle rank, for as long as the server runs), so the header comes by
  * MPI_Ibcast, tested in a loop: without sleeping for AWAIT_SPIN_S after the
  * last command (requests that follow each other pay nothing), then with
- * naps from AWAIT_NAP_MIN_NS doubling to AWAIT_NAP_MAX_NS, the most a
- * request after an idle period waits for this rank (bench/mpi_wake.py). */
+ * naps from AWAIT_NAP_MIN_NS doubling to AWAIT_NAP_MAX_NS.  A rank with a
+ * wake-up socket (below) enters it only once rank 0's byte has come, so
+ * the naps never start; one without one rests this way (2-4 % of a core). */
 #define AWAIT_SPIN_S 0.002
 #define AWAIT_NAP_MIN_NS 50000L
 #define AWAIT_NAP_MAX_NS 1000000L
@@ -410,6 +414,37 @@ static void wake_ranks(int size)
             srv_log(LOG_WARN, "rank 0: waking rank %d: %s", i, strerror(errno));
 }
 
+/* The kernel's struct sched_attr (glibc before 2.41 declares none). */
+struct sched_attr_v1 {
+    uint32_t size, sched_policy;
+    uint64_t sched_flags;
+    int32_t sched_nice;
+    uint32_t sched_priority;
+    uint64_t sched_runtime, sched_deadline, sched_period;
+};
+
+/* A task that has slept long is woken with no credit by Linux's EEVDF
+ * scheduler (6.6 and later): on a busy machine it waited 2-4 ms for a CPU
+ * after rank 0's byte.  A short time slice (sched_runtime of a normal
+ * task, honoured since Linux 6.12; ignored before) gives it an early
+ * deadline, so its wake-up preempts: the rank asks for REST_SLICE_NS while
+ * it rests and for the default (0) once woken, so its computing is not cut
+ * into short slices.  Failure changes nothing but the wake-up delay. */
+#define REST_SLICE_NS 100000
+static void rest_slice(int resting)
+{
+#ifdef SYS_sched_setattr
+    struct sched_attr_v1 a;
+    memset(&a, 0, sizeof a);
+    a.size = sizeof a;
+    a.sched_policy = 0;   /* SCHED_OTHER */
+    a.sched_runtime = resting ? REST_SLICE_NS : 0;
+    (void)syscall(SYS_sched_setattr, 0, &a, 0);
+#else
+    (void)resting;
+#endif
+}
+
 /* A rank other than 0: rank 0's byte for the next command.  For
  * AWAIT_SPIN_S it is looked for without sleeping (requests that follow each
  * other pay no wake-up), then awaited in poll.  The socket closing means
@@ -426,7 +461,11 @@ static void await_wake(int rank)
                     got == 0 ? "its wake-up socket closed" : strerror(errno));
             _exit(1);
         }
-        if (util_now() >= spin_until) wait_fd(wake_fd, POLLIN, 60000);
+        if (util_now() >= spin_until) {
+            rest_slice(1);
+            wait_fd(wake_fd, POLLIN, 60000);
+            rest_slice(0);
+        }
     }
 }
 

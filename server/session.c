@@ -184,7 +184,6 @@ static int send_parts(session *S, const struct iovec *iov, int n, silc_value *ho
     struct iovec v[8];
     char why[256];
     int i;
-    *S->state = SLOT_REPLYING;
     if (!S->queued) {
         if (n > 8) return -1;
         memcpy(v, iov, (size_t)n * sizeof *iov);   /* proto_send consumes its iovecs */
@@ -224,6 +223,7 @@ static int reply_text(session *S, uint32_t op, const char *text)
     struct iovec body;
     body.iov_base = (void *)(uintptr_t)text;
     body.iov_len = text ? strlen(text) : 0;
+    *S->state = SLOT_REPLYING;
     return send_frame(S, op, &body, 1, NULL, 1);
 }
 
@@ -248,6 +248,7 @@ static int finish_exec(session *S, int rc, const char *warnings)
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
     S->out.len = 0;
+    *S->state = SLOT_REPLYING;
     if (iov.iov_len && send_parts(S, &iov, 1, NULL, 1)) return -1;
     if (warnings && *warnings && reply_text(S, PROTO_WARN, warnings)) return -1;
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
@@ -444,6 +445,7 @@ static int do_get(session *S, const char *name)
     proto_encode_desc(desc, &d);
     body[0].iov_base = desc;
     body[0].iov_len = sizeof desc;
+    *S->state = SLOT_REPLYING;
     rc = k < 0 ? reply_error(S, "value too large to send")
                : send_frame(S, PROTO_VALUE, body, k + 1, v, 1);
     val_release(v);
