@@ -89,6 +89,20 @@ int ref_op_convert(silc_call *call);
 int ref_op_diag(silc_call *call);
 int ref_op_reduce(silc_call *call);
 int ref_op_matmul(silc_call *call);
+/* ref_elementwise_z.c: the same ops on complex operands (the real entry
+ * points hand them over). */
+int ref_op_add_z(silc_call *call);
+int ref_op_scale_z(silc_call *call);
+int ref_op_ewise_z(silc_call *call);
+int ref_op_map_z(silc_call *call);
+int ref_op_transpose_z(silc_call *call);
+int ref_op_reduce_z(silc_call *call);
+/* Shared by both: a value of v's structure (w doubles per entry, CSR
+ * pattern copied, values unset), the number of stored entries of v (band
+ * padding included), and the 2-norm (largest singular value) of a real A. */
+silc_value *ref_same_structure(const silc_view *v, int w);
+int64_t ref_stored(const silc_view *v);
+int ref_norm2(const ref_sp *A, double *out);
 int ref_op_solve(silc_call *call);
 double ref_nrm2(int64_t n, const double *x, int64_t inc); /* scaled 2-norm */
 

@@ -390,7 +390,11 @@ static const silc_backend ref_backends[1] = {
 
 /* The ops that take complex operands (ABI 1.8): only those whose every
  * sub-operation and format has a complex kernel here. */
-static const uint32_t ref_complex_ops[1] = {SILC_COMPLEX_OPS(SILC_OP_SOLVE)};
+static const uint32_t ref_complex_ops[1] = {
+    SILC_COMPLEX_OPS(SILC_OP_ADD) | SILC_COMPLEX_OPS(SILC_OP_SCALE) | SILC_COMPLEX_OPS(SILC_OP_MATMUL) |
+    SILC_COMPLEX_OPS(SILC_OP_EWISE) | SILC_COMPLEX_OPS(SILC_OP_MAP) | SILC_COMPLEX_OPS(SILC_OP_TRANSPOSE) |
+    SILC_COMPLEX_OPS(SILC_OP_SOLVE) | SILC_COMPLEX_OPS(SILC_OP_REDUCE) | SILC_COMPLEX_OPS(SILC_OP_CONVERT) |
+    SILC_COMPLEX_OPS(SILC_OP_DIAG)};
 
 static const silc_plugin ref_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
