@@ -332,6 +332,22 @@ static void test_language(void)
     run(c, "clear i\nk = i");
     expect_scalar(c, "k", 0, 1, 0);
 
+    /* subscripts and for loops keep both parts; a complex rhs makes a real target complex */
+    run(c, "v = [1+2i, 3, 4i]; e = v[2]; v[3] = 5-1i; sv = v[3]; Sc = sparse([1 2], [1 2], [1+2i, 3], 2, 2);"
+           "q = Sc[1, 1]; Sc[2, 1] = 7i; q2 = Sc[2, 1]; r = [1 2 3]; r[2] = 1i; t2 = r[2]; t3 = r[3];"
+           "for col = [1i, 2-3i]\nend\nlast = col");
+    expect_scalar(c, "e", 3, 0, 0);
+    expect_scalar(c, "sv", 5, -1, 0);
+    expect_scalar(c, "q", 1, 2, 0);
+    expect_scalar(c, "q2", 0, 7, 0);
+    expect_scalar(c, "t2", 0, 1, 0);
+    expect_scalar(c, "t3", 3, 0, 0);
+    expect_scalar(c, "last", 2, -3, 0);
+    /* HDF5 does not take complex values yet: refused, naming the value */
+    CHECK(silc_exec(c, "save \"complex_core.h5\" z") != 0 &&
+              (strstr(silc_context_errmsg(c), "'z' is complex") || strstr(silc_context_errmsg(c), "without HDF5")),
+          "save of a complex value: %s", silc_context_errmsg(c));
+
     /* complex dense and sparse solves, and a real A against a complex b */
     run(c, "A = [2+1i, 1, 0; -1, 3-2i, 1i; 0, 2, 4+1i]; b = [3+1i; 3+10i; 12+7i];"
            "x = A \\ b; xs = sparse(A) \\ b;"
