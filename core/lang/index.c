@@ -196,10 +196,10 @@ static silc_value *extract_csr(const silc_value *a, const ix_list *I, const ix_l
 }
 
 /* Complex values are subscripted part by part: the real parts, then the
- * imaginary parts, by the same real code, and the two results joined (they
- * share a format and pattern, which the real code derives from the
- * subscripts and the stored entries alone).  part_extract / part_assign run
- * one side; a NULL join is reported, never a half value. */
+ * imaginary parts, by the same real code, and the two results joined (one
+ * format and shape; a sparse assignment may leave the parts different
+ * patterns, joined as their union).  A failed join is reported, never a
+ * half value. */
 static int ix_extract_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
                            const silc_value *base, silc_value **out);
 static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
@@ -212,8 +212,7 @@ static int join_parts(lang_ev *V, const char *what, silc_value *re, silc_value *
     val_release(im);
     if (*out) return 0;
     if (*val_refusal()) return eng_error(V->E, "%s", val_refusal());
-    return eng_error(V->E, "%s: the real and imaginary parts of a subscripted complex value came out with "
-                           "different patterns (out of memory, or a sparse assignment that drops zeros)", what);
+    return eng_error(V->E, "%s: out of memory joining the parts of a subscripted complex value", what);
 }
 
 int ix_extract(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
