@@ -990,7 +990,7 @@ static int symmetry_unknown(const silc_call *call, const char *const chain[4])
 {
     const silc_value *A = call->in[0];
     return call->op == SILC_OP_SOLVE && A->props.pos_diag &&
-           (!(A->props_have & SILC_PROPS_SYMMETRY) || A->props.symmetric) &&
+           (!(A->props_have & SILC_PROPS_SYMMETRY) || A->props.hermitian) &&
            !strcmp(chain[0], A->format == SILC_FMT_CSR ? "solve.sparse" : "solve.dense");
 }
 
