@@ -283,17 +283,9 @@ extern void ref_inv_norm1_start(int64_t n, int t, double *X0);
 extern double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
                                       int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
                                       const double *Y0);
-/* The complex estimator (zlacn2's method) is written in ref_cond.c on the
- * complex-ref branch, in parallel with this one (issue 31).  Declared weak
- * so that this branch links without it: until both are merged the table
- * holds NULL there, which a plugin must treat as "no estimate" (the header
- * makes the pointer optional the same way for every host older than 1.8). */
-#if defined(__GNUC__)
+/* Its complex counterpart (zlacn2's method, issue 31), also in ref_cond.c. */
 extern double ref_inv_norm1_est_complex(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
-                                        void *ctx, double *work) __attribute__((weak));
-#else
-#define ref_inv_norm1_est_complex NULL
-#endif
+                                        void *ctx, double *work);
 
 static int h_cancelled(silc_call *call)
 {
