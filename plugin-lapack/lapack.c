@@ -492,7 +492,7 @@ static silc_plugin lp_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
     "lapack", lp_version, 1, lp_backends,
     (int)(sizeof lp_options / sizeof lp_options[0]), lp_options,
-    set_threads, NULL, NULL};
+    set_threads, NULL, NULL, NULL};
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)

@@ -1237,7 +1237,7 @@ static silc_plugin mumps_plugin = {
     (int)(sizeof mumps_options / sizeof mumps_options[0]), mumps_options,
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     NULL,
-    MUMPS_COLLECTIVE,
+    MUMPS_COLLECTIVE, NULL,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

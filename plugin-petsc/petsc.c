@@ -1032,6 +1032,7 @@ static silc_plugin petsc_plugin = {
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     petsc_shutdown,
     NULL, /* collective_ops: silc_plugin_init sets it on a 1.5 host */
+    NULL,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

@@ -93,7 +93,7 @@ static const silc_plugin ss_plugin = {
     "suitesparse", SS_VERSION,
     (int)(sizeof ss_backends / sizeof ss_backends[0]), ss_backends,
     (int)(sizeof ss_options / sizeof ss_options[0]), ss_options,
-    ss_set_threads, ss_shutdown, NULL,
+    ss_set_threads, ss_shutdown, NULL, NULL,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
