@@ -27,7 +27,9 @@
  *     SCALE, element-wise products, quotients and comparisons (real
  *     results), sqrt/log/exp (principal branches), abs, sum, max (by
  *     modulus), norm 1 and the 2-norm (closed form for a 2x2), sparse(),
- *     diagvec and diag, each against the same arithmetic written out here.
+ *     diagvec and diag, each against the same arithmetic written out here;
+ *   - examples/helmholtz: its matrix complex symmetric and not Hermitian,
+ *     and the plane wave's error (exact solution exp(i k x)) falling as h^2.
  */
 #include "check.h"
 
@@ -41,6 +43,7 @@
 
 #include "dispatch.h"
 #include "engine.h"
+#include "helmholtz.h"
 #include "ref.h"
 #include "silc.h"
 #include "silc_plugin.h"
@@ -739,6 +742,52 @@ static void test_language(void)
     silc_close(&c);
 }
 
+/* ---- the Helmholtz example ------------------------------------------------------------ */
+
+/* examples/helmholtz: its matrix is complex symmetric and not Hermitian,
+ * and the plane wave's error falls as h^2 (ratio ~4 per halving of h). */
+static void test_helmholtz(void)
+{
+    silc_context *c = NULL;
+    silc_envelope_t A;
+    char err[512];
+    double b[2 * 17 * 17];
+    CHECK(helmholtz_assemble(16, 10.0, HELMHOLTZ_PLANE_WAVE, &A, b, err, sizeof err) == 0, "assemble: %s", err);
+    int sym = 1, herm = 1;
+    int64_t N = A.m;
+    double *D = calloc((size_t)(2 * N * N), sizeof *D);
+    silc_envelope_to_dense(&A, D);
+    const cplx *Z = (const cplx *)D;
+    for (int64_t i = 0; i < N; i++)
+        for (int64_t j = 0; j < N; j++) {
+            sym &= Z[i + j * N] == Z[j + i * N];
+            herm &= Z[i + j * N] == conj(Z[j + i * N]);
+        }
+    CHECK(sym && !herm, "Helmholtz matrix: complex symmetric %d, Hermitian %d", sym, herm);
+    free(D);
+    silc_envelope_free(&A);
+    CHECK(helmholtz_assemble(1, 10.0, HELMHOLTZ_PLANE_WAVE, &A, b, err, sizeof err) == -1 && strstr(err, "n = 1"),
+          "n = 1 refused: %s", err);
+
+    CHECK(silc_open(&c, NULL) == 0, "open");
+    double e[3];
+    for (int t = 0; t < 3; t++) {
+        int n = 16 << t;
+        double *u = malloc((size_t)(2 * (n + 1) * (n + 1)) * sizeof *u);
+        e[t] = -1;
+        if (helmholtz_solve(c, n, 10.0, HELMHOLTZ_PLANE_WAVE, u, err, sizeof err) == 0)
+            e[t] = helmholtz_plane_wave_error(n, 10.0, u);
+        else
+            CHECK(0, "helmholtz n = %d: %s", n, err);
+        free(u);
+    }
+    printf("Helmholtz plane wave, k = 10: max error %.3e (n = 16), %.3e (32), %.3e (64)\n", e[0], e[1], e[2]);
+    CHECK(e[0] > 0 && e[1] > 0 && e[2] > 0 && e[0] / e[1] > 3.5 && e[0] / e[1] < 4.6 && e[1] / e[2] > 3.5 &&
+              e[1] / e[2] < 4.6, "second order: error ratios %.3f, %.3f", e[0] / e[1], e[1] / e[2]);
+    CHECK(e[2] < 0.02, "n = 64: error %.3g", e[2]);
+    silc_close(&c);
+}
+
 int main(void)
 {
     silc_context *c = NULL;
@@ -756,6 +805,7 @@ int main(void)
     test_shared("young1c.mtx", 0);
     test_shared("mhd1280b.mtx", 1);
     test_language();
+    test_helmholtz();
     rc = check_done();
     silc_close(&c);
     return rc;
