@@ -727,9 +727,14 @@ static void test_language(void)
     put_complex(c, "A", M, M, A, 0);
     put_complex(c, "S", M, M, S, 1);
     put_complex(c, "b", M, 1, b, 0);
-    /* SOLVE, dense and sparse (the core's verification of a complex solve
-     * is complex-core's; until it lands there it is switched off here) */
-    CHECK(silc_exec(c, "set solve.verify = off") == 0, "set: %s", silc_context_errmsg(c));
+    /* SOLVE, dense and sparse.  Two settings stand in for complex-core's
+     * parts of issue 31 until they land: its check of a complex solution's
+     * backward error (solve.verify), and the dispatcher's gating by
+     * complex_ops, without which a real-only backend listed first would be
+     * handed the complex operands (so the classes name the reference). */
+    CHECK(silc_exec(c, "set solve.verify = off; set dispatch.solve.dense = reference; "
+                       "set dispatch.solve.sparse = reference; set dispatch.solve.rect = reference") == 0,
+          "set: %s", silc_context_errmsg(c));
     expect(c, "r = A \\ b", M, 1, x, 0, 1e-12);
     dense_apply(M, M, S, 0, x, b);
     put_complex(c, "bs", M, 1, b, 0);
