@@ -28,7 +28,7 @@
  *     and sparse x = A \ b, every MATMUL format pair, ' (conjugate), ADD,
  *     SCALE, element-wise products, quotients and comparisons (real
  *     results), sqrt/log/exp (principal branches), abs, sum, max (by
- *     modulus), norm 1 and the 2-norm (closed form for a 2x2), sparse(),
+ *     modulus), norm 1 and the 2-norm (closed form for a 2x2), sparse(), band(),
  *     diagvec and diag, each against the same arithmetic written out here;
  *   - examples/helmholtz: its matrix complex symmetric and not Hermitian,
  *     and the plane wave's error (exact solution exp(i k x)) falling as h^2.
@@ -727,14 +727,9 @@ static void test_language(void)
     put_complex(c, "A", M, M, A, 0);
     put_complex(c, "S", M, M, S, 1);
     put_complex(c, "b", M, 1, b, 0);
-    /* SOLVE, dense and sparse.  Two settings stand in for complex-core's
-     * parts of issue 31 until they land: its check of a complex solution's
-     * backward error (solve.verify), and the dispatcher's gating by
-     * complex_ops, without which a real-only backend listed first would be
-     * handed the complex operands (so the classes name the reference). */
-    CHECK(silc_exec(c, "set solve.verify = off; set dispatch.solve.dense = reference; "
-                       "set dispatch.solve.sparse = reference; set dispatch.solve.rect = reference") == 0,
-          "set: %s", silc_context_errmsg(c));
+    /* SOLVE, dense, sparse and least squares: the dispatcher hands complex
+     * operands only to backends that list SOLVE in complex_ops, and the
+     * core verifies the complex solution */
     expect(c, "r = A \\ b", M, 1, x, 0, 1e-12);
     dense_apply(M, M, S, 0, x, b);
     put_complex(c, "bs", M, 1, b, 0);
@@ -815,11 +810,16 @@ static void test_language(void)
     expect(c, "r = norm(T)", 1, 1, W, 1, 1e-13);
     put_complex(c, "Ts", 2, 2, T, 1);
     expect(c, "r = norm(Ts)", 1, 1, W, 1, 1e-13);
-    /* CONVERT: CSR of a dense value.  (Band through the language waits for
-     * core/lang's band() pre-check to read complex entries; the band kernels
-     * are checked directly above.) */
+    /* CONVERT: CSR of a dense value; band of a tridiagonal one, and its
+     * conjugate transpose (a band TRANSPOSE) */
     expect(c, "r = sparse(A)", M, M, A, 0, 0);
+    for (int k = 0; k < M * M; k++) W[k] = abs(k % M - k / M) <= 1 ? A[k] : 0;
+    put_complex(c, "Bd", M, M, W, 0);
+    expect(c, "r = band(Bd, 1, 1)", M, M, W, 0, 0);
     cplx Wt[M * M];
+    for (int i = 0; i < M; i++)
+        for (int j = 0; j < M; j++) Wt[j + i * M] = conj(W[i + j * M]);
+    expect(c, "r = band(Bd, 1, 1)'", M, M, Wt, 0, 0);
     /* DIAG: the diagonal of a matrix, and the matrix of a vector */
     for (int i = 0; i < M; i++) W[i] = A[i + i * M];
     expect(c, "r = diagvec(A)", M, 1, W, 0, 0);

@@ -93,14 +93,8 @@ int helmholtz_solve(silc_context *c, int n, double k, int problem, double *u, ch
         free(b);
         return -1;
     }
-    /* Two settings stand in for complex-core's parts of issue 31 until they
-     * land: the core's check of a complex solution's backward error
-     * (solve.verify; the program checks its error itself), and the
-     * dispatcher's gating by complex_ops, without which a real-only backend
-     * listed first would be handed the complex matrix (so the class names
-     * the reference plugin, which takes complex values). */
     if (silc_put(c, "A", &A) || silc_put(c, "b", &be) ||
-        silc_exec(c, "set solve.verify = off; set dispatch.solve.sparse = reference; u = A \\ b") ||
+        silc_exec(c, "u = A \\ b") ||
         silc_get_complex(c, &ue, "u")) {
         snprintf(err, errlen, "helmholtz: %s", silc_context_errmsg(c));
     } else {
