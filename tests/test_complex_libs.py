@@ -14,7 +14,9 @@ the engine), is checked against independent truth:
   (d) the condition estimate within a factor 10 of the dense cond_1 NumPy
       computes;
   (e) an exactly singular complex matrix reported as singular (status 3);
-and a second solve with the same A reuses the factorization.  The lapack
+and a second solve with the same A reuses the factorization.  MUMPS must
+send a complex symmetric A to SYM=2, a Hermitian one to SYM=0, and decline
+the .spd classes for complex values (it has no Hermitian Cholesky).  The lapack
 backend also gets a complex band system (zgbtrf) and tall least squares
 (zgeqrf, checked against numpy.linalg.lstsq).
 
@@ -218,6 +220,20 @@ if have("suitesparse"):
     rep, _ = solve("suitesparse", "cholmod", "solve.sparse.spd", sp.csr_matrix(hermitian_indefinite()),
                    np.ones(30, complex), "cholmod.indefinite")
     check(rep.get("status") == str(SILC_ENOTSPD), f"cholmod: Hermitian indefinite gives ENOTSPD ({rep})")
+
+if have("mumps"):
+    check_solve("mumps", "mumps", "solve.sparse", young, "mumps.young1c")
+    check_solve("mumps", "mumps", "solve.sparse", mhd, "mumps.mhd1280b")
+    S = sp.csr_matrix(complex_symmetric())
+    check_solve("mumps", "mumps", "solve.sparse", S, "mumps.complex_symmetric")
+    rep, _ = solve("mumps", "mumps", "solve.sparse", S, S @ x_true_for(60), "mumps.sym2_method")
+    check("SYM=2" in rep.get("method", ""), f"mumps: complex symmetric A goes to SYM=2 ({rep.get('method')})")
+    rep, _ = solve("mumps", "mumps", "solve.sparse", mhd, mhd @ x_true_for(1280), "mumps.hermitian_method")
+    check("SYM=0" in rep.get("method", ""), f"mumps: a Hermitian A goes to SYM=0 ({rep.get('method')})")
+    rep, _ = solve("mumps", "mumps", "solve.sparse.spd", mhd, mhd @ x_true_for(1280), "mumps.spd_declined")
+    check(rep.get("declined", "").startswith("MUMPS has no Hermitian Cholesky"),
+          f"mumps: complex under .spd declined with its reason ({rep})")
+    check_singular("mumps", "mumps", "solve.sparse", sp.csr_matrix(singular_matrix()), "mumps.singular")
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed or not passed else 0)
