@@ -561,6 +561,7 @@ static const silc_plugin lis_plugin = {
     lis_set_threads,
     NULL,
     NULL,
+    NULL,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,

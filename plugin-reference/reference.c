@@ -297,7 +297,7 @@ static const silc_backend ref_backends[1] = {
 
 static const silc_plugin ref_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
-    "reference", "1.0", 1, ref_backends, 0, NULL, NULL, NULL, NULL};
+    "reference", "1.0", 1, ref_backends, 0, NULL, NULL, NULL, NULL, NULL};
 
 static int ref_init(const silc_host_api *host, const silc_plugin **out, const char **errmsg)
 {

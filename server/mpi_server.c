@@ -233,7 +233,7 @@ static size_t bytes_to_keep(const conn *c)
     op = proto_get_u32(c->buf);
     len = proto_get_u64(c->buf + 8);
     switch (op) { /* the texts proto_read_request reads, within its limits */
-    case PROTO_GET: case PROTO_DELETE: case PROTO_INFO:
+    case PROTO_GET: case PROTO_GET_COMPLEX: case PROTO_DELETE: case PROTO_INFO:
         return len <= PROTO_MAX_NAME ? PROTO_HEADER_BYTES + (size_t)len : PROTO_HEADER_BYTES;
     case PROTO_EXEC: case PROTO_EXPLAIN:
         return len <= srv_cfg.max_text_bytes ? PROTO_HEADER_BYTES + (size_t)len

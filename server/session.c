@@ -269,7 +269,8 @@ static int put_refusal(session *S, const proto_request *q)
      * (val_parts_claim): overflow and the value limit, with band storage
      * charged for its rows, before a byte of the arrays is read. */
     memset(&claim, 0, sizeof claim);
-    claim.format = (int)q->desc.format;
+    claim.format = env_format_base((int)q->desc.format);
+    claim.field = env_format_field((int)q->desc.format);
     claim.m = q->desc.m, claim.n = q->desc.n, claim.nnz = q->desc.nnz;
     claim.kl = q->desc.kl, claim.ku = q->desc.ku;
     if (claim.format != SILC_FMT_CSR) claim.nnz = 0;
@@ -325,7 +326,9 @@ static int do_put(session *S, proto_stream *st, const proto_request *q)
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
 }
 
-static int do_get(session *S, const char *name)
+/* GET (accept_complex 0) or GET_COMPLEX: a client that did not announce
+ * complex values is refused one, naming it (client.h). */
+static int do_get(session *S, const char *name, int accept_complex)
 {
     silc_value *v;
     proto_desc d;
@@ -338,6 +341,7 @@ static int do_get(session *S, const char *name)
         srv_mpi->command(srv_mpi, SRV_CMD_GET, S->id, name);
         if (!(v = (silc_value *)dist_whole(S->E, v, 0))) return reply_error(S, S->E->err);
     }
+    if (v && !accept_complex && env_refuse_complex(name, v, S->err, sizeof S->err)) v = NULL;
     val_retain(v);
     if (!v) return reply_error(S, S->err);
     k = proto_value_iov(v, &d, body + 1);
@@ -566,7 +570,8 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
         srv_log(LOG_DEBUG, "session %lu: %s", S->id, proto_op_name(q.op));
         switch (q.op) {
         case PROTO_PUT: rc = do_put(S, st, &q); break;
-        case PROTO_GET: rc = do_get(S, q.text); break;
+        case PROTO_GET: rc = do_get(S, q.text, 0); break;
+        case PROTO_GET_COMPLEX: rc = do_get(S, q.text, 1); break;
         case PROTO_EXEC: rc = do_exec(S, q.text); break;
         case PROTO_DELETE: rc = do_delete(S, q.text); break;
         case PROTO_LIST: rc = do_list(S); break;

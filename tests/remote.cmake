@@ -135,3 +135,10 @@ if(SILC_SYSTEM_PYTHON)
                          ENVIRONMENT "${SILC_TEST_ENV};SILC_LIBRARY=$<TARGET_FILE:silc>" TIMEOUT 120)
   endif()
 endif()
+
+# Complex values in the core (issue 31): store, properties, and the C API
+# embedded and through a private silcd.
+silc_add_test(test_complex_core INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_complex_core.c)
+target_compile_definitions(test_complex_core PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>")
+add_dependencies(test_complex_core silcd)
+set_tests_properties(test_complex_core PROPERTIES TIMEOUT 120)

@@ -317,6 +317,9 @@ int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const 
     else if (env_not_constructed(e, err, sizeof err))
         rc = ctx_error(ctx, "envelope '%s' was not constructed: %s", name, err);
     else if (first_row < 0) rc = ctx_error(ctx, "silc_put_rows '%s': first row %lld is negative", name, (long long)first_row);
+    else if (silc_envelope_is_complex(e) && ctx->E && ctx->E->dist)
+        rc = ctx_error(ctx, "silc_put_rows '%s': complex values are not distributed (put the whole value "
+                            "with silc_put)", name);
     else if (env_to_value(e, &v, err, sizeof err)) rc = ctx_error(ctx, "'%s': %s", name, err);
     if (!ctx->E || !ctx->E->dist) {
         /* One process: the block is the whole value. */
@@ -355,6 +358,7 @@ int silc_get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, con
     else if (!name) rc = ctx_error(ctx, "silc_get_rows: NULL name");
     if (ctx->R) return rc ? ctx_result(ctx, rc) : silc_get(ctx, e, name);
     if (!rc && !(v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err))) rc = -1;
+    if (!rc && env_refuse_complex(name, v, ctx->err, sizeof ctx->err)) rc = -1;
     if (spmd_enter(ctx, "GET_ROWS", name ? name : "", rc)) return ctx_result(ctx, -1);
     if (dist_rows_of(ctx->E, v, &blk, &first)) {
         snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
@@ -372,15 +376,20 @@ int silc_get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, con
     return 0;
 }
 
-int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
+/* silc_get and silc_get_complex: a caller that did not ask for complex
+ * values gets none (silc.h). */
+static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, int accept_complex)
 {
     const silc_value *v;
+    const char *fn = accept_complex ? "silc_get_complex" : "silc_get";
     if (e) memset(e, 0, sizeof *e);
-    if (!ctx) return env_error("silc_get: NULL context");
-    if (!e) return ctx_error(ctx, "silc_get: NULL envelope");
-    if (!name) return ctx_error(ctx, "silc_get: NULL name");
-    if (ctx->R) return ctx_result(ctx, rem_get(ctx->R, e, name, ctx->err, sizeof ctx->err));
+    if (!ctx) return env_error("%s: NULL context", fn);
+    if (!e) return ctx_error(ctx, "%s: NULL envelope", fn);
+    if (!name) return ctx_error(ctx, "%s: NULL name", fn);
+    if (ctx->R)
+        return ctx_result(ctx, rem_get(ctx->R, e, name, accept_complex, ctx->err, sizeof ctx->err));
     v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err);
+    if (v && !accept_complex && env_refuse_complex(name, v, ctx->err, sizeof ctx->err)) v = NULL;
     if (spmd_enter(ctx, "GET", name, v ? 0 : -1)) return ctx_result(ctx, -1);
     if (dist_is(v) && !(v = dist_whole(ctx->E, v, 1))) { /* every rank gets the whole value */
         snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
@@ -390,6 +399,16 @@ int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
         return ctx_error(ctx, "out of memory copying '%s' (%lldx%lld %s)", name, (long long)v->m,
                          (long long)v->n, val_format_name(v->format));
     return 0;
+}
+
+int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
+{
+    return get_value(ctx, e, name, 0);
+}
+
+int silc_get_complex(silc_context *ctx, silc_envelope_t *e, const char *name)
+{
+    return get_value(ctx, e, name, 1);
 }
 
 int silc_exec(silc_context *ctx, const char *statements)

@@ -84,6 +84,9 @@ enum proto_op {
     PROTO_PUT = 1, PROTO_GET = 2, PROTO_EXEC = 3, PROTO_DELETE = 4,
     PROTO_LIST = 5, PROTO_INFO = 6, PROTO_EXPLAIN = 7, PROTO_BYE = 8,
     PROTO_CANCEL = 9,   /* no reply of its own: it ends the running EXEC early */
+    PROTO_GET_COMPLEX = 10, /* GET from a client that takes complex values: a plain GET of
+                               a complex value is refused, so an older client never
+                               receives one (an older server refuses this opcode) */
     /* replies */
     PROTO_OK = 128, PROTO_ERROR = 129, PROTO_VALUE = 130, PROTO_TEXT = 131, PROTO_WARN = 132
 };
@@ -102,7 +105,8 @@ typedef struct proto_limits {
 
 /* Value descriptor: the first 48 bytes of PUT and VALUE bodies. */
 typedef struct proto_desc {
-    uint32_t format;           /* SILC_DENSE, SILC_CSR, SILC_BAND */
+    uint32_t format;           /* SILC_DENSE, SILC_CSR, SILC_BAND, | SILC_COMPLEX for a complex
+                                  value (values then 16 bytes an entry, interleaved re, im) */
     uint32_t namelen;          /* PUT: bytes of the name that follows; VALUE: 0 */
     int64_t m, n, nnz, kl, ku;
 } proto_desc;
@@ -232,7 +236,8 @@ typedef struct rem_conn rem_conn;
 int rem_open(rem_conn **out, const char *url, const char *token, char *err, size_t errlen);
 void rem_close(rem_conn **c);               /* says BYE, then closes */
 int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, size_t errlen);
-int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, char *err, size_t errlen);
+int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, int accept_complex, char *err,
+            size_t errlen);
 /* EXEC: TEXT replies go to fn (stdout when NULL) as they come,
  * WARN replies are appended to warnings. */
 int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,

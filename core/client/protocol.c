@@ -169,6 +169,7 @@ const char *proto_op_name(uint32_t op)
     case PROTO_EXPLAIN: return "EXPLAIN";
     case PROTO_BYE: return "BYE";
     case PROTO_CANCEL: return "CANCEL";
+    case PROTO_GET_COMPLEX: return "GET_COMPLEX";
     case PROTO_OK: return "OK";
     case PROTO_ERROR: return "ERROR";
     case PROTO_VALUE: return "VALUE";
@@ -189,9 +190,10 @@ static int mul_within(uint64_t a, uint64_t b, uint64_t limit, uint64_t *out)
 int proto_layout_of(const proto_desc *d, uint64_t max_bytes, proto_layout *L, char *err,
                     size_t errlen)
 {
-    uint64_t count, rp, ci, va;
+    uint64_t count, rp, ci, va, entry = d->format & SILC_COMPLEX ? 16 : 8;
+    int format = env_format_base((int)(d->format & 0xffff));
     memset(L, 0, sizeof *L);
-    if (d->format > SILC_BAND)
+    if ((d->format & ~(uint32_t)SILC_COMPLEX) > SILC_BAND)
         return perr(-1, err, errlen, "unknown value format %u", (unsigned)d->format);
     if (d->m < 0 || d->n < 0 || d->nnz < 0 || d->kl < 0 || d->ku < 0)
         return perr(-1, err, errlen, "negative size in value descriptor (m = %lld, n = %lld, "
@@ -200,32 +202,33 @@ int proto_layout_of(const proto_desc *d, uint64_t max_bytes, proto_layout *L, ch
     if (d->m > PROTO_MAX_DIM || d->n > PROTO_MAX_DIM)
         return perr(-1, err, errlen, "dimensions %lldx%lld exceed the protocol's limit of 2^40",
                     (long long)d->m, (long long)d->n);
-    switch (d->format) {
+    switch (format) {
     case SILC_DENSE:
-        if (mul_within((uint64_t)d->m, (uint64_t)d->n, UINT64_MAX / 8, &count) ||
+        if (mul_within((uint64_t)d->m, (uint64_t)d->n, UINT64_MAX / 16, &count) ||
             (uint64_t)d->nnz != count)
             return perr(-1, err, errlen, "dense %lldx%lld value declares %lld entries",
                         (long long)d->m, (long long)d->n, (long long)d->nnz);
         if (d->kl || d->ku) return perr(-1, err, errlen, "dense value with band widths");
         rp = ci = 0;
-        va = count * 8;
+        va = count * entry;
         break;
     case SILC_CSR:
         if (d->kl || d->ku) return perr(-1, err, errlen, "csr value with band widths");
         if ((uint64_t)d->nnz > UINT64_MAX / 32)
             return perr(-1, err, errlen, "csr value declares %lld entries", (long long)d->nnz);
         rp = ((uint64_t)d->m + 1) * 8;
-        ci = va = (uint64_t)d->nnz * 8;
+        ci = (uint64_t)d->nnz * 8;
+        va = (uint64_t)d->nnz * entry;
         break;
     default: /* SILC_BAND */
         if (d->kl > INT32_MAX || d->ku > INT32_MAX ||
-            mul_within((uint64_t)(d->kl + d->ku + 1), (uint64_t)d->n, UINT64_MAX / 8, &count) ||
+            mul_within((uint64_t)(d->kl + d->ku + 1), (uint64_t)d->n, UINT64_MAX / 16, &count) ||
             (uint64_t)d->nnz != count)
             return perr(-1, err, errlen, "band %lldx%lld value with kl = %lld, ku = %lld "
                         "declares %lld entries", (long long)d->m, (long long)d->n,
                         (long long)d->kl, (long long)d->ku, (long long)d->nnz);
         rp = ci = 0;
-        va = count * 8;
+        va = count * entry;
         break;
     }
     /* Each part is below 2^61, so the sum cannot wrap. */
@@ -238,7 +241,7 @@ int proto_layout_of(const proto_desc *d, uint64_t max_bytes, proto_layout *L, ch
         char over[200];
         util_fmt_over_limit(over, sizeof over, (double)L->total, (double)max_bytes);
         return perr(-1, err, errlen, "%lldx%lld %s value of %s", (long long)d->m, (long long)d->n,
-                    val_format_name((int)d->format), over);
+                    val_format_name(format), over);
     }
     return 0;
 }
@@ -249,7 +252,7 @@ int proto_value_iov(const silc_value *v, proto_desc *d, struct iovec iov[3])
     char err[256];
     int k = 0;
     memset(d, 0, sizeof *d);
-    d->format = (uint32_t)v->format;
+    d->format = (uint32_t)env_format_code(v->format, v->field);
     d->m = v->m;
     d->n = v->n;
     d->nnz = v->nnz;
@@ -552,6 +555,7 @@ int proto_read_request(proto_stream *s, const proto_limits *lim, proto_request *
         }
         return 0;
     case PROTO_GET:
+    case PROTO_GET_COMPLEX:
     case PROTO_DELETE:
     case PROTO_INFO:
         if ((rc = text_body(s, len, PROTO_MAX_NAME, "name", r, err, errlen))) return rc;
@@ -593,7 +597,7 @@ int proto_read_request(proto_stream *s, const proto_limits *lim, proto_request *
             util_fmt_over_limit(over, sizeof over, (double)len, (double)lim->max_value_bytes);
             perr(0, err, errlen, "'%s': %lldx%lld %s value of %s per value (silcd "
                  "--max-value-bytes)", r->text, (long long)r->desc.m, (long long)r->desc.n,
-                 val_format_name((int)r->desc.format), over);
+                 val_format_name(env_format_base((int)r->desc.format)), over);
             return skip_refused(s, len, err, errlen);
         }
         return 0;
@@ -692,11 +696,11 @@ static int check_arrays(const proto_desc *d, const char *name, silc_value *v, do
     /* First, so that env_check's walk over colind stays inside the nnz
      * entries that were received (rowptr[0] = 0 and monotone rows, which it
      * checks before that walk, then bound every index by rowptr[m]). */
-    if (d->format == SILC_CSR && rowptr[d->m] != d->nnz)
+    if (env_format_base((int)d->format) == SILC_CSR && rowptr[d->m] != d->nnz)
         return perr(PROTO_REFUSED, err, errlen, "'%s': rowptr[m] = %lld but the descriptor "
                     "declares %lld entries", name, (long long)rowptr[d->m], (long long)d->nnz);
     view_envelope(d, values, rowptr, colind, &view);
-    if (v && d->format == SILC_CSR ? env_csr_fill(v, &view, why, sizeof why)
+    if (v && env_format_base((int)d->format) == SILC_CSR ? env_csr_fill(v, &view, why, sizeof why)
                                    : env_check(&view, why, sizeof why))
         return perr(PROTO_REFUSED, err, errlen, "'%s': %s", name, why);
     return 0;
@@ -711,10 +715,11 @@ int proto_read_value(proto_stream *s, const proto_request *r, silc_value **out, 
     *out = NULL;
     /* Unset: every byte is received (or the value dropped), so zeroing the
      * arrays first would only cost a pass over memory. */
-    v = val_new_unset((int)d->format, d->m, d->n, d->nnz, d->kl, d->ku);
+    v = val_new_unset_field(env_format_base((int)d->format), env_format_field((int)d->format), d->m, d->n,
+                            d->nnz, d->kl, d->ku);
     if (!v) {
         snprintf(err, errlen, "out of memory copying a %lldx%lld %s matrix", (long long)d->m,
-                 (long long)d->n, val_format_name((int)d->format));
+                 (long long)d->n, val_format_name(env_format_base((int)d->format)));
         return skip_refused(s, r->layout.total, err, errlen);
     }
     rc = recv_arrays(s, &r->layout, v->rowptr, v->colind, v->val, err, errlen);
@@ -776,21 +781,21 @@ int proto_read_reply(proto_stream *s, const proto_limits *lim, proto_reply *r, c
             char over[200];
             util_fmt_over_limit(over, sizeof over, (double)L.total, (double)lim->max_value_bytes);
             perr(0, err, errlen, "a %lldx%lld %s value of %s per value (SILC_MAX_REPLY_BYTES)",
-                 (long long)desc.m, (long long)desc.n, val_format_name((int)desc.format), over);
+                 (long long)desc.m, (long long)desc.n, val_format_name(env_format_base((int)desc.format)), over);
             return skip_refused(s, L.total, err, errlen);
         }
         /* From the pool: a GET of the same size each step receives into the
          * array the last one freed. */
         e->values = val_array_alloc((int64_t)L.values_bytes, 1, 0);
-        if (desc.format == SILC_CSR) {
+        if (env_format_base((int)desc.format) == SILC_CSR) {
             e->rowptr = val_array_alloc((int64_t)L.rowptr_bytes, 1, 0);
             e->colind = val_array_alloc((int64_t)L.colind_bytes, 1, 0);
         }
-        if (!e->values || (desc.format == SILC_CSR && (!e->rowptr || !e->colind))) {
+        if (!e->values || (env_format_base((int)desc.format) == SILC_CSR && (!e->rowptr || !e->colind))) {
             silc_envelope_free(e);
             return perr(PROTO_FATAL, err, errlen, "out of memory for a %lldx%lld %s value",
                         (long long)desc.m, (long long)desc.n,
-                        val_format_name((int)desc.format));
+                        val_format_name(env_format_base((int)desc.format)));
         }
         e->m = desc.m;
         e->n = desc.n;

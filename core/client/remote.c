@@ -356,12 +356,12 @@ int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, 
     d.m = e->m;
     d.n = e->n;
     /* CSR envelopes were checked by env_check, so rowptr[m] is their count. */
-    d.nnz = e->format == SILC_CSR ? e->rowptr[e->m] : e->nnz;
-    if (e->format == SILC_BAND) {
+    d.nnz = env_format_base((int)e->format) == SILC_CSR ? e->rowptr[e->m] : e->nnz;
+    if (env_format_base((int)e->format) == SILC_BAND) {
         d.kl = e->kl;
         d.ku = e->ku;
     }
-    if (e->format == SILC_DENSE) d.nnz = e->m * e->n;
+    if (env_format_base((int)e->format) == SILC_DENSE) d.nnz = e->m * e->n;
     if (d.namelen > PROTO_MAX_NAME) {
         snprintf(err, errlen, "name longer than %u bytes", PROTO_MAX_NAME);
         return -1;
@@ -386,11 +386,13 @@ int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, 
     return await_reply(c, NULL, NULL, NULL, NULL, 0, err, errlen);
 }
 
-int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, char *err, size_t errlen)
+int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, int accept_complex, char *err,
+            size_t errlen)
 {
     char why[512];
     if (usable(c, err, errlen)) return -1;
-    if (proto_send_text(c->fd, PROTO_GET, name, c->io_timeout_ms, why, sizeof why))
+    if (proto_send_text(c->fd, accept_complex ? PROTO_GET_COMPLEX : PROTO_GET, name, c->io_timeout_ms,
+                        why, sizeof why))
         return lost(c, why, err, errlen);
     return await_reply(c, e, NULL, NULL, NULL, 0, err, errlen);
 }

@@ -177,6 +177,28 @@ static silc_value *h_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
     return val_band_new(m, n, kl, ku);
 }
 
+/* ---- ABI 1.8: complex values ---- */
+
+static int h_field(const silc_value *v)
+{
+    return v ? v->field : SILC_FIELD_REAL;
+}
+
+static silc_value *h_dense_new_complex(int64_t m, int64_t n)
+{
+    return val_dense_new_complex(m, n);
+}
+
+static silc_value *h_csr_new_complex(int64_t m, int64_t n, int64_t cap)
+{
+    return val_csr_new_complex(m, n, cap);
+}
+
+static silc_value *h_band_new_complex(int64_t m, int64_t n, int64_t kl, int64_t ku)
+{
+    return val_band_new_complex(m, n, kl, ku);
+}
+
 static int h_csr_set_nnz(silc_value *v, int64_t nnz)
 {
     return val_csr_set_nnz(v, nnz);
@@ -258,6 +280,17 @@ extern void ref_inv_norm1_start(int64_t n, int t, double *X0);
 extern double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
                                       int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
                                       const double *Y0);
+/* The complex estimator (zlacn2's method) is written in ref_cond.c on the
+ * complex-ref branch, in parallel with this one (issue 31).  Declared weak
+ * so that this branch links without it: until both are merged the table
+ * holds NULL there, which a plugin must treat as "no estimate" (the header
+ * makes the pointer optional the same way for every host older than 1.8). */
+#if defined(__GNUC__)
+extern double ref_inv_norm1_est_complex(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                                        void *ctx, double *work) __attribute__((weak));
+#else
+#define ref_inv_norm1_est_complex NULL
+#endif
 
 static int h_cancelled(silc_call *call)
 {
@@ -304,6 +337,11 @@ static const silc_host_api host_table = {
     h_layout,
     h_dist_dense_new,
     h_cancelled,
+    h_field,
+    h_dense_new_complex,
+    h_csr_new_complex,
+    h_band_new_complex,
+    ref_inv_norm1_est_complex,
 };
 
 int host_check_result(silc_call *call)

@@ -68,7 +68,16 @@ extern "C" {
 typedef enum {
     SILC_DENSE = 0, /* column-major m*n */
     SILC_CSR = 1,   /* 0-based compressed sparse rows */
-    SILC_BAND = 2   /* LAPACK band storage, ld = kl+ku+1, A(i,j) = values[(ku+i-j) + j*ld] */
+    SILC_BAND = 2,  /* LAPACK band storage, ld = kl+ku+1, A(i,j) = values[(ku+i-j) + j*ld] */
+    /* Complex values: the format of a complex envelope has the SILC_COMPLEX
+     * bit set, and its values hold two doubles an entry, the real part then
+     * the imaginary part (interleaved: the layout of C's double _Complex,
+     * Fortran's complex(8), NumPy's complex128), so a double _Complex array
+     * may be passed cast to (const double *).  Counts (nnz) count entries. */
+    SILC_COMPLEX = 16,
+    SILC_DENSE_COMPLEX = 16,
+    SILC_CSR_COMPLEX = 17,
+    SILC_BAND_COMPLEX = 18
 } silc_format_t;
 
 /* A matrix in transit between the program and SILC.  Fields are readable; build
@@ -82,7 +91,7 @@ typedef enum {
 typedef struct silc_envelope_t {
     int64_t m, n;
     silc_format_t format;
-    double *values;     /* dense: m*n; csr: nnz; band: (kl+ku+1)*n */
+    double *values;     /* dense: m*n; csr: nnz; band: (kl+ku+1)*n entries (complex: 2 doubles each) */
     int64_t *rowptr;    /* csr: m+1 entries, else NULL */
     int64_t *colind;    /* csr: nnz entries, else NULL */
     int64_t nnz;        /* csr: stored entries; dense: m*n; band: (kl+ku+1)*n */
@@ -101,12 +110,22 @@ SILC_API int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const i
                                const int64_t *colind, const double *values);
 SILC_API int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t *rowptr,
                                  const int32_t *colind, const double *values);
+/* Complex envelopes (dense column-major and CSR as above), values holding
+ * 2 doubles an entry, interleaved re, im (pass a double _Complex array
+ * cast to const double *).  A complex envelope is PUT as any other; a
+ * complex value is fetched only by silc_get_complex (below). */
+SILC_API int silc_envelope_dense_complex(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor);
+SILC_API int silc_envelope_csr_complex(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
+                                       const int64_t *colind, const double *values);
+/* 1 when e holds a complex value (format & SILC_COMPLEX). */
+SILC_API int silc_envelope_is_complex(const silc_envelope_t *e);
 /* Band, LAPACK layout with ld = kl+ku+1.  Copies. */
 SILC_API int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
                                 const double *band);
 SILC_API int64_t silc_envelope_rows(const silc_envelope_t *e);
 SILC_API int64_t silc_envelope_cols(const silc_envelope_t *e);
-/* Writes all m*n entries column-major into colmajor_out (caller's array). */
+/* Writes all m*n entries column-major into colmajor_out (caller's array;
+ * 2*m*n doubles, interleaved, for a complex envelope). */
 SILC_API int silc_envelope_to_dense(const silc_envelope_t *e, double *colmajor_out);
 /* Frees the arrays and zeroes the envelope; NULL and zeroed envelopes are fine. */
 SILC_API void silc_envelope_free(silc_envelope_t *e);
@@ -160,7 +179,12 @@ SILC_API void silc_close(silc_context **ctx);
  * takes 0.85 ms and the solve that follows needs no pass of its own for it.
  * On failure name keeps its old value. */
 SILC_API int silc_put(silc_context *ctx, const char *name, const silc_envelope_t *e);
+/* silc_get fetches real values only: a complex value is refused ("'z' is
+ * complex: fetch it with silc_get_complex"), so that a program written
+ * before complex values never reads half of one.  silc_get_complex fetches
+ * either field; silc_envelope_is_complex(e) tells which came. */
 SILC_API int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name);
+SILC_API int silc_get_complex(silc_context *ctx, silc_envelope_t *e, const char *name);
 SILC_API int silc_exec(silc_context *ctx, const char *statements);
 /* Interrupts the silc_exec running on ctx: it fails with "interrupted"
  * ("statement 2: interrupted" in a text of several statements) at its next

@@ -14,6 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+static int check_fail(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 static _Thread_local char env_err[1024];
 static _Thread_local int env_err_live;
 
@@ -104,25 +110,68 @@ static void *copy_array(const void *src, int64_t count, size_t size)
     return p;
 }
 
-int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor)
+int env_format_base(int envelope_format)
 {
-    int64_t count;
-    if (!e) return env_error("silc_envelope_dense: NULL envelope");
+    return envelope_format & ~SILC_COMPLEX;
+}
+
+int env_format_field(int envelope_format)
+{
+    return envelope_format & SILC_COMPLEX ? SILC_FIELD_COMPLEX : SILC_FIELD_REAL;
+}
+
+int env_format_code(int format, int field)
+{
+    return format | (field == SILC_FIELD_COMPLEX ? SILC_COMPLEX : 0);
+}
+
+int env_refuse_complex(const char *name, const silc_value *v, char *err, size_t errlen)
+{
+    if (!v || v->field != SILC_FIELD_COMPLEX) return 0;
+    return check_fail(err, errlen, "'%s' is complex: this client did not ask for complex values "
+                      "(fetch it with silc_get_complex, or take real(%s) or abs(%s))", name, name, name);
+}
+
+/* Doubles per entry of an envelope's values. */
+static int env_width(const silc_envelope_t *e)
+{
+    return env_format_field((int)e->format) == SILC_FIELD_COMPLEX ? 2 : 1;
+}
+
+/* The dense constructors of both fields (fn names the caller). */
+static int envelope_dense(silc_envelope_t *e, const char *fn, int field, int64_t m, int64_t n,
+                          const double *colmajor)
+{
+    int64_t count, width = field == SILC_FIELD_COMPLEX ? 2 : 1;
+    if (!e) return env_error("%s: NULL envelope", fn);
     memset(e, 0, sizeof *e);
     count = dense_count(m, n);
     if (count < 0)
-        return env_failed(e, "silc_envelope_dense: invalid size %lldx%lld", (long long)m, (long long)n);
-    if (val_claim((double)count * sizeof(double), "the envelope"))
-        return env_failed(e, "silc_envelope_dense: %lldx%lld: %s", (long long)m, (long long)n,
-                         val_refusal());
-    e->values = copy_array(colmajor, count, sizeof(double));
-    if (!e->values) return env_failed(e, "silc_envelope_dense: out of memory for %lldx%lld",
-                                     (long long)m, (long long)n);
+        return env_failed(e, "%s: invalid size %lldx%lld", fn, (long long)m, (long long)n);
+    if (val_claim((double)count * (double)width * sizeof(double), "the envelope"))
+        return env_failed(e, "%s: %lldx%lld: %s", fn, (long long)m, (long long)n, val_refusal());
+    e->values = copy_array(colmajor, count * width, sizeof(double));
+    if (!e->values) return env_failed(e, "%s: out of memory for %lldx%lld", fn, (long long)m, (long long)n);
     e->m = m;
     e->n = n;
-    e->format = SILC_DENSE;
+    e->format = (silc_format_t)env_format_code(SILC_DENSE, field);
     e->nnz = count;
     return 0;
+}
+
+int silc_envelope_dense(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor)
+{
+    return envelope_dense(e, "silc_envelope_dense", SILC_FIELD_REAL, m, n, colmajor);
+}
+
+int silc_envelope_dense_complex(silc_envelope_t *e, int64_t m, int64_t n, const double *colmajor)
+{
+    return envelope_dense(e, "silc_envelope_dense_complex", SILC_FIELD_COMPLEX, m, n, colmajor);
+}
+
+int silc_envelope_is_complex(const silc_envelope_t *e)
+{
+    return e && (int)e->format != ENV_NOT_CONSTRUCTED && env_format_field((int)e->format) == SILC_FIELD_COMPLEX;
 }
 
 int silc_envelope_scalar(silc_envelope_t *e, double x)
@@ -171,7 +220,7 @@ static int64_t band_count(int64_t n, int64_t kl, int64_t ku)
 
 double val_parts_bytes(const val_parts *p)
 {
-    return val_shape_bytes(p->format, p->m, p->n, p->nnz, p->kl, p->ku);
+    return val_shape_bytes_field(p->format, p->field, p->m, p->n, p->nnz, p->kl, p->ku);
 }
 
 int val_parts_claim(const val_parts *p, char *err, size_t errlen)
@@ -179,6 +228,8 @@ int val_parts_claim(const val_parts *p, char *err, size_t errlen)
     char what[160];
     if (p->format != SILC_FMT_DENSE && p->format != SILC_FMT_CSR && p->format != SILC_FMT_BAND)
         return check_fail(err, errlen, "unknown format %d", p->format);
+    if (p->field != SILC_FIELD_REAL && p->field != SILC_FIELD_COMPLEX)
+        return check_fail(err, errlen, "unknown field %d", p->field);
     if (p->m < 0 || p->n < 0)
         return check_fail(err, errlen, "invalid size %lldx%lld", (long long)p->m, (long long)p->n);
     switch (p->format) {
@@ -205,8 +256,8 @@ int val_parts_claim(const val_parts *p, char *err, size_t errlen)
      * (host_check_result), and formatting the text cost ~1 % of a small
      * SpMV. */
     if (val_parts_bytes(p) <= (double)val_max_bytes()) return val_claim(0, "");
-    snprintf(what, sizeof what, "a %lldx%lld %s value", (long long)p->m, (long long)p->n,
-             val_format_name(p->format));
+    snprintf(what, sizeof what, "a %lldx%lld %s%s value", (long long)p->m, (long long)p->n,
+             p->field == SILC_FIELD_COMPLEX ? "complex " : "", val_format_name(p->format));
     if (p->format == SILC_FMT_CSR)
         snprintf(what + strlen(what), sizeof what - strlen(what), " of %lld entries", (long long)p->nnz);
     if (val_claim(val_parts_bytes(p), what)) return check_fail(err, errlen, "%s", val_refusal());
@@ -285,7 +336,7 @@ int val_from_parts(const val_parts *p, silc_value **out, char *err, size_t errle
         /* rowptr first, for the size; the entries are checked while copied,
          * not in a pass of their own (val_parts_fill). */
         if (csr_check_rowptr(p, err, errlen)) return -1;
-        v = val_new_unset(SILC_FMT_CSR, p->m, p->n, p->nnz, 0, 0);
+        v = val_new_unset_field(SILC_FMT_CSR, p->field, p->m, p->n, p->nnz, 0, 0);
         if (v && val_parts_fill(v, p, err, errlen)) {
             val_release(v);
             return -1;
@@ -294,8 +345,8 @@ int val_from_parts(const val_parts *p, silc_value **out, char *err, size_t errle
         int64_t count;
         if (val_parts_check(p, err, errlen)) return -1;
         count = p->format == SILC_FMT_DENSE ? p->m * p->n : band_count(p->n, p->kl, p->ku);
-        v = val_new_unset(p->format, p->m, p->n, 0, p->kl, p->ku);
-        if (v && count > 0) memcpy(v->val, p->values, (size_t)count * sizeof(double));
+        v = val_new_unset_field(p->format, p->field, p->m, p->n, 0, p->kl, p->ku);
+        if (v && count > 0) memcpy(v->val, p->values, (size_t)count * (size_t)val_width(v) * sizeof(double));
     }
     if (!v)
         return check_fail(err, errlen, "%s", val_refusal()[0] ? val_refusal() : "out of memory");
@@ -309,7 +360,7 @@ int val_check_value(const silc_value *v, char *err, size_t errlen)
     if (!v) return check_fail(err, errlen, "no value");
     if (v->dist) return val_check_value(v->dist->block, err, errlen);
     memset(&p, 0, sizeof p);
-    p.format = v->format, p.m = v->m, p.n = v->n, p.kl = v->kl, p.ku = v->ku;
+    p.format = v->format, p.field = v->field, p.m = v->m, p.n = v->n, p.kl = v->kl, p.ku = v->ku;
     p.rowptr = v->rowptr, p.colind = v->colind, p.values = v->val;
     p.nnz = v->format == SILC_FMT_CSR ? v->nnz : 0;
     if (v->format == SILC_FMT_CSR && v->nnz > v->cap)
@@ -324,7 +375,7 @@ int val_check_value(const silc_value *v, char *err, size_t errlen)
 
 typedef struct col_val {
     int64_t col;
-    double val;
+    double val[2]; /* a complex entry's two parts; [0] only for a real one */
 } col_val;
 
 static int cmp_col(const void *a, const void *b)
@@ -335,7 +386,7 @@ static int cmp_col(const void *a, const void *b)
 
 /* Sorts the columns of every unsorted row in place (values follow) and
  * rejects duplicates.  Most rows arrive sorted; they cost one scan. */
-static int csr_sort_rows(int64_t m, const int64_t *rowptr, int64_t *colind, double *values,
+static int csr_sort_rows(int64_t m, const int64_t *rowptr, int64_t *colind, double *values, int width,
                          char *err, size_t errlen)
 {
     int64_t i, k;
@@ -358,12 +409,12 @@ static int csr_sort_rows(int64_t m, const int64_t *rowptr, int64_t *colind, doub
             }
             for (k = 0; k < len; k++) {
                 tmp[k].col = colind[lo + k];
-                tmp[k].val = values[lo + k];
+                memcpy(tmp[k].val, values + (lo + k) * width, (size_t)width * sizeof *values);
             }
             qsort(tmp, (size_t)len, sizeof *tmp, cmp_col);
             for (k = 0; k < len; k++) {
                 colind[lo + k] = tmp[k].col;
-                values[lo + k] = tmp[k].val;
+                memcpy(values + (lo + k) * width, tmp[k].val, (size_t)width * sizeof *values);
             }
         }
         for (k = lo + 1; k < hi; k++)
@@ -382,33 +433,34 @@ static int csr_sort_rows(int64_t m, const int64_t *rowptr, int64_t *colind, doub
 
 /* The CSR constructor behind both index widths: takes ownership of rowptr
  * and colind (already int64 copies), copies values. */
-static int envelope_csr_own(silc_envelope_t *e, const char *fn, int64_t m, int64_t n,
+static int envelope_csr_own(silc_envelope_t *e, const char *fn, int field, int64_t m, int64_t n,
                             int64_t *rowptr, int64_t *colind, const double *values)
 {
+    int width = field == SILC_FIELD_COMPLEX ? 2 : 1;
     char msg[512];
     int64_t nnz;
     double *vals;
     val_parts p;
     memset(&p, 0, sizeof p);
-    p.format = SILC_FMT_CSR, p.m = m, p.n = n, p.nnz = rowptr[m];
+    p.format = SILC_FMT_CSR, p.field = field, p.m = m, p.n = n, p.nnz = rowptr[m];
     p.rowptr = rowptr, p.colind = colind, p.values = values;
     if (csr_check_rowptr(&p, msg, sizeof msg) || csr_check_columns(&p, 0, msg, sizeof msg)) {
         val_array_free(rowptr), val_array_free(colind);
         return env_failed(e, "%s: %s", fn, msg);
     }
     nnz = rowptr[m];
-    vals = copy_array(values, nnz, sizeof(double));
+    vals = copy_array(values, nnz * width, sizeof(double));
     if (!vals) {
         val_array_free(rowptr), val_array_free(colind);
         return env_failed(e, "%s: out of memory for %lld entries", fn, (long long)nnz);
     }
-    if (csr_sort_rows(m, rowptr, colind, vals, msg, sizeof msg)) {
+    if (csr_sort_rows(m, rowptr, colind, vals, width, msg, sizeof msg)) {
         val_array_free(rowptr), val_array_free(colind), val_array_free(vals);
         return env_failed(e, "%s: %s", fn, msg);
     }
     e->m = m;
     e->n = n;
-    e->format = SILC_CSR;
+    e->format = (silc_format_t)env_format_code(SILC_CSR, field);
     e->rowptr = rowptr;
     e->colind = colind;
     e->values = vals;
@@ -431,7 +483,7 @@ static int csr_args(const char *fn, silc_envelope_t *e, int64_t m, int64_t n, co
     /* rowptr[m] is only trusted after the structure check; copying up to it
      * first is safe because a negative or huge count is rejected here. */
     *nnz = last(rowptr, m);
-    if (*nnz < 0 || dense_count(*nnz, 1) < 0)
+    if (*nnz < 0 || dense_count(*nnz, 2) < 0)
         return env_failed(e, "%s: rowptr[m] = %lld is not a valid entry count", fn, (long long)*nnz);
     if (*nnz > 0 && !colind)
         return env_failed(e, "%s: colind is NULL but rowptr[m] = %lld", fn, (long long)*nnz);
@@ -448,18 +500,31 @@ static int64_t last32(const void *rowptr, int64_t m)
     return ((const int32_t *)rowptr)[m];
 }
 
-int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
-                      const int64_t *colind, const double *values)
+/* The 64-bit CSR constructors of both fields. */
+static int envelope_csr64(silc_envelope_t *e, const char *fn, int field, int64_t m, int64_t n,
+                          const int64_t *rowptr, const int64_t *colind, const double *values)
 {
     int64_t *rp, *ci, nnz;
-    if (csr_args("silc_envelope_csr", e, m, n, rowptr, last64, colind, &nnz)) return -1;
+    if (csr_args(fn, e, m, n, rowptr, last64, colind, &nnz)) return -1;
     rp = copy_array(rowptr, m + 1, sizeof *rp);
     ci = copy_array(colind, nnz, sizeof *ci);
     if (!rp || !ci) {
         val_array_free(rp), val_array_free(ci);
-        return env_failed(e, "silc_envelope_csr: out of memory for %lld entries", (long long)nnz);
+        return env_failed(e, "%s: out of memory for %lld entries", fn, (long long)nnz);
     }
-    return envelope_csr_own(e, "silc_envelope_csr", m, n, rp, ci, values);
+    return envelope_csr_own(e, fn, field, m, n, rp, ci, values);
+}
+
+int silc_envelope_csr(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
+                      const int64_t *colind, const double *values)
+{
+    return envelope_csr64(e, "silc_envelope_csr", SILC_FIELD_REAL, m, n, rowptr, colind, values);
+}
+
+int silc_envelope_csr_complex(silc_envelope_t *e, int64_t m, int64_t n, const int64_t *rowptr,
+                              const int64_t *colind, const double *values)
+{
+    return envelope_csr64(e, "silc_envelope_csr_complex", SILC_FIELD_COMPLEX, m, n, rowptr, colind, values);
 }
 
 int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t *rowptr,
@@ -476,7 +541,7 @@ int silc_envelope_csr32(silc_envelope_t *e, int64_t m, int64_t n, const int32_t 
     }
     for (k = 0; k <= m; k++) rp[k] = rowptr[k];
     for (k = 0; k < nnz; k++) ci[k] = colind[k];
-    return envelope_csr_own(e, "silc_envelope_csr32", m, n, rp, ci, values);
+    return envelope_csr_own(e, "silc_envelope_csr32", SILC_FIELD_REAL, m, n, rp, ci, values);
 }
 
 int silc_envelope_band(silc_envelope_t *e, int64_t m, int64_t n, int64_t kl, int64_t ku,
@@ -515,7 +580,7 @@ int64_t silc_envelope_cols(const silc_envelope_t *e)
 
 int silc_envelope_to_dense(const silc_envelope_t *e, double *out)
 {
-    int64_t i, j, k, count;
+    int64_t i, j, k, count, w;
     char why[512];
     if (!e || !out) return env_error("silc_envelope_to_dense: NULL %s", e ? "output array" : "envelope");
     if (env_not_constructed(e, why, sizeof why))
@@ -524,28 +589,31 @@ int silc_envelope_to_dense(const silc_envelope_t *e, double *out)
     if (count < 0) return env_error("silc_envelope_to_dense: invalid envelope size");
     if (count > 0 && !e->values)
         return env_error("silc_envelope_to_dense: envelope has no values (freed or never built?)");
-    switch (e->format) {
+    w = env_width(e); /* a complex envelope's entries are two doubles here and in out */
+    switch (env_format_base((int)e->format)) {
     case SILC_DENSE:
-        memcpy(out, e->values, (size_t)count * sizeof(double));
+        memcpy(out, e->values, (size_t)(count * w) * sizeof(double));
         return 0;
     case SILC_CSR:
         if (!e->rowptr) return env_error("silc_envelope_to_dense: CSR envelope has no rowptr");
-        memset(out, 0, (size_t)count * sizeof(double));
+        memset(out, 0, (size_t)(count * w) * sizeof(double));
         for (i = 0; i < e->m; i++)
             for (k = e->rowptr[i]; k < e->rowptr[i + 1]; k++) {
                 if (e->colind[k] < 0 || e->colind[k] >= e->n)
                     return env_error("silc_envelope_to_dense: column index %lld out of range in row %lld",
                                      (long long)e->colind[k], (long long)i);
-                out[i + e->colind[k] * e->m] = e->values[k];
+                memcpy(out + (i + e->colind[k] * e->m) * w, e->values + k * w, (size_t)w * sizeof(double));
             }
         return 0;
     case SILC_BAND: {
         int64_t ld = e->kl + e->ku + 1;
-        memset(out, 0, (size_t)count * sizeof(double));
+        memset(out, 0, (size_t)(count * w) * sizeof(double));
         for (j = 0; j < e->n; j++) {
             int64_t lo = j - e->ku > 0 ? j - e->ku : 0;
             int64_t hi = j + e->kl < e->m - 1 ? j + e->kl : e->m - 1;
-            for (i = lo; i <= hi; i++) out[i + j * e->m] = e->values[(e->ku + i - j) + j * ld];
+            for (i = lo; i <= hi; i++)
+                memcpy(out + (i + j * e->m) * w, e->values + ((e->ku + i - j) + j * ld) * w,
+                       (size_t)w * sizeof(double));
         }
         return 0;
     }
@@ -571,11 +639,12 @@ void silc_envelope_free(silc_envelope_t *e)
 static void env_parts(const silc_envelope_t *e, val_parts *p)
 {
     memset(p, 0, sizeof *p);
-    p->format = (int)e->format;
+    p->format = env_format_base((int)e->format);
+    p->field = env_format_field((int)e->format);
     p->m = e->m, p->n = e->n;
-    p->nnz = e->format == SILC_CSR ? e->nnz : 0;
-    p->kl = e->format == SILC_BAND ? e->kl : 0;
-    p->ku = e->format == SILC_BAND ? e->ku : 0;
+    p->nnz = p->format == SILC_CSR ? e->nnz : 0;
+    p->kl = p->format == SILC_BAND ? e->kl : 0;
+    p->ku = p->format == SILC_BAND ? e->ku : 0;
     p->rowptr = e->rowptr, p->colind = e->colind, p->values = e->values;
 }
 
@@ -586,7 +655,8 @@ static int env_usable(const silc_envelope_t *e, char *err, size_t errlen)
     if (!e) return check_fail(err, errlen, "NULL envelope");
     if (env_not_constructed(e, why, sizeof why))
         return check_fail(err, errlen, "envelope was not constructed: %s", why);
-    if (e->format != SILC_DENSE && e->format != SILC_CSR && e->format != SILC_BAND)
+    if ((env_format_base((int)e->format) != SILC_DENSE && env_format_base((int)e->format) != SILC_CSR &&
+         env_format_base((int)e->format) != SILC_BAND) || ((int)e->format & ~(SILC_COMPLEX | 3)))
         return check_fail(err, errlen, "unknown envelope format %d", (int)e->format);
     return 0;
 }
@@ -612,7 +682,7 @@ int env_same_as_value(const silc_envelope_t *e, const silc_value *v)
     silc_view x, y;
     if (!e || !v || v->dist || !e->values) return 0;
     val_view(v, &y);
-    if ((int)e->format != y.format || e->m != y.m || e->n != y.n) return 0;
+    if ((int)e->format != env_format_code(y.format, v->field) || e->m != y.m || e->n != y.n) return 0;
     x = y;
     x.val = e->values;
     if (y.format == SILC_FMT_CSR) {
@@ -622,7 +692,7 @@ int env_same_as_value(const silc_envelope_t *e, const silc_value *v)
     } else if (y.format == SILC_FMT_BAND) {
         if (e->kl != y.kl || e->ku != y.ku || y.ld != y.kl + y.ku + 1) return 0;
     }
-    return view_same_contents(&x, &y);
+    return view_same_contents(&x, &y, val_width(v));
 }
 
 int env_to_value(const silc_envelope_t *e, silc_value **out, char *err, size_t errlen)
@@ -640,7 +710,7 @@ int env_from_value(const silc_value *v, silc_envelope_t *e)
     memset(e, 0, sizeof *e);
     if (!v) return -1;
     count = v->nnz; /* dense m*n, band ld*n, csr entries in use */
-    e->values = copy_array(v->val, count, sizeof(double));
+    e->values = copy_array(v->val, count * val_width(v), sizeof(double));
     if (!e->values) return -1;
     if (v->format == SILC_FMT_CSR) {
         e->rowptr = copy_array(v->rowptr, v->m + 1, sizeof(int64_t));
@@ -652,7 +722,7 @@ int env_from_value(const silc_value *v, silc_envelope_t *e)
     }
     e->m = v->m;
     e->n = v->n;
-    e->format = (silc_format_t)v->format;
+    e->format = (silc_format_t)env_format_code(v->format, v->field);
     e->nnz = count;
     if (v->format == SILC_FMT_BAND) {
         e->kl = v->kl;

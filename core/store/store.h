@@ -5,7 +5,9 @@
  *
  * ---- values and the store (value.c)
  *
- * A value is an immutable m x n real matrix in one storage format (dense
+ * A value is an immutable m x n real or complex matrix (its field: a complex
+ * value stores each entry as two doubles, real then imaginary, the layout of
+ * C's double complex; silc_plugin.h) in one storage format (dense
  * column-major, sorted 0-based CSR, LAPACK band), reference counted, with a
  * process-unique id, lazily computed structural properties, and attachments
  * (derived data with a destructor: factorizations, converted copies) that die
@@ -67,10 +69,11 @@ struct silc_value {
     uint64_t id;
     int64_t m, n;
     int format;              /* enum silc_format */
+    int field;               /* enum silc_field: complex values hold 2 doubles per entry in val */
     double *val;
     silc_index *rowptr, *colind;
-    int64_t nnz;             /* csr: entries in use; dense m*n; band ld*n */
-    int64_t cap;             /* csr: capacity of colind/val */
+    int64_t nnz;             /* csr: entries in use; dense m*n; band ld*n (entries, not doubles) */
+    int64_t cap;             /* csr: capacity of colind/val, in entries */
     int64_t kl, ku, ld;
     int props_have;          /* SILC_PROPS_* bits: the parts of props that are valid */
     silc_props props;
@@ -83,11 +86,33 @@ struct silc_value {
                                 cache holding a value no name holds pays for its arrays */
 };
 
-/* Constructors: zero-filled; NULL on allocation failure or negative sizes. */
+/* Doubles per entry of v's val: 1 real, 2 complex. */
+static inline int val_width(const silc_value *v)
+{
+    return v->field == SILC_FIELD_COMPLEX ? 2 : 1;
+}
+
+/* Constructors: zero-filled; NULL on allocation failure or negative sizes.
+ * The _complex ones make complex values, held to the same limits with 2
+ * doubles an entry. */
 silc_value *val_dense_new(int64_t m, int64_t n);
 silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity);
 silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku);
+silc_value *val_dense_new_complex(int64_t m, int64_t n);
+silc_value *val_csr_new_complex(int64_t m, int64_t n, int64_t nnz_capacity);
+silc_value *val_band_new_complex(int64_t m, int64_t n, int64_t kl, int64_t ku);
 silc_value *val_scalar_new(double x);
+silc_value *val_scalar_new_complex(double re, double im);
+/* Complex values from real ones, and back.  val_promote: a complex copy of
+ * v (imaginary parts 0) in v's format; a complex v is retained, not copied.
+ * val_part: the real (imag = 0) or imaginary (imag = 1) part of v as a real
+ * value in v's format (of a real v, a copy or zeros): the demotion, only
+ * on request (real(x), imag(x)).  NULL when out of memory or over a limit
+ * (val_refusal says which). */
+silc_value *val_promote(const silc_value *v);
+silc_value *val_part(const silc_value *v, int imag);
+/* 1 when every imaginary part of v is 0 (and for every real v). */
+int val_imag_is_zero(const silc_value *v);
 int val_csr_set_nnz(silc_value *v, int64_t nnz);
 /* Fills a CSR value made for rowptr[m] entries from rowptr/colind/values
  * (which may be its own arrays: data received in place), checking that each
@@ -100,6 +125,8 @@ int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_ind
                          const double *values);
 /* As the constructors, elements left unset: for a caller that writes them all. */
 silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
+silc_value *val_new_unset_field(int format, int field, int64_t m, int64_t n, int64_t nnz, int64_t kl,
+                                int64_t ku);
 /* Recycling of value arrays, process-wide (silcd installs a pool): take(bytes)
  * returns an array of at least bytes with any contents, or NULL; give(p) gets
  * every freed array and returns 1 when it kept it (then no longer to free).
@@ -147,6 +174,9 @@ int64_t val_live_bytes(void);
  * (the row sums of its norms, a product's result), which band storage
  * itself does not grow with.  A double: claims may exceed 64 bits. */
 double val_shape_bytes(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku);
+/* The same for a value of this field (a complex one: 2 doubles an entry). */
+double val_shape_bytes_field(int format, int field, int64_t m, int64_t n, int64_t nnz, int64_t kl,
+                             int64_t ku);
 
 silc_value *val_retain(silc_value *v);    /* returns v; NULL-safe */
 void val_release(silc_value *v);          /* frees at zero, attachments first; NULL-safe */
@@ -170,12 +200,15 @@ void val_forget_caches(silc_value *v);
 void val_mutated(silc_value *v);
 int val_is_scalar(const silc_value *v);   /* 1x1 */
 double val_scalar(const silc_value *v);   /* the (1,1) entry of a 1x1 value */
-double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format */
+double val_get(const silc_value *v, int64_t i, int64_t j); /* 0-based, any format; real part */
+/* The (i, j) entry as a complex number (imaginary part 0 for a real value). */
+double _Complex val_get_complex(const silc_value *v, int64_t i, int64_t j);
 /* 1 when a and b hold the same format, shape, pattern and value bits (whole
  * values only). */
 int val_same_contents(const silc_value *a, const silc_value *b);
-/* The same for two views (val_same_contents and env_same_as_value). */
-int view_same_contents(const silc_view *x, const silc_view *y);
+/* The same for two views of values of one field, width doubles an entry
+ * (val_same_contents and env_same_as_value). */
+int view_same_contents(const silc_view *x, const silc_view *y, int width);
 size_t val_bytes(const silc_value *v);    /* memory held by the arrays */
 const char *val_format_name(int format);  /* "dense", "csr", "band" */
 
@@ -249,12 +282,13 @@ size_t store_names(const silc_store *s, const char ***names);
  * never an address. */
 typedef struct val_parts {
     int format;                 /* SILC_FMT_* */
+    int field;                  /* SILC_FIELD_*: complex values hold 2 doubles an entry */
     int64_t m, n;
     int64_t nnz;                /* csr: entries colind and values hold; else unused */
     int64_t kl, ku;             /* band only */
     const silc_index *rowptr;   /* csr: m+1 */
     const silc_index *colind;   /* csr: nnz */
-    const double *values;       /* dense m*n, csr nnz, band (kl+ku+1)*n */
+    const double *values;       /* dense m*n, csr nnz, band (kl+ku+1)*n entries */
 } val_parts;
 /* The bytes the claim costs (val_shape_bytes). */
 double val_parts_bytes(const val_parts *p);
@@ -297,6 +331,15 @@ int env_csr_fill(silc_value *v, const silc_envelope_t *e, char *err, size_t errl
 int env_same_as_value(const silc_envelope_t *e, const silc_value *v);
 /* Copies a value into a freshly built envelope of the same format. */
 int env_from_value(const silc_value *v, silc_envelope_t *e);
+/* The store's format and field of an envelope format code (silc.h: the
+ * SILC_COMPLEX bit), and back. */
+int env_format_base(int envelope_format);
+int env_format_field(int envelope_format);
+int env_format_code(int format, int field);
+/* -1 with "'z' is complex: ..." in err when v is complex: what a GET from a
+ * caller that did not ask for complex values answers (silc_get, silcd's
+ * GET); 0 for a real v. */
+int env_refuse_complex(const char *name, const silc_value *v, char *err, size_t errlen);
 
 /* Records a context-free failure message; returns -1. */
 int env_error(const char *fmt, ...)

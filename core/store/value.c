@@ -11,6 +11,7 @@
 #define _DEFAULT_SOURCE   /* sysconf(_SC_PHYS_PAGES) */
 #include "store.h"
 
+#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <stdatomic.h>
@@ -112,18 +113,25 @@ int val_claim(double bytes, const char *what)
 
 double val_shape_bytes(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku)
 {
+    return val_shape_bytes_field(format, SILC_FIELD_REAL, m, n, nnz, kl, ku);
+}
+
+double val_shape_bytes_field(int format, int field, int64_t m, int64_t n, int64_t nnz, int64_t kl,
+                             int64_t ku)
+{
+    double entry = field == SILC_FIELD_COMPLEX ? 2 * sizeof(double) : sizeof(double);
     switch (format) {
     case SILC_FMT_DENSE:
-        return (double)m * (double)n * sizeof(double);
+        return (double)m * (double)n * entry;
     case SILC_FMT_CSR:
-        return ((double)m + 1) * sizeof(silc_index) + (double)nnz * (sizeof(silc_index) + sizeof(double));
+        return ((double)m + 1) * sizeof(silc_index) + (double)nnz * (sizeof(silc_index) + entry);
     default:
         /* Band storage holds (kl+ku+1) x n, but the value still has m rows:
          * its norms sum by row, a product with it makes m entries.  A
          * 250000000 x 1 band value stores one double and needs 2 GB the
          * moment anyone asks for its infinity norm, so the rows are charged
          * here, where every limit looks. */
-        return ((double)kl + (double)ku + 1) * (double)n * sizeof(double) + ((double)m + (double)n) * sizeof(double);
+        return ((double)kl + (double)ku + 1) * (double)n * entry + ((double)m + (double)n) * entry;
     }
 }
 
@@ -204,7 +212,7 @@ static silc_value *counted(silc_value *v)
     return v;
 }
 
-static silc_value *val_alloc(int64_t m, int64_t n, int format)
+static silc_value *val_alloc(int64_t m, int64_t n, int format, int field)
 {
     silc_value *v;
     if (m < 0 || n < 0) return NULL;
@@ -215,6 +223,7 @@ static silc_value *val_alloc(int64_t m, int64_t n, int format)
     v->m = m;
     v->n = n;
     v->format = format;
+    v->field = field == SILC_FIELD_COMPLEX ? SILC_FIELD_COMPLEX : SILC_FIELD_REAL;
     return v;
 }
 
@@ -227,15 +236,23 @@ static void val_free_arrays(silc_value *v)
     free(v);
 }
 
-static silc_value *dense_make(int64_t m, int64_t n, int zero)
+/* Doubles per entry of a field. */
+static int field_width(int field)
+{
+    return field == SILC_FIELD_COMPLEX ? 2 : 1;
+}
+
+static silc_value *dense_make(int64_t m, int64_t n, int field, int zero)
 {
     int64_t count = count_mul(m, n);
     silc_value *v;
-    double bytes = val_shape_bytes(SILC_FMT_DENSE, m, n, 0, 0, 0);
+    double bytes = val_shape_bytes_field(SILC_FMT_DENSE, field, m, n, 0, 0, 0);
     if (size_allowed(SILC_FMT_DENSE, m, n, bytes) || budget_refuses(SILC_FMT_DENSE, m, n, bytes))
         return NULL;
-    if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_DENSE))) return NULL;
-    v->val = val_array_alloc(count, sizeof(double), zero);
+    if (count < 0 || count_mul(count, field_width(field)) < 0 ||
+        !(v = val_alloc(m, n, SILC_FMT_DENSE, field)))
+        return NULL;
+    v->val = val_array_alloc(count * field_width(field), sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;
@@ -244,17 +261,17 @@ static silc_value *dense_make(int64_t m, int64_t n, int zero)
     return counted(v);
 }
 
-static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero)
+static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int field, int zero)
 {
     silc_value *v;
-    double bytes = val_shape_bytes(SILC_FMT_CSR, m, n, nnz_capacity, 0, 0);
+    double bytes = val_shape_bytes_field(SILC_FMT_CSR, field, m, n, nnz_capacity, 0, 0);
     if (size_allowed(SILC_FMT_CSR, m, n, bytes) || budget_refuses(SILC_FMT_CSR, m, n, bytes))
         return NULL;
-    if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, 1) < 0) return NULL;
-    if (!(v = val_alloc(m, n, SILC_FMT_CSR))) return NULL;
+    if (count_mul(m, 1) < 0 || count_mul(nnz_capacity, field_width(field)) < 0) return NULL;
+    if (!(v = val_alloc(m, n, SILC_FMT_CSR, field))) return NULL;
     v->rowptr = val_array_alloc(m + 1, sizeof(silc_index), zero);
     v->colind = val_array_alloc(nnz_capacity, sizeof(silc_index), zero);
-    v->val = val_array_alloc(nnz_capacity, sizeof(double), zero);
+    v->val = val_array_alloc(nnz_capacity * field_width(field), sizeof(double), zero);
     if (!v->rowptr || !v->colind || !v->val) {
         val_free_arrays(v);
         return NULL;
@@ -263,18 +280,20 @@ static silc_value *csr_make(int64_t m, int64_t n, int64_t nnz_capacity, int zero
     return counted(v);
 }
 
-static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int zero)
+static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int field, int zero)
 {
     int64_t ld, count;
     silc_value *v;
-    double bytes = val_shape_bytes(SILC_FMT_BAND, m, n, 0, kl, ku);
+    double bytes = val_shape_bytes_field(SILC_FMT_BAND, field, m, n, 0, kl, ku);
     if (size_allowed(SILC_FMT_BAND, m, n, bytes) || budget_refuses(SILC_FMT_BAND, m, n, bytes))
         return NULL;
     if (kl < 0 || ku < 0 || kl > INT64_MAX / 4 || ku > INT64_MAX / 4) return NULL;
     ld = kl + ku + 1;
     count = count_mul(ld, n);
-    if (count < 0 || !(v = val_alloc(m, n, SILC_FMT_BAND))) return NULL;
-    v->val = val_array_alloc(count, sizeof(double), zero);
+    if (count < 0 || count_mul(count, field_width(field)) < 0 ||
+        !(v = val_alloc(m, n, SILC_FMT_BAND, field)))
+        return NULL;
+    v->val = val_array_alloc(count * field_width(field), sizeof(double), zero);
     if (!v->val) {
         val_free_arrays(v);
         return NULL;
@@ -288,27 +307,48 @@ static silc_value *band_make(int64_t m, int64_t n, int64_t kl, int64_t ku, int z
 
 silc_value *val_dense_new(int64_t m, int64_t n)
 {
-    return dense_make(m, n, 1);
+    return dense_make(m, n, SILC_FIELD_REAL, 1);
 }
 
 silc_value *val_csr_new(int64_t m, int64_t n, int64_t nnz_capacity)
 {
-    return csr_make(m, n, nnz_capacity, 1);
+    return csr_make(m, n, nnz_capacity, SILC_FIELD_REAL, 1);
 }
 
 silc_value *val_band_new(int64_t m, int64_t n, int64_t kl, int64_t ku)
 {
-    return band_make(m, n, kl, ku, 1);
+    return band_make(m, n, kl, ku, SILC_FIELD_REAL, 1);
+}
+
+silc_value *val_dense_new_complex(int64_t m, int64_t n)
+{
+    return dense_make(m, n, SILC_FIELD_COMPLEX, 1);
+}
+
+silc_value *val_csr_new_complex(int64_t m, int64_t n, int64_t nnz_capacity)
+{
+    return csr_make(m, n, nnz_capacity, SILC_FIELD_COMPLEX, 1);
+}
+
+silc_value *val_band_new_complex(int64_t m, int64_t n, int64_t kl, int64_t ku)
+{
+    return band_make(m, n, kl, ku, SILC_FIELD_COMPLEX, 1);
+}
+
+silc_value *val_new_unset_field(int format, int field, int64_t m, int64_t n, int64_t nnz, int64_t kl,
+                                int64_t ku)
+{
+    switch (format) {
+    case SILC_FMT_DENSE: return dense_make(m, n, field, 0);
+    case SILC_FMT_CSR: return csr_make(m, n, nnz, field, 0);
+    case SILC_FMT_BAND: return band_make(m, n, kl, ku, field, 0);
+    default: return NULL;
+    }
 }
 
 silc_value *val_new_unset(int format, int64_t m, int64_t n, int64_t nnz, int64_t kl, int64_t ku)
 {
-    switch (format) {
-    case SILC_FMT_DENSE: return dense_make(m, n, 0);
-    case SILC_FMT_CSR: return csr_make(m, n, nnz, 0);
-    case SILC_FMT_BAND: return band_make(m, n, kl, ku, 0);
-    default: return NULL;
-    }
+    return val_new_unset_field(format, SILC_FIELD_REAL, m, n, nnz, kl, ku);
 }
 
 silc_value *val_scalar_new(double x)
@@ -316,6 +356,54 @@ silc_value *val_scalar_new(double x)
     silc_value *v = val_dense_new(1, 1);
     if (v) v->val[0] = x;
     return v;
+}
+
+silc_value *val_scalar_new_complex(double re, double im)
+{
+    silc_value *v = val_dense_new_complex(1, 1);
+    if (v) v->val[0] = re, v->val[1] = im;
+    return v;
+}
+
+/* A value of v's format, shape and pattern in field, entries unset (CSR:
+ * rowptr and colind copied). */
+static silc_value *same_pattern(const silc_value *v, int field)
+{
+    silc_value *w = val_new_unset_field(v->format, field, v->m, v->n, v->nnz, v->kl, v->ku);
+    if (w && v->format == SILC_FMT_CSR) {
+        memcpy(w->rowptr, v->rowptr, (size_t)(v->m + 1) * sizeof *v->rowptr);
+        if (v->nnz) memcpy(w->colind, v->colind, (size_t)v->nnz * sizeof *v->colind);
+        w->nnz = v->nnz;
+    }
+    return w;
+}
+
+silc_value *val_promote(const silc_value *v)
+{
+    silc_value *w;
+    if (!v || v->dist) return NULL; /* the evaluator gathers first (dist.h) */
+    if (v->field == SILC_FIELD_COMPLEX) return val_retain((silc_value *)v);
+    if (!(w = same_pattern(v, SILC_FIELD_COMPLEX))) return NULL;
+    for (int64_t k = 0; k < v->nnz; k++) w->val[2 * k] = v->val[k], w->val[2 * k + 1] = 0;
+    return w;
+}
+
+silc_value *val_part(const silc_value *v, int imag)
+{
+    silc_value *w;
+    if (!v || v->dist || !(w = same_pattern(v, SILC_FIELD_REAL))) return NULL;
+    for (int64_t k = 0; k < v->nnz; k++)
+        w->val[k] = v->field == SILC_FIELD_COMPLEX ? v->val[2 * k + (imag ? 1 : 0)] : imag ? 0 : v->val[k];
+    return w;
+}
+
+int val_imag_is_zero(const silc_value *v)
+{
+    if (v && v->dist) v = v->dist->whole ? v->dist->whole : v->dist->block;
+    if (!v || v->field != SILC_FIELD_COMPLEX) return 1;
+    for (int64_t k = 0; k < v->nnz; k++)
+        if (v->val[2 * k + 1] != 0) return 0;
+    return 1;
 }
 
 int val_csr_set_nnz(silc_value *v, int64_t nnz)
@@ -375,7 +463,7 @@ void dist_part_unref(dist_part *p)
 silc_value *val_dist_new(int64_t m, int64_t n, int format, struct dist_ctx *ctx, dist_part *part,
                          silc_value *block)
 {
-    silc_value *v = val_alloc(m, n, format);
+    silc_value *v = val_alloc(m, n, format, block ? block->field : SILC_FIELD_REAL);
     if (!v || !(v->dist = calloc(1, sizeof *v->dist))) {
         free(v);
         val_release(block);
@@ -415,30 +503,48 @@ double val_scalar(const silc_value *v)
     return val_get(v, 0, 0);
 }
 
-double val_get(const silc_value *v, int64_t i, int64_t j)
+/* The position in val (in entries) of (i, j) of a whole value, -1 when it
+ * is not stored. */
+static int64_t entry_index(const silc_value *v, int64_t i, int64_t j)
 {
-    if (v && v->dist) /* the evaluator gathers before reading entries (dist.h) */
-        return v->dist->whole ? val_get(v->dist->whole, i, j) : NAN;
-    if (!v || i < 0 || j < 0 || i >= v->m || j >= v->n) return 0.0;
     switch (v->format) {
     case SILC_FMT_DENSE:
-        return v->val[i + j * v->m];
+        return i + j * v->m;
     case SILC_FMT_CSR: {
         int64_t lo = v->rowptr[i], hi = v->rowptr[i + 1] - 1;
         while (lo <= hi) {
             int64_t mid = lo + (hi - lo) / 2;
-            if (v->colind[mid] == j) return v->val[mid];
+            if (v->colind[mid] == j) return mid;
             if (v->colind[mid] < j) lo = mid + 1;
             else hi = mid - 1;
         }
-        return 0.0;
+        return -1;
     }
     case SILC_FMT_BAND:
-        if (i - j > v->kl || j - i > v->ku) return 0.0;
-        return v->val[(v->ku + i - j) + j * v->ld];
+        if (i - j > v->kl || j - i > v->ku) return -1;
+        return (v->ku + i - j) + j * v->ld;
     default:
-        return 0.0;
+        return -1;
     }
+}
+
+double complex val_get_complex(const silc_value *v, int64_t i, int64_t j)
+{
+    int64_t k;
+    if (v && v->dist) /* the evaluator gathers before reading entries (dist.h) */
+        return v->dist->whole ? val_get_complex(v->dist->whole, i, j) : NAN;
+    if (!v || i < 0 || j < 0 || i >= v->m || j >= v->n || (k = entry_index(v, i, j)) < 0) return 0;
+    if (v->field != SILC_FIELD_COMPLEX) return v->val[k];
+    return util_cmplx(v->val[2 * k], v->val[2 * k + 1]);
+}
+
+double val_get(const silc_value *v, int64_t i, int64_t j)
+{
+    int64_t k;
+    if (v && v->dist) /* the evaluator gathers before reading entries (dist.h) */
+        return v->dist->whole ? val_get(v->dist->whole, i, j) : NAN;
+    if (!v || i < 0 || j < 0 || i >= v->m || j >= v->n || (k = entry_index(v, i, j)) < 0) return 0.0;
+    return v->val[k * val_width(v)];
 }
 
 int val_same_contents(const silc_value *a, const silc_value *b)
@@ -446,12 +552,13 @@ int val_same_contents(const silc_value *a, const silc_value *b)
     silc_view x, y;
     if (!a || !b || a->dist || b->dist) return 0;
     if (a == b) return 1;
+    if (a->field != b->field) return 0;
     val_view(a, &x);
     val_view(b, &y);
-    return view_same_contents(&x, &y);
+    return view_same_contents(&x, &y, val_width(a));
 }
 
-int view_same_contents(const silc_view *x, const silc_view *y)
+int view_same_contents(const silc_view *x, const silc_view *y, int width)
 {
     if (x->format != y->format || x->m != y->m || x->n != y->n || x->nnz != y->nnz || x->kl != y->kl ||
         x->ku != y->ku)
@@ -461,7 +568,7 @@ int view_same_contents(const silc_view *x, const silc_view *y)
         (memcmp(x->rowptr, y->rowptr, (size_t)(x->m + 1) * sizeof *x->rowptr) ||
          memcmp(x->colind, y->colind, (size_t)x->nnz * sizeof *x->colind)))
         return 0;
-    return x->nnz == 0 || !memcmp(x->val, y->val, (size_t)x->nnz * sizeof *x->val);
+    return x->nnz == 0 || !memcmp(x->val, y->val, (size_t)x->nnz * (size_t)width * sizeof *x->val);
 }
 
 size_t val_bytes(const silc_value *v)
@@ -469,7 +576,7 @@ size_t val_bytes(const silc_value *v)
     size_t b;
     if (!v) return 0;
     if (v->dist) return val_bytes(v->dist->block) + val_bytes(v->dist->whole);
-    b = (size_t)v->cap * sizeof(double);
+    b = (size_t)v->cap * (size_t)val_width(v) * sizeof(double);
     if (v->format == SILC_FMT_CSR)
         b += (size_t)(v->m + 1) * sizeof(silc_index) + (size_t)v->cap * sizeof(silc_index);
     return b;
@@ -591,16 +698,19 @@ static inline void shape_off_diagonal(silc_props *p, int64_t i, int64_t j)
     }
 }
 
-static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
+/* One entry of modulus x at (i, j): nonzero, finite and positive (real
+ * and > 0) as the entry is. */
+static inline void props_entry_mod(props_acc *acc, int64_t i, int64_t j, double x, int nonzero,
+                                   int finite, int positive)
 {
-    double x = fabs(a), xs = x * acc->scale;
+    double xs = x * acc->scale;
     if (x != x) acc->maxabs = x; /* NaN is sticky: x > NaN is false from then on */
     else if (x > acc->maxabs) acc->maxabs = x;
     if (acc->structure) {
         silc_props *p = acc->p;
-        if (!isfinite(a)) p->has_nonfinite = 1;
-        if (i == j && a > 0) acc->pos_diag_count++;
-        if (a != 0) {
+        if (!finite) p->has_nonfinite = 1;
+        if (i == j && positive) acc->pos_diag_count++;
+        if (nonzero) {
             p->nnz++;
             if (i != j) shape_off_diagonal(p, i, j);
         }
@@ -611,11 +721,83 @@ static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
     if (acc->rowsum) acc->rowsum[i] += xs;
 }
 
+static inline void props_entry(props_acc *acc, int64_t i, int64_t j, double a)
+{
+    props_entry_mod(acc, i, j, fabs(a), a != 0, isfinite(a), a > 0);
+}
+
+/* A complex entry: its modulus (hypot: no overflow of the squares), and
+ * positive only when real and > 0 (what Cholesky needs of a diagonal). */
+static void props_entry_complex(props_acc *acc, int64_t i, int64_t j, const double *z)
+{
+    double re = z[0], im = z[1];
+    props_entry_mod(acc, i, j, hypot(re, im), re != 0 || im != 0, isfinite(re) && isfinite(im),
+                    re > 0 && im == 0);
+}
+
+/* Calls fn on every stored entry (i, j) of a whole value, k its position in
+ * val counted in entries (explicit zeros included; band corners outside the
+ * matrix skipped).  For the complex passes, which need no inlined loops. */
+static void each_entry(const silc_value *v, void (*fn)(void *ctx, int64_t i, int64_t j, int64_t k),
+                       void *ctx)
+{
+    int64_t i, j, k;
+    switch (v->format) {
+    case SILC_FMT_DENSE:
+        for (j = 0; j < v->n; j++)
+            for (i = 0; i < v->m; i++) fn(ctx, i, j, i + j * v->m);
+        break;
+    case SILC_FMT_CSR:
+        for (i = 0; i < v->m; i++)
+            for (k = v->rowptr[i]; k < v->rowptr[i + 1]; k++) fn(ctx, i, v->colind[k], k);
+        break;
+    case SILC_FMT_BAND:
+        for (j = 0; j < v->n; j++) {
+            int64_t lo = j - v->ku > 0 ? j - v->ku : 0;
+            int64_t hi = j + v->kl < v->m - 1 ? j + v->kl : v->m - 1;
+            for (i = lo; i <= hi; i++) fn(ctx, i, j, (v->ku + i - j) + j * v->ld);
+        }
+        break;
+    default:
+        break;
+    }
+}
+
+typedef struct complex_pass {
+    const silc_value *v;
+    props_acc *acc;
+    int symmetric, hermitian;  /* symmetry walk: still possible */
+} complex_pass;
+
+static void complex_props_entry(void *ctx, int64_t i, int64_t j, int64_t k)
+{
+    complex_pass *c = ctx;
+    props_entry_complex(c->acc, i, j, c->v->val + 2 * k);
+}
+
+/* A complex value's entry against its mirror: A = A.' and A = A' hold when
+ * every stored entry equals its mirror, resp. its mirror's conjugate (an
+ * entry whose mirror is not stored meets 0 there). */
+static void complex_symmetry_entry(void *ctx, int64_t i, int64_t j, int64_t k)
+{
+    complex_pass *c = ctx;
+    double complex a = util_cmplx(c->v->val[2 * k], c->v->val[2 * k + 1]), b;
+    if (!c->symmetric && !c->hermitian) return;
+    b = i == j ? a : val_get_complex(c->v, j, i);
+    if (a != b) c->symmetric = 0;
+    if (a != conj(b)) c->hermitian = 0;
+}
+
 /* props_entry on every stored entry (explicit zeros included); called
  * directly, not through a pointer, so that it inlines into each loop. */
 static void props_pass(const silc_value *v, props_acc *acc)
 {
     int64_t i, j, k;
+    if (v->field == SILC_FIELD_COMPLEX) {
+        complex_pass c = {v, acc, 0, 0};
+        each_entry(v, complex_props_entry, &c);
+        return;
+    }
     switch (v->format) {
     case SILC_FMT_DENSE:
         for (j = 0; j < v->n; j++)
@@ -806,6 +988,21 @@ int val_csr_fill_checked(silc_value *v, const silc_index *rowptr, const silc_ind
     int64_t n = v->n, i, k, zeros = 0;
     uint64_t maxbits = 0;
     if (rowptr != v->rowptr) memcpy(v->rowptr, rowptr, (size_t)(v->m + 1) * sizeof *rowptr);
+    if (v->field == SILC_FIELD_COMPLEX) {
+        /* Columns checked and entries copied; the shape is left to the
+         * properties' complex pass, when asked for. */
+        for (i = 0; i < v->m; i++) {
+            int64_t prev = -1;
+            for (k = rowptr[i]; k < rowptr[i + 1]; k++) {
+                if (colind[k] <= prev || colind[k] >= n) return -1;
+                prev = ci[k] = colind[k];
+            }
+        }
+        if (values != x && rowptr[v->m] > 0) memcpy(x, values, (size_t)rowptr[v->m] * 2 * sizeof *x);
+        v->nnz = rowptr[v->m];
+        val_forget_caches(v);
+        return 0;
+    }
     for (i = 0; i < v->m; i++) {
         int64_t begin = rowptr[i], end = rowptr[i + 1], prev = -1, bad = 0;
         for (k = begin; k < end; k++) {
@@ -965,12 +1162,12 @@ static int csr_symmetric(const silc_value *v)
 
 static int dense_symmetric(const double *a, int64_t n)
 {
-    for (int64_t J = 0; J < n; J += SYM_TILE) {
-        int64_t jend = J + SYM_TILE < n ? J + SYM_TILE : n;
-        for (int64_t I = J; I < n; I += SYM_TILE) {
-            int64_t iend = I + SYM_TILE < n ? I + SYM_TILE : n;
-            for (int64_t j = J; j < jend; j++)
-                for (int64_t i = I > j + 1 ? I : j + 1; i < iend; i++)
+    for (int64_t tj = 0; tj < n; tj += SYM_TILE) {
+        int64_t jend = tj + SYM_TILE < n ? tj + SYM_TILE : n;
+        for (int64_t ti = tj; ti < n; ti += SYM_TILE) {
+            int64_t iend = ti + SYM_TILE < n ? ti + SYM_TILE : n;
+            for (int64_t j = tj; j < jend; j++)
+                for (int64_t i = ti > j + 1 ? ti : j + 1; i < iend; i++)
                     if (a[i + j * n] != a[j + i * n]) return 0;
         }
     }
@@ -1031,7 +1228,9 @@ static int compute_norms(const silc_value *v, silc_props *p, int shape)
     acc.rowsum = malloc((size_t)(v->m ? v->m : 1) * sizeof(double));
     props_start(v, &acc, shape, 1.0);
     int fast = 0; /* a fast pass gathered everything asked for */
-    if (!shape && v->format == SILC_FMT_CSR && !p->has_nonfinite) {
+    if (v->field == SILC_FIELD_COMPLEX) {
+        /* entry by entry below */
+    } else if (!shape && v->format == SILC_FMT_CSR && !p->has_nonfinite) {
         norms_pass_csr(v, &acc);
         fast = isfinite(acc.total) && isfinite(acc.sumsq);
     } else if (shape && v->format == SILC_FMT_DENSE && acc.colsum && acc.rowsum) {
@@ -1081,7 +1280,8 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         if ((parts & ~v->props_have) && dist_hooks.props) dist_hooks.props(v, parts & ~v->props_have);
         return p;
     }
-    if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR)
+    if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR &&
+        v->field == SILC_FIELD_REAL)
         shape_csr(v);
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
         int shape = !(v->props_have & SILC_PROPS_SHAPE);
@@ -1089,9 +1289,17 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         v->props_have |= shape ? SILC_PROPS_SHAPE : 0;
     }
     if ((parts & SILC_PROPS_SYMMETRY) && !(v->props_have & SILC_PROPS_SYMMETRY)) {
-        int sym = value_symmetric(v);
-        p->symmetric = sym > 0;
-        if (sym >= 0) v->props_have |= SILC_PROPS_SYMMETRY;
+        if (v->field == SILC_FIELD_COMPLEX) {
+            complex_pass c = {v, NULL, v->m == v->n, v->m == v->n};
+            if (v->m == v->n) each_entry(v, complex_symmetry_entry, &c);
+            p->symmetric = c.symmetric;
+            p->hermitian = c.hermitian;
+            v->props_have |= SILC_PROPS_SYMMETRY;
+        } else {
+            int sym = value_symmetric(v);
+            p->symmetric = p->hermitian = sym > 0;
+            if (sym >= 0) v->props_have |= SILC_PROPS_SYMMETRY;
+        }
     }
     return p;
 }
@@ -1140,8 +1348,21 @@ static void val_scan(const silc_value *cv, int level)
         v->scan_nonfinite = p->has_nonfinite;
         v->scan_ready = SCAN_MAXABS;
     } else if (level == SCAN_FINITE) {
-        v->scan_nonfinite = any_nonfinite(v->val, v->nnz);
+        /* both parts of a complex entry: a NaN imaginary part counts */
+        v->scan_nonfinite = any_nonfinite(v->val, v->nnz * val_width(v));
         v->scan_ready = SCAN_FINITE;
+    } else if (v->field == SILC_FIELD_COMPLEX) {
+        double maxabs = 0;
+        int nonfinite = 0;
+        for (int64_t k = 0; k < v->nnz; k++) {
+            double re = v->val[2 * k], im = v->val[2 * k + 1], x = hypot(re, im);
+            nonfinite |= !isfinite(re) || !isfinite(im);
+            if (x != x) maxabs = x;
+            else if (x > maxabs && maxabs == maxabs) maxabs = x;
+        }
+        v->scan_maxabs = maxabs;
+        v->scan_nonfinite = nonfinite;
+        v->scan_ready = SCAN_MAXABS;
     } else {
         scan_from_bits(v, max_abs_bits(v->val, v->nnz, 0, NULL));
     }

@@ -12,6 +12,18 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The complex number re + im*i, exact for every re and im (Inf and NaN
+ * parts included, which re + im*I is not): C11's CMPLX, which glibc
+ * defines for gcc but not for clang 14. */
+static inline double _Complex util_cmplx(double re, double im)
+{
+    union {
+        double _Complex z;
+        double part[2];
+    } u = {.part = {re, im}};
+    return u.z;
+}
+
 typedef struct strbuf {
     char *s;
     size_t len, cap;

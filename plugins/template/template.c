@@ -72,6 +72,7 @@ static const silc_plugin template_plugin = {
     NULL, /* set_threads: single-threaded */
     NULL, /* shutdown: nothing to release */
     NULL, /* collective_ops: runs on one process only (ABI 1.5) */
+    NULL, /* complex_ops: real values only (ABI 1.8) */
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

@@ -14,6 +14,15 @@
 #ifndef FIX_MAJOR
 #define FIX_MAJOR SILC_ABI_MAJOR
 #endif
+#ifndef FIX_MINOR
+#define FIX_MINOR SILC_ABI_MINOR
+#endif
+#ifndef FIX_STRUCT_SIZE
+#define FIX_STRUCT_SIZE sizeof(silc_plugin)
+#endif
+#ifndef FIX_COMPLEX_OPS
+#define FIX_COMPLEX_OPS 0
+#endif
 #ifndef FIX_INDEX_BYTES
 #define FIX_INDEX_BYTES ((int)sizeof(silc_index))
 #endif
@@ -49,8 +58,8 @@ static const silc_backend fix_backends[] = {
 };
 
 static const silc_plugin fix_plugin = {
-    FIX_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), FIX_INDEX_BYTES,
-    FIX_NAME, "1.0", 1, fix_backends, 0, 0, 0, 0, 0,
+    FIX_MAJOR, FIX_MINOR, FIX_STRUCT_SIZE, FIX_INDEX_BYTES,
+    FIX_NAME, "1.0", 1, fix_backends, 0, 0, 0, 0, 0, FIX_COMPLEX_OPS,
 };
 
 #ifndef FIX_NO_SYMBOL

@@ -48,7 +48,7 @@ static const silc_backend crash_backends[] = {
 
 static const silc_plugin crash_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
-    "crash", "1.0", 1, crash_backends, 0, 0, 0, 0, 0,
+    "crash", "1.0", 1, crash_backends, 0, 0, 0, 0, 0, 0,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,
