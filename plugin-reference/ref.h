@@ -29,13 +29,18 @@
 
 extern const silc_host_api *ref_host;
 
+/* Doubles per entry of a value: 1 real, 2 complex (interleaved re, im: the
+ * layout of C's double complex, so kernels cast x to double complex *). */
+int ref_width(const silc_value *v);
+
 /* Compressed-column sparse matrix (m x n).  A CSR value of A read without
  * copying is the compressed-column form of A' (owned = 0). */
 typedef struct ref_sp {
     int64_t m, n;
     int64_t *p, *i; /* p[n+1], i[nnz] */
-    double *x;      /* may be NULL for a pattern */
+    double *x;      /* w doubles per entry; may be NULL for a pattern */
     int owned;
+    int w;          /* doubles per entry of x: 1 real, 2 complex (0: pattern) */
 } ref_sp;
 
 /* ---- reference.c: memory and conversions --------------------------------- */
@@ -43,25 +48,36 @@ void *ref_alloc(size_t count, size_t size);   /* NULL on overflow or failure */
 void *ref_calloc(size_t count, size_t size);
 void ref_free(void *p);
 int ref_nomem(silc_call *call);               /* host->error(ENOMEM) */
+/* values: doubles per entry (0 pattern only, 1 real, 2 complex). */
 int ref_sp_alloc(ref_sp *A, int64_t m, int64_t n, int64_t nnz, int values);
 void ref_sp_free(ref_sp *A);
 int64_t ref_sp_nnz(const ref_sp *A);
 /* Compressed-column form of the matrix in v (any format; dense and band skip
- * zeros, CSR keeps explicit zeros).  Always an owned copy. */
+ * zeros, CSR keeps explicit zeros).  Always an owned copy.  The _w forms take
+ * the view's doubles per entry (ref_width); the plain ones are real. */
 int ref_sp_from_view(const silc_view *v, ref_sp *A);
+int ref_sp_from_view_w(const silc_view *v, int w, ref_sp *A);
 /* Compressed-column form of v' : borrowed from a CSR value, copied otherwise. */
 int ref_spt_from_view(const silc_view *v, ref_sp *At);
+int ref_spt_from_view_w(const silc_view *v, int w, ref_sp *At);
 /* Both operands of a binary operation that way; on failure neither is held. */
 int ref_spt_pair(const silc_view *a, const silc_view *b, ref_sp *At, ref_sp *Bt);
 int ref_sp_transpose(const ref_sp *A, ref_sp *T);
-/* Dense column-major copy of any format. */
+/* Dense column-major copy of any format (w doubles per entry). */
 double *ref_dense_from_view(const silc_view *v);
+double *ref_dense_from_view_w(const silc_view *v, int w);
 /* Writes v into the zeroed m x n column-major array D. */
 void ref_dense_fill(const silc_view *v, double *D);
+void ref_dense_fill_w(const silc_view *v, int w, double *D);
 double ref_view_get(const silc_view *v, int64_t i, int64_t j);
+/* Entry (i, j) of a complex view, as two doubles into z[0], z[1]. */
+void ref_view_get_w(const silc_view *v, int w, int64_t i, int64_t j, double *z);
 /* A CSR value from the compressed-column form of its transpose (rows of A). */
 silc_value *ref_value_from_rows(const ref_sp *R);
 silc_value *ref_value_from_dense(int64_t m, int64_t n, const double *x);
+/* The same for a complex result (w = 2) or a real one (w = 1). */
+silc_value *ref_value_from_rows_w(const ref_sp *R, int w);
+silc_value *ref_value_from_dense_w(int64_t m, int64_t n, int w, const double *x);
 
 /* ---- ref_elementwise.c, ref_matmul.c, ref_solve.c ------------------------ */
 int ref_op_add(silc_call *call);
@@ -73,13 +89,29 @@ int ref_op_convert(silc_call *call);
 int ref_op_diag(silc_call *call);
 int ref_op_reduce(silc_call *call);
 int ref_op_matmul(silc_call *call);
+/* ref_elementwise_z.c: the same ops on complex operands (the real entry
+ * points hand them over). */
+int ref_op_add_z(silc_call *call);
+int ref_op_scale_z(silc_call *call);
+int ref_op_ewise_z(silc_call *call);
+int ref_op_map_z(silc_call *call);
+int ref_op_transpose_z(silc_call *call);
+int ref_op_reduce_z(silc_call *call);
+/* Shared by both: a value of v's structure (w doubles per entry, CSR
+ * pattern copied, values unset), the number of stored entries of v (band
+ * padding included), and the 2-norm (largest singular value) of a real A. */
+silc_value *ref_same_structure(const silc_view *v, int w);
+int64_t ref_stored(const silc_view *v);
+int ref_norm2(const ref_sp *A, double *out);
 int ref_op_solve(silc_call *call);
 double ref_nrm2(int64_t n, const double *x, int64_t inc); /* scaled 2-norm */
 
 /* ---- factorizations ------------------------------------------------------ */
 /* solve(): x holds b (length m) on entry and the solution (length n) on exit;
  * its length is max(m, n).  trans = 1 solves with A' (square factors only; the
- * condition estimator uses it).  Kernels report failures as a status plus a
+ * condition estimator uses it).  A complex factor (w = 2) takes x and work
+ * as interleaved complex vectors (2 doubles per entry) and trans = 1 means
+ * the conjugate transpose A^H.  Kernels report failures as a status plus a
  * message written into msg. */
 typedef struct ref_factor {
     int64_t m, n;
@@ -87,6 +119,7 @@ typedef struct ref_factor {
     int (*solve)(void *data, double *x, int trans, double *work);
     void (*destroy)(void *data);
     int64_t work_len;       /* doubles of scratch solve() needs */
+    int w;                  /* doubles per entry: 1 real, 2 complex */
     double cond, rcond;     /* 1-norm estimate, computed once at factor time */
     char method[64];
     char note[256];
@@ -106,6 +139,10 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
                                int (*apply)(void *ctx, double *X, int t, int trans), void *ctx,
                                const double *Y0);
 double ref_cond_from(double anorm, double inv_est); /* guards 0 and non-finite */
+/* Complex A (LAPACK zlacn2's method: Higham 1988, Algorithm 4.1): x and work
+ * hold n complex entries, trans = 1 applies A^{-H}.  Returns -1 on failure. */
+double ref_inv_norm1_est_complex(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                                 void *ctx, double *work);
 
 /* ref_dense.c: factor an n x n (or m x n for QR) column-major matrix.  On
  * failure return a SILC_E* status with the message in msg.  *F gets solve,
@@ -114,12 +151,24 @@ int ref_dense_lu(int64_t n, const double *A, ref_factor *F, char *msg, size_t ms
 int ref_dense_chol(int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
 int ref_dense_tri(int64_t n, const double *A, int lower, ref_factor *F, char *msg, size_t msglen);
 int ref_dense_qr(int64_t m, int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+/* The complex forms (suffix _z) take interleaved complex arrays; Cholesky
+ * takes a Hermitian positive definite A (lower triangle read), QR uses
+ * complex Householder reflectors and the minimum-norm form factors A^H. */
+int ref_dense_lu_z(int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_chol_z(int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_tri_z(int64_t n, const double *A, int lower, ref_factor *F, char *msg, size_t msglen);
+int ref_dense_qr_z(int64_t m, int64_t n, const double *A, ref_factor *F, char *msg, size_t msglen);
 /* ref_band.c: A given in any format; kl, ku its bandwidths. */
 int ref_band_lu(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, char *msg, size_t msglen);
-/* ref_sparse.c: A square, compressed column (owned copies are taken as needed). */
+int ref_band_lu_z(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, char *msg, size_t msglen);
+/* ref_sparse.c: A square, compressed column (owned copies are taken as needed).
+ * The _z forms take A with complex values (A->w == 2). */
 int ref_sparse_tri(const ref_sp *A, int lower, ref_factor *F, char *msg, size_t msglen);
 int ref_sparse_chol(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
 int ref_sparse_lu(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_tri_z(const ref_sp *A, int lower, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_chol_z(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_lu_z(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
 /* Symbolic Cholesky of a symmetric pattern (upper part of C is used): the
  * column pattern of L, rows ascending with the diagonal first. */
 int ref_symbolic_chol(const ref_sp *C, ref_sp *L);

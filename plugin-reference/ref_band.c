@@ -6,130 +6,22 @@
  * in a widened copy with leading dimension 2*kl+ku+1: A(i,j) is stored at
  * ab[kl+ku+i-j + j*ldab].  Work and storage are O(n*kl*(kl+ku)), independent
  * of the input's format (band, CSR or dense are all read entry by entry).
+ * The kernel lives in ref_band_t.h, instantiated here for real and for
+ * complex entries (ref_field.h).
  */
 #include "ref.h"
 
 #include <math.h>
 #include <stdio.h>
 
-typedef struct band_lu {
-    int64_t n, kl, ku, ldab;
-    double *ab;
-    int64_t *piv;
-} band_lu;
-
 #define AB(f, i, j) ((f)->ab[(f)->kl + (f)->ku + (i) - (j) + (j) * (f)->ldab])
 
-static void band_lu_free(void *p)
-{
-    band_lu *f = p;
-    if (!f) return;
-    ref_free(f->ab);
-    ref_free(f->piv);
-    ref_free(f);
-}
+#undef REF_COMPLEX
+#include "ref_field.h"
+#include "ref_band_t.h"
 
-static int band_lu_solve(void *p, double *x, int trans, double *work)
-{
-    const band_lu *f = p;
-    int64_t n = f->n, kl = f->kl, kv = f->kl + f->ku;
-    (void)work;
-    if (!trans) {
-        for (int64_t j = 0; j < n; j++) {
-            int64_t q = f->piv[j];
-            double t = x[q];
-            x[q] = x[j];
-            x[j] = t;
-            int64_t hi = j + kl < n - 1 ? j + kl : n - 1;
-            for (int64_t i = j + 1; i <= hi; i++) x[i] -= AB(f, i, j) * t;
-        }
-        for (int64_t j = n - 1; j >= 0; j--) {
-            x[j] /= AB(f, j, j);
-            double t = x[j];
-            for (int64_t i = j - kv > 0 ? j - kv : 0; i < j; i++) x[i] -= AB(f, i, j) * t;
-        }
-    } else {
-        for (int64_t j = 0; j < n; j++) {
-            double s = x[j];
-            for (int64_t i = j - kv > 0 ? j - kv : 0; i < j; i++) s -= AB(f, i, j) * x[i];
-            x[j] = s / AB(f, j, j);
-        }
-        for (int64_t j = n - 1; j >= 0; j--) {
-            int64_t hi = j + kl < n - 1 ? j + kl : n - 1;
-            double s = x[j];
-            for (int64_t i = j + 1; i <= hi; i++) s -= AB(f, i, j) * x[i];
-            x[j] = s;
-            int64_t q = f->piv[j];
-            double t = x[q];
-            x[q] = x[j];
-            x[j] = t;
-        }
-    }
-    return 0;
-}
+#define REF_COMPLEX
+#include "ref_field.h"
+#include "ref_band_t.h"
+#undef REF_COMPLEX
 
-int ref_band_lu(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, char *msg, size_t msglen)
-{
-    int64_t n = A->n;
-    band_lu *f = ref_calloc(1, sizeof(band_lu));
-    if (!f) return SILC_ENOMEM;
-    f->n = n;
-    f->kl = kl;
-    f->ku = ku;
-    f->ldab = 2 * kl + ku + 1;
-    f->ab = ref_calloc((size_t)(f->ldab * n), sizeof(double));
-    f->piv = ref_alloc((size_t)n, sizeof(int64_t));
-    if (!f->ab || !f->piv) {
-        band_lu_free(f);
-        return SILC_ENOMEM;
-    }
-    if (A->format == SILC_FMT_CSR) {
-        for (int64_t i = 0; i < n; i++)
-            for (int64_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
-                int64_t j = A->colind[k];
-                if (i - j <= kl && j - i <= ku) AB(f, i, j) += A->val[k];
-            }
-    } else {
-        for (int64_t j = 0; j < n; j++) {
-            int64_t lo = j - ku > 0 ? j - ku : 0, hi = j + kl < n - 1 ? j + kl : n - 1;
-            for (int64_t i = lo; i <= hi; i++) AB(f, i, j) = ref_view_get(A, i, j);
-        }
-    }
-    int64_t ju = 0; /* last column touched by the pivot rows so far */
-    for (int64_t j = 0; j < n; j++) {
-        int64_t km = kl < n - 1 - j ? kl : n - 1 - j, jp = 0;
-        double big = fabs(AB(f, j, j));
-        for (int64_t i = 1; i <= km; i++)
-            if (fabs(AB(f, j + i, j)) > big) {
-                big = fabs(AB(f, j + i, j));
-                jp = i;
-            }
-        f->piv[j] = j + jp;
-        if (big == 0.0 || isnan(big)) {
-            snprintf(msg, msglen, "band LU: matrix is singular (zero pivot in column %lld)", (long long)j + 1);
-            band_lu_free(f);
-            return SILC_ESINGULAR;
-        }
-        int64_t reach = j + ku + jp < n - 1 ? j + ku + jp : n - 1;
-        if (reach > ju) ju = reach;
-        if (jp)
-            for (int64_t c = j; c <= ju; c++) {
-                double t = AB(f, j, c);
-                AB(f, j, c) = AB(f, j + jp, c);
-                AB(f, j + jp, c) = t;
-            }
-        double d = AB(f, j, j);
-        for (int64_t i = 1; i <= km; i++) AB(f, j + i, j) /= d;
-        for (int64_t c = j + 1; c <= ju; c++) {
-            double t = AB(f, j, c);
-            if (t == 0.0) continue;
-            for (int64_t i = 1; i <= km; i++) AB(f, j + i, c) -= AB(f, j + i, j) * t;
-        }
-    }
-    F->data = f;
-    F->solve = band_lu_solve;
-    F->destroy = band_lu_free;
-    snprintf(F->method, sizeof F->method, "band LU, partial pivoting (kl=%lld, ku=%lld)", (long long)kl,
-             (long long)ku);
-    return 0;
-}

@@ -12,9 +12,21 @@
  * columns per solve; a library whose solve phase costs the same for a few
  * columns as for one (MUMPS) gets a better estimate from fewer solve phases,
  * and can fold the first block into the user's own solve (Y0).
+ *
+ * For a complex matrix, ref_inv_norm1_est_complex is the one-column method
+ * of LAPACK's zlacn2 (Higham, "FORTRAN codes for estimating the one-norm of
+ * a real or complex matrix", ACM TOMS 14, 1988, Algorithm 4.1).  It is kept
+ * apart from the block form rather than folded into it because the two
+ * differ in more than arithmetic: the complex "sign" of y is y/|y| (a point
+ * on the unit circle, not +-1), so the real form's test that a sign vector
+ * repeats an earlier one (all_parallel) has no counterpart and zlacn2 stops
+ * instead when the gradient's largest entry stops moving; and the block
+ * form's column bookkeeping (t > 1) serves no complex caller.  What is the
+ * same, the alternating start vector and the final check with it, is shared.
  */
 #include "ref.h"
 
+#include <complex.h>
 #include <math.h>
 #include <string.h>
 
@@ -201,6 +213,73 @@ double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans
     alternating(n, x);
     if (apply(ctx, x, 0, work)) est = -1.0;
     else if ((alt = sum_abs(n, x)) > est || !isfinite(alt)) est = alt;
+    ref_free(x);
+    return est;
+}
+
+/* sum |x_i| over n complex entries (LAPACK dzsum1). */
+static double sum_mod(int64_t n, const double complex *x)
+{
+    double s = 0.0;
+    for (int64_t i = 0; i < n; i++) s += cabs(x[i]);
+    return s;
+}
+
+/* The first index of the largest modulus (LAPACK izmax1). */
+static int64_t max_mod_index(int64_t n, const double complex *x)
+{
+    int64_t j = 0;
+    double big = -1.0;
+    for (int64_t i = 0; i < n; i++)
+        if (cabs(x[i]) > big) big = cabs(x[i]), j = i;
+    return j;
+}
+
+double ref_inv_norm1_est_complex(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                                 void *ctx, double *work)
+{
+    enum { ITMAX = 5 };
+    if (n <= 0) return 0.0;
+    double complex *x = ref_alloc((size_t)n, sizeof(double complex));
+    double est = -1.0, estold;
+    if (!x) return -1.0;
+    for (int64_t i = 0; i < n; i++) x[i] = 1.0 / (double)n;
+    if (apply(ctx, (double *)x, 0, work)) goto fail;
+    est = sum_mod(n, x);
+    if (n == 1 || !isfinite(est)) goto done;
+    int64_t j = 0;
+    for (int iter = 1;; iter++) {
+        /* x = A^{-H} sign(A^{-1} x): the gradient; its largest entry names
+         * the unit vector to try next */
+        for (int64_t i = 0; i < n; i++) x[i] = cabs(x[i]) > 0 ? x[i] / cabs(x[i]) : 1.0;
+        if (apply(ctx, (double *)x, 1, work)) goto fail;
+        int64_t jlast = j;
+        j = max_mod_index(n, x);
+        if (iter >= 2 && (cabs(x[jlast]) == cabs(x[j]) || iter >= ITMAX)) break;
+        memset(x, 0, (size_t)n * sizeof *x);
+        x[j] = 1.0;
+        if (apply(ctx, (double *)x, 0, work)) goto fail;
+        estold = est;
+        est = sum_mod(n, x);
+        if (!isfinite(est)) goto done;
+        if (est <= estold) { /* no progress: keep the better bound (zlacn2 drops it) */
+            est = estold;
+            break;
+        }
+    }
+    /* Higham's alternating vector, as the real estimator's last step: the
+     * real values are written into the first n doubles and spread to the
+     * real parts from the last entry down, so no entry is read after its
+     * slot is overwritten. */
+    alternating(n, (double *)x);
+    for (int64_t i = n - 1; i >= 0; i--) x[i] = ((double *)x)[i];
+    if (apply(ctx, (double *)x, 0, work)) goto fail;
+    double alt = sum_mod(n, x);
+    if (alt > est || !isfinite(alt)) est = alt;
+    goto done;
+fail:
+    est = -1.0;
+done:
     ref_free(x);
     return est;
 }

@@ -9,6 +9,10 @@
  * as in CSparse), so a result's pattern depends only on its operands'
  * patterns.  Norms are computed with scaling so entries near 1e300 never
  * overflow an intermediate sum of squares.
+ *
+ * Complex operands (ABI 1.8) go to ref_elementwise_z.c, except CONVERT and
+ * DIAG, which only move entries and serve both fields here (w doubles per
+ * entry).
  */
 #include "ref.h"
 
@@ -43,14 +47,16 @@ static int out_rows(silc_call *call, ref_sp *R)
     return call->out ? 0 : ref_nomem(call);
 }
 
-/* A copy of v with the same structure and every stored value replaced. */
-static silc_value *same_structure(const silc_view *v)
+silc_value *ref_same_structure(const silc_view *v, int w)
 {
     silc_value *out = NULL;
-    if (v->format == SILC_FMT_DENSE) out = ref_host->dense_new(v->m, v->n);
-    else if (v->format == SILC_FMT_BAND) out = ref_host->band_new(v->m, v->n, v->kl, v->ku);
+    if (v->format == SILC_FMT_DENSE)
+        out = w == 2 ? ref_host->dense_new_complex(v->m, v->n) : ref_host->dense_new(v->m, v->n);
+    else if (v->format == SILC_FMT_BAND)
+        out = w == 2 ? ref_host->band_new_complex(v->m, v->n, v->kl, v->ku)
+                     : ref_host->band_new(v->m, v->n, v->kl, v->ku);
     else {
-        out = ref_host->csr_new(v->m, v->n, v->nnz);
+        out = w == 2 ? ref_host->csr_new_complex(v->m, v->n, v->nnz) : ref_host->csr_new(v->m, v->n, v->nnz);
         if (!out) return NULL;
         silc_view o;
         ref_host->view(out, &o);
@@ -64,8 +70,12 @@ static silc_value *same_structure(const silc_view *v)
     return out;
 }
 
-/* Number of stored doubles of a view (band padding included). */
-static int64_t stored(const silc_view *v)
+static silc_value *same_structure(const silc_view *v)
+{
+    return ref_same_structure(v, 1);
+}
+
+int64_t ref_stored(const silc_view *v)
 {
     if (v->format == SILC_FMT_CSR) return v->rowptr[v->m];
     if (v->format == SILC_FMT_BAND) return v->ld * v->n;
@@ -78,7 +88,7 @@ static int scale_copy(silc_call *call, const silc_view *v, double alpha)
     if (!out) return ref_nomem(call);
     silc_view o;
     ref_host->view(out, &o);
-    int64_t nz = stored(v);
+    int64_t nz = ref_stored(v);
     for (int64_t k = 0; k < nz; k++) o.val[k] = alpha * v->val[k];
     call->out = out;
     return 0;
@@ -86,6 +96,7 @@ static int scale_copy(silc_call *call, const silc_view *v, double alpha)
 
 int ref_op_scale(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2) return ref_op_scale_z(call);
     silc_view a;
     ref_host->view(call->in[0], &a);
     return scale_copy(call, &a, call->alpha);
@@ -155,6 +166,7 @@ static void add_into(double *D, const silc_view *v, double coef)
 
 int ref_op_add(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2 || ref_width(call->in[1]) == 2) return ref_op_add_z(call);
     silc_view a, b;
     ref_host->view(call->in[0], &a);
     ref_host->view(call->in[1], &b);
@@ -250,6 +262,7 @@ static int ew_on_pattern(silc_call *call, const silc_view *X, const silc_view *Y
 
 int ref_op_ewise(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2 || ref_width(call->in[1]) == 2) return ref_op_ewise_z(call);
     silc_view a, b;
     ref_host->view(call->in[0], &a);
     ref_host->view(call->in[1], &b);
@@ -305,23 +318,28 @@ static double map1(int sub, double x)
     case SILC_MAP_LOG: return log(x);
     case SILC_MAP_SIN: return sin(x);
     case SILC_MAP_COS: return cos(x);
+    case SILC_MAP_REAL: return x;
+    case SILC_MAP_IMAG: return 0.0;
+    case SILC_MAP_CONJ: return x;
+    case SILC_MAP_ANGLE: return atan2(0.0, x); /* pi for x < 0, as carg */
     default: return x == 0.0;
     }
 }
 
 int ref_op_map(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2) return ref_op_map_z(call);
     silc_view a;
     ref_host->view(call->in[0], &a);
     int sub = call->sub;
-    if (sub < SILC_MAP_NEG || sub > SILC_MAP_NOT)
+    if (sub < SILC_MAP_NEG || sub > SILC_MAP_ANGLE)
         return ref_host->error(call, SILC_EUNSUP, "map function %d is unknown", sub);
     if (a.format == SILC_FMT_DENSE || map1(sub, 0.0) == 0.0) {
         silc_value *out = same_structure(&a);
         if (!out) return ref_nomem(call);
         silc_view o;
         ref_host->view(out, &o);
-        int64_t nz = stored(&a);
+        int64_t nz = ref_stored(&a);
         for (int64_t k = 0; k < nz; k++) o.val[k] = map1(sub, a.val[k]);
         call->out = out;
         return 0;
@@ -336,6 +354,7 @@ int ref_op_map(silc_call *call)
 
 int ref_op_transpose(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2) return ref_op_transpose_z(call);
     silc_view a;
     ref_host->view(call->in[0], &a);
     if (a.format == SILC_FMT_CSR) {
@@ -363,31 +382,41 @@ int ref_op_transpose(silc_call *call)
     return out_dense(call, a.n, a.m, D);
 }
 
+/* Entry k of a compressed-column matrix with w doubles per entry is nonzero. */
+static int sp_entry_nonzero(const ref_sp *C, int w, int64_t k)
+{
+    return C->x[w * k] != 0.0 || (w == 2 && C->x[2 * k + 1] != 0.0);
+}
+
 int ref_op_convert(silc_call *call)
 {
     silc_view a;
     ref_host->view(call->in[0], &a);
+    int w = ref_width(call->in[0]);
     if (call->sub == SILC_FMT_DENSE) {
         /* Straight into the result: no second m x n array, and the host's
          * constructor is what checks (and names) the size. */
         silc_view o;
-        if (!(call->out = ref_host->dense_new(a.m, a.n))) return ref_nomem(call);
+        if (!(call->out = w == 2 ? ref_host->dense_new_complex(a.m, a.n) : ref_host->dense_new(a.m, a.n)))
+            return ref_nomem(call);
         ref_host->view(call->out, &o);
-        ref_dense_fill(&a, o.val);
+        ref_dense_fill_w(&a, w, o.val);
         return 0;
     }
     if (call->sub == SILC_FMT_CSR) {
         ref_sp R;
         if (a.format == SILC_FMT_CSR) {
-            call->out = same_structure(&a);
+            call->out = ref_same_structure(&a, w);
             if (!call->out) return ref_nomem(call);
             silc_view o;
             ref_host->view(call->out, &o);
-            if (a.nnz) memcpy(o.val, a.val, (size_t)a.rowptr[a.m] * sizeof(double));
+            if (a.nnz) memcpy(o.val, a.val, (size_t)(a.rowptr[a.m] * w) * sizeof(double));
             return 0;
         }
-        if (ref_spt_from_view(&a, &R)) return ref_nomem(call);
-        return out_rows(call, &R);
+        if (ref_spt_from_view_w(&a, w, &R)) return ref_nomem(call);
+        call->out = ref_value_from_rows_w(&R, w);
+        ref_sp_free(&R);
+        return call->out ? 0 : ref_nomem(call);
     }
     if (call->sub != SILC_FMT_BAND)
         return ref_host->error(call, SILC_EARG, "convert: unknown format %d", call->sub);
@@ -396,18 +425,18 @@ int ref_op_convert(silc_call *call)
         return ref_host->error(call, SILC_EARG, "band: widths kl=%lld, ku=%lld must be >= 0",
                                (long long)kl, (long long)ku);
     ref_sp C;
-    if (ref_sp_from_view(&a, &C)) return ref_nomem(call);
+    if (ref_sp_from_view_w(&a, w, &C)) return ref_nomem(call);
     for (int64_t j = 0; j < a.n; j++)
         for (int64_t k = C.p[j]; k < C.p[j + 1]; k++) {
             int64_t i = C.i[k];
-            if (C.x[k] != 0.0 && (i - j > kl || j - i > ku)) {
+            if (sp_entry_nonzero(&C, w, k) && (i - j > kl || j - i > ku)) {
                 ref_sp_free(&C);
                 return ref_host->error(call, SILC_EARG,
                                        "band: entry (%lld,%lld) lies outside the band kl=%lld, ku=%lld",
                                        (long long)i + 1, (long long)j + 1, (long long)kl, (long long)ku);
             }
         }
-    silc_value *out = ref_host->band_new(a.m, a.n, kl, ku);
+    silc_value *out = w == 2 ? ref_host->band_new_complex(a.m, a.n, kl, ku) : ref_host->band_new(a.m, a.n, kl, ku);
     if (!out) {
         ref_sp_free(&C);
         return ref_nomem(call);
@@ -417,7 +446,8 @@ int ref_op_convert(silc_call *call)
     for (int64_t j = 0; j < a.n; j++)
         for (int64_t k = C.p[j]; k < C.p[j + 1]; k++) {
             int64_t i = C.i[k];
-            if (i - j <= kl && j - i <= ku) o.val[(ku + i - j) + j * o.ld] += C.x[k];
+            if (i - j <= kl && j - i <= ku)
+                for (int c = 0; c < w; c++) o.val[w * ((ku + i - j) + j * o.ld) + c] += C.x[w * k + c];
         }
     ref_sp_free(&C);
     call->out = out;
@@ -428,30 +458,36 @@ int ref_op_diag(silc_call *call)
 {
     silc_view a;
     ref_host->view(call->in[0], &a);
+    int w = ref_width(call->in[0]);
     if (call->sub == 1) {
         int64_t k = a.m < a.n ? a.m : a.n;
-        double *D = ref_alloc((size_t)k, sizeof(double));
+        double *D = ref_alloc((size_t)(k * w), sizeof(double));
         if (!D) return ref_nomem(call);
-        for (int64_t i = 0; i < k; i++) D[i] = ref_view_get(&a, i, i);
-        return out_dense(call, k, 1, D);
+        for (int64_t i = 0; i < k; i++) ref_view_get_w(&a, w, i, i, D + w * i);
+        call->out = ref_value_from_dense_w(k, 1, w, D);
+        ref_free(D);
+        return call->out ? 0 : ref_nomem(call);
     }
     if (a.m != 1 && a.n != 1)
         return ref_host->error(call, SILC_EARG, "diag: needs a vector, got a %lldx%lld matrix",
                                (long long)a.m, (long long)a.n);
     int64_t len = a.m * a.n, nz = 0;
-    for (int64_t k = 0; k < len; k++)
-        if (ref_view_get(&a, a.n == 1 ? k : 0, a.n == 1 ? 0 : k) != 0.0) nz++;
-    silc_value *out = ref_host->csr_new(len, len, nz);
+    double d[2] = {0.0, 0.0};
+    for (int64_t k = 0; k < len; k++) {
+        ref_view_get_w(&a, w, a.n == 1 ? k : 0, a.n == 1 ? 0 : k, d);
+        if (d[0] != 0.0 || d[1] != 0.0) nz++;
+    }
+    silc_value *out = w == 2 ? ref_host->csr_new_complex(len, len, nz) : ref_host->csr_new(len, len, nz);
     if (!out) return ref_nomem(call);
     silc_view o;
     ref_host->view(out, &o);
     nz = 0;
     for (int64_t k = 0; k < len; k++) {
-        double d = ref_view_get(&a, a.n == 1 ? k : 0, a.n == 1 ? 0 : k);
+        ref_view_get_w(&a, w, a.n == 1 ? k : 0, a.n == 1 ? 0 : k, d);
         o.rowptr[k] = nz;
-        if (d != 0.0) {
+        if (d[0] != 0.0 || d[1] != 0.0) {
             o.colind[nz] = k;
-            o.val[nz++] = d;
+            memcpy(o.val + w * nz++, d, (size_t)w * sizeof(double));
         }
     }
     o.rowptr[len] = nz;
@@ -490,7 +526,7 @@ double ref_nrm2(int64_t n, const double *x, int64_t inc)
  * used while min(m,n)^2 * max(m,n) <= 2e8 (one sweep stays well under a
  * second); the power iteration converges slowly when the two largest singular
  * values are close, so its answer can be accurate to only ~1e-10 then. */
-static int norm2(const ref_sp *A, double *out)
+int ref_norm2(const ref_sp *A, double *out)
 {
     int64_t m = A->m, n = A->n, nz = ref_sp_nnz(A);
     double amax = 0.0;
@@ -572,6 +608,7 @@ static int norm2(const ref_sp *A, double *out)
 
 int ref_op_reduce(silc_call *call)
 {
+    if (ref_width(call->in[0]) == 2 || (call->nin > 1 && ref_width(call->in[1]) == 2)) return ref_op_reduce_z(call);
     silc_view a;
     ref_host->view(call->in[0], &a);
     int sub = call->sub;
@@ -638,7 +675,7 @@ int ref_op_reduce(silc_call *call)
     if (sub == SILC_RED_NORMFRO || (sub == SILC_RED_NORM && vec)) {
         r = ref_nrm2(nz, C.x, 1);
     } else if (sub == SILC_RED_NORM) {
-        st = norm2(&C, &r);
+        st = ref_norm2(&C, &r);
     } else if (sub == SILC_RED_NORM1 || sub == SILC_RED_NORMINF) {
         int by_col = sub == SILC_RED_NORM1;
         if (vec) { /* vector norms: sum |x| and max |x| whatever the orientation */

@@ -5,79 +5,22 @@
  * product with a dense accumulator and a marker array, giving CSR with sorted
  * columns; any dense operand gives a dense result.  Dense kernels run in
  * column order (j, k, i) so the innermost loop walks contiguous memory; a band
- * operand is read as CSR, which costs one cheap conversion.
+ * operand is read as CSR, which costs one cheap conversion.  The kernels
+ * live in ref_matmul_t.h, instantiated for real and complex entries
+ * (ref_field.h); the host never mixes fields in one call.
  */
 #include "ref.h"
 
 #include <string.h>
 
-/* C = A*B with A, B given by their rows (row-compressed). */
-static int gustavson(silc_call *call, const ref_sp *A, const ref_sp *B, int64_t m, int64_t n)
-{
-    int64_t *mark = ref_alloc((size_t)n, sizeof(int64_t));
-    double *acc = ref_alloc((size_t)n, sizeof(double));
-    ref_sp R = {0};
-    int64_t cap = 0;
-    if (!mark || !acc) goto nomem;
-    for (int64_t j = 0; j < n; j++) mark[j] = -1;
-    /* first pass: exact size of each row, so the result is allocated once */
-    for (int64_t i = 0; i < m; i++)
-        for (int64_t ka = A->p[i]; ka < A->p[i + 1]; ka++) {
-            int64_t k = A->i[ka];
-            for (int64_t kb = B->p[k]; kb < B->p[k + 1]; kb++)
-                if (mark[B->i[kb]] != i) {
-                    mark[B->i[kb]] = i;
-                    cap++;
-                }
-        }
-    if (ref_sp_alloc(&R, n, m, cap, 1)) goto nomem;
-    for (int64_t j = 0; j < n; j++) mark[j] = -1;
-    int64_t nz = 0;
-    for (int64_t i = 0; i < m; i++) {
-        int64_t start = nz;
-        R.p[i] = nz;
-        for (int64_t ka = A->p[i]; ka < A->p[i + 1]; ka++) {
-            int64_t k = A->i[ka];
-            double a = A->x[ka];
-            for (int64_t kb = B->p[k]; kb < B->p[k + 1]; kb++) {
-                int64_t j = B->i[kb];
-                if (mark[j] != i) {
-                    mark[j] = i;
-                    R.i[nz++] = j;
-                    acc[j] = a * B->x[kb];
-                } else {
-                    acc[j] += a * B->x[kb];
-                }
-            }
-        }
-        /* sort the row's columns (insertion sort: rows are short; fall back to
-         * a shell sort gap sequence for long ones) */
-        int64_t len = nz - start, *c = R.i + start;
-        for (int64_t gap = len / 2 > 0 ? len / 2 : 1;; gap = gap / 2 > 0 ? gap / 2 : 1) {
-            for (int64_t s = gap; s < len; s++) {
-                int64_t v = c[s], t = s;
-                while (t >= gap && c[t - gap] > v) {
-                    c[t] = c[t - gap];
-                    t -= gap;
-                }
-                c[t] = v;
-            }
-            if (gap == 1) break;
-        }
-        for (int64_t t = start; t < nz; t++) R.x[t] = acc[R.i[t]];
-    }
-    R.p[m] = nz;
-    ref_free(mark);
-    ref_free(acc);
-    call->out = ref_value_from_rows(&R);
-    ref_sp_free(&R);
-    return call->out ? 0 : ref_nomem(call);
-nomem:
-    ref_free(mark);
-    ref_free(acc);
-    ref_sp_free(&R);
-    return ref_nomem(call);
-}
+#undef REF_COMPLEX
+#include "ref_field.h"
+#include "ref_matmul_t.h"
+
+#define REF_COMPLEX
+#include "ref_field.h"
+#include "ref_matmul_t.h"
+#undef REF_COMPLEX
 
 int ref_op_matmul(silc_call *call)
 {
@@ -87,61 +30,9 @@ int ref_op_matmul(silc_call *call)
     if (a.n != b.m)
         return ref_host->error(call, SILC_EARG, "matmul: inner dimensions differ (%lldx%lld * %lldx%lld)",
                                (long long)a.m, (long long)a.n, (long long)b.m, (long long)b.n);
-    int64_t m = a.m, n = b.n, kk = a.n;
-    if (a.format != SILC_FMT_DENSE && b.format != SILC_FMT_DENSE) {
-        ref_sp A, B;
-        if (ref_spt_pair(&a, &b, &A, &B)) return ref_nomem(call);
-        int st = gustavson(call, &A, &B, m, n);
-        ref_sp_free(&A);
-        ref_sp_free(&B);
-        return st;
-    }
-    /* Sparse times dense writes every entry of C once: no zeroing pass
-     * (a whole extra sweep of the result, ~5 % of a 5-point SpMV). */
-    silc_value *out = a.format != SILC_FMT_DENSE && b.format == SILC_FMT_DENSE ? ref_host->dense_new_uninit(m, n)
-                                                                               : ref_host->dense_new(m, n);
-    if (!out) return ref_nomem(call);
-    silc_view o;
-    ref_host->view(out, &o);
-    double *C = o.val;
-    if (a.format == SILC_FMT_DENSE && b.format == SILC_FMT_DENSE) {
-        for (int64_t j = 0; j < n; j++)
-            for (int64_t k = 0; k < kk; k++) {
-                double t = b.val[k + j * kk];
-                const double *ak = a.val + k * m;
-                double *cj = C + j * m;
-                for (int64_t i = 0; i < m; i++) cj[i] += ak[i] * t;
-            }
-    } else if (a.format != SILC_FMT_DENSE) { /* sparse * dense: rows of A */
-        ref_sp A;
-        if (ref_spt_from_view(&a, &A)) {
-            ref_host->release(out);
-            return ref_nomem(call);
-        }
-        for (int64_t j = 0; j < n; j++) {
-            const double *bj = b.val + j * kk;
-            for (int64_t i = 0; i < m; i++) {
-                double s = 0.0;
-                for (int64_t p = A.p[i]; p < A.p[i + 1]; p++) s += A.x[p] * bj[A.i[p]];
-                C[i + j * m] = s;
-            }
-        }
-        ref_sp_free(&A);
-    } else { /* dense * sparse: C(:,j) += b_kj * A(:,k) over the rows k of B */
-        ref_sp B;
-        if (ref_spt_from_view(&b, &B)) {
-            ref_host->release(out);
-            return ref_nomem(call);
-        }
-        for (int64_t k = 0; k < kk; k++)
-            for (int64_t p = B.p[k]; p < B.p[k + 1]; p++) {
-                double t = B.x[p];
-                const double *ak = a.val + k * m;
-                double *cj = C + B.i[p] * m;
-                for (int64_t i = 0; i < m; i++) cj[i] += ak[i] * t;
-            }
-        ref_sp_free(&B);
-    }
-    call->out = out;
-    return 0;
+    int w = ref_width(call->in[0]);
+    if (ref_width(call->in[1]) != w)
+        return ref_host->error(call, SILC_EARG, "matmul: one operand is complex and the other real "
+                                                "(the host promotes the real one first)");
+    return w == 2 ? matmul_z(call, &a, &b) : matmul(call, &a, &b);
 }

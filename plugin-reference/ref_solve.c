@@ -28,136 +28,61 @@ static const char *const alg_key[] = {"reference.diag", "reference.tri", "refere
                                       "reference.dense_chol", "reference.dense_lu",
                                       "reference.sparse_chol", "reference.sparse_lu", "reference.qr"};
 
-/* ---- diagonal ------------------------------------------------------------------- */
+#undef REF_COMPLEX
+#include "ref_field.h"
+#include "ref_solve_t.h"
 
-typedef struct diag_f {
-    int64_t n;
-    double *d;
-} diag_f;
+#define REF_COMPLEX
+#include "ref_field.h"
+#include "ref_solve_t.h"
+#undef REF_COMPLEX
 
-static void diag_free(void *p)
-{
-    diag_f *f = p;
-    if (!f) return;
-    ref_free(f->d);
-    ref_free(f);
-}
-
-static int diag_solve(void *p, double *x, int trans, double *work)
-{
-    const diag_f *f = p;
-    (void)trans;
-    (void)work;
-    for (int64_t i = 0; i < f->n; i++) x[i] /= f->d[i];
-    return 0;
-}
-
-static int diag_factor(const silc_view *a, ref_factor *F, char *msg, size_t msglen)
-{
-    int64_t n = a->n;
-    diag_f *f = ref_calloc(1, sizeof(diag_f));
-    if (!f) return SILC_ENOMEM;
-    f->n = n;
-    f->d = ref_alloc((size_t)n, sizeof(double));
-    if (!f->d) {
-        diag_free(f);
-        return SILC_ENOMEM;
-    }
-    double big = 0.0, small = INFINITY;
-    for (int64_t i = 0; i < n; i++) {
-        f->d[i] = ref_view_get(a, i, i);
-        if (f->d[i] == 0.0) {
-            snprintf(msg, msglen, "singular diagonal matrix: zero diagonal entry at row %lld", (long long)i + 1);
-            diag_free(f);
-            return SILC_ESINGULAR;
-        }
-        big = fmax(big, fabs(f->d[i]));
-        small = fmin(small, fabs(f->d[i]));
-    }
-    F->data = f;
-    F->solve = diag_solve;
-    F->destroy = diag_free;
-    F->cond = n ? big / small : 1.0; /* exact for a diagonal matrix */
-    snprintf(F->method, sizeof F->method, "diagonal, division");
-    return 0;
-}
-
-/* ---- helpers ---------------------------------------------------------------------- */
-
-/* y = A x for any format. */
-static void matvec(const silc_view *a, const double *x, double *y)
-{
-    int64_t m = a->m, n = a->n;
-    memset(y, 0, (size_t)m * sizeof(double));
-    if (a->format == SILC_FMT_DENSE) {
-        for (int64_t j = 0; j < n; j++) {
-            const double *c = a->val + j * m;
-            for (int64_t i = 0; i < m; i++) y[i] += c[i] * x[j];
-        }
-    } else if (a->format == SILC_FMT_CSR) {
-        for (int64_t i = 0; i < m; i++) {
-            double s = 0.0;
-            for (int64_t k = a->rowptr[i]; k < a->rowptr[i + 1]; k++) s += a->val[k] * x[a->colind[k]];
-            y[i] = s;
-        }
-    } else {
-        for (int64_t j = 0; j < n; j++) {
-            int64_t lo = j - a->ku > 0 ? j - a->ku : 0, hi = j + a->kl + 1 < m ? j + a->kl + 1 : m;
-            for (int64_t i = lo; i < hi; i++) y[i] += a->val[(a->ku + i - j) + j * a->ld] * x[j];
-        }
-    }
-}
-
-static double norm_inf(int64_t n, const double *x)
-{
-    double s = 0.0;
-    for (int64_t i = 0; i < n; i++) s = fmax(s, fabs(x[i]));
-    return s;
-}
-
-/* r = b - A x; returns the normwise backward error. */
-static double residual(const silc_view *a, double anorm, const double *b, const double *x, double *r)
-{
-    matvec(a, x, r);
-    for (int64_t i = 0; i < a->m; i++) r[i] = b[i] - r[i];
-    double den = anorm * norm_inf(a->n, x) + norm_inf(a->m, b);
-    double num = norm_inf(a->m, r);
-    return den > 0 ? num / den : num;
-}
-
-static int pick_auto(const silc_view *a, const silc_props *P)
+/* spd: the class Cholesky takes, symmetric (real) or Hermitian (complex)
+ * with a positive real diagonal. */
+static int pick_auto(const silc_view *a, const silc_props *P, int w)
 {
     if (a->m != a->n) return ALG_RECT;
     if (P->diagonal) return ALG_DIAG;
     if (P->lower || P->upper) return ALG_TRI;
     if (a->format == SILC_FMT_BAND) return ALG_BAND;
-    int spd = P->symmetric && P->pos_diag;
+    int spd = (w == 2 ? P->hermitian : P->symmetric) && P->pos_diag;
     if (a->format == SILC_FMT_DENSE) return spd ? ALG_DENSE_SPD : ALG_DENSE;
     return spd ? ALG_SPARSE_SPD : ALG_SPARSE;
 }
 
-static int factor(int alg, const silc_view *a, const silc_props *P, ref_factor *F, char *msg, size_t ml)
+/* The sparse QR (ref_qr.c) is real only: a complex sparse least-squares
+ * problem goes to the dense complex QR when its dense copy stays this small
+ * (2^22 entries, 64 MiB), and is declined with that reason otherwise. */
+#define COMPLEX_RECT_DENSE_MAX ((int64_t)1 << 22)
+
+static int factor(int alg, const silc_view *a, const silc_props *P, int w, ref_factor *F, char *msg, size_t ml)
 {
-    int st;
-    if (alg == ALG_DIAG) return diag_factor(a, F, msg, ml);
-    if (alg == ALG_BAND) return ref_band_lu(a, P->kl, P->ku, F, msg, ml);
+    int st, z = w == 2;
+    if (alg == ALG_DIAG) return z ? diag_factor_z(a, F, msg, ml) : diag_factor(a, F, msg, ml);
+    if (alg == ALG_BAND) return (z ? ref_band_lu_z : ref_band_lu)(a, P->kl, P->ku, F, msg, ml);
     int dense = alg == ALG_DENSE || alg == ALG_DENSE_SPD ||
-                ((alg == ALG_TRI || alg == ALG_RECT) && a->format == SILC_FMT_DENSE);
+                ((alg == ALG_TRI || alg == ALG_RECT) && a->format == SILC_FMT_DENSE) || (z && alg == ALG_RECT);
     if (dense) {
-        double *D = ref_dense_from_view(a);
+        if (z && alg == ALG_RECT && a->format != SILC_FMT_DENSE && a->m * a->n > COMPLEX_RECT_DENSE_MAX) {
+            snprintf(msg, ml, "complex sparse least squares: the reference plugin's sparse QR is real only "
+                              "and a %lldx%lld dense copy is too large",
+                     (long long)a->m, (long long)a->n);
+            return SILC_EDECLINE;
+        }
+        double *D = ref_dense_from_view_w(a, w);
         if (!D) return SILC_ENOMEM;
-        if (alg == ALG_DENSE) st = ref_dense_lu(a->n, D, F, msg, ml);
-        else if (alg == ALG_DENSE_SPD) st = ref_dense_chol(a->n, D, F, msg, ml);
-        else if (alg == ALG_TRI) st = ref_dense_tri(a->n, D, P->lower, F, msg, ml);
-        else st = ref_dense_qr(a->m, a->n, D, F, msg, ml);
+        if (alg == ALG_DENSE) st = (z ? ref_dense_lu_z : ref_dense_lu)(a->n, D, F, msg, ml);
+        else if (alg == ALG_DENSE_SPD) st = (z ? ref_dense_chol_z : ref_dense_chol)(a->n, D, F, msg, ml);
+        else if (alg == ALG_TRI) st = (z ? ref_dense_tri_z : ref_dense_tri)(a->n, D, P->lower, F, msg, ml);
+        else st = (z ? ref_dense_qr_z : ref_dense_qr)(a->m, a->n, D, F, msg, ml);
         ref_free(D);
         return st;
     }
     ref_sp C;
-    if (ref_sp_from_view(a, &C)) return SILC_ENOMEM;
-    if (alg == ALG_TRI) st = ref_sparse_tri(&C, P->lower, F, msg, ml);
-    else if (alg == ALG_SPARSE_SPD) st = ref_sparse_chol(&C, F, msg, ml);
-    else if (alg == ALG_SPARSE) st = ref_sparse_lu(&C, F, msg, ml);
+    if (ref_sp_from_view_w(a, w, &C)) return SILC_ENOMEM;
+    if (alg == ALG_TRI) st = (z ? ref_sparse_tri_z : ref_sparse_tri)(&C, P->lower, F, msg, ml);
+    else if (alg == ALG_SPARSE_SPD) st = (z ? ref_sparse_chol_z : ref_sparse_chol)(&C, F, msg, ml);
+    else if (alg == ALG_SPARSE) st = (z ? ref_sparse_lu_z : ref_sparse_lu)(&C, F, msg, ml);
     else st = ref_sparse_qr(&C, F, msg, ml);
     ref_sp_free(&C);
     return st;
@@ -179,12 +104,16 @@ int ref_op_solve(silc_call *call)
     if (a.m != b.m)
         return ref_host->error(call, SILC_EARG, "solve: A is %lldx%lld but the right-hand side has %lld rows",
                                (long long)a.m, (long long)a.n, (long long)b.m);
+    int w = ref_width(call->in[0]);
+    if (ref_width(call->in[1]) != w) /* the host promotes before calling (silc_plugin.h) */
+        return ref_host->error(call, SILC_EARG, "solve: A is %s but the right-hand side is %s",
+                               w == 2 ? "complex" : "real", w == 2 ? "real" : "complex");
     const silc_props *P = ref_host->props(call->in[0]);
     int alg = -1, by_structure = 0;
     for (int k = 0; call->op_class && k < 8; k++)
         if (strcmp(call->op_class, alg_class[k]) == 0) alg = k;
     if (alg < 0) {
-        alg = pick_auto(&a, P);
+        alg = pick_auto(&a, P, w);
         by_structure = 1;
     }
     if (a.m != a.n) alg = ALG_RECT;
@@ -200,7 +129,7 @@ int ref_op_solve(silc_call *call)
         if (!F) return ref_nomem(call);
         F->m = a.m;
         F->n = a.n;
-        int st = factor(alg, &a, P, F, msg, sizeof msg);
+        int st = factor(alg, &a, P, w, F, msg, sizeof msg);
         if (st) {
             ref_free(F);
             F = NULL;
@@ -221,11 +150,11 @@ int ref_op_solve(silc_call *call)
      * none yet), on the first solve that wants one: accuracy.condest = off
      * skips it, and a later solve with the setting on makes it. */
     if (F->cond == 0.0 && !(ref_host->abi_minor >= 7 && rep->condest_off)) {
-        double *w = ref_alloc((size_t)(F->work_len + a.n + 1), sizeof(double)), est = -1;
+        double *work = ref_alloc((size_t)(F->work_len + w * a.n + 1), sizeof(double)), est = -1;
         /* The estimator fails only when it runs out of memory (it applies
          * the solve of this factor, which does not fail). */
-        if (w) est = ref_inv_norm1_est(a.n, F->solve, F->data, w);
-        ref_free(w);
+        if (work) est = (w == 2 ? ref_inv_norm1_est_complex : ref_inv_norm1_est)(a.n, F->solve, F->data, work);
+        ref_free(work);
         if (est < 0) { /* no estimate would mean no warning of an ill-conditioned matrix */
             if (!attached) ref_factor_free(F);
             return ref_nomem(call);
@@ -234,14 +163,18 @@ int ref_op_solve(silc_call *call)
         set_rcond(F);
     }
 
-    int64_t m = a.m, n = a.n, nrhs = b.n, len = m > n ? m : n;
-    silc_value *out = ref_host->dense_new(n, nrhs);
-    double *B = ref_dense_from_view(&b);
+    /* vectors below hold w doubles per entry; the refinement's own
+     * arithmetic (copies, d += x) is the same on interleaved doubles */
+    int64_t m = a.m, n = a.n, nrhs = b.n, len = (m > n ? m : n) * w;
+    double (*residual_fn)(const silc_view *, double, const double *, const double *, double *) =
+        w == 2 ? residual_z : residual;
+    silc_value *out = w == 2 ? ref_host->dense_new_complex(n, nrhs) : ref_host->dense_new(n, nrhs);
+    double *B = ref_dense_from_view_w(&b, w);
     double *x = ref_alloc((size_t)len, sizeof(double)), *r = ref_alloc((size_t)len, sizeof(double));
     double *d = ref_alloc((size_t)len, sizeof(double));
-    double *w = ref_alloc((size_t)(F->work_len + len + 1), sizeof(double));
+    double *work = ref_alloc((size_t)(F->work_len + len + 1), sizeof(double));
     int st = 0, refined = 0;
-    if (!out || !B || !x || !r || !d || !w) {
+    if (!out || !B || !x || !r || !d || !work) {
         st = ref_nomem(call);
         goto done;
     }
@@ -249,26 +182,26 @@ int ref_op_solve(silc_call *call)
     ref_host->view(out, &o);
     double anorm = P->norminf;
     for (int64_t j = 0; j < nrhs; j++) {
-        const double *bj = B + j * m;
-        memcpy(x, bj, (size_t)m * sizeof(double));
-        if (F->solve(F->data, x, 0, w)) {
+        const double *bj = B + j * m * w;
+        memcpy(x, bj, (size_t)(m * w) * sizeof(double));
+        if (F->solve(F->data, x, 0, work)) {
             st = ref_host->error(call, SILC_EINTERNAL, "%s: solve failed", F->method);
             goto done;
         }
         if (m == n && alg != ALG_DIAG) {
-            double berr = residual(&a, anorm, bj, x, r);
+            double berr = residual_fn(&a, anorm, bj, x, r);
             for (int it = 0; it < 2 && berr > DBL_EPSILON && isfinite(berr); it++) {
-                memcpy(d, r, (size_t)n * sizeof(double));
-                F->solve(F->data, d, 0, w);
-                for (int64_t i = 0; i < n; i++) d[i] += x[i];
-                double nb = residual(&a, anorm, bj, d, r);
+                memcpy(d, r, (size_t)(n * w) * sizeof(double));
+                F->solve(F->data, d, 0, work);
+                for (int64_t i = 0; i < n * w; i++) d[i] += x[i];
+                double nb = residual_fn(&a, anorm, bj, d, r);
                 if (!(nb < berr)) break;
-                memcpy(x, d, (size_t)n * sizeof(double));
+                memcpy(x, d, (size_t)(n * w) * sizeof(double));
                 berr = nb;
                 refined = 1;
             }
         }
-        memcpy(o.val + j * n, x, (size_t)n * sizeof(double));
+        memcpy(o.val + j * n * w, x, (size_t)(n * w) * sizeof(double));
     }
     snprintf(rep->method, sizeof rep->method, "%s", F->method);
     if (refined) {
@@ -291,7 +224,7 @@ done:
     ref_free(x);
     ref_free(r);
     ref_free(d);
-    ref_free(w);
+    ref_free(work);
     if (!attached) ref_factor_free(F);
     return st;
 }

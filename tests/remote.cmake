@@ -139,6 +139,7 @@ endif()
 # Complex values in the core (issue 31): store, properties, and the C API
 # embedded and through a private silcd.
 silc_add_test(test_complex_core INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_complex_core.c)
-target_compile_definitions(test_complex_core PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>")
-add_dependencies(test_complex_core silcd)
+target_compile_definitions(test_complex_core PRIVATE SILCD_PATH="$<TARGET_FILE:silcd>"
+  ABI_PLUGIN_DIR="${PROJECT_BINARY_DIR}/tests/abi")
+add_dependencies(test_complex_core silcd abi_old_minor abi_takes_complex)
 set_tests_properties(test_complex_core PROPERTIES TIMEOUT 120)

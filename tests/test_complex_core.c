@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "dispatch.h"
 #include "remote_util.h"
 #include "silc.h"
 #include "store.h"
@@ -176,9 +177,73 @@ static void test_api(void)
     CHECK(server_stop(&s) == 0, "silcd did not stop cleanly");
 }
 
+/* SCALE of in through the dispatcher with the session list (or the
+ * per-call options); rc as disp_run's, out the result (NULL on failure). */
+static int scale(silc_engine *E, const silc_value *in, double alpha, double alpha_imag, const char *options,
+                 silc_value **out)
+{
+    silc_call c;
+    int rc;
+    memset(&c, 0, sizeof c);
+    c.op = SILC_OP_SCALE;
+    c.nin = 1;
+    c.in[0] = in;
+    c.alpha = alpha;
+    c.alpha_imag = alpha_imag;
+    c.options = options;
+    rc = disp_run(E, &c);
+    *out = c.out;
+    return rc;
+}
+
+/* The gating: a complex operand goes only to a backend whose plugin lists
+ * the op in complex_ops (ABI 1.8), is passed over by a 1.7 plugin, and
+ * gets a clear error when no backend of the list takes it; a real operand
+ * with a complex alpha is promoted. */
+static void test_gating(void)
+{
+    silc_engine *E = NULL;
+    char err[1024], path[1024];
+    static const double z[4] = {1, 2, 3, -1};
+    silc_value *Z = dense_complex(2, 1, z), *R = val_dense_new(2, 1), *out = NULL;
+    R->val[0] = 1, R->val[1] = 3;
+    CHECK(eng_create(&E, "/dev/null", err, sizeof err) == 0, "eng_create: %s", err);
+    if (!E) return;
+    snprintf(path, sizeof path, "%s/abi_old_minor.so", ABI_PLUGIN_DIR);
+    CHECK(ld_load_file(E, path) == 0, "old_minor refused: %s", E->err);
+    snprintf(path, sizeof path, "%s/abi_takes_complex.so", ABI_PLUGIN_DIR);
+    CHECK(ld_load_file(E, path) == 0, "takes_complex refused: %s", E->err);
+    CHECK(cfg_set(E, CFG_SCOPE_SESSION, "dispatch.add", "old_minor, takes_complex") == 0, "%s", E->err);
+
+    /* complex: old_minor is passed over, takes_complex gives 2z + 2 */
+    CHECK(scale(E, Z, 2, 0, NULL, &out) == 0, "complex scale: %s", E->err);
+    CHECK(out && out->field == SILC_FIELD_COMPLEX && out->val[0] == 4 && out->val[1] == 4 && out->val[2] == 8 &&
+              out->val[3] == -2, "2z + 2 from takes_complex");
+    val_release(out);
+    /* real: old_minor runs (2r + 1) */
+    CHECK(scale(E, R, 2, 0, NULL, &out) == 0 && out && out->field == SILC_FIELD_REAL && out->val[0] == 3 &&
+              out->val[1] == 7, "real scale by old_minor: %s", E->err);
+    val_release(out);
+    /* a complex alpha on a real operand: promoted, (2 + i) r + 2 */
+    CHECK(scale(E, R, 2, 1, NULL, &out) == 0, "promoted scale: %s", E->err);
+    CHECK(out && out->field == SILC_FIELD_COMPLEX && out->val[0] == 4 && out->val[1] == 1 && out->val[2] == 8 &&
+              out->val[3] == 3, "(2 + i) r + 2 after promotion");
+    val_release(out);
+    CHECK(R->field == SILC_FIELD_REAL && R->refcount == 1, "the promoted operand was changed or kept");
+    /* no backend of the list takes complex values: a clear error */
+    CHECK(scale(E, Z, 2, 0, "backend = old_minor", &out) != 0 && !out, "old plugin ran a complex scale");
+    CHECK(strstr(E->err, "no backend can run scale (add) on complex values") &&
+              strstr(E->err, "operand 1 (2x1 complex dense)") &&
+              strstr(E->err, "old_minor does not take complex values"), "error: %s", E->err);
+    val_release(Z);
+    val_release(R);
+    eng_destroy(&E);
+}
+
 int main(void)
 {
     test_values();
+    test_gating();
     test_api();
     return check_done();
 }

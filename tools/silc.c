@@ -382,7 +382,7 @@ static int print_gets(silc_context *ctx, const cli_options *o)
 {
     for (int k = 0; k < o->nget; k++) {
         silc_envelope_t e = {0};
-        if (silc_get(ctx, &e, o->get_names[k])) {
+        if (silc_get_complex(ctx, &e, o->get_names[k])) { /* the CLI prints either field */
             fail("--get %s: %s", o->get_names[k], silc_context_errmsg(ctx));
             return 1;
         }

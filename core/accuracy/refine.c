@@ -33,6 +33,7 @@
 #include "accuracy.h"
 
 #include <float.h>
+#include <complex.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,6 +47,18 @@ int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const c
     int64_t i, j, p;
     if (!v || !(matrix ? val_props_part(v, SILC_PROPS_SHAPE)->has_nonfinite : val_has_nonfinite(v))) return 0;
     val_view(v, &w);
+    if (v->field == SILC_FIELD_COMPLEX) {
+        /* a NaN or Inf in either part; named by the worse of the two */
+        for (j = 0; j < w.n; j++)
+            for (i = 0; i < w.m; i++) {
+                double complex z = val_get_complex(v, i, j);
+                double re = creal(z), im = cimag(z);
+                if (isfinite(re) && isfinite(im)) continue;
+                return eng_error(E, "%s has %s at (%lld, %lld): a solve needs finite entries", name,
+                                 isnan(re) || isnan(im) ? "NaN" : "Inf", (long long)i + 1, (long long)j + 1);
+            }
+        return 0;
+    }
     for (i = 0; i < w.m; i++)
         for (j = 0; j < w.n; j++) {
             double x;
@@ -104,6 +117,10 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
     if (want <= 0 || !call->out) return;
     if (A->m != A->n || n == 0 || k == 0) {
         if (A->m != A->n) add_note(r, "refinement skipped: least-squares solve");
+        return;
+    }
+    if (A->field == SILC_FIELD_COMPLEX || Bv->field == SILC_FIELD_COMPLEX) {
+        add_note(r, "refinement skipped: complex system (not implemented)");
         return;
     }
     if (r->iterations > 0 && !r->single_factor) {

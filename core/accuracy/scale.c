@@ -38,7 +38,7 @@ static int exponent_for(const silc_value *v)
     frexp(maxabs, &e);
     if (e >= -SCALE_LIMIT && e <= SCALE_LIMIT) return 0;
     val_view(v, &w);
-    for (i = 0; i < w.nnz; i++)
+    for (i = 0; i < w.nnz * val_width(v); i++) /* both parts of a complex entry */
         if (w.val[i] != 0 && fabs(w.val[i]) < minabs) minabs = fabs(w.val[i]);
     frexp(minabs, &emin);
     /* 2^-e scales the max to [0.5, 1); the smallest must stay >= DBL_MIN. */
@@ -52,19 +52,19 @@ static silc_value *scaled(const silc_value *v, int e)
     silc_value *s;
     int64_t i;
     switch (v->format) {
-    case SILC_FMT_DENSE: s = val_dense_new(v->m, v->n); break;
+    case SILC_FMT_DENSE: s = val_new_unset_field(SILC_FMT_DENSE, v->field, v->m, v->n, 0, 0, 0); break;
     case SILC_FMT_CSR:
-        s = val_csr_new(v->m, v->n, v->nnz);
+        s = val_new_unset_field(SILC_FMT_CSR, v->field, v->m, v->n, v->nnz, 0, 0);
         if (s) {
             memcpy(s->rowptr, v->rowptr, (size_t)(v->m + 1) * sizeof *s->rowptr);
             memcpy(s->colind, v->colind, (size_t)v->nnz * sizeof *s->colind);
             val_csr_set_nnz(s, v->nnz);
         }
         break;
-    default: s = val_band_new(v->m, v->n, v->kl, v->ku); break;
+    default: s = val_new_unset_field(SILC_FMT_BAND, v->field, v->m, v->n, 0, v->kl, v->ku); break;
     }
     if (!s) return NULL;
-    for (i = 0; i < v->nnz; i++) s->val[i] = ldexp(v->val[i], e);
+    for (i = 0; i < v->nnz * val_width(v); i++) s->val[i] = ldexp(v->val[i], e);
     return s;
 }
 
@@ -126,7 +126,7 @@ int scale_solve_end(silc_call *call, scale_state *S)
     S->Bs = S->X0s = NULL;
     if (!X || S->ea == S->eb) return 0;
     was_finite = !val_has_nonfinite(X);
-    for (i = 0; i < X->nnz; i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
+    for (i = 0; i < X->nnz * val_width(X); i++) X->val[i] = ldexp(X->val[i], S->ea - S->eb);
     val_forget_caches(X); /* they described the scaled solution */
     return was_finite && val_has_nonfinite(X);
 }

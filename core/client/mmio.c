@@ -1,9 +1,11 @@
 /*
  * mmio.c -- Matrix Market files to and from envelopes.
  *
- * Reading builds CSR from coordinate files (real, integer or pattern;
- * general, symmetric or skew-symmetric, the stored triangle mirrored) and a
- * dense envelope from array files.  Nothing is summed: a repeated (i, j) --
+ * Reading builds CSR from coordinate files (real, integer, pattern or
+ * complex; general, symmetric or skew-symmetric, the stored triangle
+ * mirrored, and for complex files hermitian, mirrored conjugated) and a
+ * dense envelope from array files; a complex file gives a complex envelope
+ * (two numbers a line: real and imaginary part).  Nothing is summed: a repeated (i, j) --
  * also one created by mirroring -- is an error naming both lines, because a
  * file that says the same entry twice is more likely broken than meant.
  * Explicit zeros are kept.  Every message names file:line.  Lines are read
@@ -26,8 +28,22 @@
 #include "store.h"
 #include "util.h"
 
-enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN };
-enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW };
+enum mm_field { MM_REAL, MM_INTEGER, MM_PATTERN, MM_COMPLEX };
+enum mm_sym { MM_GENERAL, MM_SYMMETRIC, MM_SKEW, MM_HERMITIAN };
+
+/* Doubles an entry of a field: a complex entry is its real and imaginary part. */
+static int mm_width(int field)
+{
+    return field == MM_COMPLEX ? 2 : 1;
+}
+
+/* The mirror (j, i) of an entry (i, j) of value x (w doubles) under sym:
+ * the same, negated, or conjugated. */
+static void mm_mirror(int sym, int w, const double *x, double *out)
+{
+    out[0] = sym == MM_SKEW ? -x[0] : x[0];
+    if (w == 2) out[1] = sym == MM_SKEW || sym == MM_HERMITIAN ? -x[1] : x[1];
+}
 
 /* A data line holds one entry ("row col value"); comments are free text.
  * 64 KiB is far beyond either, and bounds what one line can allocate. */
@@ -273,13 +289,14 @@ static int mm_banner(mm_reader *r, int *is_array, int *field, int *sym)
     if (strcasecmp(w[3], "real") == 0 || strcasecmp(w[3], "double") == 0) *field = MM_REAL;
     else if (strcasecmp(w[3], "integer") == 0) *field = MM_INTEGER;
     else if (strcasecmp(w[3], "pattern") == 0) *field = MM_PATTERN;
-    else if (strcasecmp(w[3], "complex") == 0) return mm_fail(r, 1, "complex matrices are not supported yet");
-    else return mm_fail(r, 1, "unknown field '%s' (expected real, integer or pattern)", w[3]);
-    /* Hermitian is a property of complex matrices only, which are refused
-     * above: a real, integer or pattern file that says hermitian is
-     * malformed (its writer meant something this reader cannot know). */
+    else if (strcasecmp(w[3], "complex") == 0) *field = MM_COMPLEX;
+    else return mm_fail(r, 1, "unknown field '%s' (expected real, integer, pattern or complex)", w[3]);
+    /* Hermitian is a property of complex matrices only: a real, integer or
+     * pattern file that says hermitian is malformed (its writer meant
+     * something this reader cannot know; issue 32). */
     if (strcasecmp(w[4], "general") == 0) *sym = MM_GENERAL;
     else if (strcasecmp(w[4], "symmetric") == 0) *sym = MM_SYMMETRIC;
+    else if (strcasecmp(w[4], "hermitian") == 0 && *field == MM_COMPLEX) *sym = MM_HERMITIAN;
     else if (strcasecmp(w[4], "hermitian") == 0)
         return mm_fail(r, 1, "symmetry 'hermitian' needs a complex field, and this file's is '%s' "
                              "(say symmetric for a real symmetric matrix)", w[3]);
@@ -293,16 +310,16 @@ static int mm_banner(mm_reader *r, int *is_array, int *field, int *sym)
  * value and, for coordinate files, the triplets read before assembly (four
  * 8-byte arrays of up to 2 nz entries for symmetric files, and the
  * assembly's own copies). */
-static int mm_claim(int is_array, int64_t m, int64_t n, int64_t nz, int sym)
+static int mm_claim(int is_array, int64_t m, int64_t n, int64_t nz, int sym, int w)
 {
     char what[160];
     double cap = sym == MM_GENERAL ? (double)nz : 2.0 * (double)nz, bytes;
     if (is_array) {
-        bytes = (double)m * (double)n * 8;
+        bytes = (double)m * (double)n * 8 * w;
         snprintf(what, sizeof what, "the %lldx%lld array the size line announces", (long long)m,
                  (long long)n);
     } else {
-        bytes = ((double)m + 1) * 24 + ((double)n + 1) * 8 + cap * (32 + 32);
+        bytes = ((double)m + 1) * 24 + ((double)n + 1) * 8 + cap * (32 + 32 + 16 * (w - 1));
         snprintf(what, sizeof what, "the %lldx%lld matrix of %lld entries the size line announces",
                  (long long)m, (long long)n, (long long)nz);
     }
@@ -314,31 +331,41 @@ static int mm_claim(int is_array, int64_t m, int64_t n, int64_t nz, int sym)
 static int mm_read_array(mm_reader *r, silc_envelope_t *e, int64_t m, int64_t n, int field, int sym)
 {
     int64_t i, j;
+    int w = mm_width(field), c;
     double *a;
     if (sym != MM_GENERAL && m != n)
-        return mm_fail(r, r->lineno, "a symmetric or skew-symmetric matrix must be square, not %lldx%lld",
-                       (long long)m, (long long)n);
-    if (silc_envelope_dense(e, m, n, NULL)) return mm_fail(r, r->lineno, "out of memory for %lldx%lld",
-                                                            (long long)m, (long long)n);
+        return mm_fail(r, r->lineno, "a symmetric, skew-symmetric or hermitian matrix must be square, not "
+                                     "%lldx%lld", (long long)m, (long long)n);
+    if (w == 2 ? silc_envelope_dense_complex(e, m, n, NULL) : silc_envelope_dense(e, m, n, NULL))
+        return mm_fail(r, r->lineno, "out of memory for %lldx%lld", (long long)m, (long long)n);
     a = e->values;
     for (j = 0; j < n; j++) {
-        int64_t i0 = sym == MM_GENERAL ? 0 : sym == MM_SYMMETRIC ? j : j + 1;
+        int64_t i0 = sym == MM_GENERAL ? 0 : sym == MM_SKEW ? j + 1 : j;
         for (i = i0; i < m; i++) {
             const char *p = mm_next_data_line(r);
-            double x;
+            double x[2] = {0, 0};
             if (!p) {
                 silc_envelope_free(e);
                 return mm_fail(r, r->lineno, "file ends before entry (%lld, %lld)", (long long)i + 1,
                                (long long)j + 1);
             }
-            if (parse_value_token(r, &p, field, &x) ||
-                (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), "expected one number per line"))) {
+            for (c = 0; c < w; c++)
+                if (parse_value_token(r, &p, field == MM_COMPLEX ? MM_REAL : field, &x[c])) {
+                    silc_envelope_free(e);
+                    return -1;
+                }
+            if (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), w == 2 ? "expected two numbers per line "
+                                             "(real and imaginary part)" : "expected one number per line")) {
                 silc_envelope_free(e);
                 return -1;
             }
-            a[i + j * m] = x;
-            if (sym == MM_SYMMETRIC) a[j + i * m] = x;
-            else if (sym == MM_SKEW) a[j + i * m] = -x;
+            if (sym == MM_HERMITIAN && i == j && x[1] != 0) {
+                silc_envelope_free(e);
+                return mm_fail(r, r->lineno, "diagonal entry (%lld, %lld) of a hermitian file has imaginary "
+                                             "part %g (it must be real)", (long long)i + 1, (long long)j + 1, x[1]);
+            }
+            memcpy(a + (i + j * m) * w, x, (size_t)w * sizeof *x);
+            if (sym != MM_GENERAL && i != j) mm_mirror(sym, w, x, a + (j + i * m) * w);
         }
     }
     if (mm_next_data_line(r)) {
@@ -362,12 +389,12 @@ static void triplets_free(triplets *t)
 
 /* Assembles CSR: a counting sort by column, then a stable one by row, leaves
  * every row sorted by column; equal neighbours are duplicates. */
-static int mm_assemble(mm_reader *r, const triplets *t, int64_t m, int64_t n, silc_envelope_t *e)
+static int mm_assemble(mm_reader *r, const triplets *t, int64_t m, int64_t n, int w, silc_envelope_t *e)
 {
     int64_t *cp = calloc((size_t)n + 1, sizeof *cp), *bycol = malloc(((size_t)t->n + 1) * sizeof *bycol);
     int64_t *rp = calloc((size_t)m + 1, sizeof *rp), *next = malloc(((size_t)m + 1) * sizeof *next);
     int64_t *ci = malloc(((size_t)t->n + 1) * sizeof *ci), *src = malloc(((size_t)t->n + 1) * sizeof *src);
-    double *x = malloc(((size_t)t->n + 1) * sizeof *x);
+    double *x = malloc(((size_t)t->n + 1) * (size_t)w * sizeof *x);
     int64_t k, a, rc = 0;
     if (!cp || !bycol || !rp || !next || !ci || !src || !x) {
         rc = mm_fail(r, 0, "out of memory for %lld entries", (long long)t->n);
@@ -382,7 +409,7 @@ static int mm_assemble(mm_reader *r, const triplets *t, int64_t m, int64_t n, si
     for (a = 0; a < t->n; a++) {
         int64_t s = bycol[a], d = next[t->i[s]]++;
         ci[d] = t->j[s];
-        x[d] = t->x[s];
+        memcpy(x + d * w, t->x + s * w, (size_t)w * sizeof *x);
         src[d] = s;
     }
     for (a = 0; a < m; a++)
@@ -398,7 +425,7 @@ static int mm_assemble(mm_reader *r, const triplets *t, int64_t m, int64_t n, si
     memset(e, 0, sizeof *e);
     e->m = m;
     e->n = n;
-    e->format = SILC_CSR;
+    e->format = w == 2 ? SILC_CSR_COMPLEX : SILC_CSR;
     e->rowptr = rp;
     e->colind = ci;
     e->values = x;
@@ -415,15 +442,15 @@ static int mm_read_coordinate(mm_reader *r, silc_envelope_t *e, int64_t m, int64
 {
     triplets t = {0};
     int64_t cap, k;
-    int rc;
+    int rc, w = mm_width(field), c;
     if (sym != MM_GENERAL && m != n)
-        return mm_fail(r, r->lineno, "a symmetric or skew-symmetric matrix must be square, not %lldx%lld",
-                       (long long)m, (long long)n);
+        return mm_fail(r, r->lineno, "a symmetric, skew-symmetric or hermitian matrix must be square, not "
+                                     "%lldx%lld", (long long)m, (long long)n);
     cap = sym == MM_GENERAL ? nz : 2 * nz;
     t.i = malloc(((size_t)cap + 1) * sizeof *t.i);
     t.j = malloc(((size_t)cap + 1) * sizeof *t.j);
     t.line = malloc(((size_t)cap + 1) * sizeof *t.line);
-    t.x = malloc(((size_t)cap + 1) * sizeof *t.x);
+    t.x = malloc(((size_t)cap + 1) * (size_t)w * sizeof *t.x);
     if (!t.i || !t.j || !t.line || !t.x) {
         triplets_free(&t);
         return mm_fail(r, r->lineno, "out of memory for %lld entries", (long long)nz);
@@ -431,16 +458,25 @@ static int mm_read_coordinate(mm_reader *r, silc_envelope_t *e, int64_t m, int64
     for (k = 0; k < nz; k++) {
         const char *p = mm_next_data_line(r);
         int64_t i, j;
-        double x = 1.0;
+        double x[2] = {1.0, 0.0};
         if (!p) {
             triplets_free(&t);
             return mm_fail(r, r->lineno, "file ends after %lld of %lld entries", (long long)k, (long long)nz);
         }
         const char *start = p;
-        if (parse_int_token(r, &p, "row index", &i) || parse_int_token(r, &p, "column index", &j) ||
-            (field != MM_PATTERN && parse_value_token(r, &p, field, &x)) ||
-            (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), "unexpected text after '%s'",
-                                          field == MM_PATTERN ? "row column" : "row column value"))) {
+        if (parse_int_token(r, &p, "row index", &i) || parse_int_token(r, &p, "column index", &j)) {
+            triplets_free(&t);
+            return -1;
+        }
+        for (c = 0; c < (field == MM_PATTERN ? 0 : w); c++)
+            if (parse_value_token(r, &p, field == MM_COMPLEX ? MM_REAL : field, &x[c])) {
+                triplets_free(&t);
+                return -1;
+            }
+        if (!only_space(p) && mm_fail_at(r, p + strspn(p, " \t"), "unexpected text after '%s'",
+                                         field == MM_PATTERN ? "row column"
+                                         : w == 2          ? "row column real imaginary"
+                                                           : "row column value")) {
             triplets_free(&t);
             return -1;
         }
@@ -462,16 +498,21 @@ static int mm_read_coordinate(mm_reader *r, silc_envelope_t *e, int64_t m, int64
             triplets_free(&t);
             return mm_fail_at(r, start, "entry (%lld, %lld) is above the diagonal: a %s file stores the "
                                         "lower triangle only", (long long)i, (long long)j,
-                              sym == MM_SKEW ? "skew-symmetric" : "symmetric");
+                              sym == MM_SKEW ? "skew-symmetric" : sym == MM_HERMITIAN ? "hermitian" : "symmetric");
+        }
+        if (sym == MM_HERMITIAN && i == j && x[1] != 0) {
+            triplets_free(&t);
+            return mm_fail_at(r, start, "diagonal entry (%lld, %lld) of a hermitian file has imaginary part "
+                                        "%g (it must be real)", (long long)i, (long long)j, x[1]);
         }
         t.i[t.n] = i - 1;
         t.j[t.n] = j - 1;
-        t.x[t.n] = x;
+        memcpy(t.x + t.n * w, x, (size_t)w * sizeof *x);
         t.line[t.n++] = r->lineno;
         if (sym != MM_GENERAL && i != j) {
             t.i[t.n] = j - 1;
             t.j[t.n] = i - 1;
-            t.x[t.n] = sym == MM_SKEW ? -x : x;
+            mm_mirror(sym, w, x, t.x + t.n * w);
             t.line[t.n++] = r->lineno;
         }
     }
@@ -479,7 +520,7 @@ static int mm_read_coordinate(mm_reader *r, silc_envelope_t *e, int64_t m, int64
         triplets_free(&t);
         return mm_fail(r, r->lineno, "more entries than the %lld the size line announces", (long long)nz);
     }
-    rc = mm_assemble(r, &t, m, n, e);
+    rc = mm_assemble(r, &t, m, n, w, e);
     triplets_free(&t);
     return rc;
 }
@@ -515,7 +556,7 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
                  (!is_array && parse_int_token(&r, &p, "entry count", &nz)) || !only_space(p) || m < 0 ||
                  n < 0 || nz < 0)
             rc = mm_fail(&r, r.lineno, "expected the size line '%s'", is_array ? "rows cols" : "rows cols entries");
-        else if (mm_claim(is_array, m, n, nz, sym))
+        else if (mm_claim(is_array, m, n, nz, sym, mm_width(field)))
             rc = mm_fail(&r, r.lineno, "%s", val_refusal());
         else if (is_array)
             rc = mm_read_array(&r, e, m, n, field, sym);
@@ -544,26 +585,37 @@ int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen)
 int silc_mm_write(const silc_envelope_t *e, FILE *out)
 {
     int64_t i, j, k, count = 0;
+    int w = silc_envelope_is_complex(e) ? 2 : 1;
+    const char *field = w == 2 ? "complex" : "real";
     if (!e || !out) return env_error("silc_mm_write: NULL %s", e ? "stream" : "envelope");
-    switch (e->format) {
+    switch (env_format_base((int)e->format)) {
     case SILC_DENSE:
         if (e->m * e->n > 0 && !e->values) return env_error("silc_mm_write: envelope has no values");
-        fprintf(out, "%%%%MatrixMarket matrix array real general\n%lld %lld\n", (long long)e->m,
+        fprintf(out, "%%%%MatrixMarket matrix array %s general\n%lld %lld\n", field, (long long)e->m,
                 (long long)e->n);
-        for (k = 0; k < e->m * e->n; k++) fprintf(out, "%.17g\n", e->values[k]);
+        for (k = 0; k < e->m * e->n; k++) {
+            if (w == 2) fprintf(out, "%.17g %.17g\n", e->values[2 * k], e->values[2 * k + 1]);
+            else fprintf(out, "%.17g\n", e->values[k]);
+        }
         break;
     case SILC_CSR:
         if (!e->rowptr) return env_error("silc_mm_write: CSR envelope has no rowptr");
-        fprintf(out, "%%%%MatrixMarket matrix coordinate real general\n%lld %lld %lld\n",
+        fprintf(out, "%%%%MatrixMarket matrix coordinate %s general\n%lld %lld %lld\n", field,
                 (long long)e->m, (long long)e->n, (long long)e->rowptr[e->m]);
         for (i = 0; i < e->m; i++)
-            for (k = e->rowptr[i]; k < e->rowptr[i + 1]; k++)
-                fprintf(out, "%lld %lld %.17g\n", (long long)i + 1, (long long)e->colind[k] + 1,
-                        e->values[k]);
+            for (k = e->rowptr[i]; k < e->rowptr[i + 1]; k++) {
+                if (w == 2)
+                    fprintf(out, "%lld %lld %.17g %.17g\n", (long long)i + 1, (long long)e->colind[k] + 1,
+                            e->values[2 * k], e->values[2 * k + 1]);
+                else
+                    fprintf(out, "%lld %lld %.17g\n", (long long)i + 1, (long long)e->colind[k] + 1,
+                            e->values[k]);
+            }
         break;
     case SILC_BAND: {
         /* Only the nonzeros: the zero corners of band storage are not entries. */
         int64_t ld = e->kl + e->ku + 1;
+        if (w == 2) return env_error("silc_mm_write: complex band values are written as CSR (sparse(A))");
         for (k = 0; k < 2; k++) {
             if (k == 1)
                 fprintf(out, "%%%%MatrixMarket matrix coordinate real general\n%lld %lld %lld\n",

@@ -16,6 +16,13 @@
  *
  * Every solve gets the same accuracy report whoever ran it: the backward error
  * comes from accuracy.c, so backends are judged by one yardstick.
+ *
+ * Complex operands (ABI 1.8) go only to a backend whose plugin lists the
+ * op in complex_ops; any other is passed over ("does not take complex
+ * values") and the list moves on.  A call never mixes fields: real
+ * operands of a call with a complex one are promoted first (one copy each,
+ * released after), except a real A solved against a complex b, which is
+ * two real solves sharing A's factorization (disp_run).
  */
 #define _POSIX_C_SOURCE 200809L
 #include "dispatch.h"
@@ -216,18 +223,22 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
             snprintf(band_reason, sizeof band_reason, "banded (kl=%lld, ku=%lld)",
                      (long long)p->kl, (long long)p->ku);
             reason = band_reason;
-        } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric) {
-            /* (Not on an MPI engine: its lists start with the distributed
-             * solvers.)  A repeat is scanned only to explain itself. */
+        } else if (p->pos_diag && val_props_part(A, SILC_PROPS_SYMMETRY)->hermitian) {
+            /* Hermitian (for a real A: symmetric) with a real positive
+             * diagonal: Cholesky's class.  A complex symmetric A (A = A.')
+             * is not, and goes to the general class below (LU).  (Not on an
+             * MPI engine: its lists start with the distributed solvers.)  A
+             * repeat is scanned only to explain itself. */
             int repeat = sparse && val_attach_get(A, SOLVED_KEY) != NULL;
             int mm = sparse && E && !E->dist && (!repeat || why) && mmatrix_class_applies(E) &&
-                     large_mmatrix(A);
+                     A->field == SILC_FIELD_REAL && large_mmatrix(A);
             if (mm && !repeat) out[n++] = "solve.sparse.mmatrix.spd";
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
             snprintf(spd_reason, sizeof spd_reason, "%s%s",
                      banded ? "banded, but a sparse class is configured and solve.band is not; " : "",
-                     !mm ? "symmetric with positive diagonal"
+                     !mm ? (A->field == SILC_FIELD_COMPLEX ? "Hermitian with real positive diagonal"
+                                                          : "symmetric with positive diagonal")
                      : repeat ? "symmetric M-matrix solved before (a factorization kept for the later solves "
                                 "pays from here)"
                               : "symmetric M-matrix (positive diagonal, off-diagonal entries <= 0), first "
@@ -238,13 +249,17 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
             reason = "banded, but a sparse class is configured and solve.band is not";
         } else {
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
-            reason = why && val_props_part(A, SILC_PROPS_SYMMETRY)->symmetric
-                         ? "symmetric, some diagonal entry <= 0"
-                         : "general";
+            const silc_props *ps = why ? val_props_part(A, SILC_PROPS_SYMMETRY) : NULL;
+            reason = !ps ? "general"
+                     : A->field == SILC_FIELD_COMPLEX && ps->hermitian ? "Hermitian, some diagonal entry not real and > 0"
+                     : A->field == SILC_FIELD_COMPLEX && ps->symmetric ? "complex symmetric (A = A.'), not Hermitian"
+                     : ps->symmetric ? "symmetric, some diagonal entry <= 0"
+                                     : "general";
         }
         if (why && whylen) {
-            int k = snprintf(why, whylen, "A is %lldx%lld %s, %s -> %s", (long long)A->m,
-                             (long long)A->n, val_format_name(A->format), reason, out[0]);
+            int k = snprintf(why, whylen, "A is %lldx%lld %s%s, %s -> %s", (long long)A->m,
+                             (long long)A->n, A->field == SILC_FIELD_COMPLEX ? "complex " : "",
+                             val_format_name(A->format), reason, out[0]);
             for (int c = 1; c < n && k > 0 && (size_t)k < whylen; c++) {
                 int more = snprintf(why + k, whylen - (size_t)k, ", then %s", out[c]);
                 k = more > 0 ? k + more : -1;
@@ -386,6 +401,29 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
 static int provides(const ld_backend *b, int op)
 {
     return op < b->backend->n_ops && b->backend->ops[op].run != NULL;
+}
+
+/* 1 when call has a complex operand (or a complex alpha or beta). */
+static int call_complex(const silc_call *call)
+{
+    for (int i = 0; i < call->nin; i++)
+        if (call->in[i] && call->in[i]->field == SILC_FIELD_COMPLEX) return 1;
+    return call->alpha_imag != 0 || call->beta_imag != 0;
+}
+
+/* The complex operands of call, as a user reads them ("operand 1 (3x3
+ * complex csr)"), for the error of a chain no backend would take. */
+static void describe_complex_operands(const silc_call *call, strbuf *b)
+{
+    const char *sep = "";
+    for (int i = 0; i < call->nin; i++) {
+        const silc_value *v = call->in[i];
+        if (!v || v->field != SILC_FIELD_COMPLEX) continue;
+        sb_printf(b, "%soperand %d (%lldx%lld complex %s)", sep, i + 1, (long long)v->m, (long long)v->n,
+                  val_format_name(v->format));
+        sep = ", ";
+    }
+    if (!*sep) sb_printf(b, "a complex scalar factor");
 }
 
 static const char *status_text(int status)
@@ -726,7 +764,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
 {
     strbuf skipped, attempts;
     dist_swap swap;
-    int ci, i, rc, cholesky_failed = 0;
+    int ci, i, rc, cholesky_failed = 0, complex = call_complex(call);
     sb_init(&skipped);
     sb_init(&attempts);
     for (ci = 0; ci < nchain; ci++) {
@@ -753,6 +791,10 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
             }
             if (!provides(b, call->op)) {
                 sb_printf(&skipped, "%s does not provide %s; ", b->full_name, op_names[call->op]);
+                continue;
+            }
+            if (complex && !ld_backend_takes_complex(b, call->op)) {
+                sb_printf(&skipped, "%s does not take complex values; ", b->full_name);
                 continue;
             }
             if (call->op == SILC_OP_SOLVE && fallback_left(L, i) && failed_before(E, call->in[0], b->full_name)) {
@@ -923,7 +965,16 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
     call->host_private = NULL;
     /* Drop the trailing "; " of the last reason. */
     if (skipped.len >= 2) skipped.s[skipped.len -= 2] = '\0';
-    eng_error(E, "no backend can run %s (%s): %s", op_names[call->op], chain[0], sb_str(&skipped));
+    if (complex) {
+        strbuf what;
+        sb_init(&what);
+        describe_complex_operands(call, &what);
+        eng_error(E, "no backend can run %s (%s) on complex values -- %s: %s", op_names[call->op], chain[0],
+                  sb_str(&what), sb_str(&skipped));
+        sb_free(&what);
+    } else {
+        eng_error(E, "no backend can run %s (%s): %s", op_names[call->op], chain[0], sb_str(&skipped));
+    }
     chain_error(E, &attempts);
     sb_free(&skipped);
     sb_free(&attempts);
@@ -943,7 +994,7 @@ static int symmetry_unknown(const silc_call *call, const char *const chain[4])
            !strcmp(chain[0], A->format == SILC_FMT_CSR ? "solve.sparse" : "solve.dense");
 }
 
-int disp_run(silc_engine *E, silc_call *call)
+static int run_call(silc_engine *E, silc_call *call)
 {
     const char *chain[4];
     silc_report local;
@@ -997,6 +1048,96 @@ int disp_run(silc_engine *E, silc_call *call)
     return rc;
 }
 
+/* A real A against a complex b: x = A \ real(b) + i (A \ imag(b)), two
+ * real solves of which the second finds A's factorization attached to A
+ * by the first (promoting A would factor a complex copy of it, in 4x the
+ * arithmetic).  The report is the first solve's with the worse backward
+ * error of the two. */
+static int run_split_solve(silc_engine *E, silc_call *call)
+{
+    const silc_value *b = call->in[1];
+    silc_value *part[2] = {NULL, NULL}, *x[2] = {NULL, NULL};
+    silc_report *rep = call->report, first;
+    int nin = call->nin, rc = 0, k;
+    memset(&first, 0, sizeof first);
+    if (nin == 3 && call->in[2] && call->in[2]->field == SILC_FIELD_COMPLEX) call->nin = 2; /* no real guess */
+    for (k = 0; k < 2 && !rc; k++) {
+        if (!(part[k] = val_part(b, k))) {
+            rc = SILC_ENOMEM;
+            eng_error(E, "%s", *val_refusal() ? val_refusal() : "out of memory splitting a complex right-hand side");
+            break;
+        }
+        call->in[1] = part[k];
+        rc = run_call(E, call);
+        x[k] = call->out;
+        call->out = NULL;
+        if (!rc && rep && k == 0) first = *rep;
+    }
+    call->in[1] = b;
+    call->nin = nin;
+    if (!rc && !(call->out = val_complex_of_parts(x[0], x[1]))) {
+        rc = SILC_ENOMEM;
+        eng_error(E, "%s", *val_refusal() ? val_refusal() : "out of memory joining a complex solution");
+    }
+    if (!rc && rep) {
+        double second = rep->backward_error;
+        *rep = first;
+        if (first.backward_error >= 0 && (second > first.backward_error || second == ACC_DEFERRED))
+            rep->backward_error = second;
+    }
+    for (k = 0; k < 2; k++) {
+        val_release(part[k]);
+        val_release(x[k]);
+    }
+    return rc;
+}
+
+/* A call mixing real and complex operands (or a complex alpha with a real
+ * operand): each real operand promoted once for the call, released after;
+ * the result is the call's. */
+static int run_promoted(silc_engine *E, silc_call *call)
+{
+    const silc_value *saved[4] = {NULL, NULL, NULL, NULL};
+    silc_value *copies[4] = {NULL, NULL, NULL, NULL};
+    int i, rc = 0, n = call->nin < 4 ? call->nin : 4;
+    for (i = 0; i < n && !rc; i++) {
+        saved[i] = call->in[i];
+        if (!call->in[i] || call->in[i]->field == SILC_FIELD_COMPLEX) continue;
+        if (i > 0 && call->in[i] == saved[0]) { /* the same operand twice: one copy */
+            copies[i] = val_retain(copies[0]);
+        } else if (!(copies[i] = val_promote(call->in[i]))) {
+            rc = SILC_ENOMEM;
+            eng_error(E, "%s", *val_refusal() ? val_refusal() : "out of memory promoting a real operand to complex");
+            break;
+        }
+        call->in[i] = copies[i];
+    }
+    if (!rc) rc = run_call(E, call);
+    for (i = 0; i < n; i++) {
+        if (saved[i]) call->in[i] = saved[i];
+        val_release(copies[i]);
+    }
+    return rc;
+}
+
+int disp_run(silc_engine *E, silc_call *call)
+{
+    int i, any_real = 0;
+    if (!E || !call) return SILC_EARG;
+    if (!call_complex(call)) return run_call(E, call);
+    if (E->dist || dist_call_has(call)) {
+        call->out = NULL;
+        eng_error(E, "%s: complex values are not distributed (issue 31)",
+                  call->op >= 0 && call->op < SILC_OP_COUNT ? op_names[call->op] : "operation");
+        return SILC_EUNSUP;
+    }
+    if (call->op == SILC_OP_SOLVE && call->nin >= 2 && call->in[0] && call->in[1] &&
+        call->in[0]->field == SILC_FIELD_REAL && call->in[1]->field == SILC_FIELD_COMPLEX)
+        return run_split_solve(E, call);
+    for (i = 0; i < call->nin; i++) any_real |= call->in[i] && call->in[i]->field == SILC_FIELD_REAL;
+    return any_real ? run_promoted(E, call) : run_call(E, call);
+}
+
 /* ---- explain --------------------------------------------------------------- */
 
 int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
@@ -1040,6 +1181,10 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b)
         }
         if (!provides(be, call->op)) {
             sb_printf(b, "  %s: does not provide %s\n", be->full_name, op_names[call->op]);
+            continue;
+        }
+        if (call_complex(call) && !ld_backend_takes_complex(be, call->op)) {
+            sb_printf(b, "  %s: does not take complex values\n", be->full_name);
             continue;
         }
         memset(&ctx, 0, sizeof ctx);

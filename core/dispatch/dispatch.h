@@ -124,6 +124,9 @@ void ld_set_threads(silc_engine *E, int nthreads); /* every plugin's set_threads
 /* 1 when b's plugin lists op among b's collective_ops (ABI 1.5): b runs it
  * on the row blocks of every rank of an SPMD engine (dist.h). */
 int ld_backend_collective(const ld_backend *b, int op);
+/* 1 when b's plugin (ABI 1.8 or later) lists op among b's complex_ops: only
+ * then does b get complex operands (silc_plugin.h). */
+int ld_backend_takes_complex(const ld_backend *b, int op);
 /* Names every backend may be configured with, loaded or not (for suggestions
  * and for telling "not installed" from "unknown"). */
 extern const char *const ld_known_backends[];

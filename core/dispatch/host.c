@@ -267,7 +267,10 @@ static silc_value *h_dist_dense_new(const silc_value *like, int64_t n)
 {
     silc_value *blk;
     if (!like || !like->dist) return NULL;
-    if (!(blk = val_dense_new(like->dist->block->m, n))) return NULL;
+    /* ABI 1.8: of like's field */
+    blk = like->field == SILC_FIELD_COMPLEX ? val_dense_new_complex(like->dist->block->m, n)
+                                            : val_dense_new(like->dist->block->m, n);
+    if (!blk) return NULL;
     return val_dist_new(like->m, n, SILC_FMT_DENSE, like->dist->ctx, like->dist->part, blk);
 }
 

@@ -610,6 +610,20 @@ int ld_backend_collective(const ld_backend *b, int op)
     return 0;
 }
 
+int ld_backend_takes_complex(const ld_backend *b, int op)
+{
+    const silc_plugin *pl = b->plugin->table;
+    int i;
+    /* Read only from a 1.8 table long enough to hold the field: an older
+     * plugin's struct ends before it, and is never handed complex data. */
+    if (pl->abi_minor < 8 || pl->struct_size < offsetof(silc_plugin, complex_ops) + sizeof(void *) ||
+        !pl->complex_ops)
+        return 0;
+    for (i = 0; i < pl->n_backends; i++)
+        if (&pl->backends[i] == b->backend) return (pl->complex_ops[i] & SILC_COMPLEX_OPS(op)) != 0;
+    return 0;
+}
+
 static const ld_backend *find_loaded(const silc_engine *E, const char *full_name)
 {
     size_t i;

@@ -130,9 +130,10 @@ SILC_API int silc_envelope_to_dense(const silc_envelope_t *e, double *colmajor_o
 /* Frees the arrays and zeroes the envelope; NULL and zeroed envelopes are fine. */
 SILC_API void silc_envelope_free(silc_envelope_t *e);
 
-/* Matrix Market: read coordinate (real, integer, pattern; general, symmetric,
- * skew-symmetric) into CSR, or array into dense.  Complex files are refused with
- * a message.  Read by the format's rules, with "path:line:column: ..." messages:
+/* Matrix Market: read coordinate (real, integer, pattern, complex; general,
+ * symmetric, skew-symmetric, and for complex files hermitian, whose stored
+ * lower triangle is mirrored conjugated and whose diagonal must be real) into
+ * CSR, or array into dense; a complex file gives a complex envelope.  Read by the format's rules, with "path:line:column: ..." messages:
  * integer fields take integers within int64, reals are decimal (no hex), inf,
  * nan and reals that overflow are refused unless the environment sets
  * SILC_MM_ALLOW_NONFINITE=1, "hermitian" needs a complex field, and a symmetric
@@ -140,6 +141,8 @@ SILC_API void silc_envelope_free(silc_envelope_t *e);
  * refused).  A failed read leaves e not constructed, as a failed constructor.
  * Write: dense as array, CSR/band as coordinate general, %.17g. */
 SILC_API int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
+/* (Write: a complex envelope as `complex general`, "re im" on each line; a
+ * complex band envelope is refused: write sparse(A).) */
 SILC_API int silc_mm_write(const silc_envelope_t *e, FILE *out);
 
 /* ---- contexts -------------------------------------------------------------- */

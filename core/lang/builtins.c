@@ -20,6 +20,7 @@
  */
 #include "lang.h"
 
+#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -320,14 +321,23 @@ static int sparse_triplets(lang_ev *V, const ast_node *call, silc_value **a, sil
             return oom(V);
         }
     }
-    if (!(r = val_csr_new(m, n, s->nnz))) return oom(V);
+    if (!(r = a[2]->field == SILC_FIELD_COMPLEX ? val_csr_new_complex(m, n, s->nnz) : val_csr_new(m, n, s->nnz)))
+        return oom(V);
     memcpy(r->rowptr, s->rowptr, (size_t)(m + 1) * sizeof *r->rowptr);
     memcpy(r->colind, s->colind, (size_t)s->nnz * sizeof *r->colind);
-    memset(r->val, 0, (size_t)s->nnz * sizeof *r->val);
-    if (val_is_scalar(a[2])) {
+    if (a[2]->field == SILC_FIELD_COMPLEX) { /* complex v: both parts summed (the array is zeroed) */
+        for (k = 0; k < len; k++) {
+            double complex c = val_get_complex(a[2], val_is_scalar(a[2]) || a[2]->m == 1 ? 0 : k,
+                                               val_is_scalar(a[2]) ? 0 : a[2]->m == 1 ? k : 0);
+            r->val[2 * s->dest[k]] += creal(c);
+            r->val[2 * s->dest[k] + 1] += cimag(c);
+        }
+    } else if (val_is_scalar(a[2])) {
+        memset(r->val, 0, (size_t)s->nnz * sizeof *r->val);
         double c = val_scalar(a[2]);
         for (k = 0; k < len; k++) r->val[s->dest[k]] += c;
     } else {
+        memset(r->val, 0, (size_t)s->nnz * sizeof *r->val);
         for (k = 0; k < len; k++) r->val[s->dest[k]] += val_get(a[2], a[2]->m == 1 ? 0 : k, a[2]->m == 1 ? k : 0);
     }
     val_csr_set_nnz(r, s->nnz);
@@ -349,6 +359,12 @@ static int bi_dense(lang_ev *V, const ast_node *call, silc_value **a, int n, sil
     return run_call(V, call, SILC_OP_CONVERT, SILC_FMT_DENSE, a[0], NULL, out);
 }
 
+/* Entry k (counted in entries) of v's array val is nonzero, in either part. */
+static int entry_nonzero(const silc_value *v, const double *val, int64_t k)
+{
+    return v->field == SILC_FIELD_COMPLEX ? val[2 * k] != 0 || val[2 * k + 1] != 0 : val[k] != 0;
+}
+
 static int bi_band(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
 {
     silc_call c;
@@ -365,14 +381,14 @@ static int bi_band(lang_ev *V, const ast_node *call, silc_value **a, int n, silc
             int64_t p;
             for (p = w.rowptr[i]; p < w.rowptr[i + 1]; p++) {
                 j = w.colind[p];
-                if (w.val[p] != 0 && (j < i - kl || j > i + ku)) goto outside;
+                if (entry_nonzero(a[0], w.val, p) && (j < i - kl || j > i + ku)) goto outside;
             }
         } else if (w.format == SILC_FMT_DENSE) {
             for (j = 0; j < w.n; j++)
-                if ((j < i - kl || j > i + ku) && w.val[i + j * w.m] != 0) goto outside;
+                if ((j < i - kl || j > i + ku) && entry_nonzero(a[0], w.val, i + j * w.m)) goto outside;
         } else {
             for (j = i - w.kl > 0 ? i - w.kl : 0; j <= i + w.ku && j < w.n; j++)
-                if ((j < i - kl || j > i + ku) && val_get(a[0], i, j) != 0) goto outside;
+                if ((j < i - kl || j > i + ku) && val_get_complex(a[0], i, j) != 0) goto outside;
         }
     }
     memset(&c, 0, sizeof c);
@@ -413,9 +429,16 @@ static int bi_reduce(lang_ev *V, const ast_node *call, silc_value **a, int n, si
 
 static int bi_dot(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
 {
+    silc_value *x;
+    int rc;
     (void)n;
     if (same_shape_args(V, call, a, 0)) return -1;
-    return run_call(V, call, SILC_OP_REDUCE, SILC_RED_DOT, a[0], a[1], out);
+    if (a[0]->field != SILC_FIELD_COMPLEX) return run_call(V, call, SILC_OP_REDUCE, SILC_RED_DOT, a[0], a[1], out);
+    /* Octave's dot conjugates its first argument: sum(conj(x) .* y) */
+    if (run_call(V, call, SILC_OP_MAP, SILC_MAP_CONJ, a[0], NULL, &x)) return -1;
+    rc = run_call(V, call, SILC_OP_REDUCE, SILC_RED_DOT, x, a[1], out);
+    val_release(x);
+    return rc;
 }
 
 static int bi_norm(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
@@ -438,15 +461,73 @@ static int bi_norm(lang_ev *V, const ast_node *call, silc_value **a, int n, silc
     return run_call(V, call, SILC_OP_REDUCE, sub, a[0], NULL, out);
 }
 
+/* 1 when a stored entry of the real value v is < 0. */
+static int has_negative(const silc_value *v)
+{
+    for (int64_t k = 0; k < v->nnz; k++)
+        if (v->val[k] < 0) return 1;
+    return 0;
+}
+
+/* complex(a, b): a + bi from real a and b of one shape (or a scalar), built
+ * by the core: exactly the parts given (no arithmetic, so complex(1, -0)
+ * keeps its -0). */
+static int bi_complex(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
+{
+    int64_t m, k, i, j;
+    (void)n;
+    if (a[0]->field == SILC_FIELD_COMPLEX || a[1]->field == SILC_FIELD_COMPLEX)
+        return eng_error(V->E, "complex: the arguments must be real (argument %d is complex)",
+                         a[0]->field == SILC_FIELD_COMPLEX ? 1 : 2);
+    if (same_shape_args(V, call, a, 1)) return -1;
+    if ((*out = val_complex_of_parts(a[0], a[1]))) {
+        note_core(V, call, *out);
+        return 0;
+    }
+    /* different formats or patterns, or a scalar with a matrix: dense */
+    m = val_is_scalar(a[0]) ? a[1]->m : a[0]->m;
+    k = val_is_scalar(a[0]) ? a[1]->n : a[0]->n;
+    if (!(*out = val_dense_new_complex(m, k))) return oom(V);
+    for (j = 0; j < k; j++)
+        for (i = 0; i < m; i++) {
+            (*out)->val[2 * (i + j * m)] = val_is_scalar(a[0]) ? val_scalar(a[0]) : val_get(a[0], i, j);
+            (*out)->val[2 * (i + j * m) + 1] = val_is_scalar(a[1]) ? val_scalar(a[1]) : val_get(a[1], i, j);
+        }
+    note_core(V, call, *out);
+    return 0;
+}
+
+/* isreal(x): 1 for a real value.  A complex value stays complex when its
+ * imaginary parts are 0 (SILC demotes only on request: real(x)). */
+static int bi_isreal(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
+{
+    (void)call;
+    (void)n;
+    *out = val_scalar_new(a[0]->field == SILC_FIELD_REAL);
+    return *out ? 0 : oom(V);
+}
+
 static int bi_map(lang_ev *V, const ast_node *call, silc_value **a, int n, silc_value **out)
 {
     static const struct { const char *name; int sub; } maps[] = {
-        {"abs", SILC_MAP_ABS}, {"sqrt", SILC_MAP_SQRT}, {"exp", SILC_MAP_EXP},
-        {"log", SILC_MAP_LOG}, {"sin", SILC_MAP_SIN},   {"cos", SILC_MAP_COS}};
+        {"abs", SILC_MAP_ABS},   {"sqrt", SILC_MAP_SQRT}, {"exp", SILC_MAP_EXP},   {"log", SILC_MAP_LOG},
+        {"sin", SILC_MAP_SIN},   {"cos", SILC_MAP_COS},   {"real", SILC_MAP_REAL}, {"imag", SILC_MAP_IMAG},
+        {"conj", SILC_MAP_CONJ}, {"angle", SILC_MAP_ANGLE}};
     size_t i;
+    silc_value *z;
+    int rc;
     (void)n;
     for (i = 0; i < sizeof maps / sizeof maps[0]; i++)
         if (!strcmp(call->name, maps[i].name)) break;
+    /* sqrt(-1) and log(-1) are complex, as in Octave: a real operand with a
+     * negative entry is promoted first (the map keeps its operand's field) */
+    if ((maps[i].sub == SILC_MAP_SQRT || maps[i].sub == SILC_MAP_LOG) && a[0]->field == SILC_FIELD_REAL &&
+        has_negative(a[0])) {
+        if (!(z = val_promote(a[0]))) return oom(V);
+        rc = run_call(V, call, SILC_OP_MAP, maps[i].sub, z, NULL, out);
+        val_release(z);
+        return rc;
+    }
     return run_call(V, call, SILC_OP_MAP, maps[i].sub, a[0], NULL, out);
 }
 
@@ -501,13 +582,16 @@ static const bi_entry table[] = {
     {"abs", 1, 1, bi_map},      {"sqrt", 1, 1, bi_map},      {"exp", 1, 1, bi_map},
     {"log", 1, 1, bi_map},      {"sin", 1, 1, bi_map},       {"cos", 1, 1, bi_map},
     {"trans", 1, 1, bi_trans},  {"solve", 2, 3, bi_solve},
+    {"real", 1, 1, bi_map},     {"imag", 1, 1, bi_map},      {"conj", 1, 1, bi_map},
+    {"angle", 1, 1, bi_map},    {"complex", 2, 2, bi_complex}, {"isreal", 1, 1, bi_isreal},
 };
 #define NTABLE (sizeof table / sizeof table[0])
 
 const char *const bi_names[] = {
     "zeros", "ones", "eye", "rand", "size", "rows", "cols", "nnz", "sparse", "dense", "band",
     "diag", "diagvec", "sum", "max", "min", "dot", "norm", "abs", "sqrt", "exp", "log", "sin",
-    "cos", "trans", "solve", "disp", "pi", "inf", "nan", "eps", "Inf", "NaN", NULL};
+    "cos", "trans", "solve", "real", "imag", "conj", "angle", "complex", "isreal", "disp", "pi", "inf", "nan",
+    "eps", "Inf", "NaN", "i", "j", NULL};
 
 static const bi_entry *lookup(const char *name)
 {
@@ -599,17 +683,18 @@ silc_value *bi_to_csr(const silc_value *a)
 {
     silc_value *r;
     int64_t i, j, nnz = 0, cap;
+    int w = val_width(a); /* a complex value's entries are 2 doubles */
     if (a->format == SILC_FMT_CSR) {
-        r = val_csr_new(a->m, a->n, a->rowptr[a->m]);
+        r = val_new_unset_field(SILC_FMT_CSR, a->field, a->m, a->n, a->rowptr[a->m], 0, 0);
         if (!r) return NULL;
         memcpy(r->rowptr, a->rowptr, (size_t)(a->m + 1) * sizeof *r->rowptr);
         memcpy(r->colind, a->colind, (size_t)a->rowptr[a->m] * sizeof *r->colind);
-        memcpy(r->val, a->val, (size_t)a->rowptr[a->m] * sizeof *r->val);
+        memcpy(r->val, a->val, (size_t)(a->rowptr[a->m] * w) * sizeof *r->val);
         val_csr_set_nnz(r, a->rowptr[a->m]);
         return r;
     }
     cap = (int64_t)val_props_part(a, SILC_PROPS_SHAPE)->nnz;
-    r = val_csr_new(a->m, a->n, cap);
+    r = a->field == SILC_FIELD_COMPLEX ? val_csr_new_complex(a->m, a->n, cap) : val_csr_new(a->m, a->n, cap);
     if (!r) return NULL;
     for (i = 0; i < a->m; i++) {
         int64_t lo = 0, hi = a->n - 1;
@@ -619,10 +704,12 @@ silc_value *bi_to_csr(const silc_value *a)
         }
         r->rowptr[i] = nnz;
         for (j = lo; j <= hi; j++) {
-            double x = val_get(a, i, j);
+            double complex x = val_get_complex(a, i, j);
             if (x != 0 && nnz < cap) {
                 r->colind[nnz] = j;
-                r->val[nnz++] = x;
+                r->val[nnz * w] = creal(x);
+                if (w == 2) r->val[nnz * w + 1] = cimag(x);
+                nnz++;
             }
         }
     }

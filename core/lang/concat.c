@@ -11,6 +11,7 @@
  */
 #include "lang.h"
 
+#include <complex.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,9 +75,9 @@ static int check_shapes(lang_ev *V, const ast_node *n, silc_value **vals, int64_
 }
 
 static silc_value *build_dense(const ast_node *n, silc_value **vals, const int64_t *rows,
-                               int64_t m, int64_t width)
+                               int64_t m, int64_t width, int field)
 {
-    silc_value *out = val_dense_new(m, width);
+    silc_value *out = val_new_unset_field(SILC_FMT_DENSE, field, m, width, 0, 0, 0);
     size_t r, k, at = 0;
     int64_t i0 = 0;
     if (!out) return NULL;
@@ -87,7 +88,15 @@ static silc_value *build_dense(const ast_node *n, silc_value **vals, const int64
             int64_t i, j;
             if (is_empty(v)) continue;
             for (j = 0; j < v->n; j++)
-                for (i = 0; i < v->m; i++) out->val[(i0 + i) + (j0 + j) * m] = val_get(v, i, j);
+                for (i = 0; i < v->m; i++) {
+                    int64_t at_out = (i0 + i) + (j0 + j) * m;
+                    if (field == SILC_FIELD_COMPLEX) {
+                        double complex z = val_get_complex(v, i, j);
+                        out->val[2 * at_out] = creal(z), out->val[2 * at_out + 1] = cimag(z);
+                    } else {
+                        out->val[at_out] = val_get(v, i, j);
+                    }
+                }
             j0 += v->n;
         }
         if (rows[r] > 0) i0 += rows[r];
@@ -98,23 +107,27 @@ static silc_value *build_dense(const ast_node *n, silc_value **vals, const int64
 /* CSR result: each output row is the same row of every block of its block-row,
  * left to right, so columns come out sorted without a sort. */
 static silc_value *build_csr(const ast_node *n, silc_value **vals, const int64_t *rows, int64_t m,
-                             int64_t width)
+                             int64_t width, int field)
 {
+    int w = field == SILC_FIELD_COMPLEX ? 2 : 1;
     size_t r, k, at, nblocks = 0;
     int64_t nnz = 0, i, p, row_out = 0;
     silc_value *out = NULL;
     for (r = 0; r < n->nkids; r++) nblocks += n->kids[r]->nkids;
     /* every block as CSR (blocks already CSR are used as they are) */
     for (at = 0; at < nblocks; at++) {
-        if (vals[at]->format != SILC_FMT_CSR && !is_empty(vals[at])) {
-            silc_value *c = bi_to_csr(vals[at]);
+        if ((vals[at]->format != SILC_FMT_CSR || vals[at]->field != field) && !is_empty(vals[at])) {
+            /* a real block of a complex matrix is promoted first */
+            silc_value *src = field == SILC_FIELD_COMPLEX ? val_promote(vals[at]) : val_retain(vals[at]);
+            silc_value *c = src ? bi_to_csr(src) : NULL;
+            val_release(src);
             if (!c) return NULL;
             val_release(vals[at]);
             vals[at] = c;
         }
         if (!is_empty(vals[at])) nnz += vals[at]->nnz;
     }
-    if (!(out = val_csr_new(m, width, nnz))) return NULL;
+    if (!(out = val_new_unset_field(SILC_FMT_CSR, field, m, width, nnz, 0, 0))) return NULL;
     nnz = 0;
     out->rowptr[0] = 0;
     at = 0;
@@ -127,7 +140,8 @@ static silc_value *build_csr(const ast_node *n, silc_value **vals, const int64_t
                 if (is_empty(v)) continue;
                 for (p = v->rowptr[i]; p < v->rowptr[i + 1]; p++) {
                     out->colind[nnz] = v->colind[p] + j0;
-                    out->val[nnz++] = v->val[p];
+                    memcpy(out->val + nnz * w, v->val + p * w, (size_t)w * sizeof *out->val);
+                    nnz++;
                 }
                 j0 += v->n;
             }
@@ -144,7 +158,7 @@ int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out)
     size_t r, nblocks = 0, at;
     silc_value **vals;
     int64_t *rows, m = 0, width = 0;
-    int any_csr = 0, rc = -1;
+    int any_csr = 0, field = SILC_FIELD_REAL, rc = -1;
     *out = NULL;
     if (n->nkids == 0) {
         *out = val_dense_new(0, 0);
@@ -163,7 +177,9 @@ int cc_matrix(lang_ev *V, const ast_node *n, silc_value **out)
         if (rows[r] > 0) m += rows[r];
     for (at = 0; at < nblocks; at++)
         if (vals[at]->format == SILC_FMT_CSR) any_csr = 1;
-    *out = any_csr ? build_csr(n, vals, rows, m, width) : build_dense(n, vals, rows, m, width);
+    for (at = 0; at < nblocks; at++) /* one complex block makes the matrix complex */
+        if (vals[at]->field == SILC_FIELD_COMPLEX) field = SILC_FIELD_COMPLEX;
+    *out = any_csr ? build_csr(n, vals, rows, m, width, field) : build_dense(n, vals, rows, m, width, field);
     rc = *out ? 0 : eng_oom(V->E);
 done:
     for (at = 0; at < nblocks; at++) val_release(vals[at]);

@@ -19,6 +19,7 @@
 #include "dist.h"
 
 #include <float.h>
+#include <complex.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -343,6 +344,12 @@ static int eval_name(lang_ev *V, const ast_node *n, silc_value **out)
         *out = val_scalar_new(x);
         return *out ? 0 : eng_oom(V->E);
     }
+    /* i and j: the imaginary unit unless a name is bound to them (a loop's
+     * `for i = ...` wins, as in Octave) */
+    if (!strcmp(n->name, "i") || !strcmp(n->name, "j")) {
+        *out = val_scalar_new_complex(0, 1);
+        return *out ? 0 : eng_oom(V->E);
+    }
     return undefined_name(V, n->name);
 }
 
@@ -468,6 +475,25 @@ fail:
     return -1;
 }
 
+/* v scaled by the scalar s, complex or real (alpha_imag: ABI 1.8). */
+static int run_scale(lang_ev *V, const silc_value *v, double complex s, const char *what, silc_value **out)
+{
+    silc_call c;
+    memset(&c, 0, sizeof c);
+    c.op = SILC_OP_SCALE;
+    c.nin = 1;
+    c.in[0] = v;
+    c.alpha = creal(s);
+    c.alpha_imag = cimag(s);
+    return ev_run(V, &c, what, out);
+}
+
+/* 1 / the scalar value v: a real v keeps the real division's bits. */
+static double complex reciprocal(const silc_value *v)
+{
+    return v->field == SILC_FIELD_COMPLEX ? 1.0 / val_get_complex(v, 0, 0) : 1.0 / val_scalar(v);
+}
+
 /* a op b for every binary operator. */
 static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value *a,
                         const silc_value *b, silc_value **out)
@@ -481,15 +507,14 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
         return ev_run_op(V, SILC_OP_ADD, 0, a, b, 1, (op == TK_PLUS || op == TK_PLUSEQ) ? 1 : -1,
                          o->what, out);
     case TK_STAR: case TK_STAREQ:
-        if (val_is_scalar(a)) return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, val_scalar(a), 0, o->what, out);
-        if (val_is_scalar(b)) return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, val_scalar(b), 0, o->what, out);
+        if (val_is_scalar(a)) return run_scale(V, b, val_get_complex(a, 0, 0), o->what, out);
+        if (val_is_scalar(b)) return run_scale(V, a, val_get_complex(b, 0, 0), o->what, out);
         if (a->n != b->m) return shape_error(V, "inner dimensions differ", op, o, a, b);
         return ev_run_op(V, SILC_OP_MATMUL, 0, a, b, 1, 0, o->what, out);
     case TK_SLASH: case TK_SLASHEQ: {
         silc_value *at, *bt, *x;
         int rc;
-        if (val_is_scalar(b))
-            return ev_run_op(V, SILC_OP_SCALE, 0, a, NULL, 1.0 / val_scalar(b), 0, o->what, out);
+        if (val_is_scalar(b)) return run_scale(V, a, reciprocal(b), o->what, out);
         if (a->n != b->n)
             return shape_error(V, "needs operands with the same number of columns", op, o, a, b);
         /* a / B = (B' \ a')' */
@@ -507,8 +532,7 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
         return rc;
     }
     case TK_BACKSLASH:
-        if (val_is_scalar(a))
-            return ev_run_op(V, SILC_OP_SCALE, 0, b, NULL, 1.0 / val_scalar(a), 0, o->what, out);
+        if (val_is_scalar(a)) return run_scale(V, b, reciprocal(a), o->what, out);
         if (a->m != b->m)
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
         /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
@@ -578,7 +602,7 @@ static int eval_binary(lang_ev *V, const ast_node *n, silc_value **out)
     if (ev_expr_dist(V, n->kids[0], &a)) return -1;
     /* && and || short-circuit on a scalar left side, so `k <= n && v[k] > 0` is safe */
     if ((n->op == TK_AND || n->op == TK_OR) && val_is_scalar(a)) {
-        int truth = val_scalar(a) != 0;
+        int truth = val_get_complex(a, 0, 0) != 0;
         if (truth == (n->op == TK_OR)) {
             val_release(a);
             *out = val_scalar_new(truth ? 1.0 : 0.0);
@@ -600,8 +624,8 @@ UTIL_NOINLINE static int unary_of(lang_ev *V, const ast_node *n, silc_value *a, 
     char what[256];
     int rc;
     node_text(V, n, what, sizeof what);
-    if (n->kind == AST_TRANSPOSE)
-        rc = ev_run_op(V, SILC_OP_TRANSPOSE, 0, a, NULL, 0, 0, what, out);
+    if (n->kind == AST_TRANSPOSE) /* sub 0: A' (conjugate), 1: A.' (silc_plugin.h) */
+        rc = ev_run_op(V, SILC_OP_TRANSPOSE, n->op == TK_DOTQUOTE ? 1 : 0, a, NULL, 0, 0, what, out);
     else
         rc = ev_run_op(V, SILC_OP_MAP, n->op == TK_NOT ? SILC_MAP_NOT : SILC_MAP_NEG, a, NULL, 0, 0,
                        what, out);
@@ -762,7 +786,7 @@ static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
     *out = NULL;
     switch (n->kind) {
     case AST_NUM:
-        *out = val_scalar_new(n->num);
+        *out = n->imag ? val_scalar_new_complex(0, n->num) : val_scalar_new(n->num);
         return *out ? 0 : eng_oom(E);
     case AST_NAME:
         return eval_name(V, n, out);
@@ -903,6 +927,8 @@ static int update_in_place(lang_ev *V, int op, silc_value *x, const silc_value *
     int scalar = !s && val_is_scalar(r) && !val_is_scalar(x);
     double c = scalar ? val_scalar(r) : 0;
     /* Distributed values are never updated in place: their arrays are blocks (dist.h). */
+    /* Nor complex ones: the loop below is real arithmetic. */
+    if (x->field || r->field || (s && s->field)) return 0;
     if (x->dist || r->dist || x->format != SILC_FMT_DENSE || x->refcount != 2 || x->attach ||
         !(scalar || (r->format == SILC_FMT_DENSE && r->m == x->m && r->n == x->n)))
         return 0;

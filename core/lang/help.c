@@ -86,8 +86,16 @@ static const help_entry entries[] = {
     {"max min", 0, "`max(A,B)`, `min(A,B)`", "element-wise"},
     {"dot norm", 0, "`dot(x,y)`, `norm(x[,p])`",
      "p = 1, 2, `inf` or `\"fro\"`; `norm(A)` of a matrix is the 2-norm"},
-    {"abs sqrt exp log sin cos", 0, "`abs sqrt exp log sin cos`", "element-wise"},
+    {"abs sqrt exp log sin cos", 0, "`abs sqrt exp log sin cos`",
+     "element-wise; `sqrt` and `log` of a real value with a negative entry are complex, as in Octave"},
     {"trans", 0, "`trans(A)`", "`A'`"},
+    {"' .'", 0, "`A'`, `A.'`", "conjugate transpose, plain transpose (the same for a real `A`)"},
+    {"i j complex", 0, "`2i`, `2.5j`, `1e3i`, `i`, `j`, `complex(a,b)`",
+     "complex numbers: an imaginary literal, the imaginary unit (unless `i` or `j` is bound to a value), "
+     "`a + bi` from real `a` and `b`"},
+    {"real imag conj angle abs isreal", 0, "`real(z)`, `imag(z)`, `conj(z)`, `angle(z)`, `isreal(z)`",
+     "parts, conjugate, argument (element-wise; `real` and `imag` give real values); `isreal` is 1 for a "
+     "real value (a complex value stays complex until `real` demotes it); `dot(x,y)` conjugates `x`"},
     {"solve", 0, "`solve(A, b, \"options\")`",
      "`A \\ b` with per-call options, e.g. `\"backend = suitesparse.klu\"` or `\"mumps.icntl_7 = 5\"`"},
     {"pi inf nan eps Inf NaN", 0, "`pi`, `inf` (`Inf`), `nan` (`NaN`), `eps`",

@@ -29,6 +29,7 @@ enum lx_kind {
     TK_EOF = 0, TK_NEWLINE, TK_NUMBER, TK_NAME, TK_STRING, TK_RAW,
     TK_PLUS, TK_MINUS, TK_STAR, TK_SLASH, TK_BACKSLASH, TK_EMUL, TK_EDIV,
     TK_CARET, TK_EPOW, TK_QUOTE,
+    TK_DOTQUOTE,           /* .' plain transpose (' is the conjugate transpose) */
     TK_LPAREN, TK_RPAREN, TK_LBRACKET, TK_RBRACKET, TK_LBRACE, TK_RBRACE,
     TK_COMMA, TK_SEMI, TK_COLON,
     TK_ASSIGN, TK_PLUSEQ, TK_MINUSEQ, TK_STAREQ, TK_SLASHEQ,
@@ -40,6 +41,7 @@ typedef struct lx_token {
     int line, col;         /* 1-based */
     size_t start, len;     /* span in the source text */
     double num;            /* TK_NUMBER */
+    int imag;              /* TK_NUMBER written with an i or j suffix (2.5i): imaginary */
     int space_before;      /* white space precedes it: in a matrix literal `[1 -2]` is two
                               elements and `[1 - 2]` one, as in Octave (parser.c) */
 } lx_token;
@@ -88,6 +90,7 @@ struct ast_node {
     int quiet;             /* a statement followed by ';': its value is not shown */
     size_t start, end;     /* source span [start, end) */
     double num;            /* AST_NUM */
+    int imag;              /* AST_NUM: the number is num times the imaginary unit */
     char *name;            /* NAME, CALL, STRING (unquoted text), assignment target, SET raw text */
     /* kids: BINARY/UNARY/TRANSPOSE operands; INDEX base then subscripts; CALL
      * arguments; RANGE from, to or from, step, to; EXPR/ASSIGN/OPASSIGN the expression;

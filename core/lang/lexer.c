@@ -52,6 +52,7 @@ static int push(lx_state *L, int kind, size_t start, int line, int col, double n
         o->cap = cap;
     }
     o->t[o->n].kind = kind;
+    o->t[o->n].imag = 0;
     o->t[o->n].line = line;
     o->t[o->n].col = col;
     o->t[o->n].start = start;
@@ -136,11 +137,16 @@ static int lex_number(lx_state *L)
     memcpy(buf, s + start, p - start);
     buf[p - start] = 0;
     advance(L, p - start);
+    /* 2i, 2.5j, 1e3i: an imaginary number (Octave's suffixes) */
+    int imag = (s[p] == 'i' || s[p] == 'j') && !(isalnum((unsigned char)s[p + 1]) || s[p + 1] == '_');
+    if (imag) advance(L, 1), p++;
     if (isalpha((unsigned char)s[p]) || s[p] == '_') {
         snprintf(L->err, L->errlen, "%d:%d: malformed number near '%s%c'", line, col, buf, s[p]);
         return -1;
     }
-    return push(L, TK_NUMBER, start, line, col, strtod(buf, NULL));
+    if (push(L, TK_NUMBER, start, line, col, strtod(buf, NULL))) return -1;
+    L->out->t[L->out->n - 1].imag = imag;
+    return 0;
 }
 
 static int lex_string(lx_state *L)
@@ -160,7 +166,7 @@ static int lex_string(lx_state *L)
 /* Operators, longest first so "*@" wins over "*". */
 static const struct { const char *text; int kind; } ops[] = {
     {"*@", TK_EMUL}, {"/@", TK_EDIV}, {"^@", TK_EPOW},
-    {".*", TK_EMUL}, {"./", TK_EDIV}, {".^", TK_EPOW},
+    {".*", TK_EMUL}, {"./", TK_EDIV}, {".^", TK_EPOW}, {".'", TK_DOTQUOTE},
     {"+=", TK_PLUSEQ}, {"-=", TK_MINUSEQ}, {"*=", TK_STAREQ}, {"/=", TK_SLASHEQ},
     {"==", TK_EQ}, {"!=", TK_NE}, {"<=", TK_LE}, {">=", TK_GE},
     {"&&", TK_AND}, {"||", TK_OR},
@@ -184,7 +190,8 @@ static int opens_subscript(const lx_state *L)
     int k;
     if (L->out->n == 0) return 0;
     k = L->out->t[L->out->n - 1].kind;
-    if (k != TK_NAME && k != TK_NUMBER && k != TK_RPAREN && k != TK_RBRACKET && k != TK_QUOTE)
+    if (k != TK_NAME && k != TK_NUMBER && k != TK_RPAREN && k != TK_RBRACKET && k != TK_QUOTE &&
+        k != TK_DOTQUOTE)
         return 0;
     return !(L->space && innermost(L) == 'l');
 }

@@ -46,7 +46,7 @@
 typedef struct memo_key {
     int op, sub, nin;
     uint64_t ids[3];
-    double alpha, beta;
+    double alpha, beta, alpha_imag, beta_imag;
     int64_t ival[2];
 } memo_key;
 
@@ -94,6 +94,8 @@ static int key_of(const silc_engine *E, const silc_call *call, memo_key *k)
     }
     k->alpha = call->alpha;
     k->beta = call->beta;
+    k->alpha_imag = call->alpha_imag;
+    k->beta_imag = call->beta_imag;
     k->ival[0] = call->ival[0];
     k->ival[1] = call->ival[1];
     return 0;
@@ -104,7 +106,8 @@ static int same_key(const memo_key *a, const memo_key *b)
     /* Coefficients compare by bits: -0.0 and 0.0 scale differently. */
     return a->op == b->op && a->sub == b->sub && a->nin == b->nin && !memcmp(a->ids, b->ids, sizeof a->ids) &&
            !memcmp(&a->alpha, &b->alpha, sizeof a->alpha) && !memcmp(&a->beta, &b->beta, sizeof a->beta) &&
-           a->ival[0] == b->ival[0] && a->ival[1] == b->ival[1];
+           !memcmp(&a->alpha_imag, &b->alpha_imag, sizeof a->alpha_imag) &&
+           !memcmp(&a->beta_imag, &b->beta_imag, sizeof a->beta_imag) && a->ival[0] == b->ival[0] && a->ival[1] == b->ival[1];
 }
 
 static memo_slot *find(eng_memo *M, const memo_key *k)

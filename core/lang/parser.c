@@ -368,7 +368,7 @@ static ast_node *parse_primary(ps_state *P)
     switch (tk->kind) {
     case TK_NUMBER:
         n = node_new(P, AST_NUM, next(P));
-        if (n) n->num = tk->num;
+        if (n) n->num = tk->num, n->imag = tk->imag;
         return n;
     case TK_NAME:
         if (P->bracket_depth > 0 && tok_is_text(P, tk, "end")) return node_new(P, AST_END, next(P));
@@ -407,9 +407,10 @@ static ast_node *parse_postfix(ps_state *P)
     while (n && !starts_new_element(P)) {
         const lx_token *tk = peek(P);
         ast_node *w;
-        if (tk->kind == TK_QUOTE) {
+        if (tk->kind == TK_QUOTE || tk->kind == TK_DOTQUOTE) {
             next(P);
             w = node_new(P, AST_TRANSPOSE, tk);
+            if (w) w->op = tk->kind; /* ' conjugates, .' does not */
             if (!w || add_kid(P, w, n)) {
                 if (!w) node_free(n);
                 node_free(w);

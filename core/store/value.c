@@ -397,6 +397,21 @@ silc_value *val_part(const silc_value *v, int imag)
     return w;
 }
 
+silc_value *val_complex_of_parts(const silc_value *re, const silc_value *im)
+{
+    silc_value *w;
+    if (!re || !im || re->dist || im->dist || re->field || im->field || re->format != im->format ||
+        re->m != im->m || re->n != im->n || re->nnz != im->nnz || re->kl != im->kl || re->ku != im->ku)
+        return NULL;
+    if (re->format == SILC_FMT_CSR &&
+        (memcmp(re->rowptr, im->rowptr, (size_t)(re->m + 1) * sizeof *re->rowptr) ||
+         (re->nnz && memcmp(re->colind, im->colind, (size_t)re->nnz * sizeof *re->colind))))
+        return NULL;
+    if (!(w = same_pattern(re, SILC_FIELD_COMPLEX))) return NULL;
+    for (int64_t k = 0; k < re->nnz; k++) w->val[2 * k] = re->val[k], w->val[2 * k + 1] = im->val[k];
+    return w;
+}
+
 int val_imag_is_zero(const silc_value *v)
 {
     if (v && v->dist) v = v->dist->whole ? v->dist->whole : v->dist->block;

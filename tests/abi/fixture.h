@@ -30,6 +30,26 @@
 static const silc_host_api *fix_host;
 
 #ifndef FIX_NO_OPS
+#ifdef FIX_TAKES_COMPLEX
+/* A complex A (ABI 1.8): out = (alpha + i alpha_imag) A + 2, its own
+ * signature. */
+static int fix_scale_complex(silc_call *call, const silc_view *a)
+{
+    silc_value *out = fix_host->dense_new_complex(a->m, a->n);
+    silc_view o;
+    int64_t i;
+    if (!out) return fix_host->error(call, SILC_ENOMEM, "out of memory");
+    fix_host->view(out, &o);
+    for (i = 0; i < a->m * a->n; i++) {
+        double re = a->val[2 * i], im = a->val[2 * i + 1];
+        o.val[2 * i] = call->alpha * re - call->alpha_imag * im + 2;
+        o.val[2 * i + 1] = call->alpha * im + call->alpha_imag * re;
+    }
+    call->out = out;
+    return SILC_OK;
+}
+#endif
+
 /* out = alpha * A + 1, so a test can tell this plugin ran and not another. */
 static int fix_scale(silc_call *call)
 {
@@ -37,6 +57,15 @@ static int fix_scale(silc_call *call)
     silc_value *out;
     int64_t i;
     fix_host->view(call->in[0], &a);
+    /* The host must never hand complex data to a fixture that does not
+     * list SCALE in complex_ops (test_complex_core): say so loudly. */
+    if (fix_host->abi_minor >= 8 && fix_host->field(call->in[0]) == SILC_FIELD_COMPLEX) {
+#ifdef FIX_TAKES_COMPLEX
+        if (a.format == SILC_FMT_DENSE) return fix_scale_complex(call, &a);
+#else
+        return fix_host->error(call, SILC_EINTERNAL, "%s was handed complex data", FIX_NAME);
+#endif
+    }
     if (a.format != SILC_FMT_DENSE) return fix_host->error(call, SILC_EDECLINE, "dense only");
     out = fix_host->dense_new(a.m, a.n);
     if (!out) return fix_host->error(call, SILC_ENOMEM, "out of memory");

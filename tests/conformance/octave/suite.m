@@ -72,3 +72,42 @@ P = [pi 1]
 r3 = 1/3
 format short
 p = pi
+# complex values (issue 31): literals, the imaginary unit, display, parts
+zc = 1+2i
+zw = 1.5 - 2j
+zn = -1i
+zq = 1e-3 + 2i
+ze = 1e5+1i
+zN = 1+NaN*1i
+Zc = [1+2i, 3-4i; 5, 6i]
+Zd = [1.5+2i; -3.25-0.5i]
+Zm = [1e-3+1i, 100]
+Zs = sparse([1 2], [1 2], [1+2i, 3], 2, 2)
+zr = sqrt(-4)
+zl = log(-1)
+za = abs(3+4i)
+zg = angle(1i)
+Zt = [1+2i; 3]'
+Zp = [1+2i; 3].'
+Zre = real(Zc)
+Zim = imag(Zc)
+Zcj = conj(Zc)
+zx = complex(1, 0)
+zi = isreal(zx)
+Ar = [4 1; 1 3];
+bc = [1+1i; 2-1i];
+xr = Ar \ bc
+Hc = [2, 1+1i; 1-1i, 3];
+yc = Hc \ bc
+zd = dot([1i; 2], [1; 1i])
+zm = norm([3+4i; 0])
+zs = sum([1+2i; 3-1i])
+zp = Zc * [1; 1i]
+ze2 = Zc .* Zc
+clear i j
+zu = i
+zv = 3*j
+format long
+zL = 1/3 + 2i/3
+ZL = [1+2i, 3.5-4i]
+format short
