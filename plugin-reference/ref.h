@@ -174,6 +174,7 @@ int ref_sparse_lu_z(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
 int ref_symbolic_chol(const ref_sp *C, ref_sp *L);
 /* ref_qr.c: least squares / minimum norm for a sparse m x n A. */
 int ref_sparse_qr(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
+int ref_sparse_qr_z(const ref_sp *A, ref_factor *F, char *msg, size_t msglen);
 
 /* ---- ref_order.c --------------------------------------------------------- */
 /* Approximate minimum degree order of the symmetric pattern S (both triangles,

@@ -50,25 +50,14 @@ static int pick_auto(const silc_view *a, const silc_props *P, int w)
     return spd ? ALG_SPARSE_SPD : ALG_SPARSE;
 }
 
-/* The sparse QR (ref_qr.c) is real only: a complex sparse least-squares
- * problem goes to the dense complex QR when its dense copy stays this small
- * (2^22 entries, 64 MiB), and is declined with that reason otherwise. */
-#define COMPLEX_RECT_DENSE_MAX ((int64_t)1 << 22)
-
 static int factor(int alg, const silc_view *a, const silc_props *P, int w, ref_factor *F, char *msg, size_t ml)
 {
     int st, z = w == 2;
     if (alg == ALG_DIAG) return z ? diag_factor_z(a, F, msg, ml) : diag_factor(a, F, msg, ml);
     if (alg == ALG_BAND) return (z ? ref_band_lu_z : ref_band_lu)(a, P->kl, P->ku, F, msg, ml);
     int dense = alg == ALG_DENSE || alg == ALG_DENSE_SPD ||
-                ((alg == ALG_TRI || alg == ALG_RECT) && a->format == SILC_FMT_DENSE) || (z && alg == ALG_RECT);
+                ((alg == ALG_TRI || alg == ALG_RECT) && a->format == SILC_FMT_DENSE);
     if (dense) {
-        if (z && alg == ALG_RECT && a->format != SILC_FMT_DENSE && a->m * a->n > COMPLEX_RECT_DENSE_MAX) {
-            snprintf(msg, ml, "complex sparse least squares: the reference plugin's sparse QR is real only "
-                              "and a %lldx%lld dense copy is too large",
-                     (long long)a->m, (long long)a->n);
-            return SILC_EDECLINE;
-        }
         double *D = ref_dense_from_view_w(a, w);
         if (!D) return SILC_ENOMEM;
         if (alg == ALG_DENSE) st = (z ? ref_dense_lu_z : ref_dense_lu)(a->n, D, F, msg, ml);
@@ -83,7 +72,7 @@ static int factor(int alg, const silc_view *a, const silc_props *P, int w, ref_f
     if (alg == ALG_TRI) st = (z ? ref_sparse_tri_z : ref_sparse_tri)(&C, P->lower, F, msg, ml);
     else if (alg == ALG_SPARSE_SPD) st = (z ? ref_sparse_chol_z : ref_sparse_chol)(&C, F, msg, ml);
     else if (alg == ALG_SPARSE) st = (z ? ref_sparse_lu_z : ref_sparse_lu)(&C, F, msg, ml);
-    else st = ref_sparse_qr(&C, F, msg, ml);
+    else st = (z ? ref_sparse_qr_z : ref_sparse_qr)(&C, F, msg, ml);
     ref_sp_free(&C);
     return st;
 }

@@ -12,9 +12,11 @@
  *     solution within a small multiple of eps * cond of x_true, and the
  *     conjugate-transposed solve (trans = 1, what the estimator applies)
  *     checked by multiplying back with A^H;
- *   - dense complex QR: an overdetermined consistent system recovers
- *     x_true, an inconsistent one satisfies the normal equations
- *     A^H (b - A x) = 0, an underdetermined one A x = b;
+ *   - dense (Householder) and sparse (Givens, semi-normal equations)
+ *     complex QR: an overdetermined consistent system recovers x_true, an
+ *     inconsistent one satisfies the normal equations A^H (b - A x) = 0, an
+ *     underdetermined one A x = b (sparse: with x in range(A^H), the
+ *     minimum-norm solution);
  *   - the complex condition estimate (ref_inv_norm1_est_complex, zlacn2's
  *     method) within a factor 3 below the true ||A^{-1}||_1, computed from
  *     the explicit inverse (Gauss-Jordan here for dense A; for the two
@@ -27,7 +29,9 @@
  *     SCALE, element-wise products, quotients and comparisons (real
  *     results), sqrt/log/exp (principal branches), abs, sum, max (by
  *     modulus), norm 1 and the 2-norm (closed form for a 2x2), sparse(),
- *     diagvec and diag, each against the same arithmetic written out here.
+ *     diagvec and diag, each against the same arithmetic written out here;
+ *   - examples/helmholtz: its matrix complex symmetric and not Hermitian,
+ *     and the plane wave's error (exact solution exp(i k x)) falling as h^2.
  */
 #include "check.h"
 
@@ -41,6 +45,7 @@
 
 #include "dispatch.h"
 #include "engine.h"
+#include "helmholtz.h"
 #include "ref.h"
 #include "silc.h"
 #include "silc_plugin.h"
@@ -332,20 +337,89 @@ static void test_band(void)
 
 /* ---- sparse ----------------------------------------------------------------------- */
 
-/* Compressed-column complex matrix from dense (test sizes only). */
-static void sp_from_dense(int64_t n, const cplx *D, ref_sp *A)
+/* Compressed-column complex matrix from dense m x n (test sizes only). */
+static void sp_from_dense_mn(int64_t m, int64_t n, const cplx *D, ref_sp *A)
 {
     int64_t nz = 0;
-    for (int64_t k = 0; k < n * n; k++) nz += D[k] != 0;
-    ref_sp_alloc(A, n, n, nz, 2);
+    for (int64_t k = 0; k < m * n; k++) nz += D[k] != 0;
+    ref_sp_alloc(A, m, n, nz, 2);
     cplx *x = (cplx *)A->x;
     nz = 0;
     for (int64_t j = 0; j < n; j++) {
         A->p[j] = nz;
-        for (int64_t i = 0; i < n; i++)
-            if (D[i + j * n] != 0) A->i[nz] = i, x[nz++] = D[i + j * n];
+        for (int64_t i = 0; i < m; i++)
+            if (D[i + j * m] != 0) A->i[nz] = i, x[nz++] = D[i + j * m];
     }
     A->p[n] = nz;
+}
+
+static void sp_from_dense(int64_t n, const cplx *D, ref_sp *A)
+{
+    sp_from_dense_mn(n, n, D, A);
+}
+
+/* Sparse complex least squares (complex Givens, semi-normal equations):
+ * consistent overdetermined recovers x_true, inconsistent satisfies
+ * A^H (b - A x) = 0, underdetermined gives A x = b with x in range(A^H). */
+static void test_sparse_qr(void)
+{
+    enum { M = 60, N = 25 };
+    cplx *A = calloc(M * N, sizeof *A), xt[M], b[M], x[M], r[M], g[M];
+    double *work = NULL;
+    char msg[256];
+    for (int64_t k = 0; k < M * N; k++)
+        if (k % 4 == 0 || k % (M + 1) == 0) A[k] = crand();
+    for (int64_t i = 0; i < N; i++) xt[i] = crand();
+    dense_apply(M, N, A, 0, xt, b);
+    ref_sp S = {0};
+    sp_from_dense_mn(M, N, A, &S);
+    ref_factor F = {0};
+    CHECK(ref_sparse_qr_z(&S, &F, msg, sizeof msg) == 0, "sparse QR: %s", msg);
+    work = malloc((size_t)(F.work_len + 4) * sizeof(double));
+    memcpy(x, b, sizeof b);
+    F.solve(F.data, (double *)x, 0, work);
+    CHECK(vec_err(N, x, xt) < 1e-10, "sparse QR, consistent: error %.3g", vec_err(N, x, xt));
+    for (int64_t i = 0; i < M; i++) b[i] += 0.5 * crand();
+    memcpy(x, b, sizeof b);
+    F.solve(F.data, (double *)x, 0, work);
+    dense_apply(M, N, A, 0, x, r);
+    for (int64_t i = 0; i < M; i++) r[i] = b[i] - r[i];
+    dense_apply(M, N, A, 1, r, g);
+    double gn = 0, rn = 0;
+    for (int64_t i = 0; i < N; i++) gn = fmax(gn, cabs(g[i]));
+    for (int64_t i = 0; i < M; i++) rn = fmax(rn, cabs(r[i]));
+    CHECK(gn < 1e-10 * rn * M, "sparse QR least squares: ||A^H r|| = %.3g, ||r|| = %.3g", gn, rn);
+    CHECK(F.cond > 1 && isfinite(F.cond), "sparse QR condition estimate %.3g", F.cond);
+    F.destroy(F.data);
+    free(work);
+    ref_sp_free(&S);
+    /* underdetermined: the conjugate transpose's shape */
+    cplx *Ah = malloc(M * N * sizeof *Ah);
+    for (int64_t i = 0; i < M; i++)
+        for (int64_t j = 0; j < N; j++) Ah[j + i * N] = conj(A[i + j * M]);
+    sp_from_dense_mn(N, M, Ah, &S);
+    CHECK(ref_sparse_qr_z(&S, &F, msg, sizeof msg) == 0, "sparse QR, minimum norm: %s", msg);
+    work = malloc((size_t)(F.work_len + 4) * sizeof(double));
+    for (int64_t i = 0; i < N; i++) b[i] = crand();
+    memcpy(x, b, N * sizeof *x);
+    F.solve(F.data, (double *)x, 0, work);
+    dense_apply(N, M, Ah, 0, x, r);
+    CHECK(vec_err(N, r, b) < 1e-10, "sparse QR minimum norm: A x = b to %.3g", vec_err(N, r, b));
+    /* the minimum-norm x lies in range(A^H) = range(A here): its part
+     * orthogonal to it, x - A (A \ x), vanishes (A's dense QR, above) */
+    ref_factor D = {0};
+    double dw[4 * M];
+    ref_dense_qr_z(M, N, (const double *)A, &D, msg, sizeof msg);
+    memcpy(g, x, sizeof g);
+    D.solve(D.data, (double *)g, 0, dw);
+    dense_apply(M, N, A, 0, g, r);
+    CHECK(vec_err(M, r, x) < 1e-10, "minimum norm: x in range(A^H) to %.3g", vec_err(M, r, x));
+    D.destroy(D.data);
+    F.destroy(F.data);
+    free(work);
+    ref_sp_free(&S);
+    free(Ah);
+    free(A);
 }
 
 static void test_sparse(void)
@@ -660,6 +734,17 @@ static void test_language(void)
     dense_apply(M, M, S, 0, x, b);
     put_complex(c, "bs", M, 1, b, 0);
     expect(c, "r = S \\ bs", M, 1, x, 0, 1e-12);
+    /* least squares, dense and sparse: a consistent 7x5 system */
+    {
+        cplx R[7 * M], br[7];
+        for (int k = 0; k < 7 * M; k++) R[k] = k % 3 ? crand() : 0;
+        dense_apply(7, M, R, 0, x, br);
+        put_complex(c, "R", 7, M, R, 0);
+        put_complex(c, "Rs", 7, M, R, 1);
+        put_complex(c, "br", 7, 1, br, 0);
+        expect(c, "r = R \\ br", M, 1, x, 0, 1e-12);
+        expect(c, "r = Rs \\ br", M, 1, x, 0, 1e-12);
+    }
     /* MATMUL: dense * dense, CSR * dense, CSR * CSR, dense * CSR */
     for (int j = 0; j < M; j++) dense_apply(M, M, A, 0, A + j * M, W + j * M);
     expect(c, "r = A * A", M, M, W, 0, 1e-14);
@@ -739,6 +824,52 @@ static void test_language(void)
     silc_close(&c);
 }
 
+/* ---- the Helmholtz example ------------------------------------------------------------ */
+
+/* examples/helmholtz: its matrix is complex symmetric and not Hermitian,
+ * and the plane wave's error falls as h^2 (ratio ~4 per halving of h). */
+static void test_helmholtz(void)
+{
+    silc_context *c = NULL;
+    silc_envelope_t A;
+    char err[512];
+    double b[2 * 17 * 17];
+    CHECK(helmholtz_assemble(16, 10.0, HELMHOLTZ_PLANE_WAVE, &A, b, err, sizeof err) == 0, "assemble: %s", err);
+    int sym = 1, herm = 1;
+    int64_t N = A.m;
+    double *D = calloc((size_t)(2 * N * N), sizeof *D);
+    silc_envelope_to_dense(&A, D);
+    const cplx *Z = (const cplx *)D;
+    for (int64_t i = 0; i < N; i++)
+        for (int64_t j = 0; j < N; j++) {
+            sym &= Z[i + j * N] == Z[j + i * N];
+            herm &= Z[i + j * N] == conj(Z[j + i * N]);
+        }
+    CHECK(sym && !herm, "Helmholtz matrix: complex symmetric %d, Hermitian %d", sym, herm);
+    free(D);
+    silc_envelope_free(&A);
+    CHECK(helmholtz_assemble(1, 10.0, HELMHOLTZ_PLANE_WAVE, &A, b, err, sizeof err) == -1 && strstr(err, "n = 1"),
+          "n = 1 refused: %s", err);
+
+    CHECK(silc_open(&c, NULL) == 0, "open");
+    double e[3];
+    for (int t = 0; t < 3; t++) {
+        int n = 16 << t;
+        double *u = malloc((size_t)(2 * (n + 1) * (n + 1)) * sizeof *u);
+        e[t] = -1;
+        if (helmholtz_solve(c, n, 10.0, HELMHOLTZ_PLANE_WAVE, u, err, sizeof err) == 0)
+            e[t] = helmholtz_plane_wave_error(n, 10.0, u);
+        else
+            CHECK(0, "helmholtz n = %d: %s", n, err);
+        free(u);
+    }
+    printf("Helmholtz plane wave, k = 10: max error %.3e (n = 16), %.3e (32), %.3e (64)\n", e[0], e[1], e[2]);
+    CHECK(e[0] > 0 && e[1] > 0 && e[2] > 0 && e[0] / e[1] > 3.5 && e[0] / e[1] < 4.6 && e[1] / e[2] > 3.5 &&
+              e[1] / e[2] < 4.6, "second order: error ratios %.3f, %.3f", e[0] / e[1], e[1] / e[2]);
+    CHECK(e[2] < 0.02, "n = 64: error %.3g", e[2]);
+    silc_close(&c);
+}
+
 int main(void)
 {
     silc_context *c = NULL;
@@ -752,10 +883,12 @@ int main(void)
     test_dense_qr();
     test_band();
     test_sparse();
+    test_sparse_qr();
     test_estimator_random();
     test_shared("young1c.mtx", 0);
     test_shared("mhd1280b.mtx", 1);
     test_language();
+    test_helmholtz();
     rc = check_done();
     silc_close(&c);
     return rc;

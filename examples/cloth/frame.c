@@ -22,14 +22,12 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "cloth.h"
+#include "png_rgb.h"
 
-#include <errno.h>
 #include <math.h>
-#include <png.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #define OBLIQUE 0.35
 #define AMBIENT 0.3 /* the shade of a quad seen edge-on to the light: dark, never black */
@@ -235,11 +233,8 @@ int frame_write_png(const char *path, const cloth_scene *s, const double *x, int
                     size_t errlen)
 {
     canvas c;
-    png_image img;
-    FILE *f;
-    struct stat st;
     size_t k;
-    int ok, regular;
+    int ok;
     if (!path || !s || !x) return fail(err, errlen, "frame_write_png: no path, scene or positions");
     if (w < 16 || w > 4096 || h < 16 || h > 4096)
         return fail(err, errlen, "%s: picture size %d x %d outside 16..4096", path, w, h);
@@ -267,32 +262,7 @@ int frame_write_png(const char *path, const cloth_scene *s, const double *x, int
         free(c.rgb);
         return fail(err, errlen, "%s: out of memory sorting the quads", path);
     }
-    f = fopen(path, "wb");
-    if (!f) {
-        int e = errno;
-        free(c.rgb);
-        return fail(err, errlen, "%s: cannot open for writing: %s", path, strerror(e));
-    }
-    /* A failed write removes what it left, but only from a regular file:
-     * never a device or a pipe such as /dev/stdout. */
-    regular = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode);
-    /* The simplified API catches libpng's errors itself (its own setjmp),
-     * frees its structures on every path and leaves the message in img. */
-    memset(&img, 0, sizeof img);
-    img.version = PNG_IMAGE_VERSION;
-    img.width = (png_uint_32)w, img.height = (png_uint_32)h;
-    img.format = PNG_FORMAT_RGB;
-    ok = png_image_write_to_stdio(&img, f, 0, c.rgb, 0, NULL);
+    ok = png_write_rgb(path, w, h, c.rgb, err, errlen);
     free(c.rgb);
-    /* fclose may be where a full disk shows up, so it counts too. */
-    if (fclose(f) != 0 && ok) {
-        int e = errno;
-        if (regular) remove(path);
-        return fail(err, errlen, "%s: cannot write: %s", path, strerror(e));
-    }
-    if (!ok) {
-        if (regular) remove(path);
-        return fail(err, errlen, "%s: libpng: %s", path, img.message[0] ? img.message : "write failed");
-    }
-    return 0;
+    return ok;
 }
