@@ -17,7 +17,7 @@ if(TARGET silc_plugin_lapack OR TARGET silc_plugin_suitesparse OR TARGET silc_pl
     add_test(NAME test_complex_libs
              COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/test_complex_libs.py
                      $<TARGET_FILE:test_complex_libs> ${PROJECT_BINARY_DIR}/plugins ${SILC_SHARED_MATRICES}
-                     ${CMAKE_CURRENT_BINARY_DIR}/complex_libs)
+                     ${CMAKE_CURRENT_BINARY_DIR}/complex_libs $<TARGET_FILE:silc_cli>)
     set_tests_properties(test_complex_libs PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 300)
   else()
     message(STATUS "SILC: test_complex_libs skipped: /usr/bin/python3 lacks numpy or scipy")

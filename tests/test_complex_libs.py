@@ -20,7 +20,11 @@ the .spd classes for complex values (it has no Hermitian Cholesky).  The lapack
 backend also gets a complex band system (zgbtrf) and tall least squares
 (zgeqrf, checked against numpy.linalg.lstsq).
 
-  test_complex_libs.py HARNESS PLUGIN_DIR MATRICES WORKDIR
+Then, with the silc command given, the same solves through the language
+(silc --put, solve(A, b, "backend = NAME"), --get x): each built backend,
+named by `info`, and the default dispatch of x = A \ b going to a library.
+
+  test_complex_libs.py HARNESS PLUGIN_DIR MATRICES WORKDIR [SILC]
 
 Prints "N passed, N failed" and exits 1 on any failure.
 """
@@ -38,6 +42,7 @@ EPS = np.finfo(float).eps
 SILC_ESINGULAR, SILC_ENOTSPD = 3, 4
 
 harness, plugin_dir, matrices, workdir = sys.argv[1:5]
+silc_cli = sys.argv[5] if len(sys.argv) > 5 else None
 os.makedirs(workdir, exist_ok=True)
 passed = failed = 0
 
@@ -234,6 +239,56 @@ if have("mumps"):
     check(rep.get("declined", "").startswith("MUMPS has no Hermitian Cholesky"),
           f"mumps: complex under .spd declined with its reason ({rep})")
     check_singular("mumps", "mumps", "solve.sparse", sp.csr_matrix(singular_matrix()), "mumps.singular")
+
+# ---- through the language: the engine's complex store and dispatcher ----------
+# silc --put A=FILE --put b=FILE -e 'x = solve(A, b, "backend = NAME"); info x' --get x
+# for each backend built, then the default dispatch of x = A \ b.
+def silc_solve(tag, matrix_file, A, backend, expr=None):
+    bfile = os.path.join(workdir, f"{tag}.b.mtx")
+    xt = x_true_for(A.shape[0]).ravel()
+    b = A @ xt
+    scipy.io.mmwrite(bfile, b.reshape(-1, 1))
+    stmt = expr or f'x = solve(A, b, "backend = {backend}"); info x'
+    out = subprocess.run([silc_cli, "--put", f"A={matrix_file}", "--put", f"b={bfile}", "-e", stmt, "--get", "x"],
+                         capture_output=True, text=True, timeout=300)
+    check(out.returncode == 0, f"{tag}: silc ran ({out.stderr.strip()[:300]})")
+    if out.returncode != 0:
+        return None, out.stdout
+    mm = out.stdout[out.stdout.index("%%MatrixMarket"):]
+    import io
+    x = np.asarray(scipy.io.mmread(io.StringIO(mm))).ravel()
+    Ad = dense(A)
+    cond = cond1(Ad)
+    xs = sla.spsolve(sp.csc_matrix(A), b)
+    bound = 10 * A.shape[0] * EPS * cond
+    err = np.abs(x - xt).sum() / np.abs(xt).sum()
+    agree = np.abs(x - xs).sum() / np.abs(xs).sum()
+    check(err <= bound and agree <= 2 * bound,
+          f"{tag}: through the language, forward error {err:.3g} and SciPy agreement {agree:.3g} <= {bound:.3g}")
+    print(f"{tag}: through silc, err={err:.2e}")
+    return x, out.stdout
+
+
+if silc_cli:
+    young_file = os.path.join(matrices, "young1c.mtx")
+    mhd_file = os.path.join(matrices, "mhd1280b.mtx")
+    runs = []
+    if have("suitesparse"):
+        runs += [("suitesparse.umfpack", young_file, young), ("suitesparse.klu", young_file, young),
+                 ("suitesparse.cholmod", mhd_file, mhd)]
+    if have("mumps"):
+        runs += [("mumps", young_file, young)]
+    for backend, f, A in runs:
+        x, text = silc_solve(f"silc.{backend}", f, A, backend)
+        check(f"backend: {backend}" in text, f"silc: info names {backend}:\n{text[:600]}")
+    if have("lapack"):
+        x, text = silc_solve("silc.lapack", young_file, young, "lapack",
+                             'A = dense(A); x = solve(A, b, "backend = lapack"); info x')
+        check("backend: lapack" in text and "zgetrf" in text, f"silc: info names lapack and zgetrf:\n{text[:600]}")
+    if have("suitesparse") or have("mumps"):
+        x, text = silc_solve("silc.default", young_file, young, None, "x = A \\ b; info x")
+        check("backend: reference" not in text, f"silc: the default dispatch of a complex sparse solve "
+              f"goes to a library backend:\n{text[:600]}")
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed or not passed else 0)
