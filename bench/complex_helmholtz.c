@@ -13,7 +13,10 @@
  *
  * Rows (each the median of R runs, a fresh A each time so nothing is reused):
  *   SILC  x = A \ b   default dispatch (whatever backend the dispatcher
- *                     picks, named in the row), PUT not timed;
+ *                     picks, named in the row), each run in a new context
+ *                     (nothing reused: checked with info), PUT not timed;
+ *                     again with accuracy.condest = off (no condition
+ *                     estimate: the complex Hager-Higham's extra solves);
  *   UMFPACK direct    umfpack_zl_symbolic + numeric + solve, default
  *                     control (the baseline of the ratios);
  *   SciPy spsolve     /usr/bin/python3, scipy.sparse.linalg.spsolve (SuperLU);
@@ -71,39 +74,74 @@ static double residual(const csr *A, const double complex *x, const double compl
 
 /* ---- SILC ---------------------------------------------------------------------- */
 
-static double run_silc(const csr *A, const double complex *b, int reps, double *resid, char *backend,
-                       size_t blen)
+/* Collects what `info x` prints. */
+static void collect(void *user, const char *text)
+{
+    size_t len = strlen(user);
+    snprintf((char *)user + len, 2048 - len, "%s", text);
+}
+
+/* The value after "key: " in info's text, up to the line's end. */
+static void info_field(const char *info, const char *key, char *out, size_t len)
+{
+    const char *p = strstr(info, key);
+    size_t n = 0;
+    out[0] = 0;
+    if (!p) return;
+    p += strlen(key);
+    while (p[n] && p[n] != '\n') n++;
+    snprintf(out, len, "%.*s", (int)n, p);
+}
+
+/* Each run in a context of its own, so no factorization or analysis of an
+ * earlier run is reused (the store would hand an identical PUT the value
+ * it already has); the PUTs are not timed. */
+static double run_silc(const csr *A, const double complex *b, int reps, int condest, double *resid,
+                       char *backend, size_t blen)
 {
     silc_envelope_t EA, Eb, Ex;
+    silc_context *c = NULL;
     double *t = calloc((size_t)reps, sizeof *t), med;
-    char info[512] = "";
     double complex *x = malloc((size_t)A->n * sizeof *x);
-    if (!t || !x || SILC_INIT()) goto fail;
+    char info[2048] = "", name[64], reused[16];
+    if (!t || !x) return -1;
     if (silc_envelope_csr_complex(&EA, A->n, A->n, A->rowptr, A->colind, (const double *)A->val) ||
-        silc_envelope_dense_complex(&Eb, A->n, 1, (const double *)b) || SILC_PUT("b", &Eb))
+        silc_envelope_dense_complex(&Eb, A->n, 1, (const double *)b))
         goto fail;
     for (int r = 0; r < reps; r++) {
         double t0;
-        if (SILC_PUT("A", &EA)) goto fail; /* a new value: no factorization to reuse */
+        if (silc_open(&c, NULL) || silc_put(c, "A", &EA) || silc_put(c, "b", &Eb) ||
+            (!condest && silc_exec(c, "set accuracy.condest = off")))
+            goto fail;
         t0 = bench_now();
-        if (SILC_EXEC("x = A \\ b;")) goto fail;
+        if (silc_exec(c, "x = A \\ b;")) goto fail;
         t[r] = bench_now() - t0;
+        info[0] = 0;
+        silc_set_output(c, collect, info);
+        if (silc_exec(c, "info x")) goto fail;
+        info_field(info, "reused factorization: ", reused, sizeof reused);
+        if (strcmp(reused, "no") != 0) {
+            fprintf(stderr, "complex_helmholtz: run %d reused a factorization (info: '%s')\n", r, reused);
+            goto fail;
+        }
+        if (r == reps - 1 && (silc_get_complex(c, &Ex, "x") || silc_envelope_to_dense(&Ex, (double *)x))) goto fail;
+        if (r < reps - 1) silc_close(&c);
     }
-    if (silc_get_complex(silc_default_context(), &Ex, "x") || silc_envelope_to_dense(&Ex, (double *)x)) goto fail;
     *resid = residual(A, x, b);
+    info_field(info, "backend: ", name, sizeof name);
+    snprintf(backend, blen, "default dispatch: %s", name);
     silc_envelope_free(&Ex);
-    (void)info;
-    snprintf(backend, blen, "default dispatch");
+    silc_close(&c);
     silc_envelope_free(&EA);
     silc_envelope_free(&Eb);
     med = bench_median(t, reps);
     free(t);
     free(x);
-    SILC_FINALIZE();
     return med;
 fail:
-    fprintf(stderr, "complex_helmholtz: SILC failed: %s\n", silc_errmsg());
+    fprintf(stderr, "complex_helmholtz: SILC failed: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
     snprintf(backend, blen, "failed (message on stderr)");
+    if (c) silc_close(&c);
     free(t);
     free(x);
     return -1;
@@ -199,10 +237,10 @@ static double run_tool(const char *cmd, double *resid)
 static void row(const char *name, const char *how, double s, double resid, double base)
 {
     if (s < 0) {
-        printf("| %-18s | %-34s | %9s | %9s | %9s |\n", name, how, "n/a", "", "");
+        printf("| %-18s | %-40s | %9s | %9s | %9s |\n", name, how, "n/a", "", "");
         return;
     }
-    printf("| %-18s | %-34s | %9.3f | %9.2f | %9.1e |\n", name, how, s, base > 0 ? s / base : 0, resid);
+    printf("| %-18s | %-40s | %9.3f | %9.2f | %9.1e |\n", name, how, s, base > 0 ? s / base : 0, resid);
 }
 
 int main(int argc, char **argv)
@@ -214,7 +252,8 @@ int main(int argc, char **argv)
     csr A;
     silc_envelope_t E;
     double complex *b;
-    double t_silc, t_umf, t_sp = -1, t_oct = -1;
+    double t_silc, t_silc_nc, t_umf, t_sp = -1, t_oct = -1, r_silc_nc = 0;
+    char backend_nc[300];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--n") && i + 1 < argc) N = atoll(argv[++i]);
         else if (!strcmp(argv[i], "--k") && i + 1 < argc) k = atof(argv[++i]);
@@ -235,7 +274,8 @@ int main(int argc, char **argv)
            "median of %d\n\n",
            (long long)N, (long long)N, (long long)A.n, (long long)A.nnz, k, reps);
     t_umf = run_umfpack(&A, b, reps, &r_umf);
-    t_silc = run_silc(&A, b, reps, &r_silc, backend, sizeof backend);
+    t_silc = run_silc(&A, b, reps, 1, &r_silc, backend, sizeof backend);
+    t_silc_nc = run_silc(&A, b, reps, 0, &r_silc_nc, backend_nc, sizeof backend_nc);
     if ((scipy || octave) && mkdtemp(dir)) {
         snprintf(path, sizeof path, "%s/A.bin", dir);
         if (write_matrix(path, &A, b) == 0) {
@@ -269,10 +309,11 @@ int main(int argc, char **argv)
         unlink(script);
         rmdir(dir);
     }
-    printf("| %-18s | %-34s | %9s | %9s | %9s |\n", "solver", "how", "seconds", "/ UMFPACK", "residual");
-    printf("| %-18s | %-34s | %9s | %9s | %9s |\n", "---", "---", "---", "---", "---");
+    printf("| %-18s | %-40s | %9s | %9s | %9s |\n", "solver", "how", "seconds", "/ UMFPACK", "residual");
+    printf("| %-18s | %-40s | %9s | %9s | %9s |\n", "---", "---", "---", "---", "---");
     row("UMFPACK direct", "umfpack_zl symbolic+numeric+solve", t_umf, r_umf, t_umf);
     row("SILC x = A \\ b", backend, t_silc, r_silc, t_umf);
+    row("SILC, condest off", backend_nc, t_silc_nc, r_silc_nc, t_umf);
     if (scipy) row("SciPy spsolve", "scipy.sparse.linalg (SuperLU)", t_sp, r_sp, t_umf);
     if (octave) row("Octave A\\b", access("/usr/bin/octave-cli", X_OK) ? "octave-cli not installed" : "octave-cli",
                     t_oct, r_oct, t_umf);
