@@ -1007,13 +1007,14 @@ static void note_add(silc_report *r, const char *fmt, ...)
 static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *c)
 {
     int sym = (int)ID_SYM(F);
-    const char *fact = sym == 1 ? "LDL' Cholesky" : sym == 2 ? "complex symmetric LDL'" : "LU";
+    /* SYM=2: complex symmetric, A = A.' (method is 64 bytes: kept short) */
+    const char *fact = sym == 1 ? "LDL' Cholesky" : sym == 2 ? "LDL' (A = A.')" : F->cplx ? "complex LU" : "LU";
     if (F->single)
         snprintf(r->method, sizeof r->method, "%s (MUMPS single precision) + refinement",
                  sym == 1 ? "LDL'" : "LU");
     else
-        snprintf(r->method, sizeof r->method, "%s%s (MUMPS multifrontal, SYM=%d, %s order)",
-                 F->cplx && sym == 0 ? "complex " : "", fact, sym, ordering_name((int)INFOG(F, 7)));
+        snprintf(r->method, sizeof r->method, "%s (MUMPS multifrontal, SYM=%d, %s order)", fact, sym,
+                 ordering_name((int)INFOG(F, 7)));
     r->cond_est = F->cond_est;
     r->rcond = -1;
     r->iterations = 0;
