@@ -20,6 +20,12 @@
 #include <math.h>
 #include <string.h>
 
+/* C11's CMPLX, which glibc defines for gcc but not for clang 14 (the
+ * libFuzzer builds compile this file with clang). */
+#ifndef CMPLX
+#define CMPLX(x, y) __builtin_complex((double)(x), (double)(y))
+#endif
+
 typedef double complex zc;
 
 static zc *zval(const silc_view *v)

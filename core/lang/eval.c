@@ -1633,8 +1633,12 @@ static int for_value(lang_ev *V, const range_spec *r, const silc_value *all, int
         *out = val_scalar_new(range_at(r->base, r->inc, r->limit, r->count, (double)k));
         return *out ? 0 : eng_oom(V->E);
     }
-    if (!(*out = val_dense_new(all->m, 1))) return eng_oom(V->E);
-    for (i = 0; i < all->m; i++) (*out)->val[i] = val_get(all, i, k);
+    if (!(*out = val_new_unset_field(SILC_FMT_DENSE, all->field, all->m, 1, 0, 0, 0))) return eng_oom(V->E);
+    for (i = 0; i < all->m; i++) {
+        double complex z = val_get_complex(all, i, k); /* a complex column stays complex */
+        (*out)->val[i * val_width(all)] = creal(z);
+        if (all->field == SILC_FIELD_COMPLEX) (*out)->val[2 * i + 1] = cimag(z);
+    }
     return 0;
 }
 

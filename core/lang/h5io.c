@@ -231,6 +231,12 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
             free(all);
             return eng_error(E, "save: '%s' is distributed over ranks; save it from one process", names[i]);
         }
+        if (v->field == SILC_FIELD_COMPLEX) { /* refused before the file is touched */
+            free(all);
+            return eng_error(E, "save: '%s' is complex, and complex values are not saved to HDF5 yet (issue 31: "
+                                "h5py's compound r/i layout); save real(%s) and imag(%s)", names[i], names[i],
+                             names[i]);
+        }
     }
     if (cfg_file_write(E, "save", path, &out)) {
         free(all);

@@ -195,8 +195,71 @@ static silc_value *extract_csr(const silc_value *a, const ix_list *I, const ix_l
     return out;
 }
 
+/* Complex values are subscripted part by part: the real parts, then the
+ * imaginary parts, by the same real code, and the two results joined (one
+ * format and shape; a sparse assignment may leave the parts different
+ * patterns, joined as their union).  A failed join is reported, never a
+ * half value. */
+static int ix_extract_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+                           const silc_value *base, silc_value **out);
+static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+                          const silc_value *target, const silc_value *rhs, silc_value **out);
+
+static int join_parts(lang_ev *V, const char *what, silc_value *re, silc_value *im, silc_value **out)
+{
+    *out = val_complex_of_parts(re, im);
+    val_release(re);
+    val_release(im);
+    if (*out) return 0;
+    if (*val_refusal()) return eng_error(V->E, "%s", val_refusal());
+    return eng_error(V->E, "%s: out of memory joining the parts of a subscripted complex value", what);
+}
+
 int ix_extract(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
                const silc_value *base, silc_value **out)
+{
+    silc_value *part[2] = {NULL, NULL}, *got[2] = {NULL, NULL};
+    int k, rc = 0;
+    if (base->field != SILC_FIELD_COMPLEX) return ix_extract_real(V, subs, nsubs, what, base, out);
+    *out = NULL;
+    for (k = 0; k < 2 && !rc; k++) {
+        if (!(part[k] = val_part(base, k))) rc = eng_oom(V->E);
+        else rc = ix_extract_real(V, subs, nsubs, what, part[k], &got[k]);
+    }
+    val_release(part[0]);
+    val_release(part[1]);
+    if (rc) {
+        val_release(got[0]);
+        val_release(got[1]);
+        return -1;
+    }
+    return join_parts(V, what, got[0], got[1], out);
+}
+
+int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+              const silc_value *target, const silc_value *rhs, silc_value **out)
+{
+    silc_value *tp[2] = {NULL, NULL}, *rp[2] = {NULL, NULL}, *got[2] = {NULL, NULL};
+    int k, rc = 0;
+    if (target->field != SILC_FIELD_COMPLEX && rhs->field != SILC_FIELD_COMPLEX)
+        return ix_assign_real(V, subs, nsubs, what, target, rhs, out);
+    /* a complex right-hand side makes the target complex (promoted) */
+    *out = NULL;
+    for (k = 0; k < 2 && !rc; k++) {
+        if (!(tp[k] = val_part(target, k)) || !(rp[k] = val_part(rhs, k))) rc = eng_oom(V->E);
+        else rc = ix_assign_real(V, subs, nsubs, what, tp[k], rp[k], &got[k]);
+    }
+    for (k = 0; k < 2; k++) val_release(tp[k]), val_release(rp[k]);
+    if (rc) {
+        val_release(got[0]);
+        val_release(got[1]);
+        return -1;
+    }
+    return join_parts(V, what, got[0], got[1], out);
+}
+
+static int ix_extract_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+                           const silc_value *base, silc_value **out)
 {
     ix_list I, J;
     silc_value *r = NULL;
@@ -288,8 +351,8 @@ static silc_value *copy_value(const silc_value *t)
     return r;
 }
 
-int ix_assign(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
-              const silc_value *target, const silc_value *rhs, silc_value **out)
+static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+                          const silc_value *target, const silc_value *rhs, silc_value **out)
 {
     ix_list I, J;
     ix_entry *e = NULL;

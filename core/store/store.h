@@ -111,9 +111,9 @@ silc_value *val_scalar_new_complex(double re, double im);
  * (val_refusal says which). */
 silc_value *val_promote(const silc_value *v);
 silc_value *val_part(const silc_value *v, int imag);
-/* re + i*im as a complex value, re and im real values of one format,
- * shape and (CSR) pattern -- dense values always qualify; NULL otherwise
- * or when out of memory.  Joins the parts val_part splits. */
+/* re + i*im as a complex value, re and im real values of one format and
+ * shape (CSR: the union of their patterns); NULL otherwise or when out of
+ * memory.  Joins the parts val_part splits. */
 silc_value *val_complex_of_parts(const silc_value *re, const silc_value *im);
 /* 1 when every imaginary part of v is 0 (and for every real v). */
 int val_imag_is_zero(const silc_value *v);

@@ -397,16 +397,40 @@ silc_value *val_part(const silc_value *v, int imag)
     return w;
 }
 
+/* re + i*im for CSR parts of one shape whose patterns differ: the union,
+ * row by row (an entry missing from one part is 0 there). */
+static silc_value *csr_union_of_parts(const silc_value *re, const silc_value *im)
+{
+    silc_value *w = val_csr_new_complex(re->m, re->n, re->nnz + im->nnz);
+    int64_t i, p, q, k = 0;
+    if (!w) return NULL;
+    for (i = 0; i < re->m; i++) {
+        p = re->rowptr[i], q = im->rowptr[i];
+        while (p < re->rowptr[i + 1] || q < im->rowptr[i + 1]) {
+            int64_t cp = p < re->rowptr[i + 1] ? re->colind[p] : INT64_MAX;
+            int64_t cq = q < im->rowptr[i + 1] ? im->colind[q] : INT64_MAX;
+            w->colind[k] = cp < cq ? cp : cq;
+            w->val[2 * k] = cp <= cq ? re->val[p++] : 0;
+            w->val[2 * k + 1] = cq <= cp ? im->val[q++] : 0;
+            k++;
+        }
+        w->rowptr[i + 1] = k;
+    }
+    val_csr_set_nnz(w, k);
+    return w;
+}
+
 silc_value *val_complex_of_parts(const silc_value *re, const silc_value *im)
 {
     silc_value *w;
     if (!re || !im || re->dist || im->dist || re->field || im->field || re->format != im->format ||
-        re->m != im->m || re->n != im->n || re->nnz != im->nnz || re->kl != im->kl || re->ku != im->ku)
+        re->m != im->m || re->n != im->n || re->kl != im->kl || re->ku != im->ku)
         return NULL;
     if (re->format == SILC_FMT_CSR &&
-        (memcmp(re->rowptr, im->rowptr, (size_t)(re->m + 1) * sizeof *re->rowptr) ||
+        (re->nnz != im->nnz || memcmp(re->rowptr, im->rowptr, (size_t)(re->m + 1) * sizeof *re->rowptr) ||
          (re->nnz && memcmp(re->colind, im->colind, (size_t)re->nnz * sizeof *re->colind))))
-        return NULL;
+        return csr_union_of_parts(re, im);
+    if (re->nnz != im->nnz) return NULL;
     if (!(w = same_pattern(re, SILC_FIELD_COMPLEX))) return NULL;
     for (int64_t k = 0; k < re->nnz; k++) w->val[2 * k] = re->val[k], w->val[2 * k + 1] = im->val[k];
     return w;
