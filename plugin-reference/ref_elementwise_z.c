@@ -33,6 +33,17 @@ static zc *zval(const silc_view *v)
     return (zc *)v->val;
 }
 
+/* re + i im, exact for infinite parts too (re + I * im is not: I * inf
+ * gives a NaN real part); C11's CMPLX is missing from some compilers'
+ * headers (clang's C99 mode in the fuzz build). */
+static zc zmake(double re, double im)
+{
+    double parts[2] = {re, im};
+    zc z;
+    memcpy(&z, parts, sizeof z);
+    return z;
+}
+
 static zc zget(const silc_view *v, int64_t i, int64_t j)
 {
     zc z;
@@ -129,7 +140,7 @@ int ref_op_scale_z(silc_call *call)
 {
     silc_view a;
     ref_host->view(call->in[0], &a);
-    return scale_copy(call, &a, CMPLX(call->alpha, call->alpha_imag));
+    return scale_copy(call, &a, zmake(call->alpha, call->alpha_imag));
 }
 
 typedef struct lin_ctx {
@@ -148,7 +159,7 @@ int ref_op_add_z(silc_call *call)
     silc_view a, b;
     ref_host->view(call->in[0], &a);
     ref_host->view(call->in[1], &b);
-    zc al = CMPLX(call->alpha, call->alpha_imag), be = CMPLX(call->beta, call->beta_imag);
+    zc al = zmake(call->alpha, call->alpha_imag), be = zmake(call->beta, call->beta_imag);
     int sa = is_scalar(&a), sb = is_scalar(&b);
     if (sa != sb) {
         const silc_view *X = sa ? &b : &a;
