@@ -17,6 +17,12 @@
  * The factorization is attached to A ("lapack.<kind>"), so repeated solves
  * with an unchanged A factor once.  lapack.precision = mixed sends general
  * and SPD dense solves to dsgesv / dsposv instead (see solve_mixed).  The thread count is OpenBLAS's.
+ *
+ * Complex values (ABI 1.8): MATMUL by cblas_zgemm / zgemv, and every SOLVE
+ * class above by the z routines (lapack.h), .spd meaning Hermitian positive
+ * definite (zpotrf) and a complex symmetric A (A = A.') going to zsytrf.
+ * lapack.precision = mixed is real only (LAPACK has zcgesv but no complex
+ * path here): a complex solve is factored in double and the note says so.
  */
 #include "lapack.h"
 
@@ -84,11 +90,36 @@ int lp_illegal(silc_call *call, const char *fn, lapack_int info)
     return lp_host->error(call, SILC_ELIB, "%s: illegal argument %d (status %d)", fn, (int)-info, (int)info);
 }
 
+int lp_illegal_p(silc_call *call, char p, const char *fn, lapack_int info)
+{
+    return lp_host->error(call, SILC_ELIB, "%c%s: illegal argument %d (status %d)", p, fn, (int)-info,
+                          (int)info);
+}
+
 double lp_get(const silc_view *A, int64_t i, int64_t j)
 {
     if (A->format == SILC_FMT_DENSE) return A->val[i + j * A->m];
     if (i - j > A->kl || j - i > A->ku) return 0.0;
     return A->val[(A->ku + i - j) + j * A->ld];
+}
+
+double complex lp_getz(const silc_view *A, int64_t i, int64_t j)
+{
+    const double complex *z = (const double complex *)A->val;
+    if (A->format == SILC_FMT_DENSE) return z[i + j * A->m];
+    if (i - j > A->kl || j - i > A->ku) return 0.0;
+    return z[(A->ku + i - j) + j * A->ld];
+}
+
+int lp_is_complex(const silc_value *v)
+{
+    return lp_host->struct_size >= SILC_HOST_NEEDS(field) && lp_host->field(v) == SILC_FIELD_COMPLEX;
+}
+
+/* A new zero-filled dense m x n value of the field of the operands. */
+static silc_value *dense_out(int cx, int64_t m, int64_t n)
+{
+    return cx ? lp_host->dense_new_complex(m, n) : lp_host->dense_new(m, n);
 }
 
 static int is_class(const silc_call *call, const char *cls)
@@ -164,7 +195,12 @@ static int accepts_solve(const silc_call *call, const char **why)
         *why = "needs a triangular matrix";
         return 0;
     }
-    if (spd_class(call) && !P->symmetric) {
+    if (lp_is_complex(call->in[0])) {
+        if (spd_class(call) && !P->hermitian) {
+            *why = "needs a Hermitian matrix";
+            return 0;
+        }
+    } else if (spd_class(call) && !P->symmetric) {
         *why = "needs a symmetric matrix";
         return 0;
     }
@@ -177,7 +213,7 @@ static int op_matmul(silc_call *call)
 {
     silc_view a, b, c;
     silc_value *out;
-    int m, k, n;
+    int m, k, n, cx = lp_is_complex(call->in[0]);
     lp_host->view(call->in[0], &a);
     lp_host->view(call->in[1], &b);
     if (a.format != SILC_FMT_DENSE || b.format != SILC_FMT_DENSE)
@@ -185,15 +221,26 @@ static int op_matmul(silc_call *call)
     if (a.n != b.m)
         return lp_host->error(call, SILC_EARG, "lapack: inner dimensions differ (%lldx%lld * %lldx%lld)",
                               (long long)a.m, (long long)a.n, (long long)b.m, (long long)b.n);
+    if (cx != lp_is_complex(call->in[1]))
+        return lp_host->error(call, SILC_EARG, "lapack: operands of different fields (real and complex)");
     m = (int)a.m;
     k = (int)a.n;
     n = (int)b.n;
-    out = lp_host->dense_new(m, n);
+    out = dense_out(cx, m, n);
     if (!out) return lp_nomem(call);
     lp_host->view(out, &c);
     /* Empty inner dimension: the zero-filled result is already right, and BLAS
      * would reject the leading dimensions of empty arrays. */
-    if (m > 0 && n > 0 && k > 0) {
+    if (cx && m > 0 && n > 0 && k > 0) {
+        const double complex one = 1, zero = 0;
+        if (n == 1)
+            cblas_zgemv(CblasColMajor, CblasNoTrans, m, k, &one, a.val, m, b.val, 1, &zero, c.val, 1);
+        else if (m == 1) /* row vector times matrix: c.' = B.' a.' (no conjugation) */
+            cblas_zgemv(CblasColMajor, CblasTrans, k, n, &one, b.val, k, a.val, 1, &zero, c.val, 1);
+        else
+            cblas_zgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, m, n, k, &one, a.val, m, b.val, k, &zero,
+                        c.val, m);
+    } else if (m > 0 && n > 0 && k > 0) {
         if (n == 1)
             cblas_dgemv(CblasColMajor, CblasNoTrans, m, k, 1.0, a.val, m, b.val, 1, 0.0, c.val, 1);
         else if (m == 1) /* row vector times matrix: c' = B' a' */
@@ -236,10 +283,21 @@ static int factor(silc_call *call, int route, const silc_view *A, const silc_pro
     }
 }
 
-/* Copies the m x k right-hand side b (any format) into X with leading dimension ldx. */
-static void rhs_copy(const silc_view *b, double *X, int64_t ldx)
+/* Copies the m x k right-hand side b (any format) into X with leading
+ * dimension ldx (in entries; complex entries when cx). */
+static void rhs_copy(const silc_view *b, double *X, int64_t ldx, int cx)
 {
     int64_t i, j, p;
+    if (cx) {
+        double complex *Z = (double complex *)X;
+        const double complex *bz = (const double complex *)b->val;
+        for (j = 0; j < b->n; j++)
+            for (i = 0; i < b->m; i++) Z[i + j * ldx] = b->format == SILC_FMT_CSR ? 0 : lp_getz(b, i, j);
+        if (b->format == SILC_FMT_CSR)
+            for (i = 0; i < b->m; i++)
+                for (p = b->rowptr[i]; p < b->rowptr[i + 1]; p++) Z[i + b->colind[p] * ldx] += bz[p];
+        return;
+    }
     if (b->format == SILC_FMT_CSR) {
         for (j = 0; j < b->n; j++) memset(X + j * ldx, 0, (size_t)b->m * sizeof(double));
         for (i = 0; i < b->m; i++)
@@ -303,7 +361,7 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
     }
     lp_host->view(out, &X);
     memcpy(a, A->val, (size_t)n * (size_t)n * sizeof(double));
-    rhs_copy(B, b, n);
+    rhs_copy(B, b, n, 0);
     info = chol ? LAPACKE_dsposv_work(LAPACK_COL_MAJOR, 'L', n, nrhs, a, n, b, n, X.val, n, work,
                                       swork, &iter)
                 : LAPACKE_dsgesv_work(LAPACK_COL_MAJOR, n, nrhs, a, n, ipiv, b, n, X.val, n, work,
@@ -374,9 +432,12 @@ static int op_solve(silc_call *call)
     silc_value *out;
     double rank_tol = 0, t0, t1, *work;
     int64_t ldw;
-    int route, rc, fresh = 0;
+    int route, rc, fresh = 0, cx = lp_is_complex(call->in[0]), mixed_asked = 0;
+    size_t w = cx ? 2 : 1; /* doubles per entry */
     lp_host->view(call->in[0], &A);
     lp_host->view(call->in[1], &B);
+    if (cx != lp_is_complex(call->in[1]))
+        return lp_host->error(call, SILC_EARG, "lapack: A and b of different fields (real and complex)");
     if (A.format != SILC_FMT_DENSE && A.format != SILC_FMT_BAND)
         return lp_host->error(call, SILC_EDECLINE, "lapack: needs dense or band storage");
     if (A.m != A.n && A.format != SILC_FMT_DENSE)
@@ -385,7 +446,7 @@ static int op_solve(silc_call *call)
         return lp_host->error(call, SILC_EARG, "lapack: A is %lldx%lld but b has %lld rows",
                               (long long)A.m, (long long)A.n, (long long)B.m);
     if (A.m == 0 || A.n == 0 || B.n == 0) { /* nothing to factor: the zero-filled x is the answer */
-        if (!(call->out = lp_host->dense_new(A.n, B.n))) return lp_nomem(call);
+        if (!(call->out = dense_out(cx, A.n, B.n))) return lp_nomem(call);
         snprintf(call->report->method, sizeof call->report->method, "empty system");
         return SILC_OK;
     }
@@ -393,8 +454,9 @@ static int op_solve(silc_call *call)
     route = route_of(call, &A, P);
     if ((route == R_LU || route == R_CHOL) && A.format == SILC_FMT_DENSE) {
         const char *prec = lp_host->option_string(call, "precision", "double");
-        if (strcmp(prec, "mixed") == 0) return solve_mixed(call, route, &A, &B, P);
-        if (strcmp(prec, "double") != 0)
+        mixed_asked = cx && strcmp(prec, "mixed") == 0; /* real only: complex factors in double */
+        if (!cx && strcmp(prec, "mixed") == 0) return solve_mixed(call, route, &A, &B, P);
+        if (strcmp(prec, "double") != 0 && !mixed_asked)
             return lp_host->error(call, SILC_EARG,
                                   "option 'lapack.precision' expects double or mixed, got '%s'", prec);
     }
@@ -423,7 +485,7 @@ static int op_solve(silc_call *call)
     }
     t1 = lp_host->now();
 
-    out = lp_host->dense_new(A.n, B.n);
+    out = dense_out(cx, A.n, B.n);
     if (!out) {
         lp_factor_free(owned);
         return lp_nomem(call);
@@ -432,18 +494,19 @@ static int op_solve(silc_call *call)
     /* Square systems are solved in place in the result; least squares needs
      * max(m, n) rows of room. */
     ldw = A.m > A.n ? A.m : A.n;
-    work = A.m == A.n ? X.val : lp_host->calloc((size_t)ldw * (size_t)B.n, sizeof(double));
+    work = A.m == A.n ? X.val : lp_host->calloc((size_t)ldw * (size_t)B.n * w, sizeof(double));
     if (!work) {
         lp_host->release(out);
         lp_factor_free(owned);
         return lp_nomem(call);
     }
-    rhs_copy(&B, work, ldw);
+    rhs_copy(&B, work, ldw, cx);
     if (route == R_BAND) rc = lp_band_solve(call, F, work, (lapack_int)ldw, (lapack_int)B.n);
     else rc = lp_dense_solve(call, F, &A, work, (lapack_int)ldw, (lapack_int)B.n);
     if (rc == SILC_OK && work != X.val) {
         int64_t j;
-        for (j = 0; j < B.n; j++) memcpy(X.val + j * A.n, work + j * ldw, (size_t)A.n * sizeof(double));
+        for (j = 0; j < B.n; j++)
+            memcpy(X.val + (size_t)j * A.n * w, work + (size_t)j * ldw * w, (size_t)A.n * w * sizeof(double));
     }
     if (work != X.val) lp_free(work);
     if (rc != SILC_OK) {
@@ -452,6 +515,9 @@ static int op_solve(silc_call *call)
         return rc;
     }
     fill_report(call->report, F);
+    if (mixed_asked)
+        snprintf(call->report->note, sizeof call->report->note,
+                 "lapack.precision = mixed is real only: factored in double");
     call->report->reused_factor = !fresh && F->kind != LP_TRI && F->kind != LP_LSY;
     call->report->factor_seconds = fresh ? t1 - t0 : 0.0;
     call->report->solve_seconds = lp_host->now() - t1;
@@ -488,11 +554,14 @@ static const silc_option_spec lp_options[] = {
 
 static char lp_version[192];
 
+/* Both ops take complex operands (the z routines). */
+static const uint32_t lp_complex_ops[1] = {SILC_COMPLEX_OPS(SILC_OP_MATMUL) | SILC_COMPLEX_OPS(SILC_OP_SOLVE)};
+
 static silc_plugin lp_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
     "lapack", lp_version, 1, lp_backends,
     (int)(sizeof lp_options / sizeof lp_options[0]), lp_options,
-    set_threads, NULL, NULL, NULL};
+    set_threads, NULL, NULL, lp_complex_ops};
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,
                                         const char **errmsg)

@@ -14,12 +14,22 @@
  *   lapack_band.c   band: dgbtrf, dpbtrf; tridiagonal: dgttrf, dpttrf
  *
  * LAPACK indices are 32-bit (lapack_int); accepts() refuses larger operands.
+ *
+ * Complex values (ABI 1.8, interleaved re/im: LAPACK's complex*16) take the
+ * same paths with the z routines: a factor made from a complex A has cplx
+ * set, its a holds 2 doubles per entry, and every factor and solve function
+ * below calls the z routine where it would call the d one (zgetrf, zpotrf
+ * for a Hermitian A, zsytrf for a complex symmetric one, ztrtrs, zgbtrf,
+ * zgeqrf / zgelqf with zunmqr / zunmlq, zgelsy).  The condition estimates
+ * are LAPACK's own (zgecon, zpocon, zsycon, ztrcon; zlacn2 for band).  The
+ * mixed-precision path stays real.
  */
 #ifndef LAPACK_PLUGIN_H
 #define LAPACK_PLUGIN_H
 
 #include "silc_plugin.h"
 
+#include <complex.h>
 #include <lapacke.h>
 
 extern const silc_host_api *lp_host;
@@ -27,7 +37,7 @@ extern const silc_host_api *lp_host;
 enum lp_kind {
     LP_LU,    /* dgetrf: a = L\U (n x n), ipiv */
     LP_CHOL,  /* dpotrf: a = L (lower); bad > 0 remembers a failure */
-    LP_LDLT,  /* dsytrf: a = L, D (lower), ipiv */
+    LP_LDLT,  /* dsytrf: a = L, D (lower), ipiv (complex: zsytrf, A = A.', not Hermitian) */
     LP_TRI,   /* triangular: no factor, only the dtrcon estimate (A itself is the factor) */
     LP_GB,    /* dgbtrf: a = band LU, ld = 2 kl + ku + 1, ipiv */
     LP_PB,    /* dpbtrf: a = upper band Cholesky, ld = ku + 1 */
@@ -40,6 +50,7 @@ enum lp_kind {
 
 typedef struct lp_factor {
     int kind;                /* enum lp_kind */
+    int cplx;                /* complex factors (z routines, 2 doubles per entry in a, tau) */
     lapack_int m, n;         /* shape of A */
     lapack_int kl, ku;       /* band widths (GB, PB) */
     lapack_int ld;           /* leading dimension of a */
@@ -64,13 +75,23 @@ void lp_free(void *p);
  * of memory (nothing left allocated). */
 int lp_con_scratch(lapack_int n, lapack_int nwork, double **work, lapack_int **iwork);
 lp_factor *lp_factor_new(int kind, lapack_int m, lapack_int n);
+/* Doubles per entry: 2 for complex factors, else 1. */
+#define LP_W(F) ((F)->cplx ? 2 : 1)
+/* LAPACK's precision letter of F's routines, for messages ("%cgetrf"). */
+#define LP_P(F) ((F)->cplx ? 'z' : 'd')
 void lp_factor_free(void *F);   /* attachment destructor; NULL is fine */
 int lp_nomem(silc_call *call);  /* host->error(SILC_ENOMEM, ...) */
 /* A negative LAPACK info: "fn: illegal argument i (status -i)", SILC_ELIB. */
 int lp_illegal(silc_call *call, const char *fn, lapack_int info);
+/* The same with the precision letter p before fn ("getrf"). */
+int lp_illegal_p(silc_call *call, char p, const char *fn, lapack_int info);
 
-/* Entry A(i,j) of a dense or band view (0 outside the stored band). */
+/* Entry A(i,j) of a dense or band view (0 outside the stored band); lp_getz
+ * of a complex one. */
 double lp_get(const silc_view *A, int64_t i, int64_t j);
+double complex lp_getz(const silc_view *A, int64_t i, int64_t j);
+/* 1 when v is a complex value (always 0 on a host older than ABI 1.8). */
+int lp_is_complex(const silc_value *v);
 
 /* Factorizations.  On success *F is a new factor; on failure the status is
  * returned after host->error (LP_CHOL: a factor with bad > 0 is still returned

@@ -20,12 +20,18 @@
  * which makes them O(n^2): 13 s for n = 200000, kl = ku = 2, against 12 ms for
  * dgbtrf.  band_rcond() runs the same Hager/Higham estimator (dlacn2) through
  * dgbtrs / dpbtrs instead, O(n kd) per step.
+ *
+ * A complex band matrix always takes the general band LU, zgbtrf / zgbtrs
+ * (tridiagonal and Hermitian positive definite ones too: the complex
+ * variants of the special cases are not wired), with the complex estimator
+ * zlacn2 through zgbtrs ('N' for A^{-1}, 'C' for A^{-H}).
  */
 #include "lapack.h"
 
 #include <stdio.h>
 #include <string.h>
 
+#define LZ(p) ((lapack_complex_double *)(p))
 
 /* 1 / (||A||_1 * est ||A^{-1}||_1) for a GB or PB factor; -1 if it fails.
  * work holds 2n doubles, iwork n integers. */
@@ -35,6 +41,17 @@ static double band_rcond(const lp_factor *F, double norm1, double *work, lapack_
     double est = 0, *v = work, *x = work + n;
     if (n == 0) return -1;
     if (norm1 == 0) return 0;
+    if (F->cplx) { /* work holds 2n complex entries here */
+        lapack_complex_double *zv = LZ(work), *zx = LZ(work) + n;
+        for (;;) {
+            LAPACK_zlacn2(&n, zv, zx, &est, &kase, isave);
+            if (kase == 0) break;
+            info = LAPACKE_zgbtrs_work(LAPACK_COL_MAJOR, kase == 1 ? 'N' : 'C', n, F->kl, F->ku, 1, LZ(F->a),
+                                       F->ld, F->ipiv, zx, n);
+            if (info) return -1;
+        }
+        return est > 0 ? 1.0 / (norm1 * est) : -1;
+    }
     for (;;) {
         LAPACK_dlacn2(&n, v, x, iwork, &est, &kase, isave);
         if (kase == 0) break;
@@ -159,7 +176,7 @@ static int factor_gb(silc_call *call, const silc_view *A, double norm1, lp_facto
 {
     lapack_int n = F->n, kl = F->kl, ku = F->ku, ld = 2 * kl + ku + 1, i, j, info, *iwork;
     double *work;
-    F->a = lp_host->calloc((size_t)ld * (size_t)LP_LD(n), sizeof(double));
+    F->a = lp_host->calloc((size_t)ld * (size_t)LP_LD(n) * (size_t)LP_W(F), sizeof(double));
     F->ipiv = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
     if (!F->a || !F->ipiv) {
         lp_factor_free(F);
@@ -168,20 +185,25 @@ static int factor_gb(silc_call *call, const silc_view *A, double norm1, lp_facto
     /* Rows 0..kl-1 of each column are room for the fill-in of pivoting. */
     for (j = 0; j < n; j++) {
         lapack_int lo = j - ku > 0 ? j - ku : 0, hi = j + kl < n - 1 ? j + kl : n - 1;
-        for (i = lo; i <= hi; i++) F->a[(kl + ku + i - j) + (size_t)j * ld] = lp_get(A, i, j);
+        for (i = lo; i <= hi; i++) {
+            size_t at = (kl + ku + i - j) + (size_t)j * ld;
+            if (F->cplx) LZ(F->a)[at] = lp_getz(A, i, j);
+            else F->a[at] = lp_get(A, i, j);
+        }
     }
-    info = LAPACKE_dgbtrf_work(LAPACK_COL_MAJOR, n, n, kl, ku, F->a, ld, F->ipiv);
-    if (info) return singular(call, F, "dgbtrf", info);
+    info = F->cplx ? LAPACKE_zgbtrf_work(LAPACK_COL_MAJOR, n, n, kl, ku, LZ(F->a), ld, F->ipiv)
+                   : LAPACKE_dgbtrf_work(LAPACK_COL_MAJOR, n, n, kl, ku, F->a, ld, F->ipiv);
+    if (info) return singular(call, F, F->cplx ? "zgbtrf" : "dgbtrf", info);
     F->kind = LP_GB;
     F->ld = ld;
-    if (lp_con_scratch(n, 2 * n, &work, &iwork)) {
+    if (lp_con_scratch(n, 2 * n * LP_W(F), &work, &iwork)) {
         lp_factor_free(F);
         return lp_nomem(call);
     }
     F->rcond = band_rcond(F, norm1, work, iwork);
     lp_free(work);
     lp_free(iwork);
-    snprintf(F->method, sizeof F->method, "band LU (dgbtrf, kl=%d, ku=%d)", (int)kl, (int)ku);
+    snprintf(F->method, sizeof F->method, "band LU (%cgbtrf, kl=%d, ku=%d)", LP_P(F), (int)kl, (int)ku);
     return SILC_OK;
 }
 
@@ -189,12 +211,13 @@ int lp_band(silc_call *call, const silc_view *A, int64_t kl, int64_t ku, int spd
             lp_factor **out)
 {
     lapack_int n = (lapack_int)A->n;
-    int tri = kl <= 1 && ku <= 1, rc;
+    int cx = lp_is_complex(call->in[0]), tri = !cx && kl <= 1 && ku <= 1, rc;
     lp_factor *F = lp_factor_new(tri ? LP_GT : LP_GB, n, n);
     if (!F) return lp_nomem(call);
+    F->cplx = cx;
     F->kl = (lapack_int)kl;
     F->ku = (lapack_int)ku;
-    if (spd_first && kl == ku) {
+    if (spd_first && kl == ku && !cx) {
         rc = tri ? try_pt(call, A, norm1, F) : try_pb(call, A, norm1, F);
         if (rc < 0) {
             lp_factor_free(F);
@@ -217,9 +240,11 @@ int lp_band_solve(silc_call *call, const lp_factor *F, double *B, lapack_int ldb
     const char *fn;
     switch (F->kind) {
     case LP_GB:
-        fn = "dgbtrs";
-        info = LAPACKE_dgbtrs_work(LAPACK_COL_MAJOR, 'N', n, F->kl, F->ku, nrhs, F->a, F->ld, F->ipiv, B,
-                                   ldb);
+        fn = F->cplx ? "zgbtrs" : "dgbtrs";
+        info = F->cplx ? LAPACKE_zgbtrs_work(LAPACK_COL_MAJOR, 'N', n, F->kl, F->ku, nrhs, LZ(F->a), F->ld,
+                                             F->ipiv, LZ(B), ldb)
+                       : LAPACKE_dgbtrs_work(LAPACK_COL_MAJOR, 'N', n, F->kl, F->ku, nrhs, F->a, F->ld,
+                                             F->ipiv, B, ldb);
         break;
     case LP_PB:
         fn = "dpbtrs";

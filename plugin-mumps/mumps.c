@@ -59,6 +59,22 @@
  * step (agree below).  Distributed operands get neither the condition
  * estimate (the estimator's control flow would run on rank 0 alone) nor
  * mumps.precision = single (EUNSUP: the core's refinement is whole-operand).
+ *
+ * Complex values (ABI 1.8) go to zmumps_c (libzmumps_seq linked the same
+ * static way in the sequential module, libzmumps in the MPI one): the
+ * triplets' values are SILC's interleaved entries, which is
+ * mumps_double_complex.  MUMPS's SYM=2 means complex symmetric (A = A.'),
+ * not Hermitian, and MUMPS has no Hermitian LDL^H: so a complex A that is
+ * symmetric (A = A.') is factored with SYM=2 on its lower triangle, any
+ * other complex A (Hermitian ones included) with SYM=0, and the .spd
+ * classes decline complex operands, leaving a Hermitian positive definite
+ * matrix to CHOLMOD or LAPACK, or to this LU under the general class.  The
+ * condition estimate is the host's complex Hager-Higham
+ * (inv_norm1_est_complex): A^{-H} x by the transposed solve (ICNTL(9)=2
+ * solves A.' y = b for complex A, unconjugated) around conjugations.
+ * mumps.precision = single is real only (cmumps is not linked): a complex
+ * matrix is factored in double and the note says so.  The distributed path
+ * moves 2 doubles per entry.
  */
 #include "common/blas_threads.h"
 #include "silc_plugin.h"
@@ -72,8 +88,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <complex.h>
 #include <dmumps_c.h>
 #include <smumps_c.h>
+#include <zmumps_c.h>
 #if SILC_MUMPS_MPI
 #include <mpi.h>
 #endif
@@ -441,8 +459,10 @@ typedef struct mumps_factor {
     union {
         DMUMPS_STRUC_C d;
         SMUMPS_STRUC_C s;
-    } id;                       /* id.s when single, else id.d */
+        ZMUMPS_STRUC_C z;
+    } id;                       /* id.s when single, id.z when cplx, else id.d */
     int single;                 /* factored by smumps_c from af */
+    int cplx;                   /* complex A: zmumps_c, a holds 2 doubles per entry */
     int dist;                   /* irn/jcn/a are this rank's rows (ICNTL(18)=3), rhs is on rank 0 */
     MUMPS_INT comm_f;           /* the communicator it runs on */
     MUMPS_INT *icntl, *infog;   /* the arrays of the instance in use */
@@ -466,6 +486,9 @@ static void mumps_job(mumps_factor *F, int job)
     if (F->single) {
         F->id.s.job = job;
         smumps_c(&F->id.s);
+    } else if (F->cplx) {
+        F->id.z.job = job;
+        zmumps_c(&F->id.z);
     } else {
         F->id.d.job = job;
         dmumps_c(&F->id.d);
@@ -474,8 +497,15 @@ static void mumps_job(mumps_factor *F, int job)
 
 /* Sets an integer or index-array member of whichever instance F uses. */
 #define ID_SET(F, member, value)                                                                   \
-    ((F)->single ? (void)((F)->id.s.member = (value)) : (void)((F)->id.d.member = (value)))
-#define ID_N(F) ((F)->single ? (F)->id.s.n : (F)->id.d.n)
+    ((F)->single ? (void)((F)->id.s.member = (value))                                                \
+     : (F)->cplx ? (void)((F)->id.z.member = (value))                                                \
+                 : (void)((F)->id.d.member = (value)))
+#define ID_N(F) ((F)->single ? (F)->id.s.n : (F)->cplx ? (F)->id.z.n : (F)->id.d.n)
+#define ID_SYM(F) ((F)->single ? (F)->id.s.sym : (F)->cplx ? (F)->id.z.sym : (F)->id.d.sym)
+/* The library entry point of F's arithmetic, for messages. */
+#define ID_FN(F) ((F)->single ? "smumps_c" : (F)->cplx ? "zmumps_c" : "dmumps_c")
+/* Doubles per entry of F's values and right-hand sides. */
+#define ID_W(F) ((F)->cplx ? 2 : 1)
 
 /* Ends the MUMPS instance (collective over its communicator) and frees the
  * triplets; F stays, no longer live, so it is never reused. */
@@ -500,12 +530,15 @@ static void factor_free(void *p)
     host->free(F);
 }
 
-/* Entry (i, j) of a dense or band view, 0 outside the band. */
-static double full_get(const silc_view *v, int64_t i, int64_t j)
+/* Entry (i, j) of a dense or band view, 0 outside the band (w = 2: the
+ * complex entry, read as double complex). */
+static double complex full_get(const silc_view *v, int64_t i, int64_t j, int w)
 {
-    if (v->format == SILC_FMT_DENSE) return v->val[i + j * v->m];
-    if (i - j > v->kl || j - i > v->ku) return 0.0;
-    return v->val[(v->ku + i - j) + j * v->ld];
+    int64_t p;
+    if (v->format == SILC_FMT_DENSE) p = i + j * v->m;
+    else if (i - j > v->kl || j - i > v->ku) return 0.0;
+    else p = (v->ku + i - j) + j * v->ld;
+    return w == 2 ? ((const double complex *)v->val)[p] : v->val[p];
 }
 
 /* 1-based triplets of A (SYM=1: the lower triangle only).  CSR keeps explicit
@@ -516,11 +549,12 @@ static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_fac
                           int64_t *nnz_out)
 {
     int64_t n = v->n, cap, nz = 0, i, j, k;
+    int w = ID_W(F);
     cap = v->format == SILC_FMT_CSR ? v->nnz : v->format == SILC_FMT_BAND ? v->ld * n : n * n;
     if (cap < 1) cap = 1;
     F->irn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
     F->jcn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
-    F->a = host->alloc((size_t)cap * sizeof(double));
+    F->a = host->alloc((size_t)cap * (size_t)w * sizeof(double));
     if (!F->irn || !F->jcn || !F->a) return SILC_ENOMEM;
     if (v->format == SILC_FMT_CSR) {
         for (i = 0; i < v->m; i++)
@@ -528,7 +562,7 @@ static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_fac
                 if (lower && v->colind[k] > row0 + i) break; /* columns are sorted */
                 F->irn[nz] = (MUMPS_INT)(row0 + i + 1);
                 F->jcn[nz] = (MUMPS_INT)(v->colind[k] + 1);
-                F->a[nz++] = v->val[k];
+                memcpy(F->a + nz++ * w, v->val + k * w, (size_t)w * sizeof(double));
             }
     } else {
         for (j = 0; j < n; j++) {
@@ -538,11 +572,13 @@ static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_fac
                 if (j + v->kl + 1 < hi) hi = j + v->kl + 1;
             }
             for (i = lo; i < hi; i++) {
-                double x = full_get(v, i, j);
+                double complex x = full_get(v, i, j, w);
                 if (x == 0.0) continue;
                 F->irn[nz] = (MUMPS_INT)(i + 1);
                 F->jcn[nz] = (MUMPS_INT)(j + 1);
-                F->a[nz++] = x;
+                F->a[nz * w] = creal(x);
+                if (w == 2) F->a[nz * w + 1] = cimag(x);
+                nz++;
             }
         }
     }
@@ -554,7 +590,7 @@ static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_fac
 static int mumps_fail(silc_call *call, int status, const mumps_factor *F, int job)
 {
     return host->error(call, status, "%s (JOB=%d): %s (INFOG(1)=%d, INFOG(2)=%d)",
-                       F->single ? "smumps_c" : "dmumps_c", job, mumps_meaning((int)INFOG(F, 1)),
+                       ID_FN(F), job, mumps_meaning((int)INFOG(F, 1)),
                        (int)INFOG(F, 1), (int)INFOG(F, 2));
 }
 
@@ -622,6 +658,9 @@ static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs
     if (F->single) {
         if (solve_single(F, rhs, nrhs))
             return host->error(call, SILC_ENOMEM, "mumps: out of memory for the single-precision solve");
+    } else if (F->cplx) {
+        F->id.z.rhs = (ZMUMPS_COMPLEX *)rhs;
+        mumps_job(F, MUMPS_JOB_SOLVE);
     } else {
         F->id.d.rhs = rhs;
         mumps_job(F, MUMPS_JOB_SOLVE);
@@ -633,8 +672,7 @@ static int run_solve(silc_call *call, mumps_factor *F, double *rhs, int64_t nrhs
     F->retries++;
     mumps_job(F, MUMPS_JOB_FACTOR);
     if (INFOG(F, 1) < 0)
-        return mumps_fail(call, factor_status((int)INFOG(F, 1), F->single ? F->id.s.sym : F->id.d.sym),
-                          F, MUMPS_JOB_FACTOR);
+        return mumps_fail(call, factor_status((int)INFOG(F, 1), (int)ID_SYM(F)), F, MUMPS_JOB_FACTOR);
     return SOLVE_AGAIN;
 }
 
@@ -668,6 +706,7 @@ static int sparse_block(mumps_factor *F, const double *X, int t, void *arrays[3]
     MUMPS_INT *ptr, *idx;
     double *val;
     int j;
+    if (F->cplx) return 0; /* the sparse right-hand sides are real arrays here */
     for (i = 0; i < n * t; i++) nz += X[i] != 0;
     if (F->single || nz == 0 || nz * 8 > n * t) return 0; /* an all-zero block: nothing to prune */
     arrays[0] = ptr = host->alloc((size_t)(t + 1) * sizeof *ptr);
@@ -733,6 +772,48 @@ static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
     return SILC_OK;
 }
 
+/* The complex estimate's solve: x (n complex entries) := A^{-1} x, or
+ * A^{-H} x = conj(A.'^{-1} conj(x)) when trans is set (ICNTL(9)=2 solves
+ * with A.' for complex A). */
+static int apply_complex(void *ctx, double *x, int trans, double *work)
+{
+    est_ctx *c = ctx;
+    int64_t n = ID_N(c->F), i;
+    size_t bytes = (size_t)n * 2 * sizeof *x;
+    int rc;
+    (void)work;
+    if (trans)
+        for (i = 0; i < n; i++) x[2 * i + 1] = -x[2 * i + 1];
+    memcpy(c->keep, x, bytes);
+    do {
+        memcpy(x, c->keep, bytes);
+        ICNTL(c->F, 9) = trans ? 2 : 1;
+        rc = run_solve(c->call, c->F, x, 1);
+        ICNTL(c->F, 9) = 1;
+    } while (rc == SOLVE_AGAIN);
+    if (trans)
+        for (i = 0; i < n; i++) x[2 * i + 1] = -x[2 * i + 1];
+    return c->rc = rc;
+}
+
+/* F->cond_est of a complex F, by the host's complex estimator (ABI 1.8);
+ * nothing on a host without it (the report then says "not estimated"). */
+static int estimate_cond_complex(silc_call *call, mumps_factor *F)
+{
+    double inv;
+    est_ctx c = {call, F, NULL, 0};
+    if (host->struct_size < SILC_HOST_NEEDS(inv_norm1_est_complex) || !host->inv_norm1_est_complex)
+        return SILC_OK;
+    if (!(c.keep = host->alloc((size_t)ID_N(F) * 2 * sizeof(double))))
+        return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    inv = host->inv_norm1_est_complex(ID_N(F), apply_complex, &c, NULL);
+    host->free(c.keep);
+    if (inv < 0)
+        return c.rc ? c.rc : host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
+    F->cond_est = silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
+    return SILC_OK;
+}
+
 /* mumps.precision = single: af = 2^scale_a a in float, the largest entry near
  * 1.  Returns why that cannot be done, or NULL. */
 static const char *to_single(mumps_factor *F, int64_t nnz)
@@ -755,8 +836,8 @@ static const char *to_single(mumps_factor *F, int64_t nnz)
 static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const settings *s, int *job)
 {
     int k;
-    F->icntl = F->single ? F->id.s.icntl : F->id.d.icntl;
-    F->infog = F->single ? F->id.s.infog : F->id.d.infog;
+    F->icntl = F->single ? F->id.s.icntl : F->cplx ? F->id.z.icntl : F->id.d.icntl;
+    F->infog = F->single ? F->id.s.infog : F->cplx ? F->id.z.infog : F->id.d.infog;
     ID_SET(F, par, 1); /* rank 0 (the host) works too */
     ID_SET(F, sym, sym);
     ID_SET(F, comm_fortran, F->comm_f);
@@ -769,17 +850,22 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
         if (s->cntl_set[k - 1]) {
             if (F->single)
                 F->id.s.cntl[k - 1] = (float)s->cntl[k - 1];
+            else if (F->cplx)
+                F->id.z.cntl[k - 1] = s->cntl[k - 1];
             else
                 F->id.d.cntl[k - 1] = s->cntl[k - 1];
         }
     ID_SET(F, n, (MUMPS_INT)n);
     if (F->dist) { /* the single-precision path is not offered here */
         ICNTL(F, 18) = MUMPS_DISTRIBUTED_INPUT;
-        F->id.d.nnz_loc = nnz;
-        F->id.d.nz_loc = nnz <= INT_MAX ? (MUMPS_INT)nnz : 0;
-        F->id.d.irn_loc = F->irn;
-        F->id.d.jcn_loc = F->jcn;
-        F->id.d.a_loc = F->a;
+        ID_SET(F, nnz_loc, nnz);
+        ID_SET(F, nz_loc, nnz <= INT_MAX ? (MUMPS_INT)nnz : 0);
+        ID_SET(F, irn_loc, F->irn);
+        ID_SET(F, jcn_loc, F->jcn);
+        if (F->cplx)
+            F->id.z.a_loc = (ZMUMPS_COMPLEX *)F->a;
+        else
+            F->id.d.a_loc = F->a;
     } else {
         ID_SET(F, nnz, nnz);
         ID_SET(F, nz, nnz <= INT_MAX ? (MUMPS_INT)nnz : 0);
@@ -787,6 +873,8 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
         ID_SET(F, jcn, F->jcn);
         if (F->single)
             F->id.s.a = F->af;
+        else if (F->cplx)
+            F->id.z.a = (ZMUMPS_COMPLEX *)F->a;
         else
             F->id.d.a = F->a;
     }
@@ -804,8 +892,8 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
 /* Initializes MUMPS for A (v: this rank's rows when c->dist), analyses and
  * factors it, in single precision when the settings ask and the entries
  * allow.  Collective: every rank returns the same status. */
-static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym, const settings *s,
-                      mumps_factor **out)
+static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym, int cplx,
+                      const settings *s, mumps_factor **out)
 {
     mumps_factor *F = host->calloc(1, sizeof *F);
     int64_t nnz = 0;
@@ -819,7 +907,8 @@ static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym
         F->opts = *s;
         F->dist = c->dist;
         F->comm_f = c->comm_f;
-        if (build_triplets(v, c->dist ? c->layout.first_row : 0, sym == 1, F, &nnz))
+        F->cplx = cplx;
+        if (build_triplets(v, c->dist ? c->layout.first_row : 0, sym != 0, F, &nnz))
             rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for %lld triplets",
                              (long long)v->nnz);
     }
@@ -831,7 +920,9 @@ static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym
         factor_free(F);
         return host->error(call, SILC_ESINGULAR, "mumps: singular matrix (no nonzero entries)");
     }
-    if (s->single) {
+    if (s->single && cplx) {
+        F->fallback = "single precision is real only here (cmumps is not linked)";
+    } else if (s->single) {
         F->fallback = to_single(F, nnz);
         F->single = F->fallback == NULL;
     }
@@ -859,7 +950,7 @@ static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym
     if (sym == 1 && INFOG(F, 12) > 0) {
         rc = host->error(call, SILC_ENOTSPD,
                          "%s (JOB=4): matrix is not positive definite (INFOG(12)=%d negative pivots)",
-                         F->single ? "smumps_c" : "dmumps_c", (int)INFOG(F, 12));
+                         ID_FN(F), (int)INFOG(F, 12));
         factor_free(F);
         return rc;
     }
@@ -876,19 +967,25 @@ static const char *ordering_name(int k)
     return k >= 0 && k < 8 ? names[k] : "unknown";
 }
 
-/* Copies B (any format) into the dense n x nrhs array x. */
-static void dense_copy(const silc_view *b, double *x)
+/* Copies B (any format) into the dense n x nrhs array x; w doubles per
+ * entry (2: complex). */
+static void dense_copy(const silc_view *b, double *x, int w)
 {
     int64_t i, j, k;
     if (b->format == SILC_FMT_DENSE) {
-        if (b->m > 0 && b->n > 0) memcpy(x, b->val, (size_t)(b->m * b->n) * sizeof(double));
+        if (b->m > 0 && b->n > 0) memcpy(x, b->val, (size_t)(b->m * b->n * w) * sizeof(double));
     } else if (b->format == SILC_FMT_CSR) {
-        memset(x, 0, (size_t)(b->m * b->n) * sizeof(double));
+        memset(x, 0, (size_t)(b->m * b->n * w) * sizeof(double));
         for (i = 0; i < b->m; i++)
-            for (k = b->rowptr[i]; k < b->rowptr[i + 1]; k++) x[i + b->colind[k] * b->m] += b->val[k];
+            for (k = b->rowptr[i]; k < b->rowptr[i + 1]; k++)
+                for (int p = 0; p < w; p++) x[(i + b->colind[k] * b->m) * w + p] += b->val[k * w + p];
     } else {
         for (j = 0; j < b->n; j++)
-            for (i = 0; i < b->m; i++) x[i + j * b->m] = full_get(b, i, j);
+            for (i = 0; i < b->m; i++) {
+                double complex e = full_get(b, i, j, w);
+                x[(i + j * b->m) * w] = creal(e);
+                if (w == 2) x[(i + j * b->m) * w + 1] = cimag(e);
+            }
     }
 }
 
@@ -909,8 +1006,9 @@ static void note_add(silc_report *r, const char *fmt, ...)
 
 static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *c)
 {
-    int sym = (int)(F->single ? F->id.s.sym : F->id.d.sym);
-    const char *fact = sym == 1 ? "LDL' Cholesky" : "LU";
+    int sym = (int)ID_SYM(F);
+    /* SYM=2: complex symmetric, A = A.' (method is 64 bytes: kept short) */
+    const char *fact = sym == 1 ? "LDL' Cholesky" : sym == 2 ? "LDL' (A = A.')" : F->cplx ? "complex LU" : "LU";
     if (F->single)
         snprintf(r->method, sizeof r->method, "%s (MUMPS single precision) + refinement",
                  sym == 1 ? "LDL'" : "LU");
@@ -938,7 +1036,9 @@ static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *
     if (F->analysed && ICNTL(F, 11) == 1)
         note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
                  F->rinfog[8]);
-    if (F->cond_est >= 0)
+    if (F->cond_est >= 0 && F->cplx)
+        note_add(r, "1-norm condition estimate: complex Hager-Higham (zmumps_c solves)");
+    else if (F->cond_est >= 0)
         note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
     if (F->retries)
         note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
@@ -960,6 +1060,12 @@ static int64_t global_rows(const silc_value *v, const silc_view *view)
     return view->m;
 }
 
+/* 1 when v is a complex value (0 on a host older than ABI 1.8). */
+static int is_complex(const silc_value *v)
+{
+    return host->struct_size >= SILC_HOST_NEEDS(field) && host->field(v) == SILC_FIELD_COMPLEX;
+}
+
 /* Every rank gets the same answer: the shapes are global, and props_part
  * computes the symmetry collectively for a distributed A. */
 static int solve_accepts(const silc_call *call, const char **why)
@@ -976,6 +1082,14 @@ static int solve_accepts(const silc_call *call, const char **why)
     }
     if (a.n > INT_MAX) {
         *why = "matrix too large for MUMPS's 32-bit indices";
+        return 0;
+    }
+    if (is_complex(call->in[0]) && ends_with_spd(call->op_class)) {
+        *why = "MUMPS has no Hermitian Cholesky (SYM=2 is complex symmetric): complex values take the general class";
+        return 0;
+    }
+    if (is_complex(call->in[0]) && a.n > INT_MAX / 2) {
+        *why = "complex matrix too large for MUMPS's 32-bit indices (2 doubles per entry)";
         return 0;
     }
     if (ends_with_spd(call->op_class) && !silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
@@ -1008,11 +1122,11 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     silc_report *r = call->report;
     silc_value *X;
     int64_t n = b->m;
-    int rc, icntl11, analyse, estimate, fold;
+    int rc, icntl11, analyse, estimate, fold, w = ID_W(F);
     double t0, *rhs;
     *out = NULL;
     /* dense_copy, or the copy after a folded solve, writes every entry. */
-    X = host->dense_new_uninit(b->m, b->n);
+    X = F->cplx ? host->dense_new_complex(b->m, b->n) : host->dense_new_uninit(b->m, b->n);
     if (!X) return host->error(call, SILC_ENOMEM, "mumps: cannot allocate the %lldx%lld solution",
                                (long long)b->m, (long long)b->n);
     host->view(X, &o);
@@ -1022,7 +1136,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
     estimate = s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
-    fold = estimate && !analyse;
+    fold = estimate && !analyse && !F->cplx; /* the complex estimator takes no block */
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
         host->release(X);
@@ -1030,14 +1144,15 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     }
     if (!analyse) ICNTL(F, 11) = 0; /* restored below, after the estimate */
     do {
-        dense_copy(b, rhs);
+        dense_copy(b, rhs, w);
         if (fold) host->inv_norm1_start(n, EST_COLS, rhs + n * b->n);
     } while ((rc = run_solve(call, F, rhs, b->n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
     if (!rc && analyse) keep_analysis(F);
     if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n) * sizeof *rhs);
     r->solve_seconds = host->now() - t0;
     ICNTL(F, 11) = 0; /* the estimate's solves, if any, without it */
-    if (!rc && estimate) rc = estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
+    if (!rc && estimate)
+        rc = F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
     ICNTL(F, 11) = icntl11;
     if (rhs != o.val) host->free(rhs);
     if (rc) {
@@ -1057,7 +1172,8 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
 static int solve_dist(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
                       silc_value **out)
 {
-    int64_t n = c->layout.m_global, m = c->layout.m_local, j;
+    /* A complex entry travels as 2 MPI_DOUBLEs: n, m, counts and offsets are in doubles. */
+    int64_t w = ID_W(F), n = c->layout.m_global * w, m = c->layout.m_local * w, j;
     int *counts = NULL, *displs = NULL, rc = SILC_OK, r, icntl11 = (int)ICNTL(F, 11), analyse;
     double *rhs = NULL, t0;
     silc_value *X = host->dist_dense_new(call->in[1], b->n);
@@ -1065,18 +1181,21 @@ static int solve_dist(silc_call *call, solve_ctx *c, mumps_factor *F, const silc
     *out = NULL;
     if (!X) {
         rc = local_error(c, SILC_ENOMEM, "mumps: cannot allocate this rank's %lldx%lld block of the solution",
-                         (long long)m, (long long)b->n);
+                         (long long)c->layout.m_local, (long long)b->n);
+    } else if (F->cplx && !is_complex(X)) {
+        /* ABI 1.8 makes a distributed result of like's field (silc_plugin.h) */
+        rc = local_error(c, SILC_EUNSUP, "mumps: the host made a real distributed result for a complex solve");
     } else if (c->rank == 0) {
         rhs = host->alloc((size_t)n * (size_t)b->n * sizeof *rhs);
         counts = host->alloc((size_t)c->size * sizeof *counts);
         displs = host->alloc((size_t)c->size * sizeof *displs);
         if (!rhs || !counts || !displs)
             rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for the %lldx%lld right-hand side on rank 0",
-                             (long long)n, (long long)b->n);
+                             (long long)c->layout.m_global, (long long)b->n);
         else
-            for (r = 0; r < c->size; r++) { /* n <= INT_MAX (solve_accepts) */
-                counts[r] = (int)(c->layout.starts[r + 1] - c->layout.starts[r]);
-                displs[r] = (int)c->layout.starts[r];
+            for (r = 0; r < c->size; r++) { /* w n <= INT_MAX (solve_accepts) */
+                counts[r] = (int)((c->layout.starts[r + 1] - c->layout.starts[r]) * w);
+                displs[r] = (int)(c->layout.starts[r] * w);
             }
     }
     if ((rc = agree(call, c, rc))) goto done;
@@ -1138,7 +1257,7 @@ static int solve_run(silc_call *call)
     solve_ctx c;
     mumps_factor *F;
     silc_value *X = NULL;
-    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, attach_rc;
+    int sym = ends_with_spd(call->op_class) ? 1 : 0, rc, attach_rc, cplx = is_complex(call->in[0]);
     const char *key;
     const char *why = NULL;
     if ((rc = ctx_open(call, &c))) return rc;
@@ -1147,8 +1266,12 @@ static int solve_run(silc_call *call)
     if (c.dist && s.single)
         return host->error(call, SILC_EUNSUP,
                            "mumps: mumps.precision = single is not supported on distributed operands");
+    if (cplx != is_complex(call->in[1]))
+        return host->error(call, SILC_EARG, "mumps: A and b of different fields (real and complex)");
+    /* SYM=2: complex symmetric (A = A.'), on the lower triangle. */
+    if (cplx && silc_props_of(host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) sym = 2;
     /* Both precisions' factorizations can live on A at once. */
-    key = sym ? (s.single ? "mumps.ldlt.single" : "mumps.ldlt")
+    key = sym == 2 ? "mumps.zsym" : sym ? (s.single ? "mumps.ldlt.single" : "mumps.ldlt")
               : (s.single ? "mumps.lu.single" : "mumps.lu");
     host->view(call->in[0], &a);
     host->view(call->in[1], &b);
@@ -1162,7 +1285,9 @@ static int solve_run(silc_call *call)
         return host->error(call, SILC_EARG, "mumps: too many right-hand sides (%lld)",
                            (long long)b.n);
     if (a.n == 0 || b.n == 0) { /* nothing to factor or solve; MUMPS refuses N=0 */
-        call->out = c.dist ? host->dist_dense_new(call->in[1], b.n) : host->dense_new(b.m, b.n);
+        call->out = c.dist ? host->dist_dense_new(call->in[1], b.n)
+                    : cplx     ? host->dense_new_complex(b.m, b.n)
+                               : host->dense_new(b.m, b.n);
         rc = agree(call, &c, call->out ? SILC_OK : local_error(&c, SILC_ENOMEM, "mumps: out of memory"));
         if (rc && call->out) {
             host->release(call->out);
@@ -1178,7 +1303,7 @@ static int solve_run(silc_call *call)
          * the attachments are alike on every rank); A keeps the dead F
          * until the new one replaces it. */
         if (F) factor_end(F);
-        if ((rc = factor_new(call, &c, &a, sym, &s, &F))) return rc;
+        if ((rc = factor_new(call, &c, &a, sym, cplx, &s, &F))) return rc;
         attach_rc = host->attach_set(call->in[0], key, F, factor_free)
                         ? local_error(&c, SILC_ENOMEM, "mumps: cannot attach the factorization")
                         : SILC_OK;
@@ -1230,6 +1355,9 @@ static const silc_backend mumps_backends[] = {
      mumps_ops},
 };
 
+/* SOLVE takes complex operands (zmumps_c), whole or distributed. */
+static const uint32_t mumps_complex_ops[] = {SILC_COMPLEX_OPS(SILC_OP_SOLVE)};
+
 static silc_plugin mumps_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
     "mumps", "1.0 MUMPS " MUMPS_VERSION,
@@ -1237,7 +1365,8 @@ static silc_plugin mumps_plugin = {
     (int)(sizeof mumps_options / sizeof mumps_options[0]), mumps_options,
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     NULL,
-    MUMPS_COLLECTIVE, NULL,
+    MUMPS_COLLECTIVE,
+    mumps_complex_ops,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

@@ -634,12 +634,31 @@ static int64_t global_rows(const silc_value *v, const silc_view *view)
 /* Every rank of a collective call gets the same answer: it looks at global
  * shapes and properties only (the host computes a distributed A's
  * collectively); the local entry count is check_local's. */
+/* Complex values: this plugin passes SILC's arrays to PETSc as PetscScalar,
+ * which Debian's default PETSc (petsc-real) makes a double.  A PETSc built
+ * with complex scalars would take SILC's interleaved complex arrays as they
+ * are (PetscScalar = double complex), but it is another library with the
+ * same symbols, so it would be another build of this plugin, not a switch;
+ * see plugin-petsc/README.md. */
+#if defined(PETSC_USE_COMPLEX)
+#error "plugin-petsc is written for real PetscScalar: build it against the real PETSc (README.md)"
+#endif
+#define PETSC_SCALAR_WHY "this PETSc is built with real scalars (PetscScalar is double): no complex values"
+
 static int solve_accepts(const silc_call *call, const char **why)
 {
     silc_view a;
     silc_layout L;
     if (call->nin < 2) {
         *why = "needs a right-hand side";
+        return 0;
+    }
+    /* The host hands complex values only to backends listing the op in
+     * complex_ops, which this plugin leaves out on a real PETSc; the test
+     * here says why to a host (or a caller) that asks anyway. */
+    if (host->struct_size >= SILC_HOST_NEEDS(field) &&
+        (host->field(call->in[0]) == SILC_FIELD_COMPLEX || host->field(call->in[1]) == SILC_FIELD_COMPLEX)) {
+        *why = PETSC_SCALAR_WHY;
         return 0;
     }
     if (!call->op_class || strncmp(call->op_class, "solve.sparse", 12) != 0 ||
@@ -1032,7 +1051,7 @@ static silc_plugin petsc_plugin = {
     NULL, /* set_threads: blas_threads_attach fills it when OpenBLAS is found */
     petsc_shutdown,
     NULL, /* collective_ops: silc_plugin_init sets it on a 1.5 host */
-    NULL,
+    NULL, /* complex_ops: none, PetscScalar is real here (PETSC_SCALAR_WHY) */
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *h, const silc_plugin **out,

@@ -57,7 +57,12 @@ int ss_cholmod_accepts(const silc_call *call, const char **why)
         *why = "Cholesky only: runs under the solve.*.spd classes";
         return 0;
     }
-    if (!silc_props_of(ss_host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
+    if (ss_is_complex(call->in[0])) {
+        if (!silc_props_of(ss_host, call->in[0], SILC_PROPS_SYMMETRY)->hermitian) {
+            *why = "needs a Hermitian matrix";
+            return 0;
+        }
+    } else if (!silc_props_of(ss_host, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
         *why = "needs a symmetric matrix";
         return 0;
     }
@@ -239,6 +244,7 @@ int ss_cholmod_solve(silc_call *call)
     double *B, t0;
     int64_t n, k;
     int owned, rc, condest, status, fold;
+    if (ss_is_complex(call->in[0])) return ss_cholmod_solve_complex(call);
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;

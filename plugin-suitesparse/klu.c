@@ -203,6 +203,7 @@ int ss_klu_solve(silc_call *call)
     double t0, *fold;
     int64_t n, k;
     int rc, condest;
+    if (ss_is_complex(call->in[0])) return ss_klu_solve_complex(call);
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;

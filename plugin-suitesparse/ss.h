@@ -10,6 +10,8 @@
  *   cholmod.c      CHOLMOD: sparse Cholesky under the .spd classes
  *   klu.c          KLU: sparse LU for circuit-like matrices, fast refactor
  *   spqr.c         SuiteSparseQR: rectangular least squares
+ *   ss_complex.c   complex values on UMFPACK, KLU and CHOLMOD (umfpack_zl,
+ *                  klu_zl, CHOLMOD_COMPLEX); SPQR stays real
  *
  * Zero-copy: a CSR value of A is, array for array, the compressed-column form
  * of A'.  UMFPACK and KLU factor that A' in place and solve with the
@@ -43,6 +45,12 @@ int ss_klu_accepts(const silc_call *call, const char **why);
 int ss_klu_solve(silc_call *call);
 int ss_spqr_accepts(const silc_call *call, const char **why);
 int ss_spqr_solve(silc_call *call);
+
+/* ---- ss_complex.c: complex values (ABI 1.8) on UMFPACK, KLU, CHOLMOD -------- */
+int ss_is_complex(const silc_value *v);   /* 0 on a host older than ABI 1.8 */
+int ss_umfpack_solve_complex(silc_call *call);
+int ss_klu_solve_complex(silc_call *call);
+int ss_cholmod_solve_complex(silc_call *call);
 
 /* ---- ss_common.c ------------------------------------------------------------ */
 int ss_start(void);                 /* 0 on success; starts the cholmod_common */

@@ -220,6 +220,7 @@ int ss_umfpack_solve(silc_call *call)
     SuiteSparse_long *Wi = NULL;
     int64_t n, k, j, irstep;
     int owned = 0, rc, condest, st;
+    if (ss_is_complex(call->in[0])) return ss_umfpack_solve_complex(call);
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;

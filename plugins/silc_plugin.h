@@ -368,7 +368,10 @@ typedef struct silc_host_api {
     int (*layout)(const silc_value *v, silc_layout *out);
     /* A distributed dense value with like's row blocks (like is
      * distributed) and n columns, this rank's block zero-filled: the
-     * result of a collective call (x = A \ b: like = b).  NULL on failure. */
+     * result of a collective call (x = A \ b: like = b).  NULL on failure.
+     * ABI 1.8: the value has like's field (a complex like gives a complex
+     * result, 2 doubles per entry): the one distributed constructor serves
+     * both fields, as a collective complex solve needs. */
     silc_value *(*dist_dense_new)(const silc_value *like, int64_t n);
 
     /* ABI 1.7: 1 when the request running this call is to stop (an
