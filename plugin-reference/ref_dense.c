@@ -107,6 +107,11 @@ int ref_dense_lu(int64_t n, const double *A, ref_factor *F, char *msg, size_t ms
     if (n) memcpy(f->LU, A, (size_t)(n * n) * sizeof(double));
     double *a = f->LU;
     for (int64_t k = 0; k < n; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            dense_lu_free(f);
+            return SILC_ELIB;
+        }
         int64_t p = k;
         double big = fabs(a[k + k * n]);
         for (int64_t i = k + 1; i < n; i++)
@@ -195,6 +200,11 @@ int ref_dense_chol(int64_t n, const double *A, ref_factor *F, char *msg, size_t 
     double *L = f->T;
     /* left-looking: column j gets the updates of columns k < j, then scales */
     for (int64_t j = 0; j < n; j++) {
+        if (j % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            dense_tri_free(f);
+            return SILC_ELIB;
+        }
         double *cj = L + j * n;
         for (int64_t i = 0; i < j; i++) cj[i] = 0.0; /* the upper triangle is not read */
         for (int64_t k = 0; k < j; k++) {
@@ -328,6 +338,13 @@ int ref_dense_qr(int64_t m, int64_t n, const double *A, ref_factor *F, char *msg
         vn1[j] = vn2[j] = ref_nrm2(rows, a + j * rows, 1);
     }
     for (int64_t k = 0; k < cols; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            ref_free(vn1);
+            ref_free(vn2);
+            dense_qr_free(f);
+            return SILC_ELIB;
+        }
         int64_t p = k;
         for (int64_t j = k + 1; j < cols; j++)
             if (vn1[j] > vn1[p]) p = j;

@@ -6,7 +6,8 @@
  * embedded context, on a remote one (a private silcd: the CANCEL frame,
  * docs/protocol.md) and inside a plugin call that polls host->cancelled()
  * (the "crash" test plugin, alpha 19, which spins until told to stop; a
- * lis-style and a PETSc iterative solve, which ask between iterations).
+ * lis-style and a PETSc iterative solve, which ask between iterations; the
+ * reference plugin's dense LU, which asks every 64 columns).
  * With SILC_SERVER set, only the remote part, against that server (run so
  * against silcd --mpi by tests/mpi.cmake).
  *
@@ -153,6 +154,22 @@ static void check_petsc_cancelled(silc_context *ctx)
     CHECK(scalar(ctx, "r") < 1e-8, "PETSc solve after the interrupt: error %g", scalar(ctx, "r"));
 }
 
+/* The reference plugin's dense LU of a 3000x3000 matrix (9e9 flops: seconds)
+ * asks host->cancelled() every 64 columns: interrupted, the name keeps its
+ * value. */
+static void check_reference_cancelled(silc_context *ctx)
+{
+    int rc;
+    CHECK(silc_exec(ctx, "set dispatch.solve.dense = reference; n = 3000; "
+                         "A = rand(n) + n * eye(n); x = 5") == 0,
+          "reference setup: %s", silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+          "reference dense LU: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "x"), 5, 0);
+    CHECK(silc_exec(ctx, "clear A") == 0, "clear: %s", silc_context_errmsg(ctx));
+}
+
 /* A plugin call that polls host->cancelled() returns when told to, and the
  * next backend of the list does not take over the interrupted operation. */
 static void check_plugin_cancelled(void)
@@ -212,6 +229,7 @@ int main(void)
         check_loop_cancelled(ctx, "embedded");
         check_iterative_cancelled(ctx);
         check_petsc_cancelled(ctx);
+        check_reference_cancelled(ctx);
     }
     silc_close(&ctx);
 

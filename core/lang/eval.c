@@ -269,6 +269,9 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     t0 = V->profile ? util_now() : 0;
     rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
+    /* ... and right after one: a call that cannot be stopped from inside (a
+     * MUMPS or UMFPACK factorization) is followed by nothing more */
+    if (!rc && !E->dist && eng_cancel_check(E)) rc = -1;
     if (V->profile && !rc && call->out) profile_call(V, call, &rep, util_now() - t0);
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
