@@ -154,13 +154,13 @@ static void check_petsc_cancelled(silc_context *ctx)
     CHECK(scalar(ctx, "r") < 1e-8, "PETSc solve after the interrupt: error %g", scalar(ctx, "r"));
 }
 
-/* The reference plugin's dense LU of a 3000x3000 matrix (9e9 flops: seconds)
+/* The reference plugin's dense LU of a 2000x2000 matrix (5e9 flops: seconds)
  * asks host->cancelled() every 64 columns: interrupted, the name keeps its
  * value. */
 static void check_reference_cancelled(silc_context *ctx)
 {
     int rc;
-    CHECK(silc_exec(ctx, "set dispatch.solve.dense = reference; n = 3000; "
+    CHECK(silc_exec(ctx, "set dispatch.solve.dense = reference; n = 2000; "
                          "A = rand(n) + n * eye(n); x = 5") == 0,
           "reference setup: %s", silc_context_errmsg(ctx));
     rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
