@@ -307,6 +307,8 @@ typedef struct psc_solver {
     double setup_seconds, cond_est;
     int cond_block;      /* cond_est came from the block estimator */
     char method[64];
+    silc_call *call;     /* the call solving with ksp now, for host->cancelled(); else NULL */
+    int stopped;         /* the convergence test ended that solve on request */
 } psc_solver;
 
 /* Destroys the PETSc objects (collective over the solver's communicator),
@@ -582,6 +584,93 @@ static double condition_estimate(const psc_ranks *R, psc_solver *S, int64_t n, d
     return est >= 0 && isfinite(est) ? norm1 * est : -1;
 }
 
+/* ---- stopping on request, -log_view ------------------------------------------------ */
+
+/* The KSP's own convergence test (PETSc's default or what the options
+ * chose), wrapped: after it, between iterations, the wrapper asks
+ * host->cancelled() -- an interrupt (Ctrl-C, silc_cancel, a CANCEL frame)
+ * or silcd's request limit; a clock read -- and ends the solve with a
+ * negative reason, which run_solves reports as "stopped on request". */
+typedef struct psc_stop {
+    PetscErrorCode (*test)(KSP, PetscInt, PetscReal, KSPConvergedReason *, void *);
+    void *ctx;
+    PetscErrorCode (*destroy)(void *);
+    psc_solver *S;
+} psc_stop;
+
+static PetscErrorCode stop_test(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason *reason,
+                                void *p)
+{
+    psc_stop *w = p;
+    PetscErrorCode ierr = w->test ? w->test(ksp, it, rnorm, reason, w->ctx) : 0;
+    if (ierr) return ierr;
+    if (*reason == KSP_CONVERGED_ITERATING && w->S->call && host->cancelled(w->S->call)) {
+        w->S->stopped = 1;
+        *reason = KSP_DIVERGED_ITS; /* PETSc 3.18 has no reason of its own for it */
+    }
+    return 0;
+}
+
+static PetscErrorCode stop_destroy(void *p)
+{
+    psc_stop *w = p;
+    PetscErrorCode ierr = w->destroy ? w->destroy(w->ctx) : 0;
+    PetscFree(w);
+    return ierr;
+}
+
+/* Puts the wrapper around S's convergence test (a host older than ABI 1.7
+ * cannot be asked: the test stays as it is). */
+static PetscErrorCode stop_install(psc_solver *S)
+{
+    psc_stop *w = NULL;
+    PetscErrorCode ierr;
+    if (host->struct_size < SILC_HOST_NEEDS(cancelled)) return 0;
+    if ((ierr = PetscNew(&w))) return ierr;
+    w->S = S;
+    if ((ierr = KSPGetAndClearConvergenceTest(S->ksp, &w->test, &w->ctx, &w->destroy)) ||
+        (ierr = KSPSetConvergenceTest(S->ksp, stop_test, w, stop_destroy))) {
+        if (w->destroy) w->destroy(w->ctx);
+        PetscFree(w);
+    }
+    return ierr;
+}
+
+/* -log_view in the user's string starts PETSc's default logging (once per
+ * process: PETSc then counts every later call, whatever asked for it). */
+static int log_begin(silc_call *call, const char *text)
+{
+    static int began;
+    PetscErrorCode ierr;
+    if (began || !psc_find_option(text, "log_view", NULL, 0)) return SILC_OK;
+    if ((ierr = PetscLogDefaultBegin())) return psc_fail(call, "PetscLogDefaultBegin", ierr);
+    began = 1;
+    return SILC_OK;
+}
+
+/* After a solve whose options hold -log_view[:file[:format]]: PETSc's
+ * performance table (KSPSolve, PCApply, MatMult, ... since logging began),
+ * printed as PETSc prints it at PetscFinalize -- to standard output, or to
+ * the file the option names -- since a session may never finalize PETSc.
+ * PETSc parses the option itself (PetscOptionsGetViewer), which also marks
+ * it read.  Collective over R's communicator, as PetscLogView is. */
+static int log_view(silc_call *call, const psc_ranks *R, psc_solver *S)
+{
+    PetscViewer v = NULL;
+    PetscViewerFormat format = PETSC_VIEWER_DEFAULT;
+    PetscBool set = PETSC_FALSE;
+    PetscErrorCode ierr = PetscOptionsGetViewer(R->comm, S->opts, NULL, "-log_view", &v, &format, &set);
+    if (ierr) return psc_fail(call, "-log_view", ierr);
+    if (!set || !v) return SILC_OK;
+    if (!(ierr = PetscViewerPushFormat(v, format))) {
+        ierr = PetscLogView(v);
+        PetscViewerPopFormat(v);
+    }
+    PetscViewerDestroy(&v);
+    fflush(stdout);
+    return ierr ? psc_fail(call, "PetscLogView", ierr) : SILC_OK;
+}
+
 /* Builds the matrix and the KSP on R's communicator, and sets the
  * preconditioner up (PETSc's options database pushed by the caller).
  * Collective. */
@@ -598,6 +687,7 @@ static int solver_setup(silc_call *call, const psc_ranks *R, psc_solver *S, cons
     TRY(KSPSetOperators(S->ksp, S->A, S->A), "KSPSetOperators");
     TRY(KSPSetFromOptions(S->ksp), "KSPSetFromOptions");
     TRY(KSPSetUp(S->ksp), "KSPSetUp");
+    TRY(stop_install(S), "KSPSetConvergenceTest");
     describe(S);
     TRY(KSPGetPC(S->ksp, &pc), "KSPGetPC");
     if ((fr = pc_reason(R, S)) != PC_NOERROR) return pc_failed(call, S, fr, "KSPSetUp");
@@ -775,6 +865,7 @@ static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double
     double worst = 0;
     int64_t j, max_its = 0;
     int rc = SILC_OK, len;
+    PetscErrorCode ierr;
     TRY(vec_wrap(R, m, n, &b), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
     TRY(vec_wrap(R, m, n, &x), R->size > 1 ? "VecCreateMPIWithArray" : "VecCreateSeqWithArray");
     TRY(VecDuplicate(b, &res), "VecDuplicate");
@@ -791,7 +882,15 @@ static int run_solves(silc_call *call, const psc_ranks *R, psc_solver *S, double
             if (nr < nb) (*guess)++;
             else TRY(VecSet(x, 0.0), "VecSet");
         }
-        TRY(KSPSolve(S->ksp, b, x), "KSPSolve");
+        S->stopped = 0;
+        ierr = KSPSolve(S->ksp, b, x);
+        if (S->stopped) { /* before ierr: -ksp_error_if_not_converged makes it an error */
+            KSPGetIterationNumber(S->ksp, &its);
+            rc = psc_error(call, SILC_ELIB, "stopped on request (KSPSolve, after %lld iteration%s)",
+                           (long long)its, its == 1 ? "" : "s");
+            goto done;
+        }
+        TRY(ierr, "KSPSolve");
         TRY(KSPGetConvergedReason(S->ksp, &reason), "KSPGetConvergedReason");
         TRY(KSPGetIterationNumber(S->ksp, &its), "KSPGetIterationNumber");
         /* The true residual b - A x, whatever norm the convergence test watched. */
@@ -888,6 +987,7 @@ static int solve_run(silc_call *call)
         return host->error(call, SILC_EARG, "right-hand side has %lld rows, A has %lld",
                            (long long)bv.m, (long long)a.n);
     if ((rc = petsc_start(call, R.dist ? &R.comm : NULL))) return rc;
+    if ((rc = log_begin(call, text))) return rc;
     /* Reusing A's solver is decided first, by every rank, before a rank-local
      * failure could make one rank skip this collective step. */
     S = host->attach_get(call->in[0], key);
@@ -964,10 +1064,17 @@ agreed:
             goto done;
         }
         t0 = host->now();
-        if ((rc = run_solves(call, &R, S, B, o.val, bv.m, a.n, bv.n, &guess))) goto done;
+        S->call = call;
+        rc = run_solves(call, &R, S, B, o.val, bv.m, a.n, bv.n, &guess);
+        S->call = NULL;
+        if (rc) goto done;
         r->initial_guess = guess > 0;
     }
     r->solve_seconds = host->now() - t0;
+    if ((rc = log_view(call, &R, S))) goto done;
+    if (fresh && psc_find_option(text, "help", NULL, 0) &&
+        (rc = psc_options_print_help(call, R.comm, text, spd, S->A)))
+        goto done;
     if (!S->checked) {
         if ((rc = psc_options_check_used(call, R.comm, S->opts, text, spd, S->A))) goto done;
         S->checked = 1;

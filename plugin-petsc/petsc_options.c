@@ -56,9 +56,8 @@ static int is_option(const char *tok)
     return tok[0] == '-' && isalpha((unsigned char)tok[1]);
 }
 
-/* Whether text sets option name (without '-'), and its value if it does
- * (the last setting wins, as in PETSc). */
-static int find_option(const char *text, const char *name, char *value, size_t cap)
+/* petsc_plugin.h: whether text sets option name, and its value. */
+int psc_find_option(const char *text, const char *name, char *value, size_t cap)
 {
     char tok[NAME_MAX_LEN + 160];
     const char *p = text ? text : "";
@@ -96,10 +95,10 @@ static int fill_options(silc_call *call, PetscOptions o, const char *user, int s
     if (spd && (ierr = PetscOptionsInsertString(o, "-ksp_type cg"))) goto fail;
     /* This PETSc's MUMPS has neither METIS nor SCOTCH, and its fallback, PORD,
      * was 2.5x slower than AMF on 2-D grids. */
-    if (!find_option(user, "pc_factor_mat_solver_type", solver, sizeof solver))
-        find_option(global, "pc_factor_mat_solver_type", solver, sizeof solver);
-    if (strcasecmp(solver, "mumps") == 0 && !find_option(user, "mat_mumps_icntl_7", NULL, 0) &&
-        !find_option(global, "mat_mumps_icntl_7", NULL, 0) &&
+    if (!psc_find_option(user, "pc_factor_mat_solver_type", solver, sizeof solver))
+        psc_find_option(global, "pc_factor_mat_solver_type", solver, sizeof solver);
+    if (strcasecmp(solver, "mumps") == 0 && !psc_find_option(user, "mat_mumps_icntl_7", NULL, 0) &&
+        !psc_find_option(global, "mat_mumps_icntl_7", NULL, 0) &&
         (ierr = PetscOptionsInsertString(o, "-mat_mumps_icntl_7 2")))
         goto fail;
     if (global && (ierr = PetscOptionsInsertString(o, global))) goto fail;
@@ -122,7 +121,10 @@ int psc_options_create(silc_call *call, const char *user, int spd, PetscOptions 
     int rc;
     *out = NULL;
     if (ierr) return psc_fail(call, "PetscOptionsCreate", ierr);
-    if ((rc = fill_options(call, o, user, spd))) {
+    /* -help is answered by psc_options_print_help: PETSc's own printing
+     * shows each options block once per process only. */
+    if ((rc = fill_options(call, o, user, spd)) ||
+        ((ierr = PetscOptionsClearValue(o, "-help")) && (rc = psc_fail(call, "PetscOptionsClearValue", ierr)))) {
         PetscOptionsDestroy(&o);
         return rc;
     }
@@ -170,6 +172,20 @@ static const char *const common_options[] = {
 };
 
 static names *capture_into;
+static FILE *echo_to; /* also print the help text here, prefix removed (NULL: do not) */
+
+/* line with every "-<prefix>" written as "-": the help of the throw-away KSP
+ * as the user's options would show it. */
+static void echo_text(const char *line, const char *prefix)
+{
+    size_t plen = strlen(prefix);
+    const char *p = line, *hit;
+    while (plen && (hit = strstr(p, prefix)) != NULL) {
+        fwrite(p, 1, (size_t)(hit - p), echo_to);
+        p = hit + plen;
+    }
+    fputs(p, echo_to);
+}
 
 /* Keeps every "-name" of a help text. */
 static void capture_text(const char *line)
@@ -177,6 +193,7 @@ static void capture_text(const char *line)
     const char *p;
     size_t skip;
     if (!capture_into) return;
+    if (echo_to) echo_text(line, capture_into->strip);
     skip = strlen(capture_into->strip);
     for (p = line; (p = strchr(p, '-')) != NULL; p++) {
         size_t len = 0;
@@ -250,6 +267,20 @@ done:
     KSPDestroy(&ksp);
     if (pushed) PetscOptionsPop();
     PetscOptionsDestroy(&o);
+}
+
+int psc_options_print_help(silc_call *call, MPI_Comm comm, const char *user, int spd, Mat A)
+{
+    names L = {NULL, 0, 0, ""};
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    fflush(stdout);
+    echo_to = rank == 0 ? stdout : NULL;
+    collect_names(call, comm, user, spd, A, &L);
+    echo_to = NULL;
+    fflush(stdout);
+    psc_host->free(L.name);
+    return SILC_OK;
 }
 
 /* Optimal string alignment distance (edits and transpositions), capped inputs. */
@@ -340,7 +371,7 @@ int psc_options_check_used(silc_call *call, MPI_Comm comm, PetscOptions opts, co
     if ((ierr = PetscOptionsLeftGet(opts, &n, &nm, &val))) return psc_fail(call, "PetscOptionsLeftGet", ierr);
     /* Only the user's own options count: the process-wide ones may be meant for other code. */
     for (i = 0; i < n; i++)
-        if (find_option(user, nm[i], NULL, 0)) {
+        if (psc_find_option(user, nm[i], NULL, 0)) {
             if (first < 0) {
                 first = i;
                 snprintf(unread, sizeof unread, "%s", nm[i]);

@@ -32,11 +32,21 @@ int psc_error(silc_call *call, int status, const char *fmt, ...)
  * SILC status for it. */
 int psc_fail(silc_call *call, const char *what, PetscErrorCode ierr);
 
+/* Whether text (a PETSc option string) sets option name (without '-'), and
+ * then its value in value (cap bytes; "" for none; the last setting wins, as
+ * in PETSc).  value may be NULL. */
+int psc_find_option(const char *text, const char *name, char *value, size_t cap);
+
 /* A new options database for one solver: the plugin's defaults for this
  * class, then the process-wide PETSc options (PETSC_OPTIONS, ~/.petscrc),
  * then the user's string, later entries overriding earlier ones.  Local to
  * this process (no communication). */
 int psc_options_create(silc_call *call, const char *user, int spd, PetscOptions *out);
+
+/* -help in the user's string: PETSc's help for the KSP/PC configuration it
+ * makes (every block, whatever was printed before in the process), on
+ * standard output on rank 0.  Collective over A's communicator comm. */
+int psc_options_print_help(silc_call *call, MPI_Comm comm, const char *user, int spd, Mat A);
 
 /* After the first solve: SILC_OK when PETSc read every option of the user's
  * string, else an error naming the first one it ignored, with a suggestion

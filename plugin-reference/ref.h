@@ -33,6 +33,15 @@ extern const silc_host_api *ref_host;
  * layout of C's double complex, so kernels cast x to double complex *). */
 int ref_width(const silc_value *v);
 
+/* An interrupt (host->cancelled) reaches the factorizations, which have no
+ * call at hand, through the call ref_op_solve factors for (per thread):
+ * they ask ref_cancelled() every REF_CANCEL_EVERY columns (a clock read)
+ * and then fail with SILC_ELIB and REF_STOPPED. */
+void ref_cancel_scope(silc_call *call); /* NULL ends the scope */
+int ref_cancelled(void);
+#define REF_CANCEL_EVERY 64
+#define REF_STOPPED "stopped on request"
+
 /* Compressed-column sparse matrix (m x n).  A CSR value of A read without
  * copying is the compressed-column form of A' (owned = 0). */
 typedef struct ref_sp {

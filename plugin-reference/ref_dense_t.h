@@ -101,6 +101,11 @@ int FN(ref_dense_lu)(int64_t n, const double *A, ref_factor *F, char *msg, size_
     if (n) memcpy(f->LU, A, (size_t)(n * n) * sizeof(ENT));
     ENT *a = f->LU;
     for (int64_t k = 0; k < n; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            FN(dense_lu_free)(f);
+            return SILC_ELIB;
+        }
         int64_t p = k;
         double big = MOD(a[k + k * n]);
         for (int64_t i = k + 1; i < n; i++)
@@ -193,6 +198,11 @@ int FN(ref_dense_chol)(int64_t n, const double *A, ref_factor *F, char *msg, siz
      * the diagonal of a Hermitian matrix is real (its imaginary part is not
      * read, as zpotrf does not) */
     for (int64_t j = 0; j < n; j++) {
+        if (j % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            FN(dense_tri_free)(f);
+            return SILC_ELIB;
+        }
         ENT *cj = L + j * n;
         for (int64_t i = 0; i < j; i++) cj[i] = 0.0; /* the upper triangle is not read */
         cj[j] = RE(cj[j]);
@@ -339,6 +349,13 @@ int FN(ref_dense_qr)(int64_t m, int64_t n, const double *Ad, ref_factor *F, char
         vn1[j] = vn2[j] = FN(nrm2)(rows, a + j * rows);
     }
     for (int64_t k = 0; k < cols; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            ref_free(vn1);
+            ref_free(vn2);
+            FN(dense_qr_free)(f);
+            return SILC_ELIB;
+        }
         int64_t p = k;
         for (int64_t j = k + 1; j < cols; j++)
             if (vn1[j] > vn1[p]) p = j;

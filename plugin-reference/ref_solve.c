@@ -118,7 +118,9 @@ int ref_op_solve(silc_call *call)
         if (!F) return ref_nomem(call);
         F->m = a.m;
         F->n = a.n;
+        ref_cancel_scope(call);
         int st = factor(alg, &a, P, w, F, msg, sizeof msg);
+        ref_cancel_scope(NULL);
         if (st) {
             ref_free(F);
             F = NULL;

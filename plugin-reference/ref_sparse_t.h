@@ -204,6 +204,11 @@ int FN(ref_sparse_chol)(const ref_sp *A, ref_factor *F, char *msg, size_t msglen
     memcpy(L->p, c, (size_t)(n + 1) * sizeof(int64_t));
     for (int64_t j = 0; j < n; j++) w[j] = -1;
     for (int64_t k = 0; k < n; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            st = SILC_ELIB;
+            goto fail;
+        }
         int64_t top = ereach(&C, k, parent, s, w);
         for (int64_t p = C.p[k]; p < C.p[k + 1]; p++)
             if (C.i[p] <= k) x[C.i[p]] += Cx[p];
@@ -377,6 +382,11 @@ int FN(ref_sparse_lu)(const ref_sp *A, ref_factor *F, char *msg, size_t msglen)
         mark[i] = -1;
     }
     for (int64_t k = 0; k < n; k++) {
+        if (k % REF_CANCEL_EVERY == REF_CANCEL_EVERY - 1 && ref_cancelled()) {
+            snprintf(msg, msglen, REF_STOPPED);
+            st = SILC_ELIB;
+            goto fail;
+        }
         L->p[k] = lnz;
         U->p[k] = unz;
         if (FN(grow)(L, &lcap, lnz + n) || FN(grow)(U, &ucap, unz + n)) goto fail;

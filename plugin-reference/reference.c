@@ -15,6 +15,18 @@
 
 const silc_host_api *ref_host;
 
+static _Thread_local silc_call *cancel_call;
+
+void ref_cancel_scope(silc_call *call)
+{
+    cancel_call = call;
+}
+
+int ref_cancelled(void)
+{
+    return cancel_call && ref_host->struct_size >= SILC_HOST_NEEDS(cancelled) && ref_host->cancelled(cancel_call);
+}
+
 /* ---- memory ----------------------------------------------------------------- */
 
 void *ref_alloc(size_t count, size_t size)

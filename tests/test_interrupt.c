@@ -5,7 +5,9 @@
  * before it intact, and the next EXEC runs normally.  The same on an
  * embedded context, on a remote one (a private silcd: the CANCEL frame,
  * docs/protocol.md) and inside a plugin call that polls host->cancelled()
- * (the "crash" test plugin, alpha 19, which spins until told to stop).
+ * (the "crash" test plugin, alpha 19, which spins until told to stop; a
+ * lis-style and a PETSc iterative solve, which ask between iterations; the
+ * reference plugin's dense LU, which asks every 64 columns).
  * With SILC_SERVER set, only the remote part, against that server (run so
  * against silcd --mpi by tests/mpi.cmake).
  *
@@ -125,6 +127,49 @@ static void check_iterative_cancelled(silc_context *ctx)
     CHECK_NEAR(scalar(ctx, "x"), 5, 0);
 }
 
+/* A PETSc GMRES solve that would run 1e8 iterations (rtol 1e-300 is never
+ * met) stops when interrupted: the plugin's convergence test asks
+ * host->cancelled() between iterations.  The name keeps its value, and the
+ * next solve runs. */
+static void check_petsc_cancelled(silc_context *ctx)
+{
+    int rc;
+    if (silc_exec(ctx, "set dispatch.solve.sparse.spd = petsc")) {
+        printf("skipped the PETSc case: %s\n", silc_context_errmsg(ctx));
+        return;
+    }
+    CHECK(silc_exec(ctx, "set petsc.options = -ksp_type gmres -pc_type none -ksp_rtol 1e-300 "
+                         "-ksp_max_it 100000000; "
+                         "n = 3000; E = eye(n); S = [zeros(1, n); E[1:n-1, :]]; "
+                         "A = 2*E - S - S'; x = 5") == 0,
+          "PETSc setup: %s", silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+          "PETSc solve: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "x"), 5, 0);
+    /* PETSc works on after the interrupt. */
+    CHECK(silc_exec(ctx, "set petsc.options = -ksp_type preonly -pc_type lu; "
+                         "x = A \\ (A * ones(n, 1)); r = norm(x - 1, inf)") == 0,
+          "PETSc solve after the interrupt: %s", silc_context_errmsg(ctx));
+    CHECK(scalar(ctx, "r") < 1e-8, "PETSc solve after the interrupt: error %g", scalar(ctx, "r"));
+}
+
+/* The reference plugin's dense LU of a 2000x2000 matrix (5e9 flops: seconds)
+ * asks host->cancelled() every 64 columns: interrupted, the name keeps its
+ * value. */
+static void check_reference_cancelled(silc_context *ctx)
+{
+    int rc;
+    CHECK(silc_exec(ctx, "set dispatch.solve.dense = reference; n = 2000; "
+                         "A = rand(n) + n * eye(n); x = 5") == 0,
+          "reference setup: %s", silc_context_errmsg(ctx));
+    rc = exec_cancelled(ctx, "x = A \\ ones(n, 1)");
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"),
+          "reference dense LU: message '%s', want 'interrupted'", silc_context_errmsg(ctx));
+    CHECK_NEAR(scalar(ctx, "x"), 5, 0);
+    CHECK(silc_exec(ctx, "clear A") == 0, "clear: %s", silc_context_errmsg(ctx));
+}
+
 /* A plugin call that polls host->cancelled() returns when told to, and the
  * next backend of the list does not take over the interrupted operation. */
 static void check_plugin_cancelled(void)
@@ -183,6 +228,8 @@ int main(void)
     } else {
         check_loop_cancelled(ctx, "embedded");
         check_iterative_cancelled(ctx);
+        check_petsc_cancelled(ctx);
+        check_reference_cancelled(ctx);
     }
     silc_close(&ctx);
 

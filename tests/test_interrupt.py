@@ -10,8 +10,9 @@ loop's own assignments are undone (read back with --get after `exit`);
 Ctrl-C at a half-typed line or a continuation prompt drops the statement,
 twice at an empty prompt does not leave; ~/.silc_history has every entered
 line, also when the REPL is killed.  Python: Session.cancel() from a
-thread, and SIGINT during exec (KeyboardInterrupt after the server's
-answer), embedded too when SILC_LIBRARY names libsilc.
+thread, and SIGINT during exec (KeyboardInterrupt once the statement
+stopped), raised in the process and sent from outside to a Python child,
+embedded too when SILC_LIBRARY names libsilc.
 
 No speed is asserted: an interrupt must only come back within a generous
 bound (5 s, 20 s under a sanitizer), which the loop could never meet by
@@ -192,7 +193,7 @@ def values(s, names):
     return [float(np.ravel(s.get(n))[0]) for n in names]  # scalars come back as floats
 
 
-def check_python(s, what, sigint):
+def check_python(s, what, remote):
     s.exec("a = 7; x = 1; i = 0")
     t = threading.Timer(0.3 * SLOW, s.cancel)
     t.start()
@@ -205,24 +206,74 @@ def check_python(s, what, sigint):
     t.join()
     if values(s, ["a", "x", "i"]) != [7, 1, 0]:
         fail("%s: a x i = %s after cancel, want [7, 1, 0]" % (what, values(s, ["a", "x", "i"])))
-    if sigint:
-        # SIGINT during exec: CANCEL, then KeyboardInterrupt once the server answered.
-        t = threading.Timer(0.3 * SLOW, os.kill, (os.getpid(), signal.SIGINT))
-        t.start()
-        try:
-            s.exec(LOOP)
-            fail("%s: exec returned normally after SIGINT" % what)
-        except KeyboardInterrupt:
-            pass
-        t.join()
-        if values(s, ["a", "x", "i"]) != [7, 1, 0]:
-            fail("%s: a x i = %s after SIGINT" % (what, values(s, ["a", "x", "i"])))
+    # SIGINT during exec: cancel (remote: CANCEL), then KeyboardInterrupt
+    # once the statement stopped.
+    t = threading.Timer(0.3 * SLOW, os.kill, (os.getpid(), signal.SIGINT))
+    t.start()
+    try:
+        s.exec(LOOP)
+        fail("%s: exec returned normally after SIGINT" % what)
+    except KeyboardInterrupt:
+        pass
+    t.join()
+    if values(s, ["a", "x", "i"]) != [7, 1, 0]:
+        fail("%s: a x i = %s after SIGINT" % (what, values(s, ["a", "x", "i"])))
+    if remote:
         # A CANCEL that comes when nothing runs gets no reply: the session stays in step.
         s._s.sock.sendall(struct.pack("<IIQ", 9, 0, 0))
     s.cancel()  # nothing running: nothing happens
     s.exec("q = 2; i = 0; while (i < 100) { i = i + 1 }")
     if values(s, ["q", "i"]) != [2, 100]:
         fail("%s: the exec after the interrupts gave %s" % (what, values(s, ["q", "i"])))
+
+
+CHILD = r"""
+import signal, sys
+sys.path.insert(0, sys.argv[1])
+import silc
+# as an interactive program has it (a background job inherits SIGINT ignored)
+signal.signal(signal.SIGINT, signal.default_int_handler)
+s = silc.Session(*sys.argv[2:-1])  # an address, or none: embedded
+s.exec("a = 7; x = 1; i = 0")
+print("ready", flush=True)
+try:
+    s.exec(sys.argv[-1])
+    print("returned normally", flush=True)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+print("values", [float(s[n]) for n in ("a", "x", "i")], flush=True)
+s.exec("q = 2; i = 0; while (i < 100) { i = i + 1 }")
+print("after", [float(s[n]) for n in ("q", "i")], flush=True)
+s.close()
+"""
+
+
+def check_python_child(env, what, address=None):
+    """Ctrl-C as a user gives it: SIGINT sent to a Python program from
+    outside while its exec runs a loop of 1e9 iterations.  The program gets
+    KeyboardInterrupt, its values are as before the statement, and its
+    session runs the next exec."""
+    args = [sys.executable, "-c", CHILD, BINDINGS] + ([address] if address else []) + [LOOP]
+    child = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        line = child.stdout.readline()
+        if line.strip() != "ready":
+            fail("%s: the child did not start: %r %s" % (what, line, child.stdout.read()))
+            return
+        time.sleep(0.3 * SLOW)
+        child.send_signal(signal.SIGINT)
+        try:
+            out, _ = child.communicate(timeout=BOUND + 10 * SLOW)
+        except subprocess.TimeoutExpired:
+            fail("%s: the child did not stop within %g s of SIGINT" % (what, BOUND + 10 * SLOW))
+            return
+        want = "KeyboardInterrupt\nvalues [7.0, 1.0, 0.0]\nafter [2.0, 100.0]\n"
+        if out != want or child.returncode != 0:
+            fail("%s: child printed %r (exit %s), want %r" % (what, out, child.returncode, want))
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
 
 
 def start_silcd(tmp):
@@ -257,6 +308,7 @@ def main():
             s = silc.Session(url)
             check_python(s, "python remote", True)
             s.close()
+            check_python_child(env, "python remote, SIGINT from outside", url)
         finally:
             silcd.terminate()
             try:
@@ -268,6 +320,7 @@ def main():
             s = silc.Session()
             check_python(s, "python embedded", False)
             s.close()
+            check_python_child(env, "python embedded, SIGINT from outside")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("%s" % ("ok" if not failures else "%d failures" % len(failures)))

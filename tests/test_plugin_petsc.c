@@ -27,9 +27,14 @@
  *     the PETSc call;
  *   - a dense matrix is declined with a reason (`explain` shows it);
  *   - two contexts in one process both solving through petsc (PETSc and MPI
- *     initialised once).
+ *     initialised once);
+ *   - -log_view passes through: PETSc's performance table (KSPSolve's row)
+ *     after the solve, on standard output or in the file -log_view :path
+ *     names, and the answer is unchanged; -help prints the KSP/PC options.
  */
+#define _POSIX_C_SOURCE 200809L
 #include <float.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -156,6 +161,75 @@ static void test_direct(silc_context *cp, const double *ones, int64_t n, double 
         printf("%-8s %-8s error %8.2g  cond %8.2g  %.3g s\n", cases[i].pc, cases[i].package,
                tl_rel_diff(x, ones, n), c, secs);
     }
+    free(x);
+}
+
+/* The whole of a small file ("" if it cannot be read); free it. */
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *text = calloc(1 << 20, 1);
+    if (f && text) text[fread(text, 1, (1 << 20) - 1, f)] = '\0';
+    if (f) fclose(f);
+    return text;
+}
+
+/* Runs a solve with opts while standard output (fd 1, where PETSc prints)
+ * goes to a file; returns what was printed, NULL if the solve failed. */
+static char *solve_printing(silc_context *cp, const char *opts)
+{
+    char path[] = "petsc-stdout-XXXXXX";
+    int fd = mkstemp(path), saved, rc;
+    char *text = NULL;
+    if (fd < 0) return NULL;
+    fflush(stdout);
+    saved = dup(1);
+    dup2(fd, 1);
+    rc = solve_with(cp, "x", opts);
+    fflush(stdout);
+    dup2(saved, 1);
+    close(saved);
+    close(fd);
+    if (rc == 0) text = slurp(path);
+    else CHECK(0, "solve with %s: %s", opts, silc_context_errmsg(cp));
+    unlink(path);
+    return text;
+}
+
+/* PETSc's own -log_view and -help, through petsc.options. */
+static void test_log_view(silc_context *cp, const double *ones, int64_t n)
+{
+    double *x = malloc((size_t)n * sizeof *x);
+    char file[] = "petsc-logview-XXXXXX", opts[128], *text;
+    int fd;
+    if (!x) return;
+    text = solve_printing(cp, "-ksp_type cg -pc_type jacobi -ksp_rtol 1e-10 -log_view");
+    CHECK(text && strstr(text, "PETSc Performance Summary") && strstr(text, "\nKSPSolve "),
+          "-log_view printed no table with KSPSolve:\n%.2000s", text ? text : "(failed)");
+    free(text);
+    CHECK(tl_get_vec(cp, "x", x, n) == 0 && tl_rel_diff(x, ones, n) < 1e-6,
+          "-log_view: forward error %g", tl_rel_diff(x, ones, n));
+    /* -log_view :path, PETSc's syntax: the table goes to that file. */
+    fd = mkstemp(file);
+    CHECK(fd >= 0, "mkstemp");
+    if (fd >= 0) {
+        close(fd);
+        snprintf(opts, sizeof opts, "-ksp_type preonly -pc_type lu -log_view :%s", file);
+        text = solve_printing(cp, opts);
+        CHECK(text && !strstr(text, "KSPSolve"), "-log_view :file printed on stdout");
+        free(text);
+        text = slurp(file);
+        CHECK(text && strstr(text, "\nKSPSolve ") && strstr(text, "\nMatLUFactorNum "),
+              "-log_view :%s holds no table with KSPSolve and MatLUFactorNum", file);
+        free(text);
+        unlink(file);
+        CHECK(tl_get_vec(cp, "x", x, n) == 0 && tl_rel_diff(x, ones, n) < 1e-10,
+              "-log_view :file: forward error %g", tl_rel_diff(x, ones, n));
+    }
+    text = solve_printing(cp, "-ksp_type gmres -pc_type ilu -help");
+    CHECK(text && strstr(text, "-ksp_rtol") && strstr(text, "-pc_factor_levels"),
+          "-help printed no KSP and PC options:\n%.2000s", text ? text : "(failed)");
+    free(text);
     free(x);
 }
 
@@ -422,6 +496,7 @@ int main(void)
         CHECK(put_system(cp, &A, ones, b) == 0 && put_system(cr, &A, ones, b) == 0, "put laplacian");
         double cond = reference_cond(cr);
         CHECK(cond > 1e2 && cond < 1e4, "laplacian condition estimate %g", cond);
+        test_log_view(cp, ones, n); /* first: PETSc prints a -help block once per process */
         test_iterative(cp, cr, ones, n, cond);
         test_direct(cp, ones, n, cond);
         test_options(cp);

@@ -620,9 +620,6 @@ static int unknown_function(lang_ev *V, const char *name)
 {
     const char *fn[NTABLE], *best;
     size_t i;
-    if (store_get(&V->E->store, name))
-        return eng_error(V->E, "unknown function '%s' ('%s' is a variable: subscripts use %s[...])",
-                         name, name, name);
     if (!strcmp(name, "disp"))   /* eval.c runs disp(x) as a statement */
         return eng_error(V->E, "disp(x) shows x and has no value: write it as a statement of its own");
     for (i = 0; i < NTABLE; i++) fn[i] = table[i].name;

@@ -270,6 +270,9 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     t0 = V->profile ? util_now() : 0;
     rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
+    /* ... and right after one: a call that cannot be stopped from inside (a
+     * MUMPS or UMFPACK factorization) is followed by nothing more */
+    if (!rc && !E->dist && eng_cancel_check(E)) rc = -1;
     if (V->profile && !rc && call->out) profile_call(V, call, &rep, util_now() - t0);
     if (rc || !call->out) {
         if (call->out) val_release(call->out);
@@ -657,6 +660,27 @@ static UTIL_NOINLINE int eval_index(lang_ev *V, const ast_node *n, silc_value **
     return rc;
 }
 
+/* v(i), A(i, j), v(): Octave's subscripts on the variable n names. */
+static UTIL_NOINLINE int eval_call_index(lang_ev *V, const ast_node *n, silc_value **out)
+{
+    silc_value *base;
+    char what[80];
+    int rc;
+    if (eval_name(V, n, &base)) return -1;
+    if (dist_make_whole(V->E, &base)) {
+        val_release(base);
+        return -1;
+    }
+    if (n->nkids == 0) { /* v() is v, as in Octave */
+        *out = base;
+        return 0;
+    }
+    snprintf(what, sizeof what, "'%s'", n->name);
+    rc = ix_extract(V, n->kids, n->nkids, what, base, out);
+    val_release(base);
+    return rc;
+}
+
 int ev_expr(lang_ev *V, const ast_node *n, silc_value **out)
 {
     if (ev_expr_dist(V, n, out)) return -1;
@@ -791,12 +815,14 @@ static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
     case AST_NAME:
         return eval_name(V, n, out);
     case AST_END:
+        if (!V->in_subscript)
+            return eng_error(E, "'end' here is not inside a subscript (v(end), A(end, :) on a variable)");
         *out = val_scalar_new((double)V->end_value);
         return *out ? 0 : eng_oom(E);
     case AST_STRING:
         return eng_error(E, "a string (\"%s\") is only allowed as an option argument", n->name);
     case AST_COLON_ALL:
-        return eng_error(E, "':' alone is only allowed as a subscript (A[:, j])");
+        return eng_error(E, "':' alone is only allowed as a subscript (A(:, j) on a variable)");
     case AST_RANGE:
         return eval_range(V, n, out);
     case AST_BINARY:
@@ -807,6 +833,9 @@ static int expr_any(lang_ev *V, const ast_node *n, silc_value **out)
     case AST_INDEX:
         return eval_index(V, n, out);
     case AST_CALL:
+        /* v(i) on a variable is a subscript: a variable hides a function of
+         * the same name, as in Octave */
+        if (store_get(&E->store, n->name)) return eval_call_index(V, n, out);
         return bi_call(V, n, out);
     case AST_MATRIX:
         return cc_matrix(V, n, out);

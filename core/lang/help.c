@@ -29,8 +29,12 @@ static const help_entry entries[] = {
      "`x += dt * v` scales `v` into `x` with no temporary: at the speed of the plain C loop from 10⁴ entries "
      "up, 3.9-6.5x faster than making a new array (docs/overhead.md). `x = x + e` and `x = x - e` are the "
      "same updates. The numbers are those of the copying path, bit for bit"},
-    {"[]=", 1, "`x[i, j] = e`, `x[a:b] = e`", "assign into a block of an existing `x` (same shape, or a scalar)"},
-    {"()", 1, "`f(args)`", "procedure call (value discarded)"},
+    {"[]=", 1, "`x(i, j) = e`, `x(a:b) = e`, `x(x > 0) = e`, `x[i, j] = e`",
+     "assign into a block of an existing `x` (same shape, or a scalar): a new value is bound to `x`, the "
+     "old one is left as it was (copy-on-write); a subscript outside `x` is an error (no growth)"},
+    {"()", 1, "`f(args)`",
+     "procedure call (value discarded); on a variable, `v(i)` and `A(i, j)` are subscripts (a variable "
+     "hides a built-in of its name, as in Octave)"},
     {"if elseif else while for end break continue", 1,
      "`if c ... elseif c ... else ... end`, `while c ... end`, `for i = 1:n ... end`; or with braces "
      "`if (c) { ... } else { ... }`, `while (c) { ... }`, `for (i = v) { ... }`; `break`, `continue`",

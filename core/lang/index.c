@@ -1,7 +1,10 @@
 /*
  * index.c -- subscripts: A[i, j], v[k] (linear, column-major, on any matrix),
- * ranges a:b, ':' alone, `end`, and index vectors; extraction and assignment
- * into a block.
+ * and the same as Octave writes them, A(i, j), v(k), on a variable (eval.c
+ * tells them from calls); ranges a:b, ':' alone, `end`, index vectors and
+ * masks (a comparison or logical expression: v(v > 0)); extraction and
+ * assignment into a block.  A bad subscript is reported in Octave's words
+ * ("v(7): out of bound 5 (dimensions are 1x5)").
  *
  * Subscripts are 1-based in the language and 0-based here once resolved.
  * Extraction keeps the storage family: dense gives dense, CSR gives CSR (with
@@ -21,6 +24,7 @@
 typedef struct ix_list {
     int64_t *ix;           /* 0-based */
     int64_t n;
+    int row;               /* the subscript is row-shaped (a range, a 1xk value or mask) */
 } ix_list;
 
 static int oom(lang_ev *V)
@@ -28,21 +32,50 @@ static int oom(lang_ev *V)
     return eng_oom(V->E);
 }
 
-static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, const char *what,
+/* Octave's wording of a bad subscript: "v(7): out of bound 5 (dimensions
+ * are 1x5)", "A(4,_): ..." for a row, "A(_,7): ..." for a column.  pos: 0
+ * a linear subscript, 1 a row, 2 a column; what is the operand's quoted
+ * name or text ('v'), or a phrase. */
+static int bad_index(lang_ev *V, double x, int64_t extent, int pos, const char *what,
+                     const silc_value *base)
+{
+    char num[40], shape[48], name[64], at[48];
+    size_t len = strlen(what);
+    util_fmt_double(num, sizeof num, x);
+    ev_shape(base, shape, sizeof shape);
+    if (len >= 2 && what[0] == '\'' && what[len - 1] == '\'')
+        snprintf(name, sizeof name, "%.*s", (int)(len - 2), what + 1);
+    else
+        snprintf(name, sizeof name, "index ");
+    snprintf(at, sizeof at, "%s%s%s", pos == 2 ? "_," : "", num, pos == 1 ? ",_" : "");
+    if (x != floor(x) || !(x >= 1))
+        return eng_error(V->E, "%s(%s): subscripts must be integers from 1 up (%s is %s)", name, at, what,
+                         shape);
+    return eng_error(V->E, "%s(%s): out of bound %lld (dimensions are %s)", name, at, (long long)extent,
+                     shape);
+}
+
+static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, int pos, const char *what,
                       const silc_value *base)
 {
-    char num[40], shape[48];
-    if (x != floor(x)) {
-        util_fmt_double(num, sizeof num, x);
-        return eng_error(V->E, "index %s into %s is not an integer", num, what);
-    }
-    if (!(x >= 1 && x <= (double)extent)) {
-        util_fmt_double(num, sizeof num, x);
-        ev_shape(base, shape, sizeof shape);
-        return eng_error(V->E, "index %s is out of range for %s (%s)", num, what, shape);
-    }
+    if (!(x >= 1 && x <= (double)extent) || x != floor(x)) return bad_index(V, x, extent, pos, what, base);
     l->ix[l->n++] = (int64_t)x - 1;
     return 0;
+}
+
+/* A subscript whose value is a mask rather than a list of indices: a
+ * comparison or a logical operation (v(v > 0), A(:, !(c == 0))).  Values
+ * have no logical type, so the form of the expression decides. */
+static int is_mask(const ast_node *sub)
+{
+    if (sub->kind == AST_UNARY) return sub->op == TK_NOT;
+    if (sub->kind != AST_BINARY) return 0;
+    switch (sub->op) {
+    case TK_EQ: case TK_NE: case TK_LT: case TK_LE: case TK_GT: case TK_GE: case TK_AND: case TK_OR:
+        return 1;
+    default:
+        return 0;
+    }
 }
 
 static int range_end(lang_ev *V, const ast_node *n, double *x)
@@ -75,15 +108,18 @@ static int64_t *ix_alloc(lang_ev *V, int64_t count)
     return ix;
 }
 
-/* Resolves one subscript against a dimension of the given extent. */
-static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *what,
+/* Resolves one subscript against a dimension of the given extent (pos as
+ * bad_index's). */
+static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int pos, const char *what,
                    const silc_value *base, ix_list *out)
 {
     int64_t saved_end = V->end_value, k;
     int rc = 0;
     out->ix = NULL;
     out->n = 0;
+    out->row = sub->kind == AST_RANGE;
     V->end_value = extent;
+    V->in_subscript++;
     if (sub->kind == AST_COLON_ALL) {
         if (!(out->ix = ix_alloc(V, extent))) rc = -1;
         for (k = 0; !rc && k < extent; k++) out->ix[out->n++] = k;
@@ -101,26 +137,35 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, const char *
                 double bad = a < 1 || a != floor(a) || a > (double)extent ? a : (double)extent + 1;
                 int64_t one;
                 out->ix = &one;
-                rc = push_index(V, out, bad, extent, what, base);
+                rc = push_index(V, out, bad, extent, pos, what, base);
                 out->ix = NULL;
             } else {
                 if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
                 for (x = a, k = 0; !rc && k < cnt; k++, x += 1.0)
-                    rc = push_index(V, out, x, extent, what, base);
+                    rc = push_index(V, out, x, extent, pos, what, base);
             }
         }
     } else {
         silc_value *v;
         if (ev_expr(V, sub, &v)) {
             rc = -1;
+        } else if ((out->row = v->m == 1 && v->n != 1), is_mask(sub)) {
+            /* the positions of its nonzeros; a mask longer than the
+             * dimension may only hold zeros past it, as in Octave */
+            int64_t cnt = v->m * v->n;
+            if (!(out->ix = ix_alloc(V, cnt < extent ? cnt : extent))) rc = -1;
+            for (k = 0; !rc && k < cnt; k++)
+                if (val_get(v, k % v->m, k / v->m) != 0) rc = push_index(V, out, (double)k + 1, extent, pos, what, base);
+            val_release(v);
         } else {
             int64_t cnt = v->m * v->n;
             if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
             for (k = 0; !rc && k < cnt; k++)
-                rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, what, base);
+                rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, pos, what, base);
             val_release(v);
         }
     }
+    V->in_subscript--;
     V->end_value = saved_end;
     if (rc) {
         free(out->ix);
@@ -137,9 +182,9 @@ static int resolve_all(lang_ev *V, ast_node *const *subs, size_t nsubs, const ch
     I->n = J->n = 0;
     if (nsubs == 0 || nsubs > 2)
         return eng_error(V->E, "%s takes 1 or 2 subscripts, got %zu", what, nsubs);
-    if (nsubs == 1) return resolve(V, subs[0], base->m * base->n, what, base, I);
-    if (resolve(V, subs[0], base->m, what, base, I)) return -1;
-    if (resolve(V, subs[1], base->n, what, base, J)) {
+    if (nsubs == 1) return resolve(V, subs[0], base->m * base->n, 0, what, base, I);
+    if (resolve(V, subs[0], base->m, 1, what, base, I)) return -1;
+    if (resolve(V, subs[1], base->n, 2, what, base, J)) {
         free(I->ix);
         I->ix = NULL;
         return -1;
@@ -267,8 +312,11 @@ static int ix_extract_real(lang_ev *V, ast_node *const *subs, size_t nsubs, cons
     *out = NULL;
     if (resolve_all(V, subs, nsubs, what, base, &I, &J)) return -1;
     if (nsubs == 1) {
-        /* linear: a vector keeps its orientation, anything else gives a column */
-        int row = base->m == 1 && base->n != 1;
+        /* linear, as Octave: v(:) is a column, a vector keeps its
+         * orientation, a matrix takes the subscript's (a column for a
+         * matrix of indices) */
+        int vector = base->m == 1 || base->n == 1;
+        int row = subs[0]->kind == AST_COLON_ALL ? 0 : vector ? base->m == 1 && base->n != 1 : I.row;
         r = val_dense_new(row ? 1 : I.n, row ? I.n : 1);
         if (r)
             for (a = 0; a < I.n; a++) r->val[a] = val_get(base, I.ix[a] % m, I.ix[a] / m);

@@ -256,9 +256,9 @@ static int starts_new_element(const ps_state *P)
 }
 
 /* Subscript item: ':' alone, or an expression (a range a:b or a:s:b among them). */
-static ast_node *parse_subscript(ps_state *P)
+static ast_node *parse_subscript(ps_state *P, int closer)
 {
-    if (is(P, TK_COLON) && (peek_at(P, 1)->kind == TK_COMMA || peek_at(P, 1)->kind == TK_RBRACKET))
+    if (is(P, TK_COLON) && (peek_at(P, 1)->kind == TK_COMMA || peek_at(P, 1)->kind == closer))
         return node_new(P, AST_COLON_ALL, next(P));
     return parse_expr(P);
 }
@@ -274,14 +274,17 @@ static int parse_list(ps_state *P, ast_node *n, int closer, const char *closetex
     return rc;
 }
 
+/* subscripts: 1 for A[...] (subscripts only), 2 for f(...) (a call, or
+ * Octave's v(i) when f is a variable, which only the evaluator knows: strings,
+ * ':' alone and `end` are all accepted), 0 for neither. */
 static int parse_list_items(ps_state *P, ast_node *n, int closer, const char *closetext,
                             const lx_token *opener, int subscripts)
 {
-    if (is(P, closer) && !subscripts) return close_with(P, closer, closetext, opener, n);
+    if (is(P, closer) && subscripts != 1) return close_with(P, closer, closetext, opener, n);
     for (;;) {
         ast_node *item;
-        if (subscripts) {
-            item = parse_subscript(P);
+        if (subscripts == 1 || (subscripts == 2 && !is(P, TK_STRING))) {
+            item = parse_subscript(P, closer);
         } else if (is(P, TK_STRING)) {
             const lx_token *tk = next(P);
             item = node_new(P, AST_STRING, tk);
@@ -434,9 +437,13 @@ static ast_node *parse_postfix(ps_state *P)
             }
             P->bracket_depth--;
         } else if (tk->kind == TK_LPAREN && n->kind == AST_NAME) {
+            int rc;
             next(P);
             n->kind = AST_CALL;
-            if (parse_list(P, n, TK_RPAREN, ")", tk, 0)) {
+            P->bracket_depth++;  /* v(end): `end` is v's, if v is a variable */
+            rc = parse_list(P, n, TK_RPAREN, ")", tk, 2);
+            P->bracket_depth--;
+            if (rc) {
                 node_free(n);
                 return NULL;
             }
@@ -1163,17 +1170,18 @@ static ast_node *parse_statement_body(ps_state *P)
     }
     e = parse_expr(P);
     if (!e) return NULL;
-    if (is(P, TK_ASSIGN) && e->kind == AST_INDEX && e->kids[0]->kind == AST_NAME) {
-        /* x[...] = value: kids are the value, then the subscripts */
-        size_t i;
+    if (is(P, TK_ASSIGN) && ((e->kind == AST_INDEX && e->kids[0]->kind == AST_NAME) || e->kind == AST_CALL)) {
+        /* x[...] = value, x(...) = value: kids are the value, then the subscripts */
+        size_t i, first = e->kind == AST_CALL ? 0 : 1;
         next(P);
         n = node_new(P, ST_INDEX_ASSIGN, tk);
-        if (!n || !(n->name = util_strdup(e->kids[0]->name)) || add_kid(P, n, parse_expr(P))) {
+        if (!n || !(n->name = util_strdup(first ? e->kids[0]->name : e->name)) ||
+            add_kid(P, n, parse_expr(P))) {
             node_free(n);
             node_free(e);
             return n ? NULL : fail(P, tk, "out of memory while parsing");
         }
-        for (i = 1; i < e->nkids; i++) {
+        for (i = first; i < e->nkids; i++) {
             ast_node *sub = e->kids[i];
             e->kids[i] = NULL;          /* moved: add_kid frees it on failure */
             if (add_kid(P, n, sub)) {

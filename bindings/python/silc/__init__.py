@@ -196,8 +196,9 @@ class Session:
         """Interrupts the exec running on this session, from another thread
         (or, remote, a signal handler): it raises silc.Error "interrupted"
         and the interrupted statement leaves the store as before it.
-        Remote, Ctrl-C during exec does this itself and raises
-        KeyboardInterrupt once the server has answered."""
+        Ctrl-C during exec (on the main thread, with Python's default SIGINT
+        handler) does this itself and raises KeyboardInterrupt once the
+        statement has stopped: embedded and remote alike."""
         self._s.cancel()
 
     def explain(self, statement):

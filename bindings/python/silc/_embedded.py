@@ -8,6 +8,8 @@ package's two back ends (_remote.py the other).
 import ctypes
 import ctypes.util
 import os
+import signal
+import threading
 
 import numpy as np
 
@@ -85,6 +87,62 @@ def _library():
     return lib
 
 
+class _SigintCanceller:
+    """Ctrl-C during an embedded exec.  The exec is one ctypes call that
+    holds the main thread until the engine returns, so Python's SIGINT
+    handler, which only runs between bytecodes on the main thread, would
+    wait for the whole statement.  Python's C-level handler does run at
+    once, and writes the signal's number to the wakeup fd
+    (signal.set_wakeup_fd): while an exec runs on the main thread that fd is
+    this pipe, and a daemon thread (one per process, started at the first
+    such exec) reads it and calls silc_cancel.  The exec then fails with
+    "interrupted" and, back in Python, the pending SIGINT raises
+    KeyboardInterrupt as usual.  No thread is made per call."""
+
+    _instance = None
+
+    def __init__(self):
+        self._r, self._w = os.pipe()
+        os.set_blocking(self._w, False)          # set_wakeup_fd wants it so
+        self._lock = threading.Lock()
+        self._target = None                      # (lib, ctx) of the running exec
+        threading.Thread(target=self._watch, name="silc-sigint", daemon=True).start()
+
+    @classmethod
+    def get(cls):
+        if cls._instance is None:
+            cls._instance = cls()
+        return cls._instance
+
+    def _watch(self):
+        while True:
+            signals = os.read(self._r, 64)
+            if signal.SIGINT in signals:
+                with self._lock:
+                    if self._target is not None:
+                        self._target[0].silc_cancel(self._target[1])
+
+    def run(self, lib, ctx, text):
+        """lib.silc_exec(ctx, text), cancelled by SIGINT."""
+        with self._lock:
+            self._target = (lib, ctx)
+        previous = signal.set_wakeup_fd(self._w, warn_on_full_buffer=False)
+        try:
+            return lib.silc_exec(ctx, text)
+        finally:
+            signal.set_wakeup_fd(previous)
+            with self._lock:
+                self._target = None
+
+
+def _sigint_cancels():
+    """Whether Ctrl-C is Python's KeyboardInterrupt here: on the main thread,
+    with Python's default SIGINT handler (a program's own handler is left
+    alone, as the remote session does)."""
+    return (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+
+
 def _copy(pointer, count, dtype):
     if count == 0 or not pointer:
         return np.empty(count, dtype=dtype)
@@ -143,9 +201,17 @@ class EmbeddedSession:
             self._lib.silc_envelope_free(ctypes.byref(e))
 
     def exec(self, statements, out=None):
+        """Ctrl-C (SIGINT on the main thread) cancels the statement running
+        (the store as before it) and raises KeyboardInterrupt; a library
+        call that never asks for interrupts (a MUMPS or UMFPACK
+        factorization) finishes first."""
+        text = statements.encode()
         self._sink = out
         try:
-            rc = self._lib.silc_exec(self._ctx, statements.encode())
+            if _sigint_cancels():
+                rc = _SigintCanceller.get().run(self._lib, self._ctx, text)
+            else:
+                rc = self._lib.silc_exec(self._ctx, text)
         finally:
             self._sink = None
         w = self._lib.silc_context_warnings(self._ctx)

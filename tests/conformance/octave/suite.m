@@ -63,6 +63,31 @@ f = 2 * (1:4) + 1
 g = (1:4) .^ 2
 h = [1 2 3] * [4 5 6]'
 abs([-1.5 2])
+# subscripts, as Octave writes them (on a variable: a call otherwise)
+vv = [10 20 30 40 50];
+vv(2)
+vv(2:4)
+vv(end)
+vv(end - 1:end)
+vv([1 3 5])
+vv(vv > 25)
+vv(:)
+AA = [1 2 3; 4 5 6; 7 8 10];
+AA(2, 3)
+AA(:, 2)
+AA(2:3, :)
+AA(end, end)
+AA(5)
+AA([1 3])
+AA(AA > 5)
+AA(1, AA(1, :) > 1)
+ww = vv;
+ww(2) = 0
+ww(ww > 35) = -1
+BB = AA;
+BB(2, :) = [0 0 0]
+BB(:, 1) = 9
+m1 = AA(2, :) * AA(:, 2)
 1 + 1;
 disp(pi)
 disp([1 2; 3 4])
