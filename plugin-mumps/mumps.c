@@ -733,6 +733,22 @@ static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
     return SILC_OK;
 }
 
+/* The estimate made when the report is read (ABI 1.8, docs/accuracy.md):
+ * condest_later asks to leave out an estimate (it costs EST_PHASES solve
+ * phases unfolded, where MUMPS's fixed cost per phase is 20-40 % of a
+ * factorization of the shared matrices) and say it is owed; condest_only
+ * asks for it alone with the attached factorization (condest_only_run). */
+#define EST_PHASES 3
+static int condest_later(const silc_call *call)
+{
+    return host->abi_minor >= 8 && call->report->condest_later;
+}
+
+static int condest_wanted(const silc_call *call, const settings *s, const mumps_factor *F)
+{
+    return s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
+}
+
 /* mumps.precision = single: af = 2^scale_a a in float, the largest entry near
  * 1.  Returns why that cannot be done, or NULL. */
 static const char *to_single(mumps_factor *F, int64_t nnz)
@@ -1021,7 +1037,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     analyse = analysis_due(F, b->n);
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    estimate = s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
+    estimate = condest_wanted(call, s, F) && !condest_later(call);
     fold = estimate && !analyse;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
@@ -1043,6 +1059,10 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     if (rc) {
         host->release(X);
         return rc;
+    }
+    if (condest_wanted(call, s, F) && condest_later(call)) {
+        r->condest_deferred = 1;
+        r->condest_solves = EST_PHASES; /* a solve phase costs about the same for 1 or 2 columns */
     }
     *out = X;
     return SILC_OK;
@@ -1171,6 +1191,17 @@ static int solve_run(silc_call *call)
         return rc;
     }
     F = host->attach_get(call->in[0], key);
+    if (host->abi_minor >= 8 && r->condest_only) { /* the estimate alone, owed by an earlier solve */
+        int icntl11;
+        if (c.dist || !F || !F->live || !same_settings(&F->opts, &s))
+            return host->error(call, SILC_EDECLINE, "mumps: no factorization attached to A for the condition estimate");
+        icntl11 = (int)ICNTL(F, 11);
+        ICNTL(F, 11) = 0; /* the error analysis would run on every one of the estimate's solves */
+        rc = condest_wanted(call, &s, F) ? estimate_cond(call, F, NULL) : SILC_OK;
+        ICNTL(F, 11) = icntl11;
+        if (!rc) fill_report(r, F, &c);
+        return rc;
+    }
     if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {
         r->reused_factor = 1;
     } else {

@@ -170,6 +170,23 @@ static void set_rcond(ref_factor *F)
     if (isinf(F->cond)) F->rcond = 0.0;
 }
 
+/* A square factor's estimate ||A||_1 * est ||A^{-1}||_1 into F->cond, by
+ * dlacon's method with F's solves: about REF_EST_SOLVES column solves, next
+ * to which a solve of this plugin (with its refinement steps) costs at
+ * least one.  -1 when out of memory (the estimator's only failure: the
+ * solve of a factor does not fail). */
+#define REF_EST_SOLVES 5
+static int make_estimate(ref_factor *F, int64_t n, double norm1)
+{
+    double *w = ref_alloc((size_t)(F->work_len + n + 1), sizeof(double)), est = -1;
+    if (w) est = ref_inv_norm1_est(n, F->solve, F->data, w);
+    ref_free(w);
+    if (est < 0) return -1;
+    F->cond = ref_cond_from(norm1, est);
+    set_rcond(F);
+    return 0;
+}
+
 int ref_op_solve(silc_call *call)
 {
     silc_view a, b;
@@ -190,6 +207,22 @@ int ref_op_solve(silc_call *call)
     if (a.m != a.n) alg = ALG_RECT;
     if (alg == ALG_TRI && !P->lower && !P->upper)
         return ref_host->error(call, SILC_EDECLINE, "triangular solve: the matrix is not triangular");
+
+    /* accuracy.condest = off skips the estimate (ABI 1.7); condest_later
+     * leaves it owed, condest_only makes it alone (ABI 1.8, see
+     * make_estimate). */
+    int wanted = !(ref_host->abi_minor >= 7 && rep->condest_off);
+    int later = ref_host->abi_minor >= 8 && rep->condest_later;
+    if (ref_host->abi_minor >= 8 && rep->condest_only) {
+        ref_factor *F = ref_host->attach_get(call->in[0], alg_key[alg]);
+        if (!F && by_structure && (alg == ALG_DENSE_SPD || alg == ALG_SPARSE_SPD)) /* Cholesky had failed */
+            F = ref_host->attach_get(call->in[0], alg_key[alg == ALG_DENSE_SPD ? ALG_DENSE : ALG_SPARSE]);
+        if (!F) return ref_host->error(call, SILC_EDECLINE, "no factorization attached to A for the condition estimate");
+        if (F->cond == 0.0 && wanted && make_estimate(F, a.n, P->norm1)) return ref_nomem(call);
+        rep->cond_est = F->cond == 0.0 ? -1 : F->cond;
+        rep->rcond = F->cond == 0.0 ? -1 : F->rcond;
+        return SILC_OK;
+    }
 
     double t0 = ref_host->now();
     ref_factor *F = ref_host->attach_get(call->in[0], alg_key[alg]);
@@ -217,21 +250,12 @@ int ref_op_solve(silc_call *call)
         attached = ref_host->attach_set(call->in[0], alg_key[alg], F, ref_factor_free) == 0;
     }
     double t1 = ref_host->now();
-    /* A square factor's estimate ||A||_1 * est ||A^{-1}||_1 (F->cond == 0:
-     * none yet), on the first solve that wants one: accuracy.condest = off
-     * skips it, and a later solve with the setting on makes it. */
-    if (F->cond == 0.0 && !(ref_host->abi_minor >= 7 && rep->condest_off)) {
-        double *w = ref_alloc((size_t)(F->work_len + a.n + 1), sizeof(double)), est = -1;
-        /* The estimator fails only when it runs out of memory (it applies
-         * the solve of this factor, which does not fail). */
-        if (w) est = ref_inv_norm1_est(a.n, F->solve, F->data, w);
-        ref_free(w);
-        if (est < 0) { /* no estimate would mean no warning of an ill-conditioned matrix */
-            if (!attached) ref_factor_free(F);
-            return ref_nomem(call);
-        }
-        F->cond = ref_cond_from(P->norm1, est);
-        set_rcond(F);
+    /* A square factor's estimate (F->cond == 0: none yet), on the first
+     * solve that wants one: a later solve with the setting on makes it. */
+    if (F->cond == 0.0 && wanted && !later && make_estimate(F, a.n, P->norm1)) {
+        /* no estimate would mean no warning of an ill-conditioned matrix */
+        if (!attached) ref_factor_free(F);
+        return ref_nomem(call);
     }
 
     int64_t m = a.m, n = a.n, nrhs = b.n, len = m > n ? m : n;
@@ -282,6 +306,10 @@ int ref_op_solve(silc_call *call)
     rep->factor_seconds = reused ? 0.0 : t1 - t0;
     rep->solve_seconds = ref_host->now() - t1;
     rep->iterations = 0;
+    if (F->cond == 0.0 && wanted && later && attached) {
+        rep->condest_deferred = 1;
+        rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
+    }
     snprintf(rep->note, sizeof rep->note, "%s", F->note);
     call->out = out;
     out = NULL;
