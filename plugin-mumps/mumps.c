@@ -1199,7 +1199,9 @@ static int solve_run(silc_call *call)
         ICNTL(F, 11) = 0; /* the error analysis would run on every one of the estimate's solves */
         rc = condest_wanted(call, &s, F) ? estimate_cond(call, F, NULL) : SILC_OK;
         ICNTL(F, 11) = icntl11;
-        if (!rc) fill_report(r, F, &c);
+        r->cond_est = F->cond_est;
+        if (F->cond_est >= 0) /* the note says how the estimate was made, and only that */
+            note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
         return rc;
     }
     if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {

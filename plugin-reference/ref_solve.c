@@ -251,8 +251,10 @@ int ref_op_solve(silc_call *call)
     }
     double t1 = ref_host->now();
     /* A square factor's estimate (F->cond == 0: none yet), on the first
-     * solve that wants one: a later solve with the setting on makes it. */
-    if (F->cond == 0.0 && wanted && !later && make_estimate(F, a.n, P->norm1)) {
+     * solve that wants one: a later solve with the setting on makes it.
+     * Owed (later) only by a factorization kept on A, where the
+     * condest_only call will find it. */
+    if (F->cond == 0.0 && wanted && !(later && attached) && make_estimate(F, a.n, P->norm1)) {
         /* no estimate would mean no warning of an ill-conditioned matrix */
         if (!attached) ref_factor_free(F);
         return ref_nomem(call);

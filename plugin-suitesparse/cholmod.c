@@ -246,10 +246,9 @@ int ss_cholmod_solve(silc_call *call)
         ch_est e = {NULL, NULL, NULL, NULL};
         if (!(F = n > 0 ? ss_host->attach_get(call->in[0], CH_KEY) : NULL)) return ss_no_factor(call, "CHOLMOD");
         e.F = F;
-        ss_square_cond(call, condest, n, ch_apply_inv, &e, &F->info, NULL);
+        rc = ss_estimate_alone(call, condest, n, ch_apply_inv, &e, &F->info);
         ch_est_free(&e);
-        ss_report_factor(r, &F->info);
-        return SILC_OK;
+        return rc;
     }
 
     if (n > 0) {

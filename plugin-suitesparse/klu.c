@@ -210,9 +210,7 @@ int ss_klu_solve(silc_call *call)
         kl_apply u;
         if (!(F = n > 0 ? ss_host->attach_get(call->in[0], KL_KEY) : NULL)) return ss_no_factor(call, "KLU");
         u.F = F, u.n = n;
-        ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info, NULL);
-        ss_report_factor(r, &F->info);
-        return SILC_OK;
+        return ss_estimate_alone(call, condest, n, kl_apply_inv, &u, &F->info);
     }
 
     if (n > 0) {

@@ -228,11 +228,10 @@ int ss_umfpack_solve(silc_call *call)
         um_apply u = {0};
         if (!(F = n > 0 ? ss_host->attach_get(call->in[0], UM_KEY) : NULL)) return ss_no_factor(call, "UMFPACK");
         u.a = &a, u.numeric = F->numeric;
-        ss_square_cond(call, condest, n, um_apply_block, &u, &F->info, NULL);
+        rc = ss_estimate_alone(call, condest, n, um_apply_block, &u, &F->info);
         ss_host->free(u.y);
         ss_host->free(u.wi);
-        ss_report_factor(r, &F->info);
-        return SILC_OK;
+        return rc;
     }
 
     t0 = ss_host->now();

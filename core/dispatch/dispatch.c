@@ -547,8 +547,10 @@ void disp_condest_why(const silc_report *r, char *buf, size_t len)
 }
 
 /* Backend b's estimate alone (condest_only) for the call like's A, class and
- * options (those in force); its status, the estimate in *cond (-1: none). */
-static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *like, double *cond)
+ * options (those in force), into r: cond_est, and the plugin's note of how
+ * it was made added to r's.  The call's status; r unchanged unless SILC_OK
+ * and an estimate came. */
+static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *like, silc_report *r)
 {
     silc_call c = *like;
     silc_report rep;
@@ -566,8 +568,13 @@ static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *l
     c.host_private = &ctx;
     rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
     val_release(c.out);
-    *cond = rc == SILC_OK ? rep.cond_est : -1;
-    return rc;
+    if (rc != SILC_OK || !(rep.cond_est >= 0 || isnan(rep.cond_est))) return rc == SILC_OK ? SILC_EDECLINE : rc;
+    r->cond_est = rep.cond_est;
+    if (rep.note[0] && !strstr(r->note, rep.note)) {
+        size_t len = strlen(r->note);
+        snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", rep.note);
+    }
+    return SILC_OK;
 }
 
 /* A solve whose backend left its estimate out (condest_deferred = 1): made
@@ -575,7 +582,6 @@ static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *l
 static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
 {
     silc_report *r = call->report;
-    double cond;
     const char *mode = cfg_get(E, "accuracy.condest");
     if (r->condest_deferred != 1) {
         r->condest_deferred = 0; /* a plugin that knows no deferral may have left anything */
@@ -589,14 +595,13 @@ static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
         !(r->pivot_ratio == 0 && acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_HINT))
         return; /* owed */
     r->condest_deferred = 0;
-    if (estimate_only(E, b, call, &cond) == SILC_OK) r->cond_est = cond;
+    estimate_only(E, b, call, r); /* none on failure: "the backend gives none" */
 }
 
 void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
 {
     const ld_backend *b;
     silc_call c;
-    double cond = -1;
     if (r->condest_deferred != 1) return;
     r->condest_deferred = DISP_CONDEST_LOST;
     if (!p->A || !p->B || !(b = ld_find(E, r->backend)) || !provides(b, SILC_OP_SOLVE)) return;
@@ -609,8 +614,7 @@ void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
     c.options = p->options;
     c.op_class = p->op_class;
     if (p->options && cfg_set_call_options(E, p->options)) return;
-    if (estimate_only(E, b, &c, &cond) == SILC_OK && cond >= 0) {
-        r->cond_est = cond;
+    if (estimate_only(E, b, &c, r) == SILC_OK) {
         r->condest_deferred = DISP_CONDEST_READ;
         warn_condition(E, r);
     }
