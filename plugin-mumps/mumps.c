@@ -744,6 +744,26 @@ static int condest_later(const silc_call *call)
     return host->abi_minor >= 8 && call->report->condest_later;
 }
 
+/* The 1-norms of the n x EST_COLS block X (into sums). */
+static void column_sums(int64_t n, const double *X, double sums[EST_COLS])
+{
+    for (int j = 0; j < EST_COLS; j++) {
+        sums[j] = 0;
+        for (int64_t i = 0; i < n; i++) sums[j] += fabs(X[i + j * n]);
+    }
+}
+
+/* ||A||_1 max_j ||Y_j||_1 / ||X0_j||_1 for the start block X0 (column sums
+ * x0) solved into Y: a lower bound of cond_1(A) (condest_lower). */
+static double start_bound(silc_call *call, int64_t n, const double *Y, const double x0[EST_COLS])
+{
+    double y[EST_COLS], best = 0;
+    column_sums(n, Y, y);
+    for (int j = 0; j < EST_COLS; j++)
+        if (x0[j] > 0 && y[j] / x0[j] > best) best = y[j] / x0[j];
+    return best * silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1;
+}
+
 static int condest_wanted(const silc_call *call, const settings *s, const mumps_factor *F)
 {
     return s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
@@ -1025,7 +1045,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     silc_value *X;
     int64_t n = b->m;
     int rc, icntl11, analyse, estimate, fold;
-    double t0, *rhs;
+    double t0, *rhs, lower = 0, x0[EST_COLS] = {0};
     *out = NULL;
     /* dense_copy, or the copy after a folded solve, writes every entry. */
     X = host->dense_new_uninit(b->m, b->n);
@@ -1038,7 +1058,10 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
     estimate = condest_wanted(call, s, F) && !condest_later(call);
-    fold = estimate && !analyse;
+    /* Owed (condest_later), the start block still rides along: a solve phase
+     * costs about the same for a few more columns, and A^-1 X0 gives the
+     * host a lower bound of cond_1 that warns of ill-conditioning at once. */
+    fold = condest_wanted(call, s, F) && !analyse;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
         host->release(X);
@@ -1048,6 +1071,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     do {
         dense_copy(b, rhs);
         if (fold) host->inv_norm1_start(n, EST_COLS, rhs + n * b->n);
+        if (fold) column_sums(n, rhs + n * b->n, x0); /* the solve overwrites the block */
     } while ((rc = run_solve(call, F, rhs, b->n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
     if (!rc && analyse) keep_analysis(F);
     if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n) * sizeof *rhs);
@@ -1055,6 +1079,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     ICNTL(F, 11) = 0; /* the estimate's solves, if any, without it */
     if (!rc && estimate) rc = estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
     ICNTL(F, 11) = icntl11;
+    if (!rc && fold && !estimate) lower = start_bound(call, n, rhs + n * b->n, x0);
     if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);
@@ -1064,6 +1089,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
         r->condest_deferred = 1;
         r->condest_solves = EST_PHASES; /* a solve phase costs about the same for 1 or 2 columns */
     }
+    if (fold && !estimate) r->condest_lower = lower;
     *out = X;
     return SILC_OK;
 }

@@ -187,6 +187,30 @@ static int make_estimate(ref_factor *F, int64_t n, double norm1)
     return 0;
 }
 
+/* ||A||_1 max_j ||A^-1 x_j||_1 / ||x_j||_1 over the estimator's two start
+ * vectors (e/n and the alternating one): a lower bound of cond_1(A) for two
+ * column solves, a fraction of the estimate's, that tells the host whether
+ * an owed estimate must be made at once (condest_lower); 0 when out of
+ * memory.  w: F's solve workspace. */
+static double start_bound(ref_factor *F, int64_t n, double norm1, double *w)
+{
+    double *X = ref_alloc((size_t)(2 * n), sizeof(double)), best = 0;
+    if (!X || n == 0) {
+        ref_free(X);
+        return 0;
+    }
+    ref_inv_norm1_start(n, 2, X);
+    for (int j = 0; j < 2 && n > 1; j++) {
+        double *x = X + j * n, sx = 0, sy = 0;
+        for (int64_t i = 0; i < n; i++) sx += fabs(x[i]);
+        if (F->solve(F->data, x, 0, w)) break;
+        for (int64_t i = 0; i < n; i++) sy += fabs(x[i]);
+        if (sy / sx > best) best = sy / sx;
+    }
+    ref_free(X);
+    return best * norm1;
+}
+
 int ref_op_solve(silc_call *call)
 {
     silc_view a, b;
@@ -311,6 +335,7 @@ int ref_op_solve(silc_call *call)
     if (F->cond == 0.0 && wanted && later && attached) {
         rep->condest_deferred = 1;
         rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
+        rep->condest_lower = start_bound(F, n, P->norm1, w);
     }
     snprintf(rep->note, sizeof rep->note, "%s", F->note);
     call->out = out;

@@ -228,6 +228,10 @@ typedef struct silc_report {
                                when the report was read, 3 = could not be made then */
     double condest_solves;  /* plugin: the estimate's cost in solves like this call's (column
                                solves over this call's columns, or solve phases) */
+    double condest_lower;   /* plugin, with condest_deferred: a lower bound of cond_1(A) it got for
+                               next to nothing (||A||_1 ||A^-1 x||_1 / ||x||_1 for the estimator's
+                               start block solved with the user's columns), which makes the host
+                               estimate at once when it hints at ill-conditioning; 0 = none */
 } silc_report;
 
 typedef struct silc_call {

@@ -449,7 +449,7 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
 /* A report as a backend gets it: zeroed, estimates unknown, and told
  * whether the session wants a condition estimate (accuracy.condest), and
  * whether one that costs solves of its own may be left for later (later:
- * the caller may defer it, and accuracy.condest is auto). */
+ * the caller may defer it, and accuracy.condest is auto or on_request). */
 static void report_reset(silc_engine *E, silc_report *r, int later)
 {
     const char *c = cfg_get(E, "accuracy.condest");
@@ -511,8 +511,12 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * the same backend, whose factorization is attached to A -- when that costs
  * at most DISP_CONDEST_BUDGET of the factorization the call made, or when
  * what the solve knows for free hints at ill-conditioning, so that the
- * warnings come at solve time: the library's pivot ratio, or the lower bound
- * ||A||_1 ||x||_1 / ||b||_1 (acc_cond_lower_bound), above DISP_CONDEST_HINT.
+ * warnings come at solve time: the library's pivot ratio (UMFPACK, KLU,
+ * CHOLMOD), the lower bound ||A||_1 ||A^-1 x0||_1 / ||x0||_1 of the
+ * estimator's start block x0 solved with the user's columns (MUMPS, where
+ * a few more columns cost a solve phase nothing; the reference, two column
+ * solves), or else the solve's own ||A||_1 ||x||_1 / ||b||_1
+ * (acc_cond_lower_bound), above DISP_CONDEST_HINT.
  * Otherwise the estimate is owed and made when the report is read
  * (disp_condest_resolve, from `info`).  A solve that reused a factorization
  * made none to weigh the cost against: its estimate is owed.
@@ -522,7 +526,7 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * warnings then come when the report is read), for a program of many
  * solves that reads few reports. */
 #define DISP_CONDEST_BUDGET 0.15
-/* Both hints lie below cond_1 (the bound rigorously; the pivot ratio is 3.8
+/* The hints lie below cond_1 (the bounds rigorously; the pivot ratio is 3.8
  * against 840 on the 1-D Laplacian): a hint of 1e6 leaves a margin of 4.5e5
  * below the "fewer than 4 correct digits" warning at 4.5e11 (docs/accuracy.md
  * gives the ratios measured on the shared matrices). */
@@ -588,11 +592,13 @@ static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
         return;
     }
     if (mode && !strcmp(mode, "on_request")) return; /* owed, whatever it costs */
-    /* The lower bound costs a pass over A (for ||A||_1) and the operands,
-     * a few per cent of a KLU factorization: only where the backend gives
-     * no pivot ratio (MUMPS, reference). */
+    /* The solve's own lower bound costs a pass over A (for ||A||_1) and
+     * the operands, a few per cent of a KLU factorization: only where the
+     * backend gives no hint of its own. */
     if (condest_share(r) > DISP_CONDEST_BUDGET && !(r->pivot_ratio > DISP_CONDEST_HINT) &&
-        !(r->pivot_ratio == 0 && acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_HINT))
+        !(r->condest_lower > DISP_CONDEST_HINT) &&
+        !(r->pivot_ratio == 0 && r->condest_lower == 0 &&
+          acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_HINT))
         return; /* owed */
     r->condest_deferred = 0;
     estimate_only(E, b, call, r); /* none on failure: "the backend gives none" */
@@ -614,9 +620,13 @@ void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
     c.options = p->options;
     c.op_class = p->op_class;
     if (p->options && cfg_set_call_options(E, p->options)) return;
-    if (estimate_only(E, b, &c, r) == SILC_OK) {
+    switch (estimate_only(E, b, &c, r)) {
+    case SILC_OK:
         r->condest_deferred = DISP_CONDEST_READ;
         warn_condition(E, r);
+        break;
+    case SILC_EDECLINE: break; /* no factorization attached any more: DISP_CONDEST_LOST */
+    default: r->condest_deferred = 0; /* it failed (out of memory): "the backend gives none" */
     }
     if (p->options) cfg_clear_call_options(E);
 }
