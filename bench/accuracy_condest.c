@@ -18,10 +18,10 @@
  *            time, where the estimate is made when it costs at most 15 % of
  *            the factorization (predicted by the backend's timings) or the
  *            matrix looks ill-conditioned, and is otherwise deferred;
- *   at       where auto made it: "solve", "read" (deferred), or "mixed" when
- *            the prediction (from this call's wall-clock timings) fell on
- *            either side of the budget between repetitions; auto's share
- *            is then that of the dearer way (each way's best run);
+ *   at       where auto made it: "solve", "read" (deferred), or "N/M" when
+ *            the prediction (from the call's wall-clock timings) deferred
+ *            it in N of the M repetitions only (auto's share is the best
+ *            run's, so the deferred way's);
  *   read     what `info x` costs more under auto than under now (the
  *            deferred estimate, and the residual pass for its bound), in
  *            solves (read / solve) and as a share of factor.
@@ -185,12 +185,12 @@ int main(int argc, char **argv)
         for (size_t k = 0; k < NB; k++) {
             const backend *be = &backends[k];
             timing off = {INFINITY, INFINITY, INFINITY, 0}, now = off, au = off, t = off;
-            /* auto's best first solve where it deferred, and where it made
-             * the estimate at once; info's best where it made it */
-            double auto_d, now_d, read_d, info_read = INFINITY, au_defer = INFINITY, au_at_once = INFINITY;
+            /* info's best where it made the estimate */
+            double auto_d, now_d, read_d, info_read = INFINITY;
             /* Small rows are cheap and the noisiest next to the budget:
              * three times the repetitions. */
             int ok = 1, reps_here = nnz < 20000 ? 3 * reps : reps, read = 0;
+            char at[16];
             if ((be->spd_only && strcmp(cls, "spd")) || n > be->max_n ||
                 (only_backend && !strstr(be->name, only_backend)))
                 continue;
@@ -204,16 +204,11 @@ int main(int argc, char **argv)
                     if (t.again < best[m]->again) best[m]->again = t.again;
                     if (m == 2) read += t.read;
                     if (m == 2 && t.read && t.info < info_read) info_read = t.info;
-                    if (m == 2 && t.read && t.first < au_defer) au_defer = t.first;
-                    if (m == 2 && !t.read && t.first < au_at_once) au_at_once = t.first;
                 }
             }
             if (!ok) continue; /* not built, declines, or fails on it */
             now_d = (now.first - off.first) / off.first;
-            /* a row that went both ways counts at its dearer way */
-            auto_d = ((au_at_once < INFINITY ? au_at_once : au_defer) - off.first) / off.first;
-            if (au_at_once < INFINITY && au_defer < INFINITY && au_defer > au_at_once)
-                auto_d = (au_defer - off.first) / off.first;
+            auto_d = (au.first - off.first) / off.first;
             read_d = info_read - now.info;
             over += auto_d > CE_BUDGET;
             nover[k] += auto_d > CE_BUDGET;
@@ -224,9 +219,10 @@ int main(int argc, char **argv)
                 auto_share[k][nrow[k]] = auto_d;
                 read_solves[k][nrow[k]++] = read ? read_d / off.again : 0;
             }
+            if (read > 0 && read < reps_here) snprintf(at, sizeof at, "%d/%d", read, reps_here);
+            else snprintf(at, sizeof at, "%s", read ? "read" : "solve");
             printf("%c %-17s %-20s %6lld  %10.3g  %10.3g  %5.1f%%  %5.1f%%  %-5s", auto_d > CE_BUDGET ? '!' : ' ',
-                   file, be->name, n, off.first, off.again, 100 * now_d, 100 * auto_d,
-                   !read ? "solve" : read == reps_here ? "read" : "mixed");
+                   file, be->name, n, off.first, off.again, 100 * now_d, 100 * auto_d, at);
             if (read) printf("  %12.1f  %5.1f%%\n", read_d / off.again, 100 * read_d / off.first);
             else printf("  %12s  %6s\n", "--", "--");
             fflush(stdout);

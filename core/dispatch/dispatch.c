@@ -516,7 +516,7 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * estimator's start block x0 solved with the user's columns (MUMPS, where
  * a few more columns cost a solve phase nothing; the reference, two column
  * solves), or else the solve's own ||A||_1 ||x||_1 / ||b||_1
- * (acc_cond_lower_bound), above DISP_CONDEST_HINT.
+ * (acc_cond_lower_bound), above DISP_CONDEST_PIVOT_HINT or _BOUND_HINT.
  * Otherwise the estimate is owed and made when the report is read
  * (disp_condest_resolve, from `info`).  A solve that reused a factorization
  * made none to weigh the cost against: its estimate is owed.
@@ -526,11 +526,16 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * warnings then come when the report is read), for a program of many
  * solves that reads few reports. */
 #define DISP_CONDEST_BUDGET 0.15
-/* The hints lie below cond_1 (the bounds rigorously; the pivot ratio is 3.8
- * against 840 on the 1-D Laplacian): a hint of 1e6 leaves a margin of 4.5e5
- * below the "fewer than 4 correct digits" warning at 4.5e11 (docs/accuracy.md
- * gives the ratios measured on the shared matrices). */
-#define DISP_CONDEST_HINT 1e6
+/* The hints, against the "fewer than 4 correct digits" warning at cond_1 =
+ * 4.5e11 (docs/accuracy.md gives them on the shared matrices).  The pivot
+ * ratio is no bound (3.8 against 840 on the 1-D Laplacian, 2 against 1.5e11
+ * on fs_183_6), but the matrices that warn have ratios of 1.2e7 and more:
+ * 1e6 keeps them with a margin of 12.  The start block's bound is rigorous
+ * and at most 8000x below cond_1 on the shared matrices (bayer10): 1e7
+ * keeps a margin of 4.5e4 below the warning, and leaves the estimates of
+ * the merely ill-conditioned (494_bus, 3.9e6) owed. */
+#define DISP_CONDEST_PIVOT_HINT 1e6
+#define DISP_CONDEST_BOUND_HINT 1e7
 
 /* The estimate's cost as a share of the factorization the solve made
  * (INFINITY when it made none). */
@@ -595,10 +600,10 @@ static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
     /* The solve's own lower bound costs a pass over A (for ||A||_1) and
      * the operands, a few per cent of a KLU factorization: only where the
      * backend gives no hint of its own. */
-    if (condest_share(r) > DISP_CONDEST_BUDGET && !(r->pivot_ratio > DISP_CONDEST_HINT) &&
-        !(r->condest_lower > DISP_CONDEST_HINT) &&
+    if (condest_share(r) > DISP_CONDEST_BUDGET && !(r->pivot_ratio > DISP_CONDEST_PIVOT_HINT) &&
+        !(r->condest_lower > DISP_CONDEST_BOUND_HINT) &&
         !(r->pivot_ratio == 0 && r->condest_lower == 0 &&
-          acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_HINT))
+          acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_BOUND_HINT))
         return; /* owed */
     r->condest_deferred = 0;
     estimate_only(E, b, call, r); /* none on failure: "the backend gives none" */
