@@ -190,14 +190,14 @@ static int make_estimate(ref_factor *F, int64_t n, double norm1)
 /* ||A||_1 max_j ||A^-1 x_j||_1 / ||x_j||_1 over the estimator's two start
  * vectors (e/n and the alternating one): a lower bound of cond_1(A) for two
  * column solves, a fraction of the estimate's, that tells the host whether
- * an owed estimate must be made at once (condest_lower); 0 when out of
+ * an owed estimate must be made at once (condest_lower); -1 when out of
  * memory.  w: F's solve workspace. */
 static double start_bound(ref_factor *F, int64_t n, double norm1, double *w)
 {
     double *X = ref_alloc((size_t)(2 * n), sizeof(double)), best = 0;
     if (!X || n == 0) {
         ref_free(X);
-        return 0;
+        return n ? -1 : 0;
     }
     ref_inv_norm1_start(n, 2, X);
     for (int j = 0; j < 2 && n > 1; j++) {
@@ -278,7 +278,11 @@ int ref_op_solve(silc_call *call)
      * solve that wants one: a later solve with the setting on makes it.
      * Owed (later) only by a factorization kept on A, where the
      * condest_only call will find it. */
-    if (F->cond == 0.0 && wanted && !(later && attached) && make_estimate(F, a.n, P->norm1)) {
+    if (F->cond == 0.0 && wanted && later && !attached) { /* owed, but nothing keeps the factorization */
+        ref_factor_free(F);
+        return ref_nomem(call);
+    }
+    if (F->cond == 0.0 && wanted && !later && make_estimate(F, a.n, P->norm1)) {
         /* no estimate would mean no warning of an ill-conditioned matrix */
         if (!attached) ref_factor_free(F);
         return ref_nomem(call);
@@ -335,7 +339,10 @@ int ref_op_solve(silc_call *call)
     if (F->cond == 0.0 && wanted && later && attached) {
         rep->condest_deferred = 1;
         rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
-        rep->condest_lower = start_bound(F, n, P->norm1, w);
+        if ((rep->condest_lower = start_bound(F, n, P->norm1, w)) < 0) {
+            st = ref_nomem(call); /* without the hint an ill-conditioned matrix could go unwarned */
+            goto done;
+        }
     }
     snprintf(rep->note, sizeof rep->note, "%s", F->note);
     call->out = out;

@@ -33,7 +33,7 @@
 static const char *const deferring[] = {"reference", "suitesparse.umfpack", "suitesparse.klu", "suitesparse.cholmod",
                                         "mumps"};
 #define NDEFER (sizeof deferring / sizeof deferring[0])
-#define READ_NOTE "computed when the report was first read: deferred at solve time because it costs "
+#define READ_NOTE "computed when the report was first read)\n  deferred at solve time: it costs "
 
 static int have[NDEFER];
 

@@ -155,7 +155,7 @@ static int solve_with(silc_context *c, const backend *be, const char *mode, doub
     *bound = tl_out_number(in, "forward error bound (estimate: est ||A^-1||_1 ||b - A x||_1 / ||x||_1): ");
     if (tl_contains(in, "condition estimate: inf")) *est = INFINITY;
     if (!(*est >= 0)) snprintf(why, whylen, "no condition estimate:\n%s", in);
-    else if (be->defers && !strcmp(mode, "on_request") && !tl_contains(in, "computed when the report was first read"))
+    else if (be->defers && !strcmp(mode, "on_request") && !tl_contains(in, "computed when the report was first read)"))
         *est = -1, snprintf(why, whylen, "not deferred under on_request:\n%s", in);
     return 0;
 }

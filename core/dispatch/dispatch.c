@@ -587,16 +587,18 @@ static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *l
 }
 
 /* A solve whose backend left its estimate out (condest_deferred = 1): made
- * now when it is cheap or the matrix may be ill-conditioned, else owed. */
-static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
+ * now when it is cheap or the matrix may be ill-conditioned, else owed.
+ * -1 when that estimate ran out of memory: the solve fails, as it did when
+ * the backend made it (no estimate would mean no warning). */
+static int condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
 {
     silc_report *r = call->report;
     const char *mode = cfg_get(E, "accuracy.condest");
     if (r->condest_deferred != 1) {
         r->condest_deferred = 0; /* a plugin that knows no deferral may have left anything */
-        return;
+        return 0;
     }
-    if (mode && !strcmp(mode, "on_request")) return; /* owed, whatever it costs */
+    if (mode && !strcmp(mode, "on_request")) return 0; /* owed, whatever it costs */
     /* The solve's own lower bound costs a pass over A (for ||A||_1) and
      * the operands, a few per cent of a KLU factorization: only where the
      * backend gives no hint of its own. */
@@ -604,18 +606,19 @@ static void condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
         !(r->condest_lower > DISP_CONDEST_BOUND_HINT) &&
         !(r->pivot_ratio == 0 && r->condest_lower == 0 &&
           acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_BOUND_HINT))
-        return; /* owed */
+        return 0; /* owed */
     r->condest_deferred = 0;
-    estimate_only(E, b, call, r); /* none on failure: "the backend gives none" */
+    return estimate_only(E, b, call, r) == SILC_ENOMEM ? -1 : 0; /* else none: "the backend gives none" */
 }
 
-void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
+int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
 {
     const ld_backend *b;
     silc_call c;
-    if (r->condest_deferred != 1) return;
+    int rc = 0;
+    if (r->condest_deferred != 1) return 0;
     r->condest_deferred = DISP_CONDEST_LOST;
-    if (!p->A || !p->B || !(b = ld_find(E, r->backend)) || !provides(b, SILC_OP_SOLVE)) return;
+    if (!p->A || !p->B || !(b = ld_find(E, r->backend)) || !provides(b, SILC_OP_SOLVE)) return 0;
     memset(&c, 0, sizeof c);
     c.op = SILC_OP_SOLVE;
     c.sub = p->sub;
@@ -624,16 +627,21 @@ void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
     c.in[1] = p->B;
     c.options = p->options;
     c.op_class = p->op_class;
-    if (p->options && cfg_set_call_options(E, p->options)) return;
+    if (p->options && cfg_set_call_options(E, p->options)) return 0;
     switch (estimate_only(E, b, &c, r)) {
     case SILC_OK:
         r->condest_deferred = DISP_CONDEST_READ;
         warn_condition(E, r);
         break;
     case SILC_EDECLINE: break; /* no factorization attached any more: DISP_CONDEST_LOST */
-    default: r->condest_deferred = 0; /* it failed (out of memory): "the backend gives none" */
+    case SILC_ENOMEM: /* still owed: `info` fails, and may be asked again */
+        r->condest_deferred = 1;
+        rc = eng_error(E, "out of memory for the condition estimate");
+        break;
+    default: r->condest_deferred = 0; /* it failed: "the backend gives none" */
     }
     if (p->options) cfg_clear_call_options(E);
+    return rc;
 }
 
 /* ---- running --------------------------------------------------------------- */
@@ -949,9 +957,14 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                     snprintf(ctx.err, sizeof ctx.err, "%.1000s", E->err);
                 }
             }
+            if (rc == SILC_OK && call->op == SILC_OP_SOLVE && condest_settle(E, call, b)) {
+                val_release(call->out);
+                call->out = NULL;
+                rc = SILC_ENOMEM;
+                snprintf(ctx.err, sizeof ctx.err, "out of memory for the condition estimate");
+            }
             if (rc == SILC_OK) {
                 double limit;
-                if (call->op == SILC_OP_SOLVE) condest_settle(E, call, b);
                 /* Hook (refine.c): iterative refinement as solve.refine asks,
                  * by the backend that just solved, before the report (not
                  * of a distributed solve: refine.c reads whole arrays). */

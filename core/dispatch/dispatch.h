@@ -174,8 +174,9 @@ int disp_explain(silc_engine *E, const silc_call *call, strbuf *b);
  * A, asked for the estimate alone; warns as a solve would.  It does not
  * factor again: with the factorization released (A's attachment evicted by
  * the memo's limit) r says DISP_CONDEST_LOST.  p is kept (the forward-error
- * bound needs its residual: acc_pending_resolve). */
-void disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r);
+ * bound needs its residual: acc_pending_resolve).  -1 (E->err) when out of
+ * memory: still owed. */
+int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r);
 /* Why r's estimate was owed: "it costs N solves = X % of the factorization". */
 void disp_condest_why(const silc_report *r, char *buf, size_t len);
 /* Class chain of a call, most specific first, e.g. {"solve.sparse.spd",

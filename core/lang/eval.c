@@ -1221,8 +1221,19 @@ static int exec_info(lang_ev *V, const ast_node *s)
          * computed again, to the same bits). */
         if (in->has_solve && r->condest_deferred) disp_condest_why(r, why, sizeof why);
         if (in->has_solve && r->condest_deferred == 1) {
-            disp_condest_resolve(E, &in->pending, &in->report);
-            if (r->cond_est >= 0 && !deferred) acc_pending_resolve(E, &in->pending, &in->report);
+            if (disp_condest_resolve(E, &in->pending, &in->report)) {
+                sb_free(&b);
+                return -1;
+            }
+            if (r->cond_est >= 0 && !deferred) {
+                double be = r->backward_error;
+                acc_pending_resolve(E, &in->pending, &in->report);
+                if (!(r->forward_bound >= 0) || r->backward_error < 0) { /* its residual ran out of memory */
+                    in->report.backward_error = be;
+                    sb_free(&b);
+                    return eng_error(E, "out of memory computing the forward error bound");
+                }
+            }
             else if (!deferred) eng_pending_release(&in->pending);
         }
         if (deferred)
@@ -1248,8 +1259,10 @@ static int exec_info(lang_ev *V, const ast_node *s)
                           r->backward_error_unrefined);
             if (r->cond_est >= 0) {
                 if (r->condest_deferred == DISP_CONDEST_READ)
+                    /* the why line holds timings: "time:" marks such lines */
                     sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization; "
-                                  "computed when the report was first read: deferred at solve time because %s)\n", r->cond_est, why);
+                                  "computed when the report was first read)\n  deferred at solve time: %s\n",
+                              r->cond_est, why);
                 else
                     sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization)\n",
                               r->cond_est);
