@@ -4,28 +4,37 @@
  *
  * For every real square nonsingular matrix of ../shared/matrices (index.tsv)
  * and every direct backend that takes it, the first solve x = A \ b with a
- * freshly put A (so it factors) is timed with accuracy.condest = off and on,
- * alternately, best of --reps each (default CE_REPS; three times as many
- * for matrices under 20000 entries), and so is a second
- * solve with the same A (the factorization reused):
+ * freshly put A (so it factors) is timed with accuracy.condest = off, now
+ * and auto, in turn, best of --reps each (default CE_REPS; three times as
+ * many for matrices under 20000 entries), and so are `info x` after it and
+ * a second solve with the same A (the factorization reused):
  *
  *   factor   the first solve without the estimate (factorization + one solve);
  *   solve    the second solve (one more solve with the factors, and SILC's
  *            per-statement work: parse, dispatch, report);
- *   condest  the difference of the first solves, on - off (the estimate's
- *            extra solves and bookkeeping);
- *   ratio    condest / factor;
- *   solves   condest / solve: the estimate's cost counted in solves.
+ *   now      accuracy.condest = now, the estimate at solve time: (now - off)
+ *            over factor, as a share;
+ *   auto     the default, accuracy.condest = auto: the same share at solve
+ *            time, where the estimate is made when it costs at most 15 % of
+ *            the factorization (predicted by the backend's timings) or the
+ *            matrix looks ill-conditioned, and is otherwise deferred;
+ *   at       where auto made it: "solve", "read" (deferred), or "N/M" when
+ *            the prediction (from the call's wall-clock timings) deferred
+ *            it in N of the M repetitions only (auto's share is the best
+ *            run's, so the deferred way's);
+ *   read     what `info x` costs more under auto than under now (the
+ *            deferred estimate, and the residual pass for its bound), in
+ *            solves (read / solve) and as a share of factor.
  *
- * The budget is 15 % of a factorization; rows above it are marked '!', and
- * the last lines give each backend's median ratio.  Times are the process's
- * CPU time (CLOCK_PROCESS_CPUTIME_ID; every backend runs single-threaded
- * here with OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1): on a shared machine
- * wall time counts the other jobs' time slices too, and moved rows by 10-20
- * points between runs.  A difference is printed as measured (a negative one
- * is noise).  lapack is not listed: its estimate (dgecon & co., O(n^2) after
- * an O(n^3) factorization) is made whatever accuracy.condest says, so on and
- * off time the same work.
+ * The budget is 15 % of a factorization; auto rows above it are marked '!',
+ * and the last lines give each backend's median shares.  Times are the
+ * process's CPU time (CLOCK_PROCESS_CPUTIME_ID; every backend runs
+ * single-threaded here with OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1): on a
+ * shared machine wall time counts the other jobs' time slices too, and moved
+ * rows by 10-20 points between runs.  A difference is printed as measured (a
+ * negative one is noise).  lapack is not listed: its estimate (dgecon & co.,
+ * O(n^2) after an O(n^3) factorization) is made whatever accuracy.condest
+ * says, so every mode times the same work.
  *
  *   ./build/bench/accuracy_condest [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING]
  *   (OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1)
@@ -63,39 +72,61 @@ static double cpu_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* CPU seconds of one first solve with a fresh A, and in *again of a second
- * solve reusing its factorization (when again is not NULL); -1 when the
- * backend fails.  The first entry of A is nudged by an ulp each time, so
- * that no factorization, symbolic or numeric, is found again by its values. */
-static double timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest,
-                          double *again)
+static int by_value(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* What `info` printed (silc_set_output), to tell where auto made the estimate. */
+static char info_text[8192];
+static void keep_text(void *user, const char *text)
+{
+    size_t len = strlen(info_text);
+    (void)user;
+    snprintf(info_text + len, sizeof info_text - len, "%s", text);
+}
+
+/* One run of a mode: CPU seconds of the first solve with a fresh A, of
+ * `info x` after it, and of a second solve reusing the factorization; *read
+ * says whether info made the estimate.  -1 when the backend fails.  The
+ * first entry of A is nudged by an ulp each time, so that no factorization,
+ * symbolic or numeric, is found again by its values. */
+typedef struct timing {
+    double first, info, again;
+    int read;
+} timing;
+
+static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest, timing *t)
 {
     char stmt[512];
-    double t;
     A->values[0] = nextafter(A->values[0], INFINITY);
     if (silc_put(c, "A", A)) return -1;
     snprintf(stmt, sizeof stmt, "set accuracy.condest = %s%s", condest, be->dense ? "; A = dense(A)" : "");
     if (silc_exec(c, stmt)) return -1;
     snprintf(stmt, sizeof stmt, "x = solve(A, b, \"backend = %s%s\")", be->name, be->opts);
-    t = cpu_now();
+    t->first = cpu_now();
     if (silc_exec(c, stmt)) return -1;
-    t = cpu_now() - t;
-    if (again) {
-        *again = cpu_now();
-        if (silc_exec(c, stmt)) return -1;
-        *again = cpu_now() - *again;
-        /* Its backward error is deferred and keeps A alive: dropped, so
-         * that both timed first solves find A's predecessor dead (KLU
-         * refactors into its factors then, as in a time loop). */
-        if (silc_exec(c, "x = 0")) return -1;
-    }
-    return t;
+    t->first = cpu_now() - t->first;
+    info_text[0] = 0;
+    t->info = cpu_now();
+    if (silc_exec(c, "info x")) return -1;
+    t->info = cpu_now() - t->info;
+    t->read = strstr(info_text, "deferred at solve time") != NULL;
+    t->again = cpu_now();
+    if (silc_exec(c, stmt)) return -1;
+    t->again = cpu_now() - t->again;
+    /* Its backward error is deferred and keeps A alive: dropped, so that
+     * every timed first solve finds A's predecessor dead (KLU refactors
+     * into its factors then, as in a time loop). */
+    return silc_exec(c, "x = 0") ? -1 : 0;
 }
 
-static int by_value(const void *a, const void *b)
+static double median(double *v, int n)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    if (!n) return NAN;
+    qsort(v, (size_t)n, sizeof *v, by_value);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 int main(int argc, char **argv)
@@ -105,8 +136,8 @@ int main(int argc, char **argv)
     const char *only_matrix = NULL, *only_backend = NULL;
     FILE *idx;
     int over = 0, rows = 0, reps = CE_REPS;
-    int nratio[NB] = {0}, nover[NB] = {0};
-    static double ratios[NB][MAX_ROWS];
+    int nrow[NB] = {0}, nover[NB] = {0}, nread[NB] = {0};
+    static double now_share[NB][MAX_ROWS], auto_share[NB][MAX_ROWS], read_solves[NB][MAX_ROWS];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc && atoi(argv[i + 1]) > 0) reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--matrix") && i + 1 < argc) only_matrix = argv[++i];
@@ -120,15 +151,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "silc_open: %s\n", silc_errmsg());
         return 1;
     }
+    silc_set_output(c, keep_text, NULL);
     snprintf(path, sizeof path, "%s/index.tsv", SILC_SHARED_MATRICES);
     if (!(idx = fopen(path, "r"))) {
         fprintf(stderr, "cannot open %s\n", path);
         return 1;
     }
-    printf("condition estimate cost: first solve (factorization + solve) with accuracy.condest = off / on, "
-           "CPU time, best of %d (%d under 20000 entries)\n\n", reps, 3 * reps);
-    printf("  %-17s %-20s %6s  %11s  %11s  %11s  %7s  %6s\n", "matrix", "backend", "n", "factor [s]", "solve [s]",
-           "condest [s]", "ratio", "solves");
+    printf("condition estimate cost: first solve (factorization + solve) with accuracy.condest = off, now and "
+           "auto, CPU time, best of %d (%d under 20000 entries)\n\n", reps, 3 * reps);
+    printf("  %-17s %-20s %6s  %10s  %10s  %6s  %6s  %-5s  %12s  %6s\n", "matrix", "backend", "n", "factor [s]",
+           "solve [s]", "now", "auto", "at", "read [solves]", "read");
     while (fgets(line, sizeof line, idx)) {
         char file[256], field[32], sym[32], cls[32];
         long long m, n, nnz;
@@ -152,43 +184,65 @@ int main(int argc, char **argv)
         }
         for (size_t k = 0; k < NB; k++) {
             const backend *be = &backends[k];
-            double off = INFINITY, on = INFINITY, again = INFINITY, d, ratio;
+            timing off = {INFINITY, INFINITY, INFINITY, 0}, now = off, au = off, t = off;
+            /* info's best where it made the estimate */
+            double auto_d, now_d, read_d, info_read = INFINITY;
             /* Small rows are cheap and the noisiest next to the budget:
              * three times the repetitions. */
-            int ok = 1, reps_here = nnz < 20000 ? 3 * reps : reps;
+            int ok = 1, reps_here = nnz < 20000 ? 3 * reps : reps, read = 0;
+            char at[16];
             if ((be->spd_only && strcmp(cls, "spd")) || n > be->max_n ||
                 (only_backend && !strstr(be->name, only_backend)))
                 continue;
             for (int r = 0; r < reps_here && ok; r++) {
-                double a, t0 = timed_solve(c, &A, be, "off", &a), t1 = timed_solve(c, &A, be, "on", NULL);
-                ok = t0 >= 0 && t1 >= 0;
-                if (t0 < off) off = t0;
-                if (t1 < on) on = t1;
-                if (a < again) again = a;
+                static const char *const modes[3] = {"off", "now", "auto"};
+                timing *best[3] = {&off, &now, &au};
+                for (int m = 0; m < 3 && ok; m++) {
+                    ok = timed_solve(c, &A, be, modes[m], &t) == 0;
+                    if (t.first < best[m]->first) best[m]->first = t.first;
+                    if (t.info < best[m]->info) best[m]->info = t.info;
+                    if (t.again < best[m]->again) best[m]->again = t.again;
+                    if (m == 2) read += t.read;
+                    if (m == 2 && t.read && t.info < info_read) info_read = t.info;
+                }
             }
             if (!ok) continue; /* not built, declines, or fails on it */
-            d = on - off;
-            ratio = d / off;
-            over += ratio > CE_BUDGET;
-            nover[k] += ratio > CE_BUDGET;
+            now_d = (now.first - off.first) / off.first;
+            auto_d = (au.first - off.first) / off.first;
+            read_d = info_read - now.info;
+            over += auto_d > CE_BUDGET;
+            nover[k] += auto_d > CE_BUDGET;
+            nread[k] += read > 0;
             rows++;
-            if (nratio[k] < MAX_ROWS) ratios[k][nratio[k]++] = ratio;
-            printf("%c %-17s %-20s %6lld  %11.3g  %11.3g  %11.3g  %6.1f%%  %6.1f\n", ratio > CE_BUDGET ? '!' : ' ',
-                   file, be->name, n, off, again, d, 100 * ratio, d / again);
+            if (nrow[k] < MAX_ROWS) {
+                now_share[k][nrow[k]] = now_d;
+                auto_share[k][nrow[k]] = auto_d;
+                read_solves[k][nrow[k]++] = read ? read_d / off.again : 0;
+            }
+            if (read > 0 && read < reps_here) snprintf(at, sizeof at, "%d/%d", read, reps_here);
+            else snprintf(at, sizeof at, "%s", read ? "read" : "solve");
+            printf("%c %-17s %-20s %6lld  %10.3g  %10.3g  %5.1f%%  %5.1f%%  %-5s", auto_d > CE_BUDGET ? '!' : ' ',
+                   file, be->name, n, off.first, off.again, 100 * now_d, 100 * auto_d, at);
+            if (read) printf("  %12.1f  %5.1f%%\n", read_d / off.again, 100 * read_d / off.first);
+            else printf("  %12s  %6s\n", "--", "--");
             fflush(stdout);
         }
         silc_envelope_free(&A);
     }
     fclose(idx);
-    printf("\n%d of %d rows above %.0f %% of the factorization ('!')\n", over, rows, 100 * CE_BUDGET);
-    printf("median ratio per backend:\n");
+    printf("\n%d of %d rows above %.0f %% of the factorization at solve time under auto ('!')\n", over, rows,
+           100 * CE_BUDGET);
+    printf("median per backend: now, auto (share of the factorization at solve time), rows deferred, "
+           "their cost when read (solves)\n");
     for (size_t k = 0; k < NB; k++) {
-        if (!nratio[k]) continue;
-        qsort(ratios[k], (size_t)nratio[k], sizeof(double), by_value);
-        printf("  %-20s %4.0f %%  (%d of %d rows over)\n", backends[k].name,
-               100 * (nratio[k] % 2 ? ratios[k][nratio[k] / 2]
-                                    : 0.5 * (ratios[k][nratio[k] / 2 - 1] + ratios[k][nratio[k] / 2])),
-               nover[k], nratio[k]);
+        double rs[MAX_ROWS];
+        int nr = 0;
+        if (!nrow[k]) continue;
+        for (int i = 0; i < nrow[k]; i++)
+            if (read_solves[k][i] != 0) rs[nr++] = read_solves[k][i];
+        printf("  %-20s %5.0f %%  %5.0f %%  %2d of %2d  %5.1f  (%d over)\n", backends[k].name,
+               100 * median(now_share[k], nrow[k]), 100 * median(auto_share[k], nrow[k]), nread[k], nrow[k],
+               median(rs, nr), nover[k]);
     }
     silc_close(&c);
     return 0;

@@ -814,6 +814,42 @@ static int estimate_cond_complex(silc_call *call, mumps_factor *F)
     return SILC_OK;
 }
 
+/* The estimate made when the report is read (ABI 1.8, docs/accuracy.md):
+ * condest_later asks to leave out an estimate (it costs EST_PHASES solve
+ * phases unfolded, where MUMPS's fixed cost per phase is 20-40 % of a
+ * factorization of the shared matrices) and say it is owed; condest_only
+ * asks for it alone with the attached factorization (condest_only_run). */
+#define EST_PHASES 3
+static int condest_later(const silc_call *call)
+{
+    return host->abi_minor >= 8 && call->report->condest_later;
+}
+
+/* The 1-norms of the n x EST_COLS block X (into sums). */
+static void column_sums(int64_t n, const double *X, double sums[EST_COLS])
+{
+    for (int j = 0; j < EST_COLS; j++) {
+        sums[j] = 0;
+        for (int64_t i = 0; i < n; i++) sums[j] += fabs(X[i + j * n]);
+    }
+}
+
+/* ||A||_1 max_j ||Y_j||_1 / ||X0_j||_1 for the start block X0 (column sums
+ * x0) solved into Y: a lower bound of cond_1(A) (condest_lower). */
+static double start_bound(silc_call *call, int64_t n, const double *Y, const double x0[EST_COLS])
+{
+    double y[EST_COLS], best = 0;
+    column_sums(n, Y, y);
+    for (int j = 0; j < EST_COLS; j++)
+        if (x0[j] > 0 && y[j] / x0[j] > best) best = y[j] / x0[j];
+    return best * silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1;
+}
+
+static int condest_wanted(const silc_call *call, const settings *s, const mumps_factor *F)
+{
+    return s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
+}
+
 /* mumps.precision = single: af = 2^scale_a a in float, the largest entry near
  * 1.  Returns why that cannot be done, or NULL. */
 static const char *to_single(mumps_factor *F, int64_t nnz)
@@ -1123,7 +1159,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     silc_value *X;
     int64_t n = b->m;
     int rc, icntl11, analyse, estimate, fold, w = ID_W(F);
-    double t0, *rhs;
+    double t0, *rhs, lower = 0, x0[EST_COLS] = {0};
     *out = NULL;
     /* dense_copy, or the copy after a folded solve, writes every entry. */
     X = F->cplx ? host->dense_new_complex(b->m, b->n) : host->dense_new_uninit(b->m, b->n);
@@ -1135,8 +1171,13 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     analyse = analysis_due(F, b->n);
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    estimate = s->condest && F->cond_est < 0 && !(host->abi_minor >= 7 && call->report->condest_off);
-    fold = estimate && !analyse && !F->cplx; /* the complex estimator takes no block */
+    /* A complex factorization makes its estimate at once: the start block
+     * (and the lower bound it gives, start_bound) is real-only. */
+    estimate = condest_wanted(call, s, F) && (F->cplx || !condest_later(call));
+    /* Owed (condest_later), the start block still rides along: a solve phase
+     * costs about the same for a few more columns, and A^-1 X0 gives the
+     * host a lower bound of cond_1 that warns of ill-conditioning at once. */
+    fold = condest_wanted(call, s, F) && !analyse && !F->cplx; /* the complex estimator takes no block */
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
         host->release(X);
@@ -1146,6 +1187,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     do {
         dense_copy(b, rhs, w);
         if (fold) host->inv_norm1_start(n, EST_COLS, rhs + n * b->n);
+        if (fold) column_sums(n, rhs + n * b->n, x0); /* the solve overwrites the block */
     } while ((rc = run_solve(call, F, rhs, b->n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
     if (!rc && analyse) keep_analysis(F);
     if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n) * sizeof *rhs);
@@ -1154,11 +1196,17 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     if (!rc && estimate)
         rc = F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
     ICNTL(F, 11) = icntl11;
+    if (!rc && fold && !estimate) lower = start_bound(call, n, rhs + n * b->n, x0);
     if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);
         return rc;
     }
+    if (condest_wanted(call, s, F) && condest_later(call)) {
+        r->condest_deferred = 1;
+        r->condest_solves = EST_PHASES; /* a solve phase costs about the same for 1 or 2 columns */
+    }
+    if (fold && !estimate) r->condest_lower = lower;
     *out = X;
     return SILC_OK;
 }
@@ -1296,6 +1344,19 @@ static int solve_run(silc_call *call)
         return rc;
     }
     F = host->attach_get(call->in[0], key);
+    if (host->abi_minor >= 8 && r->condest_only) { /* the estimate alone, owed by an earlier solve */
+        int icntl11;
+        if (c.dist || !F || !F->live || !same_settings(&F->opts, &s))
+            return host->error(call, SILC_EDECLINE, "mumps: no factorization attached to A for the condition estimate");
+        icntl11 = (int)ICNTL(F, 11);
+        ICNTL(F, 11) = 0; /* the error analysis would run on every one of the estimate's solves */
+        rc = !condest_wanted(call, &s, F) ? SILC_OK : F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, NULL);
+        ICNTL(F, 11) = icntl11;
+        r->cond_est = F->cond_est;
+        if (F->cond_est >= 0) /* the note says how the estimate was made, and only that */
+            note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+        return rc;
+    }
     if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {
         r->reused_factor = 1;
     } else {

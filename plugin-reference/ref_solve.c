@@ -84,6 +84,48 @@ static void set_rcond(ref_factor *F)
     if (isinf(F->cond)) F->rcond = 0.0;
 }
 
+/* A square factor's estimate ||A||_1 * est ||A^{-1}||_1 into F->cond, by
+ * dlacon's method (zlacn2's for complex, w = 2) with F's solves: about
+ * REF_EST_SOLVES column solves, next to which a solve of this plugin (with
+ * its refinement steps) costs at least one.  -1 when out of memory (the
+ * estimator's only failure: the solve of a factor does not fail). */
+#define REF_EST_SOLVES 5
+static int make_estimate(ref_factor *F, int64_t n, int w, double norm1)
+{
+    double *work = ref_alloc((size_t)(F->work_len + w * n + 1), sizeof(double)), est = -1;
+    if (work) est = (w == 2 ? ref_inv_norm1_est_complex : ref_inv_norm1_est)(n, F->solve, F->data, work);
+    ref_free(work);
+    if (est < 0) return -1;
+    F->cond = ref_cond_from(norm1, est);
+    set_rcond(F);
+    return 0;
+}
+
+/* ||A||_1 max_j ||A^-1 x_j||_1 / ||x_j||_1 over the estimator's two start
+ * vectors (e/n and the alternating one): a lower bound of cond_1(A) for two
+ * column solves, a fraction of the estimate's, that tells the host whether
+ * an owed estimate must be made at once (condest_lower); -1 when out of
+ * memory.  work: F's solve workspace.  Real factors only: a complex one
+ * makes its estimate at once (ref_op_solve). */
+static double start_bound(ref_factor *F, int64_t n, double norm1, double *work)
+{
+    double *X = ref_alloc((size_t)(2 * n), sizeof(double)), best = 0;
+    if (!X || n == 0) {
+        ref_free(X);
+        return n ? -1 : 0;
+    }
+    ref_inv_norm1_start(n, 2, X);
+    for (int j = 0; j < 2 && n > 1; j++) {
+        double *x = X + j * n, sx = 0, sy = 0;
+        for (int64_t i = 0; i < n; i++) sx += fabs(x[i]);
+        if (F->solve(F->data, x, 0, work)) break;
+        for (int64_t i = 0; i < n; i++) sy += fabs(x[i]);
+        if (sy / sx > best) best = sy / sx;
+    }
+    ref_free(X);
+    return best * norm1;
+}
+
 int ref_op_solve(silc_call *call)
 {
     silc_view a, b;
@@ -108,6 +150,24 @@ int ref_op_solve(silc_call *call)
     if (a.m != a.n) alg = ALG_RECT;
     if (alg == ALG_TRI && !P->lower && !P->upper)
         return ref_host->error(call, SILC_EDECLINE, "triangular solve: the matrix is not triangular");
+
+    /* accuracy.condest = off skips the estimate (ABI 1.7); condest_later
+     * leaves it owed, condest_only makes it alone (ABI 1.8, see
+     * make_estimate).  A complex factor makes it at once: the lower bound
+     * that decides whether an owed estimate is urgent (start_bound) is
+     * written for real factors. */
+    int wanted = !(ref_host->abi_minor >= 7 && rep->condest_off);
+    int later = ref_host->abi_minor >= 8 && rep->condest_later && w == 1;
+    if (ref_host->abi_minor >= 8 && rep->condest_only) {
+        ref_factor *F = ref_host->attach_get(call->in[0], alg_key[alg]);
+        if (!F && by_structure && (alg == ALG_DENSE_SPD || alg == ALG_SPARSE_SPD)) /* Cholesky had failed */
+            F = ref_host->attach_get(call->in[0], alg_key[alg == ALG_DENSE_SPD ? ALG_DENSE : ALG_SPARSE]);
+        if (!F) return ref_host->error(call, SILC_EDECLINE, "no factorization attached to A for the condition estimate");
+        if (F->cond == 0.0 && wanted && make_estimate(F, a.n, w, P->norm1)) return ref_nomem(call);
+        rep->cond_est = F->cond == 0.0 ? -1 : F->cond;
+        rep->rcond = F->cond == 0.0 ? -1 : F->rcond;
+        return SILC_OK;
+    }
 
     double t0 = ref_host->now();
     ref_factor *F = ref_host->attach_get(call->in[0], alg_key[alg]);
@@ -137,21 +197,18 @@ int ref_op_solve(silc_call *call)
         attached = ref_host->attach_set(call->in[0], alg_key[alg], F, ref_factor_free) == 0;
     }
     double t1 = ref_host->now();
-    /* A square factor's estimate ||A||_1 * est ||A^{-1}||_1 (F->cond == 0:
-     * none yet), on the first solve that wants one: accuracy.condest = off
-     * skips it, and a later solve with the setting on makes it. */
-    if (F->cond == 0.0 && !(ref_host->abi_minor >= 7 && rep->condest_off)) {
-        double *work = ref_alloc((size_t)(F->work_len + w * a.n + 1), sizeof(double)), est = -1;
-        /* The estimator fails only when it runs out of memory (it applies
-         * the solve of this factor, which does not fail). */
-        if (work) est = (w == 2 ? ref_inv_norm1_est_complex : ref_inv_norm1_est)(a.n, F->solve, F->data, work);
-        ref_free(work);
-        if (est < 0) { /* no estimate would mean no warning of an ill-conditioned matrix */
-            if (!attached) ref_factor_free(F);
-            return ref_nomem(call);
-        }
-        F->cond = ref_cond_from(P->norm1, est);
-        set_rcond(F);
+    /* A square factor's estimate (F->cond == 0: none yet), on the first
+     * solve that wants one: a later solve with the setting on makes it.
+     * Owed (later) only by a factorization kept on A, where the
+     * condest_only call will find it. */
+    if (F->cond == 0.0 && wanted && later && !attached) { /* owed, but nothing keeps the factorization */
+        ref_factor_free(F);
+        return ref_nomem(call);
+    }
+    if (F->cond == 0.0 && wanted && !later && make_estimate(F, a.n, w, P->norm1)) {
+        /* no estimate would mean no warning of an ill-conditioned matrix */
+        if (!attached) ref_factor_free(F);
+        return ref_nomem(call);
     }
 
     /* vectors below hold w doubles per entry; the refinement's own
@@ -206,6 +263,14 @@ int ref_op_solve(silc_call *call)
     rep->factor_seconds = reused ? 0.0 : t1 - t0;
     rep->solve_seconds = ref_host->now() - t1;
     rep->iterations = 0;
+    if (F->cond == 0.0 && wanted && later && attached) {
+        rep->condest_deferred = 1;
+        rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
+        if ((rep->condest_lower = start_bound(F, n, P->norm1, work)) < 0) {
+            st = ref_nomem(call); /* without the hint an ill-conditioned matrix could go unwarned */
+            goto done;
+        }
+    }
     snprintf(rep->note, sizeof rep->note, "%s", F->note);
     call->out = out;
     out = NULL;

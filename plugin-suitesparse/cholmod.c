@@ -248,6 +248,14 @@ int ss_cholmod_solve(silc_call *call)
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
+    if (ss_condest_only(call)) { /* the estimate alone, owed by an earlier solve */
+        ch_est e = {NULL, NULL, NULL, NULL};
+        if (!(F = n > 0 ? ss_host->attach_get(call->in[0], CH_KEY) : NULL)) return ss_no_factor(call, "CHOLMOD");
+        e.F = F;
+        rc = ss_estimate_alone(call, condest, n, ch_apply_inv, &e, &F->info);
+        ch_est_free(&e);
+        return rc;
+    }
 
     if (n > 0) {
         void *f;
@@ -287,5 +295,6 @@ int ss_cholmod_solve(silc_call *call)
     if (!call->out) return ss_nomem(call, "CHOLMOD result");
     r->solve_seconds = ss_host->now() - t0;
     ss_report_factor(r, &F->info);
+    ss_report_owed(call, condest, &F->info, k);
     return SILC_OK;
 }

@@ -207,6 +207,12 @@ int ss_klu_solve(silc_call *call)
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
     k = b.n;
+    if (ss_condest_only(call)) { /* the estimate alone, owed by an earlier solve */
+        kl_apply u;
+        if (!(F = n > 0 ? ss_host->attach_get(call->in[0], KL_KEY) : NULL)) return ss_no_factor(call, "KLU");
+        u.F = F, u.n = n;
+        return ss_estimate_alone(call, condest, n, kl_apply_inv, &u, &F->info);
+    }
 
     if (n > 0) {
         void *f;
@@ -240,6 +246,9 @@ int ss_klu_solve(silc_call *call)
     }
     call->out = out;
     r->solve_seconds = ss_host->now() - t0;
-    if (F) ss_report_factor(r, &F->info);
+    if (F) {
+        ss_report_factor(r, &F->info);
+        ss_report_owed(call, condest, &F->info, k);
+    }
     return SILC_OK;
 }

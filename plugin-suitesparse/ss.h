@@ -147,6 +147,23 @@ typedef struct ss_factor_info {
 #define SS_EST_STEPS 2
 typedef int (*ss_block_fn)(void *ctx, double *X, int t, int trans);
 int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi);
+
+/* The estimate made when the report is read (ABI 1.8, docs/accuracy.md).
+ * ss_condest_later: the host asks to leave out an estimate that costs solves
+ * (ss_cond_due is then 0); ss_report_owed, after the solve of k columns,
+ * tells it that one is owed and its cost in such solves.  ss_condest_only:
+ * the host asks for the estimate alone, made with the factorization attached
+ * to A (none attached: ss_no_factor, a decline; nothing is factored; the
+ * report's note then says how the estimate was made, and the host adds it
+ * to the solve's). */
+#define SS_EST_COLUMN_SOLVES 4 /* the start's two columns, then one A' and one A solve */
+int ss_condest_later(const silc_call *call);
+int ss_condest_only(const silc_call *call);
+void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t k);
+int ss_no_factor(silc_call *call, const char *library);
+/* The condest_only call once the factorization is found: the estimate
+ * (made now if it is not yet), its note alone in the report; SILC_OK. */
+int ss_estimate_alone(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi);
 void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi,
                     const double *Y0);
 /* B (b->n columns) then the estimator's starting block (SS_EST_COLS

@@ -186,9 +186,45 @@ int ss_condest_wanted(const silc_call *call, int mode)
     return mode != SS_CONDEST_NEVER && !off;
 }
 
+int ss_condest_later(const silc_call *call)
+{
+    return ss_host->abi_minor >= 8 && call->report->condest_later;
+}
+
+int ss_condest_only(const silc_call *call)
+{
+    return ss_host->abi_minor >= 8 && call->report->condest_only;
+}
+
 int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi)
 {
-    return !fi->estimated && ss_condest_wanted(call, mode);
+    return !fi->estimated && ss_condest_wanted(call, mode) && !ss_condest_later(call);
+}
+
+void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t k)
+{
+    if (fi->estimated || !ss_condest_wanted(call, mode) || !ss_condest_later(call)) return;
+    call->report->condest_deferred = 1;
+    /* per column: KLU's and CHOLMOD's solves cost their columns' passes
+     * over the factors, UMFPACK's solve one column a call */
+    call->report->condest_solves = (double)SS_EST_COLUMN_SOLVES / (double)(k > 0 ? k : 1);
+}
+
+int ss_estimate_alone(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi)
+{
+    size_t before = strlen(fi->note);
+    ss_square_cond(call, mode, n, apply, ctx, fi, NULL);
+    call->report->cond_est = fi->estimated ? fi->cond : -1;
+    /* the note says how the estimate was made, and only that */
+    snprintf(call->report->note, sizeof call->report->note, "%s",
+             fi->note + before + (before && fi->note[before] == ';' ? 2 : 0));
+    return SILC_OK;
+}
+
+int ss_no_factor(silc_call *call, const char *library)
+{
+    return ss_host->error(call, SILC_EDECLINE, "%s: no factorization attached to A for the condition estimate",
+                          library);
 }
 
 /* The column of the solved starting block Y (n x SS_EST_COLS) with the

@@ -225,6 +225,15 @@ int ss_umfpack_solve(silc_call *call)
     n = a.n;
     k = b.n;
     if ((rc = ss_host->option_int(call, "umfpack_irstep", 2, &irstep))) return rc;
+    if (ss_condest_only(call)) { /* the estimate alone, owed by an earlier solve */
+        um_apply u = {0};
+        if (!(F = n > 0 ? ss_host->attach_get(call->in[0], UM_KEY) : NULL)) return ss_no_factor(call, "UMFPACK");
+        u.a = &a, u.numeric = F->numeric;
+        rc = ss_estimate_alone(call, condest, n, um_apply_block, &u, &F->info);
+        ss_host->free(u.y);
+        ss_host->free(u.wi);
+        return rc;
+    }
 
     t0 = ss_host->now();
     F = n > 0 ? ss_host->attach_get(call->in[0], UM_KEY) : NULL;
@@ -243,7 +252,7 @@ int ss_umfpack_solve(silc_call *call)
         }
     }
     r->factor_seconds = ss_host->now() - t0;
-    if (F && !F->info.estimated && ss_condest_wanted(call, condest)) {
+    if (F && ss_cond_due(call, condest, &F->info)) {
         um_apply u = {0};
         u.a = &a, u.numeric = F->numeric;
         ss_square_cond(call, condest, n, um_apply_block, &u, &F->info, NULL);
@@ -275,7 +284,10 @@ int ss_umfpack_solve(silc_call *call)
     call->out = out;
     out = NULL;
     r->solve_seconds = ss_host->now() - t0;
-    if (F) ss_report_factor(r, &F->info);
+    if (F) {
+        ss_report_factor(r, &F->info);
+        ss_report_owed(call, condest, &F->info, k);
+    }
     rc = SILC_OK;
 done:
     if (out) ss_host->release(out);

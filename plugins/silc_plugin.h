@@ -214,6 +214,24 @@ typedef struct silc_report {
     double forward_bound;   /* host: est ||A^-1||_1 * max_j ||b_j - A x_j||_1 / ||x_j||_1, the
                                residual bound on the relative forward error with the
                                estimate in place of ||A^-1||_1; -1 = none */
+    /* ABI 1.8: the condition estimate made when the report is read, where it
+     * costs too much next to the factorization (docs/accuracy.md).  Read or
+     * write these only when host->abi_minor >= 8. */
+    int condest_later;      /* host, set before the call: make no estimate that costs solves of
+                               its own in this call; say instead that it is owed
+                               (condest_deferred = 1) and what it costs (condest_solves) */
+    int condest_only;       /* host, set before the call: make only the estimate, with the
+                               factorization an earlier call attached to in[0] (same options and
+                               class); solve nothing (out stays NULL), factor nothing: with no
+                               factorization attached return SILC_EDECLINE */
+    int condest_deferred;   /* plugin: 1 = the estimate is owed (condest_later); host: 2 = made
+                               when the report was read, 3 = could not be made then */
+    double condest_solves;  /* plugin: the estimate's cost in solves like this call's (column
+                               solves over this call's columns, or solve phases) */
+    double condest_lower;   /* plugin, with condest_deferred: a lower bound of cond_1(A) it got for
+                               next to nothing (||A||_1 ||A^-1 x||_1 / ||x||_1 for the estimator's
+                               start block solved with the user's columns), which makes the host
+                               estimate at once when it hints at ill-conditioning; 0 = none */
 } silc_report;
 
 typedef struct silc_call {

@@ -862,7 +862,7 @@ static void test_set(void)
           "unknown key shown: %s", silc_context_errmsg(c));
     captured[0] = 0;
     CHECK(silc_exec(c, "set") == 0 && strstr(captured, "\ndispatch.solve.sparse          = ") &&
-              strstr(captured, "\naccuracy.condest               = on  (default)\n"),
+              strstr(captured, "\naccuracy.condest               = auto  (default)\n"),
           "set lists defaults: %s", captured);
     captured[0] = 0;
     CHECK(silc_exec(c, "set") == 0 && strstr(captured, "tune.accuracy") != NULL, "set list: %s", captured);

@@ -420,6 +420,27 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when
     warn_if_unsolved(E, r->backend, r->backward_error);
 }
 
+double acc_cond_lower_bound(const silc_value *A, const silc_value *B, const silc_value *X)
+{
+    double best = -1, nA1;
+    int64_t i, j;
+    if (A->m != A->n || A->dist || B->dist || X->dist || B->format != SILC_FMT_DENSE ||
+        X->format != SILC_FMT_DENSE || B->m != X->m || B->n != X->n)
+        return -1;
+    for (j = 0; j < X->n; j++) {
+        const double *b = B->val + j * B->m, *x = X->val + j * X->m;
+        double sb = 0, sx = 0;
+        for (i = 0; i < X->m; i++) {
+            sb += fabs(b[i]);
+            sx += fabs(x[i]);
+        }
+        if (sb > 0 && sx / sb > best) best = sx / sb; /* NaN compares false: skipped */
+    }
+    if (best < 0) return -1;
+    nA1 = val_props_part(A, SILC_PROPS_NORMS)->norm1;
+    return nA1 * best;
+}
+
 void acc_pending_resolve(silc_engine *E, eng_pending *p, silc_report *r)
 {
     r->backward_error = p->A && p->B && p->X ? backward_error_and_bound(p->A, p->B, p->X, r) : -1;

@@ -91,6 +91,13 @@ void acc_report(silc_engine *E, silc_call *call, int may_defer, const char *when
 #define ACC_VERIFY_FACTOR 10.0
 double acc_verify_limit(const char *verify, const silc_report *r);
 
+/* A lower bound of cond_1(A) that a solve gives for free: A X = B, so
+ * ||A^-1||_1 >= ||x_j||_1 / ||b_j||_1 for every column, times ||A||_1 (A's
+ * properties).  One pass over B and X; -1 when not computed (not square,
+ * distributed, or B not dense).  The dispatcher's hint that a matrix may be
+ * ill-conditioned, when it weighs deferring the condition estimate. */
+double acc_cond_lower_bound(const silc_value *A, const silc_value *B, const silc_value *X);
+
 /* The deferred backward error held by p (context.h: eng_pending_hold),
  * computed now into r->backward_error (with the warning a bad one
  * deserves), with r->forward_bound; releases p. */

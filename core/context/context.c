@@ -73,12 +73,18 @@ void eng_interrupt_clear(silc_engine *E)
 /* ---- snapshots ------------------------------------------------------------ */
 
 /* The copy of a record holds its own references to the deferred backward
- * error's operands, so the record it came from may be replaced meanwhile. */
-static void pending_retain(eng_pending *p)
+ * error's operands (and its own copy of the options), so the record it came
+ * from may be replaced meanwhile.  -1 (p empty) when out of memory. */
+static int pending_retain(eng_pending *p)
 {
+    if (p->options && !(p->options = util_strdup(p->options))) {
+        memset(p, 0, sizeof *p);
+        return -1;
+    }
     if (p->A) val_retain(p->A);
     if (p->B) val_retain(p->B);
     if (p->X) val_retain(p->X);
+    return 0;
 }
 
 static void infos_free(eng_info_entry *e)
@@ -134,7 +140,7 @@ int eng_snapshot_take(const silc_engine *E, eng_snapshot *s)
         if (ie->info.statement && !(c->info.statement = util_strdup(ie->info.statement)))
             goto oom;
         c->info.pending = ie->info.pending;
-        pending_retain(&c->info.pending);
+        if (pending_retain(&c->info.pending)) goto oom;
     }
     return 0;
 oom:
@@ -261,12 +267,16 @@ void eng_info_remove(silc_engine *E, const char *name)
     }
 }
 
-void eng_pending_hold(eng_pending *p, const silc_call *call)
+int eng_pending_hold(eng_pending *p, const silc_call *call)
 {
     eng_pending_release(p);
+    if (call->options && !(p->options = util_strdup(call->options))) return -1;
     p->A = val_retain((silc_value *)call->in[0]);
     p->B = val_retain((silc_value *)call->in[1]);
     p->X = val_retain(call->out);
+    p->op_class = call->op_class;
+    p->sub = call->sub;
+    return 0;
 }
 
 void eng_pending_release(eng_pending *p)
@@ -274,5 +284,6 @@ void eng_pending_release(eng_pending *p)
     val_release(p->A);
     val_release(p->B);
     val_release(p->X);
+    free(p->options);
     memset(p, 0, sizeof *p);
 }

@@ -24,10 +24,16 @@ typedef struct cfg_db cfg_db;
 typedef struct ld_set ld_set;
 typedef struct eng_memo eng_memo;
 
-/* The operands and result of a solve whose backward error is deferred
- * (accuracy.h: acc_pending_resolve computes it); all NULL when none is. */
+/* The operands and result of a solve whose backward error or condition
+ * estimate is deferred (accuracy.h: acc_pending_resolve computes the one,
+ * dispatch.h: disp_condest_resolve the other, with the factorization still
+ * attached to A, asked of the same backend under the same class and
+ * options); all NULL when none is. */
 typedef struct eng_pending {
     silc_value *A, *B, *X;
+    const char *op_class;   /* the class the backend solved under (a static string) */
+    int sub;
+    char *options;          /* the call's option text (owned), NULL when none */
 } eng_pending;
 
 /* How a value bound to a name was last computed (`info x`). */
@@ -149,9 +155,10 @@ void eng_info_remove(silc_engine *E, const char *name);
 /* Every record, at the engine's end. */
 void eng_info_free_all(silc_engine *E);
 
-/* Holds call's operands and result (retained) as the deferred backward error
- * of the statement's solve; releases what p held before. */
-void eng_pending_hold(eng_pending *p, const silc_call *call);
+/* Holds call's operands and result (retained), class and options as the
+ * deferred backward error or condition estimate of the statement's solve;
+ * releases what p held before.  -1 when out of memory (p then empty). */
+int eng_pending_hold(eng_pending *p, const silc_call *call);
 /* Releases what p holds and empties it. */
 void eng_pending_release(eng_pending *p);
 

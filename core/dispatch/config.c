@@ -414,10 +414,12 @@ static int check_key(silc_engine *E, int scope, const char *section, const char 
         }
         return keep_value(E, norm, section, name, value);
     }
-    if (strcmp(section, "accuracy") == 0) { /* accuracy.condest = on | off (dispatch.c: report_reset) */
+    if (strcmp(section, "accuracy") == 0) { /* accuracy.condest (dispatch.c: report_reset, condest_settle) */
         if (strcmp(name, "condest") != 0) return unknown_key(E, section, name, (const char *const[]){"condest"}, 1);
-        if (strcmp(value, "on") != 0 && strcmp(value, "off") != 0)
-            return eng_error(E, "accuracy.condest expects 'on' or 'off', got '%s'", value);
+        if (strcmp(value, "auto") != 0 && strcmp(value, "now") != 0 && strcmp(value, "on") != 0 &&
+            strcmp(value, "on_request") != 0 && strcmp(value, "off") != 0)
+            return eng_error(E, "accuracy.condest expects auto, now, on_request, on (= auto) or off, got '%s'",
+                             value);
         return keep_value(E, norm, section, name, value);
     }
     if (strcmp(section, "solve") == 0) {
@@ -520,7 +522,10 @@ static const key_rule key_rules[] = {
     {"dispatch.<class>", KEY_SESSION, NULL, "the backends a class of operation tries, in order"},
     {"tune.accuracy", KEY_SESSION, "1e-10", "the accuracy the tuner's backend choice must reach"},
     {"tune.budget", KEY_SESSION, "0.05", "the share of the run the tuner may spend measuring"},
-    {"accuracy.condest", KEY_SESSION, "on", "on or off: the condition estimate of every solve"},
+    {"accuracy.condest", KEY_SESSION, "auto",
+     "auto (or on), now, on_request or off: the condition estimate of every solve; auto makes it at solve "
+     "time when it costs at most 15 % of the factorization or the matrix looks ill-conditioned, else when "
+     "the report is read (info); now always at solve time; on_request always when read"},
     {"solve.refine", KEY_SESSION, "(up to 3 steps when a direct result misses solve.verify)",
      "steps of iterative refinement after a direct solve (0 to 100)"},
     {"solve.refine_residual", KEY_SESSION, "double", "double or extended: the refinement's residual"},

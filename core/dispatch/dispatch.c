@@ -445,13 +445,25 @@ static const char *status_text(int status)
 
 /* ---- the accuracy report --------------------------------------------------- */
 
+/* The warnings a condition estimate deserves, when it is made (at solve time,
+ * or when the report is read: disp_condest_resolve). */
+static void warn_condition(silc_engine *E, const silc_report *r)
+{
+    double eps_cond = r->cond_est * DBL_EPSILON;
+    if (r->cond_est > 0 && eps_cond >= 1)
+        eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
+                 r->cond_est);
+    else if (r->cond_est > 0 && eps_cond > 1e-4)
+        eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
+                 r->cond_est);
+}
+
 /* Completes the report of a solve that succeeded and warns about a result that
  * deserves distrust.  -1 when the backward error could not be computed (out
  * of memory): a result returned without it could hide an unsolved system. */
 static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, int may_defer)
 {
     silc_report *r = call->report;
-    double eps_cond;
     if (cholesky_failed) {
         char note[sizeof r->note];
         /* Name the method that did solve: after Cholesky, a symmetric
@@ -461,13 +473,7 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
                  r->note[0] ? "; " : "", r->note);
         memcpy(r->note, note, sizeof note);
     }
-    eps_cond = r->cond_est * DBL_EPSILON;
-    if (r->cond_est > 0 && eps_cond >= 1)
-        eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
-                 r->cond_est);
-    else if (r->cond_est > 0 && eps_cond > 1e-4)
-        eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
-                 r->cond_est);
+    warn_condition(E, r);
     acc_report(E, call, may_defer, cfg_get(E, "solve.backward_error"));
     if (r->backward_error < 0 && r->backward_error != ACC_DEFERRED)
         return eng_error(E, "out of memory computing the backward error of '\\'");
@@ -479,14 +485,17 @@ static int finish_solve(silc_engine *E, silc_call *call, int cholesky_failed, in
 /* ---- refinement (refine.c) -------------------------------------------------- */
 
 /* A report as a backend gets it: zeroed, estimates unknown, and told
- * whether the session wants a condition estimate (accuracy.condest). */
-static void report_reset(silc_engine *E, silc_report *r)
+ * whether the session wants a condition estimate (accuracy.condest), and
+ * whether one that costs solves of its own may be left for later (later:
+ * the caller may defer it, and accuracy.condest is auto or on_request). */
+static void report_reset(silc_engine *E, silc_report *r, int later)
 {
     const char *c = cfg_get(E, "accuracy.condest");
     memset(r, 0, sizeof *r);
     r->cond_est = r->rcond = -1;
     r->forward_bound = -1;
     r->condest_off = c && !strcmp(c, "off");
+    r->condest_later = later && (!c || !strcmp(c, "auto") || !strcmp(c, "on") || !strcmp(c, "on_request"));
 }
 
 /* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
@@ -499,7 +508,7 @@ static silc_value *correction(const void *be, silc_engine *E, const silc_call *c
     silc_report rep;
     host_call_ctx ctx;
     int rc;
-    report_reset(E, &rep);
+    report_reset(E, &rep, 1); /* a correction makes no estimate: the solve's report has it */
     memset(&ctx, 0, sizeof ctx);
     ctx.E = E;
     ctx.backend = b;
@@ -526,6 +535,151 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
     how.correct = correction;
     how.ctx = b;
     refine_solve(E, call, &how, at_least);
+}
+
+/* ---- the condition estimate, now or when the report is read -----------------
+ * Hager-Higham needs about four column solves after the factorization; where
+ * a solve costs 10-30 % of the factorization (KLU and CHOLMOD on very sparse
+ * matrices, MUMPS's fixed cost per solve phase) the estimate cannot cost
+ * under 15 % of it at solve time.  So under accuracy.condest = auto (the
+ * default; `on` says the same) a solve asks its backend to leave out an
+ * estimate that costs solves of its own (report->condest_later, ABI 1.8).
+ * A backend that did says so, with the estimate's cost in solves like the one
+ * it just made, and condest_settle makes it at once -- a condest_only call to
+ * the same backend, whose factorization is attached to A -- when that costs
+ * at most DISP_CONDEST_BUDGET of the factorization the call made, or when
+ * what the solve knows for free hints at ill-conditioning, so that the
+ * warnings come at solve time: the library's pivot ratio (UMFPACK, KLU,
+ * CHOLMOD), the lower bound ||A||_1 ||A^-1 x0||_1 / ||x0||_1 of the
+ * estimator's start block x0 solved with the user's columns (MUMPS, where
+ * a few more columns cost a solve phase nothing; the reference, two column
+ * solves), or else the solve's own ||A||_1 ||x||_1 / ||b||_1
+ * (acc_cond_lower_bound), above DISP_CONDEST_PIVOT_HINT or _BOUND_HINT.
+ * Otherwise the estimate is owed and made when the report is read
+ * (disp_condest_resolve, from `info`).  A solve that reused a factorization
+ * made none to weigh the cost against: its estimate is owed.
+ * accuracy.condest = now keeps every estimate at solve time (the backend
+ * then folds its first block into the user's solve, as before);
+ * on_request owes every estimate that costs solves, hints or not (its
+ * warnings then come when the report is read), for a program of many
+ * solves that reads few reports. */
+#define DISP_CONDEST_BUDGET 0.15
+/* The hints, against the "fewer than 4 correct digits" warning at cond_1 =
+ * 4.5e11 (docs/accuracy.md gives them on the shared matrices).  The pivot
+ * ratio is no bound (3.8 against 840 on the 1-D Laplacian, 2 against 1.5e11
+ * on fs_183_6), but the matrices that warn have ratios of 1.2e7 and more:
+ * 1e6 keeps them with a margin of 12.  The start block's bound is rigorous
+ * and at most 8000x below cond_1 on the shared matrices (bayer10): 1e7
+ * keeps a margin of 4.5e4 below the warning, and leaves the estimates of
+ * the merely ill-conditioned (494_bus, 3.9e6) owed. */
+#define DISP_CONDEST_PIVOT_HINT 1e6
+#define DISP_CONDEST_BOUND_HINT 1e7
+
+/* The estimate's cost as a share of the factorization the solve made
+ * (INFINITY when it made none). */
+static double condest_share(const silc_report *r)
+{
+    if (r->reused_factor || !(r->factor_seconds > 0)) return INFINITY;
+    return r->condest_solves * r->solve_seconds / r->factor_seconds;
+}
+
+void disp_condest_why(const silc_report *r, char *buf, size_t len)
+{
+    double share = condest_share(r);
+    if (isfinite(share))
+        snprintf(buf, len, "it costs %.3g solves = %.0f %% of the factorization", r->condest_solves,
+                 100 * share);
+    else
+        snprintf(buf, len, "it costs %.3g solves and the solve reused a factorization", r->condest_solves);
+}
+
+/* Backend b's estimate alone (condest_only) for the call like's A, class and
+ * options (those in force), into r: cond_est, and the plugin's note of how
+ * it was made added to r's.  The call's status; r unchanged unless SILC_OK
+ * and an estimate came. */
+static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *like, silc_report *r)
+{
+    silc_call c = *like;
+    silc_report rep;
+    host_call_ctx ctx;
+    int rc;
+    report_reset(E, &rep, 0);
+    rep.condest_off = 0; /* owed under the setting of the solve, whatever it is now */
+    rep.condest_only = 1;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.E = E;
+    ctx.backend = b;
+    c.nin = 2; /* no initial guess */
+    c.out = NULL;
+    c.report = &rep;
+    c.host_private = &ctx;
+    rc = b->backend->ops[SILC_OP_SOLVE].run(&c);
+    val_release(c.out);
+    if (rc != SILC_OK || !(rep.cond_est >= 0 || isnan(rep.cond_est))) return rc == SILC_OK ? SILC_EDECLINE : rc;
+    r->cond_est = rep.cond_est;
+    if (rep.note[0] && !strstr(r->note, rep.note)) {
+        size_t len = strlen(r->note);
+        snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", rep.note);
+    }
+    return SILC_OK;
+}
+
+/* A solve whose backend left its estimate out (condest_deferred = 1): made
+ * now when it is cheap or the matrix may be ill-conditioned, else owed.
+ * -1 when that estimate ran out of memory: the solve fails, as it did when
+ * the backend made it (no estimate would mean no warning). */
+static int condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
+{
+    silc_report *r = call->report;
+    const char *mode = cfg_get(E, "accuracy.condest");
+    if (r->condest_deferred != 1) {
+        r->condest_deferred = 0; /* a plugin that knows no deferral may have left anything */
+        return 0;
+    }
+    if (mode && !strcmp(mode, "on_request")) return 0; /* owed, whatever it costs */
+    /* The solve's own lower bound costs a pass over A (for ||A||_1) and
+     * the operands, a few per cent of a KLU factorization: only where the
+     * backend gives no hint of its own. */
+    if (condest_share(r) > DISP_CONDEST_BUDGET && !(r->pivot_ratio > DISP_CONDEST_PIVOT_HINT) &&
+        !(r->condest_lower > DISP_CONDEST_BOUND_HINT) &&
+        !(r->pivot_ratio == 0 && r->condest_lower == 0 &&
+          acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_BOUND_HINT))
+        return 0; /* owed */
+    r->condest_deferred = 0;
+    return estimate_only(E, b, call, r) == SILC_ENOMEM ? -1 : 0; /* else none: "the backend gives none" */
+}
+
+int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
+{
+    const ld_backend *b;
+    silc_call c;
+    int rc = 0;
+    if (r->condest_deferred != 1) return 0;
+    r->condest_deferred = DISP_CONDEST_LOST;
+    if (!p->A || !p->B || !(b = ld_find(E, r->backend)) || !provides(b, SILC_OP_SOLVE)) return 0;
+    memset(&c, 0, sizeof c);
+    c.op = SILC_OP_SOLVE;
+    c.sub = p->sub;
+    c.nin = 2;
+    c.in[0] = p->A;
+    c.in[1] = p->B;
+    c.options = p->options;
+    c.op_class = p->op_class;
+    if (p->options && cfg_set_call_options(E, p->options)) return 0;
+    switch (estimate_only(E, b, &c, r)) {
+    case SILC_OK:
+        r->condest_deferred = DISP_CONDEST_READ;
+        warn_condition(E, r);
+        break;
+    case SILC_EDECLINE: break; /* no factorization attached any more: DISP_CONDEST_LOST */
+    case SILC_ENOMEM: /* still owed: `info` fails, and may be asked again */
+        r->condest_deferred = 1;
+        rc = eng_error(E, "out of memory for the condition estimate");
+        break;
+    default: r->condest_deferred = 0; /* it failed: "the backend gives none" */
+    }
+    if (p->options) cfg_clear_call_options(E);
+    return rc;
 }
 
 /* ---- running --------------------------------------------------------------- */
@@ -601,14 +755,15 @@ static void watch_end(attach_watch *w, const silc_call *call)
 }
 
 /* One attempt of backend b; the report is reset for every attempt so nothing
- * of a failed backend leaks into the one that succeeds. */
-static int run_one(silc_engine *E, silc_call *call, const ld_backend *b)
+ * of a failed backend leaks into the one that succeeds.  condest_later: the
+ * condition estimate may be left for later (report_reset). */
+static int run_one(silc_engine *E, silc_call *call, const ld_backend *b, int condest_later)
 {
     double t0;
     attach_watch watch;
     int rc;
     call->out = NULL;
-    if (call->op == SILC_OP_SOLVE) report_reset(E, call->report);
+    if (call->op == SILC_OP_SOLVE) report_reset(E, call->report, condest_later);
     watch_begin(&watch, call);
     t0 = util_now();
     rc = b->backend->ops[call->op].run(call);
@@ -827,7 +982,7 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&
                                  b->plugin->table->abi_minor < 6;
                 if (hide_guess) call->nin = 2;
-                rc = run_one(E, call, b);
+                rc = run_one(E, call, b, may_defer && !ctx.collective && !E->dist);
                 if (hide_guess) call->nin = 3;
             }
             if (rc == SILC_OK && !call->out) {
@@ -843,6 +998,12 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                     call->out = NULL;
                     snprintf(ctx.err, sizeof ctx.err, "%.1000s", E->err);
                 }
+            }
+            if (rc == SILC_OK && call->op == SILC_OP_SOLVE && condest_settle(E, call, b)) {
+                val_release(call->out);
+                call->out = NULL;
+                rc = SILC_ENOMEM;
+                snprintf(ctx.err, sizeof ctx.err, "out of memory for the condition estimate");
             }
             if (rc == SILC_OK) {
                 double limit;

@@ -168,6 +168,20 @@ typedef struct host_call_ctx {
 int disp_run(silc_engine *E, silc_call *call);
 /* Appends to b what disp_run would do for call and why, without running it. */
 int disp_explain(silc_engine *E, const silc_call *call, strbuf *b);
+/* report->condest_deferred as the host leaves it: 0 made at solve time (or
+ * none), 1 owed (accuracy.condest = auto and costly: dispatch.c), and: */
+#define DISP_CONDEST_READ 2   /* made when the report was read */
+#define DISP_CONDEST_LOST 3   /* owed, but the factorization was gone when it was read */
+/* Makes the estimate r owes (condest_deferred = 1) with the operands, class
+ * and options p holds: backend r->backend's factorization still attached to
+ * A, asked for the estimate alone; warns as a solve would.  It does not
+ * factor again: with the factorization released (A's attachment evicted by
+ * the memo's limit) r says DISP_CONDEST_LOST.  p is kept (the forward-error
+ * bound needs its residual: acc_pending_resolve).  -1 (E->err) when out of
+ * memory: still owed. */
+int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r);
+/* Why r's estimate was owed: "it costs N solves = X % of the factorization". */
+void disp_condest_why(const silc_report *r, char *buf, size_t len);
 /* Class chain of a call, most specific first, e.g. {"solve.sparse.spd",
  * "solve.sparse"}; returns the count (<= 4). */
 int disp_classes(silc_engine *E, const silc_call *call, const char *out[4]);

@@ -283,8 +283,17 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     if (call->op == SILC_OP_SOLVE) {
         V->has_solve = 1;
         V->report = rep;
-        if (rep.backward_error == ACC_DEFERRED) eng_pending_hold(&V->pending, call);
-        else eng_pending_release(&V->pending);
+        /* What `info` needs to compute a deferred backward error or
+         * condition estimate (disp_condest_resolve) */
+        if (rep.backward_error == ACC_DEFERRED || rep.condest_deferred == 1) {
+            if (eng_pending_hold(&V->pending, call)) {
+                val_release(call->out);
+                call->out = NULL;
+                return eng_oom(E);
+            }
+        } else {
+            eng_pending_release(&V->pending);
+        }
         add_backend(V, rep.backend);
         if (!E->dist) tuner_note_solve(E, call); /* the tuner times one process (issue 18) */
     }
@@ -1261,6 +1270,27 @@ static int exec_info(lang_ev *V, const ast_node *s)
     } else {
         const silc_report *r = &in->report;
         int deferred = in->has_solve && r->backward_error == ACC_DEFERRED;
+        char why[96] = "";
+        /* An owed condition estimate first: the forward-error bound comes
+         * from the residual pass with it (a computed backward error is
+         * computed again, to the same bits). */
+        if (in->has_solve && r->condest_deferred) disp_condest_why(r, why, sizeof why);
+        if (in->has_solve && r->condest_deferred == 1) {
+            if (disp_condest_resolve(E, &in->pending, &in->report)) {
+                sb_free(&b);
+                return -1;
+            }
+            if (r->cond_est >= 0 && !deferred) {
+                double be = r->backward_error;
+                acc_pending_resolve(E, &in->pending, &in->report);
+                if (!(r->forward_bound >= 0) || r->backward_error < 0) { /* its residual ran out of memory */
+                    in->report.backward_error = be;
+                    sb_free(&b);
+                    return eng_error(E, "out of memory computing the forward error bound");
+                }
+            }
+            else if (!deferred) eng_pending_release(&in->pending);
+        }
         if (deferred)
             acc_pending_resolve(E, &in->pending, &in->report);
         sb_printf(&b, "  statement: %s\n", in->statement ? in->statement : "");
@@ -1283,8 +1313,14 @@ static int exec_info(lang_ev *V, const ast_node *s)
                           r->refine_steps, r->refine_steps == 1 ? "" : "s",
                           r->backward_error_unrefined);
             if (r->cond_est >= 0) {
-                sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization)\n",
-                          r->cond_est);
+                if (r->condest_deferred == DISP_CONDEST_READ)
+                    /* the why line holds timings: "time:" marks such lines */
+                    sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization; "
+                                  "computed when the report was first read)\n  deferred at solve time: %s\n",
+                              r->cond_est, why);
+                else
+                    sb_printf(&b, "  condition estimate: %.3g (of cond_1(A), through the backend's factorization)\n",
+                              r->cond_est);
                 /* The residual bound with the estimated ||A^-1||_1 (accuracy.h). */
                 if (r->forward_bound >= 0)
                     sb_printf(&b, "  forward error bound (estimate: est ||A^-1||_1 ||b - A x||_1 / ||x||_1): %.3g\n",
@@ -1292,6 +1328,8 @@ static int exec_info(lang_ev *V, const ast_node *s)
             } else {
                 sb_printf(&b, "  condition estimate: not estimated (%s); no forward error bound\n",
                           r->condest_off ? "accuracy.condest = off"
+                          : r->condest_deferred == DISP_CONDEST_LOST
+                              ? "deferred at solve time, and the factorization was released before the report was read"
                           : r->iterations > 0 ? "iterative solver"
                                               : "the backend gives none");
             }

@@ -37,11 +37,10 @@ def _typed(text):
         return text == "yes"
     if text.isdigit():
         return int(text)
-    head = text
-    for tail in (" s", " ("):
-        if tail in text:
-            head = text.split(tail, 1)[0]
-            break
+    # the number ends where the first of the two tails starts (a remark
+    # may itself hold " s": "... deferred at solve time ...")
+    cuts = [text.find(tail) for tail in (" s", " (") if tail in text]
+    head = text[:min(cuts)] if cuts else text
     try:
         return float(head)
     except ValueError:
