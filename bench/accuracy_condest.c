@@ -190,7 +190,7 @@ int main(int argc, char **argv)
             /* Small rows are cheap and the noisiest next to the budget:
              * three times the repetitions. */
             int ok = 1, reps_here = nnz < 20000 ? 3 * reps : reps, read = 0;
-            char at[16];
+            char at[32];
             if ((be->spd_only && strcmp(cls, "spd")) || n > be->max_n ||
                 (only_backend && !strstr(be->name, only_backend)))
                 continue;
