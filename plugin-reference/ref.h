@@ -52,6 +52,11 @@ typedef struct ref_sp {
     int w;          /* doubles per entry of x: 1 real, 2 complex (0: pattern) */
 } ref_sp;
 
+/* The 1-norm (by_col) or infinity norm of the compressed-column C (m x n,
+ * w doubles per entry: the modulus for complex), or of its entries as a
+ * vector when vec; 0 or SILC_ENOMEM.  The reductions of both fields call it. */
+int ref_sp_norm1_inf(const ref_sp *C, int64_t m, int64_t n, int vec, int by_col, int w, double *r);
+
 /* ---- reference.c: memory and conversions --------------------------------- */
 void *ref_alloc(size_t count, size_t size);   /* NULL on overflow or failure */
 void *ref_calloc(size_t count, size_t size);

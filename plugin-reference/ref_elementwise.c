@@ -20,6 +20,37 @@
 #include <math.h>
 #include <string.h>
 
+
+/* |entry| of the w-double entry at e: w = 1 real, 2 complex (the modulus). */
+static double entry_abs(const double *e, int w)
+{
+    return w == 2 ? hypot(e[0], e[1]) : fabs(e[0]);
+}
+
+int ref_sp_norm1_inf(const ref_sp *C, int64_t m, int64_t n, int vec, int by_col, int w, double *r)
+{
+    int64_t nz = C->p[n];
+    const double *x = C->x;
+    *r = 0.0;
+    if (vec) { /* vector norms: sum |x| and max |x| whatever the orientation */
+        for (int64_t k = 0; k < nz; k++)
+            *r = by_col ? *r + entry_abs(x + w * k, w) : fmax(*r, entry_abs(x + w * k, w));
+    } else if (by_col) {
+        for (int64_t j = 0; j < n; j++) {
+            double s = 0.0;
+            for (int64_t k = C->p[j]; k < C->p[j + 1]; k++) s += entry_abs(x + w * k, w);
+            *r = fmax(*r, s);
+        }
+    } else {
+        double *rs = ref_calloc((size_t)m, sizeof(double));
+        if (!rs) return SILC_ENOMEM;
+        for (int64_t k = 0; k < nz; k++) rs[C->i[k]] += entry_abs(x + w * k, w);
+        for (int64_t i = 0; i < m; i++) *r = fmax(*r, rs[i]);
+        ref_free(rs);
+    }
+    return 0;
+}
+
 static int is_scalar(const silc_view *v)
 {
     return v->m == 1 && v->n == 1;
@@ -677,25 +708,7 @@ int ref_op_reduce(silc_call *call)
     } else if (sub == SILC_RED_NORM) {
         st = ref_norm2(&C, &r);
     } else if (sub == SILC_RED_NORM1 || sub == SILC_RED_NORMINF) {
-        int by_col = sub == SILC_RED_NORM1;
-        if (vec) { /* vector norms: sum |x| and max |x| whatever the orientation */
-            for (int64_t k = 0; k < nz; k++)
-                r = sub == SILC_RED_NORM1 ? r + fabs(C.x[k]) : fmax(r, fabs(C.x[k]));
-        } else if (by_col) {
-            for (int64_t j = 0; j < a.n; j++) {
-                double s = 0.0;
-                for (int64_t k = C.p[j]; k < C.p[j + 1]; k++) s += fabs(C.x[k]);
-                r = fmax(r, s);
-            }
-        } else {
-            double *rs = ref_calloc((size_t)a.m, sizeof(double));
-            if (!rs) st = SILC_ENOMEM;
-            else {
-                for (int64_t k = 0; k < nz; k++) rs[C.i[k]] += fabs(C.x[k]);
-                for (int64_t i = 0; i < a.m; i++) r = fmax(r, rs[i]);
-                ref_free(rs);
-            }
-        }
+        st = ref_sp_norm1_inf(&C, a.m, a.n, vec, sub == SILC_RED_NORM1, 1, &r);
     } else {
         ref_sp_free(&C);
         return ref_host->error(call, SILC_EUNSUP, "reduction %d is unknown", sub);

@@ -509,23 +509,7 @@ int ref_op_reduce_z(silc_call *call)
     } else if (sub == SILC_RED_NORM) {
         st = znorm2(&C, &r);
     } else if (sub == SILC_RED_NORM1 || sub == SILC_RED_NORMINF) {
-        if (vec) {
-            for (int64_t k = 0; k < nz; k++) r = sub == SILC_RED_NORM1 ? r + cabs(x[k]) : fmax(r, cabs(x[k]));
-        } else if (sub == SILC_RED_NORM1) {
-            for (int64_t j = 0; j < a.n; j++) {
-                double s = 0.0;
-                for (int64_t k = C.p[j]; k < C.p[j + 1]; k++) s += cabs(x[k]);
-                r = fmax(r, s);
-            }
-        } else {
-            double *rs = ref_calloc((size_t)a.m, sizeof(double));
-            if (!rs) st = SILC_ENOMEM;
-            else {
-                for (int64_t k = 0; k < nz; k++) rs[C.i[k]] += cabs(x[k]);
-                for (int64_t i = 0; i < a.m; i++) r = fmax(r, rs[i]);
-                ref_free(rs);
-            }
-        }
+        st = ref_sp_norm1_inf(&C, a.m, a.n, vec, sub == SILC_RED_NORM1, 2, &r);
     } else {
         ref_sp_free(&C);
         return ref_host->error(call, SILC_EUNSUP, "reduction %d is unknown", sub);

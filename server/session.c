@@ -204,18 +204,9 @@ static int send_frame(session *S, uint32_t op, const struct iovec *body, int n, 
                       int borrowed)
 {
     uint8_t hdr[PROTO_HEADER_BYTES];
-    struct iovec iov[8];
-    uint64_t len = 0;
-    int i;
-    if (n > 7) return -1;
-    iov[0].iov_base = hdr;
-    iov[0].iov_len = sizeof hdr;
-    for (i = 0; i < n; i++) {
-        iov[i + 1] = body[i];
-        len += body[i].iov_len;
-    }
-    proto_encode_header(hdr, op, len);
-    return send_parts(S, iov, n + 1, hold, borrowed + 1);
+    struct iovec iov[PROTO_FRAME_PARTS];
+    int parts = proto_frame_iov(hdr, op, body, n, iov);
+    return parts < 0 ? -1 : send_parts(S, iov, parts, hold, borrowed + 1);
 }
 
 static int reply_text(session *S, uint32_t op, const char *text)

@@ -158,6 +158,12 @@ uint32_t proto_get_u32(const uint8_t *p);
 uint64_t proto_get_u64(const uint8_t *p);
 void proto_encode_hello(uint8_t out[PROTO_HELLO_BYTES], uint32_t version, uint32_t token_len);
 void proto_encode_header(uint8_t out[PROTO_HEADER_BYTES], uint32_t op, uint64_t len);
+/* A frame's parts: iov[0] = hdr, filled with op and the body's length, then
+ * body[0..n).  Returns n + 1, or -1 when n > PROTO_FRAME_PARTS - 1.  One
+ * function for the client's send and the server's (which may queue it). */
+#define PROTO_FRAME_PARTS 8
+int proto_frame_iov(uint8_t hdr[PROTO_HEADER_BYTES], uint32_t op, const struct iovec *body, int n,
+                    struct iovec iov[PROTO_FRAME_PARTS]);
 void proto_encode_desc(uint8_t out[PROTO_DESC_BYTES], const proto_desc *d);
 /* Descriptor and array pointers of a value, for sending it without a copy;
  * returns the number of iovecs (at most 3) filled, -1 if too large. */

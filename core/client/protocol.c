@@ -387,22 +387,30 @@ int proto_send(int fd, struct iovec *iov, int iovcnt, int timeout_ms, char *err,
     return 0;
 }
 
-int proto_send_frame(int fd, uint32_t op, const struct iovec *body, int n, int timeout_ms,
-                     char *err, size_t errlen)
+int proto_frame_iov(uint8_t hdr[PROTO_HEADER_BYTES], uint32_t op, const struct iovec *body, int n,
+                    struct iovec iov[PROTO_FRAME_PARTS])
 {
-    uint8_t hdr[PROTO_HEADER_BYTES];
-    struct iovec iov[8];
     uint64_t len = 0;
     int i;
-    if (n > 7) return perr(PROTO_FATAL, err, errlen, "internal: frame of %d parts", n);
+    if (n > PROTO_FRAME_PARTS - 1) return -1;
     iov[0].iov_base = hdr;
-    iov[0].iov_len = sizeof hdr;
+    iov[0].iov_len = PROTO_HEADER_BYTES;
     for (i = 0; i < n; i++) {
         iov[i + 1] = body[i];
         len += body[i].iov_len;
     }
     proto_encode_header(hdr, op, len);
-    return proto_send(fd, iov, n + 1, timeout_ms, err, errlen);
+    return n + 1;
+}
+
+int proto_send_frame(int fd, uint32_t op, const struct iovec *body, int n, int timeout_ms,
+                     char *err, size_t errlen)
+{
+    uint8_t hdr[PROTO_HEADER_BYTES];
+    struct iovec iov[PROTO_FRAME_PARTS];
+    int parts = proto_frame_iov(hdr, op, body, n, iov);
+    if (parts < 0) return perr(PROTO_FATAL, err, errlen, "internal: frame of %d parts", n);
+    return proto_send(fd, iov, parts, timeout_ms, err, errlen);
 }
 
 int proto_send_text(int fd, uint32_t op, const char *text, int timeout_ms, char *err,
