@@ -14,10 +14,12 @@
 #undef calloc
 #undef realloc
 #undef strdup
+#undef clock_gettime
 
 #include <execinfo.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 static int armed, persistent_, trace = -1;
@@ -95,4 +97,16 @@ long failalloc_count(void)
 long failalloc_failures(void)
 {
     return failures;
+}
+
+/* The counting clock of failalloc.h: deterministic, and never standing still
+ * (a loop waiting for a deadline still ends). */
+int failalloc_clock_gettime(int clock, struct timespec *ts)
+{
+    static long long ticks;
+    long long us = 100 * ++ticks;
+    (void)clock;
+    ts->tv_sec = (time_t)(us / 1000000);
+    ts->tv_nsec = (long)(us % 1000000) * 1000;
+    return 0;
 }
