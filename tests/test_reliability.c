@@ -94,8 +94,10 @@ static const row rows[] = {
     LANG("x = v[end + 1]", "v(4): out of bound 3 (dimensions are 3x1)"),
     LANG("x = v(end + 1)", "v(4): out of bound 3 (dimensions are 3x1)"),
     LANG("x = M[3, 1]", "M(3,_): out of bound 2 (dimensions are 2x2)"),
-    LANG("v[5] = 1", "v(5): out of bound 3 (dimensions are 3x1)"),
-    LANG("v(5) = 1", "v(5): out of bound 3 (dimensions are 3x1)"),
+    LANG("M(5) = 1", "M(5): out of bound 4 (dimensions are 2x2): a matrix grows by assignment only with two "
+                     "subscripts, A(i, j) = x (Octave: invalid resizing operation or ambiguous assignment to an "
+                     "out-of-bounds array element)"),
+    LANG("v(1e300) = 1", "v(1e+300): out of bound 3 (dimensions are 3x1)"),
     LANG("v[1:2] = [1; 2; 3]", "cannot assign a 3x1 value to 2 elements of 'v'"),
     LANG("v += [1; 2]", "'+' needs operands of the same shape or a scalar: 'v' is 3x1, '[1; 2]' is 2x1"),
     LANG("M *= v", "'*' inner dimensions differ: 'M' is 2x2, 'v' is 3x1"),

@@ -1090,8 +1090,13 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
         if (rc) return -1;
         return bind(V, s, s->name, v, t0);
     }
-    if (!cur) return undefined_name(V, s->name);
-    val_retain(cur);          /* the rhs may rebind nothing, but stay safe */
+    if (!cur && s->kind == ST_INDEX_ASSIGN) {
+        /* q(3) = 1 on a new name makes it, as Octave does: as if q = [] */
+        if (!(cur = val_dense_new(0, 0))) return eng_oom(V->E);
+    } else {
+        if (!cur) return undefined_name(V, s->name);
+        val_retain(cur);      /* the rhs may rebind nothing, but stay safe */
+    }
     if (op) {
         rc = update_operand(V, op, cur, s, s->kind == ST_OPASSIGN ? s->kids[0] : s->kids[0]->kids[1], &r);
         if (rc < 0) {

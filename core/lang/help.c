@@ -30,8 +30,9 @@ static const help_entry entries[] = {
      "up, 3.9-6.5x faster than making a new array (docs/overhead.md). `x = x + e` and `x = x - e` are the "
      "same updates. The numbers are those of the copying path, bit for bit"},
     {"[]=", 1, "`x(i, j) = e`, `x(a:b) = e`, `x(x > 0) = e`, `x[i, j] = e`",
-     "assign into a block of an existing `x` (same shape, or a scalar): a new value is bound to `x`, the "
-     "old one is left as it was (copy-on-write); a subscript outside `x` is an error (no growth)"},
+     "assign into a block of `x` (same shape, or a scalar): a new value is bound to `x`, the old one is "
+     "left as it was (copy-on-write); a subscript past the end grows `x` zero-filled, as in "
+     "Octave (a new name starts as `[]`)"},
     {"()", 1, "`f(args)`",
      "procedure call (value discarded); on a variable, `v(i)` and `A(i, j)` are subscripts (a variable "
      "hides a built-in of its name, as in Octave)"},

@@ -55,10 +55,12 @@ static int bad_index(lang_ev *V, double x, int64_t extent, int pos, const char *
                      shape);
 }
 
-static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, int pos, const char *what,
-                      const silc_value *base)
+/* limit: the largest index taken -- the extent, or for an assignment that
+ * may grow its target (Octave's v(end+1) = x), GROW_LIMIT. */
+static int push_index(lang_ev *V, ix_list *l, double x, int64_t extent, int64_t limit, int pos,
+                      const char *what, const silc_value *base)
 {
-    if (!(x >= 1 && x <= (double)extent) || x != floor(x)) return bad_index(V, x, extent, pos, what, base);
+    if (!(x >= 1 && x <= (double)limit) || x != floor(x)) return bad_index(V, x, extent, pos, what, base);
     l->ix[l->n++] = (int64_t)x - 1;
     return 0;
 }
@@ -108,12 +110,20 @@ static int64_t *ix_alloc(lang_ev *V, int64_t count)
     return ix;
 }
 
+/* The largest index an assignment may grow its target to: far past any
+ * value the limits allow (the grown value is claimed like any other, and
+ * refused with the limit's message), and small enough that index + 1 and
+ * the product of two dimensions stay exact in a double. */
+#define GROW_LIMIT ((int64_t)1 << 48)
+
 /* Resolves one subscript against a dimension of the given extent (pos as
- * bad_index's). */
-static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int pos, const char *what,
+ * bad_index's).  grow: indices past the extent are taken (an assignment
+ * that grows its target), except from a mask, which selects among the
+ * entries there are. */
+static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int grow, int pos, const char *what,
                    const silc_value *base, ix_list *out)
 {
-    int64_t saved_end = V->end_value, k;
+    int64_t saved_end = V->end_value, k, limit = grow && !is_mask(sub) ? GROW_LIMIT : extent;
     int rc = 0;
     out->ix = NULL;
     out->n = 0;
@@ -130,19 +140,19 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int pos, con
         } else {
             /* counted as a double: the count of 1:1e84 does not fit int64_t */
             double span = b >= a ? floor(b - a) + 1 : 0;
-            int64_t cnt = span > (double)extent ? extent + 1 : (int64_t)span;
-            if (cnt > extent) {
+            int64_t cnt = span > (double)limit ? limit + 1 : (int64_t)span;
+            if (cnt > limit) {
                 /* some index must be out of range: report the first without
                  * allocating for a range that may be huge */
-                double bad = a < 1 || a != floor(a) || a > (double)extent ? a : (double)extent + 1;
+                double bad = a < 1 || a != floor(a) || a > (double)limit ? a : (double)limit + 1;
                 int64_t one;
                 out->ix = &one;
-                rc = push_index(V, out, bad, extent, pos, what, base);
+                rc = push_index(V, out, bad, extent, limit, pos, what, base);
                 out->ix = NULL;
             } else {
                 if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
                 for (x = a, k = 0; !rc && k < cnt; k++, x += 1.0)
-                    rc = push_index(V, out, x, extent, pos, what, base);
+                    rc = push_index(V, out, x, extent, limit, pos, what, base);
             }
         }
     } else {
@@ -155,13 +165,14 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int pos, con
             int64_t cnt = v->m * v->n;
             if (!(out->ix = ix_alloc(V, cnt < extent ? cnt : extent))) rc = -1;
             for (k = 0; !rc && k < cnt; k++)
-                if (val_get(v, k % v->m, k / v->m) != 0) rc = push_index(V, out, (double)k + 1, extent, pos, what, base);
+                if (val_get(v, k % v->m, k / v->m) != 0)
+                    rc = push_index(V, out, (double)k + 1, extent, limit, pos, what, base);
             val_release(v);
         } else {
             int64_t cnt = v->m * v->n;
             if (!(out->ix = ix_alloc(V, cnt))) rc = -1;
             for (k = 0; !rc && k < cnt; k++)
-                rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, pos, what, base);
+                rc = push_index(V, out, val_get(v, k % v->m, k / v->m), extent, limit, pos, what, base);
             val_release(v);
         }
     }
@@ -174,17 +185,18 @@ static int resolve(lang_ev *V, const ast_node *sub, int64_t extent, int pos, con
     return rc;
 }
 
-/* Resolves the subscripts: one (linear) or two (row, column). */
-static int resolve_all(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
+/* Resolves the subscripts: one (linear) or two (row, column); grow as
+ * resolve's. */
+static int resolve_all(lang_ev *V, ast_node *const *subs, size_t nsubs, int grow, const char *what,
                        const silc_value *base, ix_list *I, ix_list *J)
 {
     I->ix = J->ix = NULL;
     I->n = J->n = 0;
     if (nsubs == 0 || nsubs > 2)
         return eng_error(V->E, "%s takes 1 or 2 subscripts, got %zu", what, nsubs);
-    if (nsubs == 1) return resolve(V, subs[0], base->m * base->n, 0, what, base, I);
-    if (resolve(V, subs[0], base->m, 1, what, base, I)) return -1;
-    if (resolve(V, subs[1], base->n, 2, what, base, J)) {
+    if (nsubs == 1) return resolve(V, subs[0], base->m * base->n, grow, 0, what, base, I);
+    if (resolve(V, subs[0], base->m, grow, 1, what, base, I)) return -1;
+    if (resolve(V, subs[1], base->n, grow, 2, what, base, J)) {
         free(I->ix);
         I->ix = NULL;
         return -1;
@@ -310,7 +322,7 @@ static int ix_extract_real(lang_ev *V, ast_node *const *subs, size_t nsubs, cons
     silc_value *r = NULL;
     int64_t a, b, m = base->m;
     *out = NULL;
-    if (resolve_all(V, subs, nsubs, what, base, &I, &J)) return -1;
+    if (resolve_all(V, subs, nsubs, 0, what, base, &I, &J)) return -1;
     if (nsubs == 1) {
         /* linear, as Octave: v(:) is a column, a vector keeps its
          * orientation, a matrix takes the subscript's (a column for a
@@ -399,17 +411,87 @@ static silc_value *copy_value(const silc_value *t)
     return r;
 }
 
+/* t with m rows and n columns, its entries where they were and zeros in
+ * the new places: dense stays dense, CSR and band become CSR (a grown band
+ * is rarely banded about its new diagonal).  NULL when out of memory or
+ * past the limits (val_refusal says which). */
+static silc_value *resized(const silc_value *t, int64_t m, int64_t n)
+{
+    int64_t i, j, rows = t->m < m ? t->m : m, cols = t->n < n ? t->n : n;
+    silc_value *r, *c;
+    if (t->format == SILC_FMT_DENSE) {
+        if (!(r = val_dense_new(m, n))) return NULL;
+        for (j = 0; j < cols; j++)
+            for (i = 0; i < rows; i++) r->val[i + j * m] = t->val[i + j * t->m];
+        return r;
+    }
+    c = t->format == SILC_FMT_CSR ? NULL : bi_to_csr(t);
+    if (t->format != SILC_FMT_CSR && !c) return NULL;
+    if (c) t = c;
+    /* rows past the old ones are empty; the old columns all fit, since a
+     * grown CSR never loses columns that hold entries (a 0xN one has none) */
+    r = val_csr_new(m, n, t->rowptr[t->m]);
+    if (r) {
+        for (i = 0; i <= m; i++) r->rowptr[i] = t->rowptr[i < t->m ? i : t->m];
+        for (i = 0; i < t->rowptr[t->m]; i++) r->colind[i] = t->colind[i], r->val[i] = t->val[i];
+        val_csr_set_nnz(r, t->rowptr[t->m]);
+    }
+    val_release(c);
+    return r;
+}
+
+/* Octave's growth by assignment: a subscript past the end grows the
+ * target, zero-filled -- both dimensions as far as the largest row and
+ * column subscripts reach; with one (linear) subscript, a 0x0, 1x1, row or
+ * 0xN value becomes a row and a column stays a column, while a matrix is
+ * refused (which way it should grow is ambiguous, as Octave says).
+ * *grown: the grown copy, or NULL when every subscript is inside. */
+static int grow_target(lang_ev *V, size_t nsubs, const ix_list *I, const ix_list *J, const char *what,
+                       const silc_value *t, silc_value **grown)
+{
+    int64_t k, mi = -1, mj = -1, m = t->m, n = t->n;
+    size_t len = strlen(what);
+    *grown = NULL;
+    for (k = 0; k < I->n; k++)
+        if (I->ix[k] > mi) mi = I->ix[k];
+    if (nsubs == 1) {
+        if (mi < m * n) return 0;
+        if (m == 0 || m == 1) {
+            m = 1;
+            n = mi + 1;
+        } else if (n == 1) {
+            m = mi + 1;
+        } else {
+            int quoted = len >= 2 && what[0] == '\'' && what[len - 1] == '\'';
+            return eng_error(V->E,
+                             "%.*s(%lld): out of bound %lld (dimensions are %lldx%lld): a matrix grows by "
+                             "assignment only with two subscripts, A(i, j) = x (Octave: invalid resizing "
+                             "operation or ambiguous assignment to an out-of-bounds array element)",
+                             quoted ? (int)len - 2 : (int)len, what + quoted, (long long)mi + 1,
+                             (long long)(m * n), (long long)m, (long long)n);
+        }
+    } else {
+        for (k = 0; k < J->n; k++)
+            if (J->ix[k] > mj) mj = J->ix[k];
+        if (mi < m && mj < n) return 0;
+        if (mi >= m) m = mi + 1;
+        if (mj >= n) n = mj + 1;
+    }
+    if (!(*grown = resized(t, m, n))) return oom(V);
+    return 0;
+}
+
 static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const char *what,
                           const silc_value *target, const silc_value *rhs, silc_value **out)
 {
     ix_list I, J;
     ix_entry *e = NULL;
-    int64_t ne, k, a, b, m = target->m;
+    int64_t ne, k, a, b, m;
     int scalar = val_is_scalar(rhs), inband = 1;
-    silc_value *r = NULL;
+    silc_value *r = NULL, *grown = NULL;
     char s0[48], s1[48];
     *out = NULL;
-    if (resolve_all(V, subs, nsubs, what, target, &I, &J)) return -1;
+    if (resolve_all(V, subs, nsubs, 1, what, target, &I, &J)) return -1;
     ne = nsubs == 1 ? I.n : I.n * J.n;
     if (!scalar) {
         int ok = nsubs == 1 ? rhs->m * rhs->n == I.n && (rhs->m == 1 || rhs->n == 1)
@@ -425,6 +507,13 @@ static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const
             return eng_error(V->E, "cannot assign a %s value to %s of %s", s0, s1, what);
         }
     }
+    if (grow_target(V, nsubs, &I, &J, what, target, &grown)) {
+        free(I.ix);
+        free(J.ix);
+        return -1;
+    }
+    if (grown) target = grown;
+    m = target->m;
     /* I.n * J.n entries: each list fits (ix_alloc), their product may not */
     if (val_claim((double)(ne ? ne : 1) * sizeof *e, "the assigned block")) goto nomem;
     e = malloc((size_t)(ne ? ne : 1) * sizeof *e);
@@ -470,11 +559,13 @@ static int ix_assign_real(lang_ev *V, ast_node *const *subs, size_t nsubs, const
     free(e);
     free(I.ix);
     free(J.ix);
+    val_release(grown);
     *out = r;
     return 0;
 nomem:
     free(e);
     free(I.ix);
     free(J.ix);
+    val_release(grown);
     return oom(V);
 }

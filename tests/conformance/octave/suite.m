@@ -132,6 +132,28 @@ ze2 = Zc .* Zc
 clear i j
 zu = i
 zv = 3*j
+# growth by assignment, as Octave grows (zero-filled)
+gv = [1 2 3];
+gv(5) = 9
+ga = [];
+ga(3) = 1
+gc = [1; 2];
+gc(4) = 7
+gA = ones(2);
+gA(3, 4) = 5
+gw = 1:3;
+gw(end+1) = 4
+gz = 5;
+gz(3) = 2
+ge = zeros(0, 3);
+ge(2) = 1
+gr = [1 2 3];
+gr([2 6]) = [8 9]
+gt = ones(2, 3);
+gt(:, 5) = 2
+gn(3) = 1
+gx = 1;
+gx(2, 2) = 1i
 format long
 zL = 1/3 + 2i/3
 ZL = [1+2i, 3.5-4i]
