@@ -136,6 +136,8 @@ with silc.Session() as s:
     back = s.get("z64")
     check(back.dtype == np.complex128 and np.array_equal(back, z64.astype(np.complex128)),
           "complex64 is promoted to complex128")
+    s.put("zl", [1 + 2j, 3])                 # a list: its dtype decides, never float64 by force
+    check(np.array_equal(s.get("zl"), np.array([1 + 2j, 3])), "a list of complex numbers stays complex")
     s.put("rv", np.float32(3.5))
     check(type(s.get("rv")) is float, "a real value stays real")
     if s.remote:
