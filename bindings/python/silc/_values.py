@@ -6,9 +6,10 @@ indices, float64 data; dense: float64 column-major), without a copy where
 the caller's arrays already are so.  A complex value (any complex dtype,
 promoted to complex128) goes with the format's COMPLEX bit and its entries
 as NumPy stores complex128: real and imaginary part interleaved, SILC's own
-layout (silc.h).  Other dtypes than bool, integers, floats and complex
-(object, strings, dates) are refused, never converted by guess: the real
-path used to make any array float64, which dropped an imaginary part.  What comes back is checked before any
+layout (silc.h).  The dtype decides the field; other dtypes than bool,
+integers, floats and complex (object, strings, dates) are refused, never
+converted by guess (forcing every array to float64 is what once dropped
+imaginary parts, issue 31).  What comes back is checked before any
 array is allocated or trusted, as silcd checks what it receives (the same
 rules and messages as core/client/protocol.c and core/store/envelope.c): a
 descriptor's sizes against its format and the client's cap, CSR structure
