@@ -1,7 +1,7 @@
 # Tests of the Fortran binding (included from tests/CMakeLists.txt): the module's
 # own test and the Fortran diffusion example, which exits 1 if its error exceeds
-# the scheme's bound.  Both run embedded here; with SILC_SERVER set they run
-# against silcd unchanged.  With MPI for Fortran, the SPMD example
+# the scheme's bound.  Both run embedded; the module's test runs against the
+# fixture's silcd too (test_fortran_remote).  With MPI for Fortran, the SPMD example
 # (diffusion1d_mpi.f90) runs under mpirun -np 2 and must print the serial
 # example's summary and end with its field to 1e-12 relative.
 if(TARGET silc_fortran)
@@ -15,6 +15,13 @@ if(TARGET silc_fortran)
   add_test(NAME example_diffusion1d_fortran COMMAND diffusion1d_fortran)
   set_tests_properties(test_fortran example_diffusion1d_fortran PROPERTIES
     ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)
+  # The same test through libsilc's remote mode against the fixture's silcd
+  # (complex values and every other call go over the protocol there).
+  if(TARGET silcd)
+    add_test(NAME test_fortran_remote COMMAND test_fortran)
+    set_tests_properties(test_fortran_remote PROPERTIES ENVIRONMENT "${_remote_env}" TIMEOUT 120
+                         FIXTURES_REQUIRED silcd)
+  endif()
 
   if(TARGET diffusion1d_mpi_fortran AND MPIEXEC_EXECUTABLE)
     # sh -c SCRIPT sh MPIRUN SERIAL SPMD OUTDIR: both examples write their

@@ -2,12 +2,15 @@
 ! vectors, dense 2-D arrays in column-major order, 1-based CSR in both integer
 ! kinds, shape checks on silc_get, error statuses with their messages, and the
 ! row-block calls of MPI programs on one process (silc_rank, silc_put_rows,
-! silc_get_rows: the block is the whole value, first row 1).
+! silc_get_rows: the block is the whole value, first row 1), and complex(8)
+! values through the same generics (a complex tridiagonal solve against its
+! exact solution, bit-exact round trips, a real array refusing a complex
+! value).
 ! Prints "N passed, N failed" as its last line, like the C tests (tests/check.h),
 ! and ends with error stop when anything failed.  Runs embedded, or remote when
 ! SILC_SERVER is set.
 program test_fortran
-  use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
+  use, intrinsic :: iso_c_binding, only: c_double, c_double_complex, c_int64_t
   use silc
   implicit none
   integer :: passed = 0, failed = 0
@@ -21,6 +24,7 @@ program test_fortran
   call test_csr_mistakes()
   call test_errors()
   call test_rows()
+  call test_complex()
   call check_ok(silc_finalize(), 'silc_finalize')
   call check_fails(silc_exec('x = 1'), '', 'exec after silc_finalize')
   call test_rows_closed()
@@ -185,6 +189,102 @@ contains
     call check_ok(silc_get('ok' // repeat(' ', 10), x), 'a name with trailing blanks')
     call check(x > 0.5_c_double, 'value fetched by a blank-padded name')
   end subroutine test_errors
+
+  ! Complex values (issue 31).  A Helmholtz-like complex tridiagonal A
+  ! (diagonal 2.5 + 0.5i, off-diagonals -1 + 0.1i: complex symmetric and
+  ! strictly diagonally dominant) with exact solution xt = (1 + 2i, ...):
+  ! b = A xt, and x = A \ b must match xt within 10 n eps cond_1(A), where
+  ! cond_1(A) <= ||A||_1 / min_i (|a_ii| - sum_j/=i |a_ij|) (Varah's bound on
+  ! ||A^-1||, rows and columns alike since A = A.').
+  subroutine test_complex()
+    integer, parameter :: n = 40
+    complex(c_double_complex), parameter :: d = (2.5_c_double, 0.5_c_double), &
+                                            o = (-1.0_c_double, 0.1_c_double)
+    integer :: rp(n + 1), ci(3 * n), i, j, k, m2, n2
+    complex(c_double_complex) :: vals(3 * n), xt(n), b(n), x(n), z(2, 3), zt(3, 2), zback(2, 3), w
+    complex(c_double_complex), allocatable :: gv(:)
+    integer, allocatable :: grp(:), gci(:)
+    real(c_double) :: bound, err, rz(2, 3)
+    real(c_double), allocatable :: rvals(:)
+    integer(c_int64_t) :: bits(6), bits_back(6)
+
+    k = 0
+    rp(1) = 1
+    do i = 1, n
+      do j = max(1, i - 1), min(n, i + 1)
+        k = k + 1
+        ci(k) = j
+        vals(k) = merge(d, o, i == j)
+      end do
+      rp(i + 1) = k + 1
+      xt(i) = cmplx(1 + mod(i - 1, 3), 2 - mod(i - 1, 5), c_double_complex)
+    end do
+    do i = 1, n
+      b(i) = sum(vals(rp(i):rp(i + 1) - 1) * xt(ci(rp(i):rp(i + 1) - 1)))
+    end do
+    call check_ok(silc_put_csr('Az', n, n, rp, ci, vals(1:k)), 'put complex CSR')
+    call check_ok(silc_put('bz', b), 'put a complex vector')
+    call check_ok(silc_exec('xz = Az \ bz'), 'complex sparse solve')
+    x = 0
+    call check_ok(silc_get('xz', x), 'get a complex vector')
+    bound = 10 * n * epsilon(1.0_c_double) * (abs(d) + 2 * abs(o)) / (abs(d) - 2 * abs(o))
+    err = maxval(abs(x - xt)) / maxval(abs(xt))
+    call check(err <= bound, 'complex solve against the exact solution: error ' // real_text(err) // &
+               ', bound ' // real_text(bound))
+    call check_ok(silc_get_shape('xz', m2, n2), 'get_shape of a complex value')
+    call check(m2 == n .and. n2 == 1, 'shape of a complex vector')
+
+    ! CSR round trip, exact: indices 1-based again, values bit for bit.
+    call check_ok(silc_get_csr('Az', m2, n2, grp, gci, gv), 'get complex CSR')
+    if (allocated(gv)) then
+      call check(m2 == n .and. n2 == n .and. all(grp == rp) .and. all(gci == ci(1:k)) .and. &
+                 all(gv == vals(1:k)), 'complex CSR round trip')
+    else
+      call check(.false., 'complex CSR round trip: nothing fetched')
+    end if
+    ! A real values array takes no complex value: the library's message, nothing half-read.
+    call check_fails(silc_get_csr('Az', m2, n2, grp, gci, rvals), '''Az'' is complex', &
+                     'get_csr of a complex value into real values')
+
+    ! Dense, column-major as Fortran stores it; a signed zero and a subnormal survive.
+    z = reshape([(cmplx(i, -2 * i, c_double_complex), i = 1, 6)], [2, 3])
+    z(1, 1) = cmplx(-0.0_c_double, tiny(1.0_c_double) / 4, c_double_complex)
+    call check_ok(silc_put('Z', z), 'put a complex matrix')
+    call check_ok(silc_get('Z', zback), 'get a complex matrix')
+    bits = transfer(real(zback), bits)
+    bits_back = transfer(real(z), bits_back)
+    call check(all(bits == bits_back), 'complex matrix round trip: real parts bit for bit')
+    bits = transfer(aimag(zback), bits)
+    bits_back = transfer(aimag(z), bits_back)
+    call check(all(bits == bits_back), 'complex matrix round trip: imaginary parts bit for bit')
+    call check_ok(silc_exec("Zt = Z.'; Zh = Z'"), 'transposes of a complex matrix')
+    call check_ok(silc_get('Zt', zt), 'get Z.''')
+    call check(all(zt == transpose(z)), 'Z.'' is the plain transpose, in column-major order')
+    call check_ok(silc_get('Zh', zt), 'get Z''')
+    call check(all(zt == conjg(transpose(z))), 'Z'' is the conjugate transpose')
+
+    ! A real array refuses a complex value, untouched; a complex one takes a real value.
+    rz = 7
+    call check_fails(silc_get('Z', rz), '''Z'' is complex', 'a complex value into a real array')
+    call check(all(rz == 7), 'the refused real array is unchanged')
+    call check_ok(silc_exec('Zr = real(Z)'), 'real(Z)')
+    call check_ok(silc_get('Zr', zback), 'a real value into a complex array')
+    call check(all(zback == cmplx(real(z), 0.0_c_double, c_double_complex)), 'real value, imaginary parts 0')
+
+    call check_ok(silc_put('zs', (1.0_c_double, 2.0_c_double)), 'put a complex scalar')
+    call check_ok(silc_exec('w = zs * zs'), 'complex scalar arithmetic')
+    w = 0
+    call check_ok(silc_get('w', w), 'get a complex scalar')
+    call check(w == (-3.0_c_double, 4.0_c_double), '(1 + 2i)^2 = -3 + 4i')
+  end subroutine test_complex
+
+  pure function real_text(x) result(s)
+    real(c_double), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=32) :: buf
+    write (buf, '(es12.4)') x
+    s = trim(adjustl(buf))
+  end function real_text
 
   ! One process: rank 0 of 1, and a block of rows is the whole value.
   subroutine test_rows()

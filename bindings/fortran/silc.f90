@@ -46,7 +46,13 @@
 ! instead of waiting.
 !
 ! Every function returns an integer status, 0 on success; after a failure
-! silc_errmsg() says why.  Arrays are real(c_double).  A 1-D array is a vector
+! silc_errmsg() says why.  Arrays are real(c_double), or complex(c_double_complex)
+! (complex(8)) for complex values: the same generic calls take either, a
+! complex array is stored as a complex value (Fortran's complex layout, real
+! and imaginary part side by side, is SILC's own), and a complex array
+! fetches a complex value or a real one (imaginary parts 0), while a real
+! array refuses a complex value with the library's message ("'z' is
+! complex ..."), never taking half of it.  A 1-D array is a vector
 ! (n x 1), a 2-D array a dense matrix in Fortran's own column-major order (no
 ! transposition).  CSR indices are 1-based on the Fortran side and converted to
 ! the 0-based int64 arrays of the C API here.  silc_get never allocates or
@@ -64,7 +70,7 @@ module silc
 
   ! silc_format_t of silc.h.
   enum, bind(c)
-    enumerator :: SILC_DENSE = 0, SILC_CSR = 1, SILC_BAND = 2
+    enumerator :: SILC_DENSE = 0, SILC_CSR = 1, SILC_BAND = 2, SILC_COMPLEX = 16
   end enum
 
   ! Mirror of silc_envelope_t in silc.h, field for field (the enum is a C int,
@@ -78,20 +84,23 @@ module silc
     integer(c_int64_t) :: nnz, kl, ku
   end type silc_envelope_t
 
+  ! Each generic takes real(c_double) or complex(c_double_complex) values.
   interface silc_put
     module procedure put_scalar, put_vector, put_matrix
+    module procedure put_scalar_complex, put_vector_complex, put_matrix_complex
   end interface silc_put
 
   interface silc_get
     module procedure get_scalar, get_vector, get_matrix
+    module procedure get_scalar_complex, get_vector_complex, get_matrix_complex
   end interface silc_get
 
   interface silc_put_csr
-    module procedure put_csr_int, put_csr_int64
+    module procedure put_csr_int, put_csr_int64, put_csr_int_complex, put_csr_int64_complex
   end interface silc_put_csr
 
   interface silc_get_csr
-    module procedure get_csr_int, get_csr_int64
+    module procedure get_csr_int, get_csr_int64, get_csr_int_complex, get_csr_int64_complex
   end interface silc_get_csr
 
   ! silc_put_rows(name, first_row, x) for a dense block (1-D or 2-D), and
@@ -136,6 +145,13 @@ module silc
       character(kind=c_char), intent(in) :: text(*)
     end function c_silc_exec
 
+    integer(c_int) function c_silc_get_complex(ctx, e, name) bind(c, name='silc_get_complex')
+      import :: c_int, c_char, c_ptr, silc_envelope_t
+      type(c_ptr), value :: ctx
+      type(silc_envelope_t), intent(inout) :: e
+      character(kind=c_char), intent(in) :: name(*)
+    end function c_silc_get_complex
+
     type(c_ptr) function c_silc_default_context() bind(c, name='silc_default_context')
       import :: c_ptr
     end function c_silc_default_context
@@ -176,6 +192,22 @@ module silc
       integer(c_int64_t), value :: m, n
       real(c_double), intent(in) :: x(*)
     end function c_envelope_dense
+
+    integer(c_int) function c_envelope_dense_complex(e, m, n, x) bind(c, name='silc_envelope_dense_complex')
+      import :: c_int, c_int64_t, c_double_complex, silc_envelope_t
+      type(silc_envelope_t), intent(inout) :: e
+      integer(c_int64_t), value :: m, n
+      complex(c_double_complex), intent(in) :: x(*)
+    end function c_envelope_dense_complex
+
+    integer(c_int) function c_envelope_csr_complex(e, m, n, rowptr, colind, values) &
+        bind(c, name='silc_envelope_csr_complex')
+      import :: c_int, c_int64_t, c_double_complex, silc_envelope_t
+      type(silc_envelope_t), intent(inout) :: e
+      integer(c_int64_t), value :: m, n
+      integer(c_int64_t), intent(in) :: rowptr(*), colind(*)
+      complex(c_double_complex), intent(in) :: values(*)
+    end function c_envelope_csr_complex
 
     integer(c_int) function c_envelope_scalar(e, x) bind(c, name='silc_envelope_scalar')
       import :: c_int, c_double, silc_envelope_t
@@ -304,6 +336,27 @@ contains
     status = put_dense(name, int(size(x, 1), c_int64_t), int(size(x, 2), c_int64_t), x)
   end function put_matrix
 
+  integer function put_scalar_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(in) :: x
+    own_failure = .false.
+    status = put_dense_complex(name, 1_c_int64_t, 1_c_int64_t, [x])
+  end function put_scalar_complex
+
+  integer function put_vector_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(in) :: x(:)
+    own_failure = .false.
+    status = put_dense_complex(name, int(size(x), c_int64_t), 1_c_int64_t, x)
+  end function put_vector_complex
+
+  integer function put_matrix_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(in) :: x(:, :)
+    own_failure = .false.
+    status = put_dense_complex(name, int(size(x, 1), c_int64_t), int(size(x, 2), c_int64_t), x)
+  end function put_matrix_complex
+
   !> Deposits an m x n sparse matrix given as 1-based CSR: row i holds
   !> values(rowptr(i):rowptr(i+1)-1) in columns colind(rowptr(i):rowptr(i+1)-1).
   integer function put_csr_int(name, m, n, rowptr, colind, values) result(status)
@@ -315,7 +368,7 @@ contains
     allocate(rp(size(rowptr)), ci(size(colind)))
     rp(:) = int(rowptr, c_int64_t)
     ci(:) = int(colind, c_int64_t)
-    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, values)
+    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, values=values)
   end function put_csr_int
 
   integer function put_csr_int64(name, m, n, rowptr, colind, values) result(status)
@@ -327,8 +380,33 @@ contains
     allocate(rp(size(rowptr)), ci(size(colind)))
     rp(:) = rowptr
     ci(:) = colind
-    status = put_csr_0based(name, m, n, rp, ci, values)
+    status = put_csr_0based(name, m, n, rp, ci, values=values)
   end function put_csr_int64
+
+  !> A complex m x n sparse matrix as 1-based CSR, as silc_put_csr above.
+  integer function put_csr_int_complex(name, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: m, n, rowptr(:), colind(:)
+    complex(c_double_complex), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = int(rowptr, c_int64_t)
+    ci(:) = int(colind, c_int64_t)
+    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, zvalues=values)
+  end function put_csr_int_complex
+
+  integer function put_csr_int64_complex(name, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: m, n, rowptr(:), colind(:)
+    complex(c_double_complex), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = rowptr
+    ci(:) = colind
+    status = put_csr_0based(name, m, n, rp, ci, zvalues=values)
+  end function put_csr_int64_complex
 
   ! ---- get -------------------------------------------------------------------
 
@@ -340,7 +418,7 @@ contains
     own_failure = .false.
     m = 0
     n = 0
-    status = get_envelope(name, e)
+    status = get_envelope(name, e, accept_complex=.true.)
     if (status /= 0) return
     if (e%m > huge(m) .or. e%n > huge(n)) then
       status = fail('silc_get_shape: ''' // trim(name) // ''' is ' // shape_text(e%m, e%n) // &
@@ -380,20 +458,83 @@ contains
     status = get_dense(name, m, n, .false., 'an array of shape ' // shape_text(m, n), x)
   end function get_matrix
 
+  integer function get_scalar_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(inout) :: x
+    complex(c_double_complex) :: buf(1)
+    own_failure = .false.
+    status = get_dense_complex(name, 1_c_int64_t, 1_c_int64_t, .false., 'a scalar', buf)
+    if (status == 0) x = buf(1)
+  end function get_scalar_complex
+
+  integer function get_vector_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(inout) :: x(:)
+    own_failure = .false.
+    status = get_dense_complex(name, int(size(x), c_int64_t), 1_c_int64_t, .true., &
+                               'an array of size ' // int_text(int(size(x), c_int64_t)), x)
+  end function get_vector_complex
+
+  integer function get_matrix_complex(name, x) result(status)
+    character(len=*), intent(in) :: name
+    complex(c_double_complex), intent(inout) :: x(:, :)
+    integer(c_int64_t) :: m, n
+    own_failure = .false.
+    m = int(size(x, 1), c_int64_t)
+    n = int(size(x, 2), c_int64_t)
+    status = get_dense_complex(name, m, n, .false., 'an array of shape ' // shape_text(m, n), x)
+  end function get_matrix_complex
+
   !> Fetches a sparse matrix as 1-based CSR into allocatable arrays (allocated,
   !> or reallocated, here).  Dense and band values are refused: fetch those
-  !> into a 2-D array with silc_get.
+  !> into a 2-D array with silc_get.  Complex values arrays take a complex
+  !> matrix (or a real one, imaginary parts 0); real ones refuse a complex one.
   integer function get_csr_int(name, m, n, rowptr, colind, values) result(status)
     character(len=*), intent(in) :: name
     integer, intent(out) :: m, n
     integer, allocatable, intent(inout) :: rowptr(:), colind(:)
     real(c_double), allocatable, intent(inout) :: values(:)
+    status = get_csr_default_int(name, m, n, rowptr, colind, values=values)
+  end function get_csr_int
+
+  integer function get_csr_int_complex(name, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: m, n
+    integer, allocatable, intent(inout) :: rowptr(:), colind(:)
+    complex(c_double_complex), allocatable, intent(inout) :: values(:)
+    status = get_csr_default_int(name, m, n, rowptr, colind, zvalues=values)
+  end function get_csr_int_complex
+
+  integer function get_csr_int64(name, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: m, n
+    integer(c_int64_t), allocatable, intent(inout) :: rowptr(:), colind(:)
+    real(c_double), allocatable, intent(inout) :: values(:)
+    status = get_csr_c_int64(name, m, n, rowptr, colind, values=values)
+  end function get_csr_int64
+
+  integer function get_csr_int64_complex(name, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: m, n
+    integer(c_int64_t), allocatable, intent(inout) :: rowptr(:), colind(:)
+    complex(c_double_complex), allocatable, intent(inout) :: values(:)
+    status = get_csr_c_int64(name, m, n, rowptr, colind, zvalues=values)
+  end function get_csr_int64_complex
+
+  ! silc_get_csr with default-integer indices; values (real) or zvalues
+  ! (complex), one of them present.
+  integer function get_csr_default_int(name, m, n, rowptr, colind, values, zvalues) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: m, n
+    integer, allocatable, intent(inout) :: rowptr(:), colind(:)
+    real(c_double), allocatable, intent(inout), optional :: values(:)
+    complex(c_double_complex), allocatable, intent(inout), optional :: zvalues(:)
     type(silc_envelope_t) :: e
     integer(c_int64_t), pointer :: rp(:), ci(:)
     own_failure = .false.
     m = 0
     n = 0
-    status = get_csr_envelope(name, e, rp, ci, values)
+    status = get_csr_envelope(name, e, rp, ci, values, zvalues)
     if (status /= 0) return
     if (max(e%m, e%n, e%nnz + 1) > huge(m)) then
       status = fail('silc_get_csr: ''' // trim(name) // ''' (' // shape_text(e%m, e%n) // &
@@ -405,19 +546,21 @@ contains
       call replace_int(colind, int(ci + 1))
     end if
     call c_envelope_free(e)
-  end function get_csr_int
+  end function get_csr_default_int
 
-  integer function get_csr_int64(name, m, n, rowptr, colind, values) result(status)
+  ! silc_get_csr with integer(c_int64_t) indices, as get_csr_default_int.
+  integer function get_csr_c_int64(name, m, n, rowptr, colind, values, zvalues) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(out) :: m, n
     integer(c_int64_t), allocatable, intent(inout) :: rowptr(:), colind(:)
-    real(c_double), allocatable, intent(inout) :: values(:)
+    real(c_double), allocatable, intent(inout), optional :: values(:)
+    complex(c_double_complex), allocatable, intent(inout), optional :: zvalues(:)
     type(silc_envelope_t) :: e
     integer(c_int64_t), pointer :: rp(:), ci(:)
     own_failure = .false.
     m = 0
     n = 0
-    status = get_csr_envelope(name, e, rp, ci, values)
+    status = get_csr_envelope(name, e, rp, ci, values, zvalues)
     if (status /= 0) return
     m = e%m
     n = e%n
@@ -426,7 +569,7 @@ contains
     rowptr = rp + 1
     colind = ci + 1
     call c_envelope_free(e)
-  end function get_csr_int64
+  end function get_csr_c_int64
 
   ! ---- rows (MPI programs, SPMD) ----------------------------------------------
 
@@ -496,8 +639,8 @@ contains
     allocate(rp(size(rowptr)), ci(size(colind)))
     rp(:) = int(rowptr, c_int64_t)
     ci(:) = int(colind, c_int64_t)
-    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, values, &
-                            int(first_row, c_int64_t))
+    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, &
+                            int(first_row, c_int64_t), values=values)
   end function put_rows_csr_int
 
   integer function put_rows_csr_int64(name, first_row, m, n, rowptr, colind, values) result(status)
@@ -509,7 +652,7 @@ contains
     allocate(rp(size(rowptr)), ci(size(colind)))
     rp(:) = rowptr
     ci(:) = colind
-    status = put_csr_0based(name, m, n, rp, ci, values, first_row)
+    status = put_csr_0based(name, m, n, rp, ci, first_row, values=values)
   end function put_rows_csr_int64
 
   !> Fetches this rank's rows of the vector name into x, allocated (or
@@ -596,6 +739,16 @@ contains
     if (status == 0) status = put_envelope(name, e)
   end function put_dense
 
+  integer function put_dense_complex(name, m, n, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: m, n
+    complex(c_double_complex), intent(in) :: x(*)
+    type(silc_envelope_t) :: e
+    e = empty_envelope()
+    status = int(c_envelope_dense_complex(e, m, n, x))
+    if (status == 0) status = put_envelope(name, e)
+  end function put_dense_complex
+
   ! Deposits e and frees it whatever happens.
   integer function put_envelope(name, e) result(status)
     character(len=*), intent(in) :: name
@@ -607,29 +760,41 @@ contains
   ! Checks 1-based CSR, so a mistake is reported in the caller's own indices,
   ! then shifts rp and ci to 0-based in place and deposits: the whole value,
   ! or with first (1-based) the block of rows first..first+m-1 (silc_put_rows).
-  integer function put_csr_0based(name, m, n, rp, ci, values, first) result(status)
+  ! The values are real (values) or complex (zvalues): one of them is given.
+  integer function put_csr_0based(name, m, n, rp, ci, first, values, zvalues) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(in) :: m, n
     integer(c_int64_t), intent(inout) :: rp(:), ci(:)
-    real(c_double), intent(in) :: values(:)
     integer(c_int64_t), intent(in), optional :: first
+    real(c_double), intent(in), optional :: values(:)
+    complex(c_double_complex), intent(in), optional :: zvalues(:)
     type(silc_envelope_t) :: e
+    integer(c_int64_t) :: nvalues
 
+    if (present(zvalues)) then
+      nvalues = size(zvalues, kind=c_int64_t)
+    else
+      nvalues = size(values, kind=c_int64_t)
+    end if
     if (present(first)) then
-      status = check_csr('silc_put_rows: ', m, n, rp, ci, values)
+      status = check_csr('silc_put_rows: ', m, n, rp, ci, nvalues)
       if (status /= 0) then
         call spoil_put_rows(name)
         return
       end if
     else
-      status = check_csr('silc_put_csr: ', m, n, rp, ci, values)
+      status = check_csr('silc_put_csr: ', m, n, rp, ci, nvalues)
       if (status /= 0) return
     end if
     rp = rp - 1
     ci = ci - 1
     e = empty_envelope()
     ! colind/values may be empty: the C side reads nnz = rp(m+1) entries, none.
-    status = int(c_envelope_csr(e, m, n, rp, ci, values))
+    if (present(zvalues)) then
+      status = int(c_envelope_csr_complex(e, m, n, rp, ci, zvalues))
+    else
+      status = int(c_envelope_csr(e, m, n, rp, ci, values))
+    end if
     if (present(first)) then
       status = put_rows_envelope(name, first, e, status)
     else if (status == 0) then
@@ -637,11 +802,11 @@ contains
     end if
   end function put_csr_0based
 
-  ! The checks of put_csr_0based, messages prefixed with who.
-  integer function check_csr(who, m, n, rp, ci, values) result(status)
+  ! The checks of put_csr_0based (nvalues: the size of the values array),
+  ! messages prefixed with who.
+  integer function check_csr(who, m, n, rp, ci, nvalues) result(status)
     character(len=*), intent(in) :: who
-    integer(c_int64_t), intent(in) :: m, n, rp(:), ci(:)
-    real(c_double), intent(in) :: values(:)
+    integer(c_int64_t), intent(in) :: m, n, rp(:), ci(:), nvalues
     integer(c_int64_t) :: i, k, nnz
     integer(c_int64_t), allocatable :: seen(:)
 
@@ -669,10 +834,9 @@ contains
       end if
     end do
     nnz = rp(m + 1) - 1
-    if (size(ci, kind=c_int64_t) < nnz .or. size(values, kind=c_int64_t) < nnz) then
+    if (size(ci, kind=c_int64_t) < nnz .or. nvalues < nnz) then
       status = fail(who // 'rowptr(m+1) - 1 = ' // int_text(nnz) // ' entries but colind has ' // &
-                    int_text(size(ci, kind=c_int64_t)) // ' and values ' // &
-                    int_text(size(values, kind=c_int64_t)))
+                    int_text(size(ci, kind=c_int64_t)) // ' and values ' // int_text(nvalues))
       return
     end if
     ! seen(j) is the last row that used column j: duplicates found in O(nnz).
@@ -780,12 +944,30 @@ contains
     first = first0 + 1
   end function get_rows_envelope
 
-  integer function get_envelope(name, e) result(status)
+  ! Fetches name into e: a real value only (SILC_GET refuses a complex one,
+  ! naming it), or either field when accept_complex (silc_get_complex on
+  ! the default context).
+  integer function get_envelope(name, e, accept_complex) result(status)
     character(len=*), intent(in) :: name
     type(silc_envelope_t), intent(out) :: e
+    logical, intent(in), optional :: accept_complex
+    type(c_ptr) :: ctx
     e = empty_envelope()
+    status = 0
+    if (present(accept_complex)) then
+      if (accept_complex) then
+        status = default_context('silc_get: ', ctx)
+        if (status == 0) status = int(c_silc_get_complex(ctx, e, c_string(name)))
+        return
+      end if
+    end if
     status = int(c_silc_get(e, c_string(name)))
   end function get_envelope
+
+  logical function is_complex(e)
+    type(silc_envelope_t), intent(in) :: e
+    is_complex = iand(int(e%format), int(SILC_COMPLEX)) /= 0
+  end function is_complex
 
   ! Fetches name into x(1:m*n) if its shape is m x n (or n x m for a vector,
   ! when either_way); otherwise fails naming both shapes.
@@ -795,44 +977,96 @@ contains
     logical, intent(in) :: either_way
     real(c_double), intent(inout) :: x(*)
     type(silc_envelope_t) :: e
-    logical :: fits
     status = get_envelope(name, e)
     if (status /= 0) return
-    fits = e%m == m .and. e%n == n
-    if (either_way) fits = fits .or. (min(e%m, e%n) <= 1 .and. e%m * e%n == m * n)
-    if (fits) then
-      status = int(c_envelope_to_dense(e, x))
-    else
-      status = fail('silc_get: ''' // trim(name) // ''' is ' // &
-                    shape_text(c_envelope_rows(e), c_envelope_cols(e)) // ' but was asked into ' // &
-                    what // '; allocate it after silc_get_shape(name, m, n)')
-    end if
+    status = shape_fits(name, e, m, n, either_way, what)
+    if (status == 0) status = int(c_envelope_to_dense(e, x))
     call c_envelope_free(e)
   end function get_dense
 
+  ! get_dense for a complex array: a complex value, or a real one with
+  ! imaginary parts 0.  The envelope is made dense through a buffer of
+  ! doubles (silc_envelope_to_dense takes doubles: 2 an entry when complex).
+  integer function get_dense_complex(name, m, n, either_way, what, x) result(status)
+    character(len=*), intent(in) :: name, what
+    integer(c_int64_t), intent(in) :: m, n
+    logical, intent(in) :: either_way
+    complex(c_double_complex), intent(inout) :: x(*)
+    type(silc_envelope_t) :: e
+    real(c_double), allocatable :: buf(:)
+    status = get_envelope(name, e, accept_complex=.true.)
+    if (status /= 0) return
+    status = shape_fits(name, e, m, n, either_way, what)
+    if (status == 0) then
+      if (is_complex(e)) then
+        allocate(buf(2 * m * n))
+        status = int(c_envelope_to_dense(e, buf))
+        if (status == 0) x(1:m * n) = cmplx(buf(1::2), buf(2::2), c_double_complex)
+      else
+        allocate(buf(m * n))
+        status = int(c_envelope_to_dense(e, buf))
+        if (status == 0) x(1:m * n) = cmplx(buf, 0.0_c_double, c_double_complex)
+      end if
+    end if
+    call c_envelope_free(e)
+  end function get_dense_complex
+
+  ! 0 if e (the value of name) is m x n (or n x m for a vector, when
+  ! either_way); otherwise a failure naming both shapes.
+  integer function shape_fits(name, e, m, n, either_way, what) result(status)
+    character(len=*), intent(in) :: name, what
+    type(silc_envelope_t), intent(in) :: e
+    integer(c_int64_t), intent(in) :: m, n
+    logical, intent(in) :: either_way
+    logical :: fits
+    status = 0
+    fits = e%m == m .and. e%n == n
+    if (either_way) fits = fits .or. (min(e%m, e%n) <= 1 .and. e%m * e%n == m * n)
+    if (.not. fits) &
+      status = fail('silc_get: ''' // trim(name) // ''' is ' // &
+                    shape_text(c_envelope_rows(e), c_envelope_cols(e)) // ' but was asked into ' // &
+                    what // '; allocate it after silc_get_shape(name, m, n)')
+  end function shape_fits
+
   ! Fetches a CSR value; rp and ci point into e (0-based) until it is freed,
-  ! values is already copied out.
-  integer function get_csr_envelope(name, e, rp, ci, values) result(status)
+  ! the values are already copied out: into values (a real value only), or
+  ! into zvalues (either field; a real value's imaginary parts 0).
+  integer function get_csr_envelope(name, e, rp, ci, values, zvalues) result(status)
     character(len=*), intent(in) :: name
     type(silc_envelope_t), intent(out) :: e
     integer(c_int64_t), pointer, intent(out) :: rp(:), ci(:)
-    real(c_double), allocatable, intent(inout) :: values(:)
+    real(c_double), allocatable, intent(inout), optional :: values(:)
+    complex(c_double_complex), allocatable, intent(inout), optional :: zvalues(:)
     real(c_double), pointer :: v(:)
+    complex(c_double_complex), pointer :: z(:)
+    integer :: base
     nullify(rp, ci)
-    status = get_envelope(name, e)
+    status = get_envelope(name, e, accept_complex=present(zvalues))
     if (status /= 0) return
-    if (e%format /= SILC_CSR) then
+    base = iand(int(e%format), not(int(SILC_COMPLEX)))
+    if (base /= SILC_CSR) then
       status = fail('silc_get_csr: ''' // trim(name) // ''' is a ' // shape_text(e%m, e%n) // ' ' // &
-                    trim(merge('dense', 'band ', e%format == SILC_DENSE)) // &
+                    trim(merge('dense', 'band ', base == SILC_DENSE)) // &
                     ' matrix, not sparse; fetch it into a 2-D array with silc_get')
       call c_envelope_free(e)
       return
     end if
     call c_f_pointer(e%rowptr, rp, [e%m + 1])
     call c_f_pointer(e%colind, ci, [e%nnz])
-    call c_f_pointer(e%values, v, [e%nnz])
-    if (allocated(values)) deallocate(values)
-    values = v
+    if (present(zvalues)) then
+      if (allocated(zvalues)) deallocate(zvalues)
+      if (is_complex(e)) then
+        call c_f_pointer(e%values, z, [e%nnz])
+        zvalues = z
+      else
+        call c_f_pointer(e%values, v, [e%nnz])
+        zvalues = cmplx(v, 0.0_c_double, c_double_complex)
+      end if
+    else
+      call c_f_pointer(e%values, v, [e%nnz])
+      if (allocated(values)) deallocate(values)
+      values = v
+    end if
   end function get_csr_envelope
 
   subroutine replace_int(a, b)

@@ -394,7 +394,16 @@ int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, int accept_comple
     if (proto_send_text(c->fd, accept_complex ? PROTO_GET_COMPLEX : PROTO_GET, name, c->io_timeout_ms,
                         why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, e, NULL, NULL, NULL, 0, err, errlen);
+    if (await_reply(c, e, NULL, NULL, NULL, 0, err, errlen)) return -1;
+    /* A plain GET's caller reads real values only (silc.h): a server that
+     * answers it with a complex one breaks the protocol, and the caller
+     * must not read half of each entry. */
+    if (!accept_complex && silc_envelope_is_complex(e)) {
+        silc_envelope_free(e);
+        return bad_reply(c, PROTO_FATAL, "a complex value in reply to a GET, which asks for real "
+                         "values only", err, errlen);
+    }
+    return 0;
 }
 
 int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,

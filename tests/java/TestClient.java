@@ -5,8 +5,10 @@
  * norms, a sparse solve against its residual), errors as SILCException with
  * the server's message (and the session going on after each), output,
  * warnings, LIST/DELETE/INFO/EXPLAIN, GET into a ColumnVector, the seeds'
- * PUT/EXEC/GET loop on a 1-D diffusion against the exact solution, and a
- * connection the server refuses.
+ * PUT/EXEC/GET loop on a 1-D diffusion against the exact solution, complex
+ * values (ComplexCRS and ComplexMatrix in, a complex tridiagonal solve
+ * against its exact solution, bit-exact round trips, the plain GET of a
+ * complex value refused), and a connection the server refuses.
  *
  *     SILC_SERVER=unix:/path java -cp silc.jar:classes TestClient
  *
@@ -18,6 +20,8 @@ import java.util.Random;
 
 import silc.CRS;
 import silc.ColumnVector;
+import silc.ComplexCRS;
+import silc.ComplexMatrix;
 import silc.DenseMatrix;
 import silc.SILC;
 import silc.SILCException;
@@ -60,6 +64,85 @@ public final class TestClient {
             if (r + 1 < n) { i[k] = r; j[k] = r + 1; v[k++] = off; }
         }
         return CRS.fromTriplets(n, n, i, j, v, k);
+    }
+
+    /*
+     * Complex values (issue 31).  A Helmholtz-like complex tridiagonal A
+     * (diagonal 2.5 + 0.5i, off-diagonals -1 + 0.1i: complex symmetric and
+     * strictly diagonally dominant) with exact solution x_true = (1 + 2i, ...):
+     * b = A x_true, x = A \\ b must match x_true within 10 n eps cond_1(A).
+     * cond_1(A) is bounded without solving anything: ||A||_1 is the largest
+     * column sum of moduli and, A = A.' being diagonally dominant by rows
+     * and columns alike, ||A^-1||_1 <= 1 / min_i (|a_ii| - sum_j!=i |a_ij|)
+     * (Varah's bound).
+     */
+    private static void complexCases(SILC s) throws SILCException {
+        int n = 40;
+        int[] i = new int[3 * n], j = new int[3 * n];
+        double[] re = new double[3 * n], im = new double[3 * n];
+        int k = 0;
+        for (int r = 0; r < n; r++) {
+            i[k] = r; j[k] = r; re[k] = 2.5; im[k++] = 0.5;
+            if (r > 0) { i[k] = r; j[k] = r - 1; re[k] = -1; im[k++] = 0.1; }
+            if (r + 1 < n) { i[k] = r; j[k] = r + 1; re[k] = -1; im[k++] = 0.1; }
+        }
+        ComplexCRS A = ComplexCRS.fromTriplets(n, n, i, j, re, im, k);
+        double[] xt = new double[2 * n];
+        for (int r = 0; r < n; r++) {
+            xt[2 * r] = 1 + r % 3;
+            xt[2 * r + 1] = 2 - r % 5;
+        }
+        ComplexMatrix b = new ComplexMatrix(n, 1, A.times(xt));
+        s.PUT("Az", A);
+        s.PUT("bz", b);
+        s.EXEC("xz = Az \\ bz");
+        Value xv = s.GETComplex("xz");
+        double offSum = 2 * Math.hypot(-1, 0.1), cond1 = (Math.hypot(2.5, 0.5) + offSum) / (Math.hypot(2.5, 0.5) - offSum);
+        double err = 0, scale = 0;
+        if (xv instanceof ComplexMatrix x && x.m == n && x.n == 1)
+            for (int r = 0; r < n; r++) {
+                err = Math.max(err, Math.hypot(x.re(r, 0) - xt[2 * r], x.im(r, 0) - xt[2 * r + 1]));
+                scale = Math.max(scale, Math.hypot(xt[2 * r], xt[2 * r + 1]));
+            }
+        else
+            err = Double.NaN;
+        double bound = 10 * n * Math.ulp(1.0) * cond1;
+        check(xv instanceof ComplexMatrix && err / scale <= bound,
+              "complex solve: relative error " + err / scale + " bound " + bound + " (cond_1 " + cond1 + ")");
+
+        // Bit-for-bit round trips, CSR and dense; a signed zero and a subnormal part survive.
+        Value back = s.GETComplex("Az");
+        check(back instanceof ComplexCRS c && c.nnz() == A.nnz() && java.util.Arrays.equals(c.rowptr, A.rowptr)
+              && java.util.Arrays.equals(c.colind, A.colind) && java.util.Arrays.equals(c.val, A.val)
+              && c.re(3, 3) == 2.5 && c.im(3, 4) == 0.1 && c.re(3, 5) == 0,
+              "complex CSR round trip bit for bit");
+        ComplexMatrix Z = ComplexMatrix.ofParts(2, 3, new double[] {-0.0, 1, 2, 3, 4, 5},
+                                                new double[] {Double.MIN_VALUE, -1, 0.5, 1e300, -2, 0});
+        s.PUT("Z", Z);
+        back = s.GETComplex("Z");
+        boolean same = back instanceof ComplexMatrix d && d.m == 2 && d.n == 3;
+        if (same) {
+            double[] got = ((ComplexMatrix) back).a;
+            for (int q = 0; q < got.length; q++)
+                same &= Double.doubleToRawLongBits(got[q]) == Double.doubleToRawLongBits(Z.a[q]);
+        }
+        check(same && Z.re(1, 2) == 5 && Z.im(0, 2) == -2, "complex dense round trip bit for bit");
+        s.EXEC("Zt = Z.'; Zb = band(Az, 1, 1); zr = real(Z)");
+        check(s.GETComplex("Zt") instanceof ComplexMatrix t && t.m == 3 && t.n == 2 && t.re(2, 1) == 5
+              && t.im(2, 0) == -2, "a complex result comes back a ComplexMatrix");
+        check(s.GETComplex("Zb") instanceof ComplexMatrix d && d.m == n && d.re(3, 3) == 2.5 && d.im(3, 3) == 0.5
+              && d.im(4, 3) == 0.1 && d.re(5, 3) == 0, "a complex band value comes back dense");
+        check(s.GETComplex("zr") instanceof DenseMatrix d && d.get(1, 2) == 5,
+              "GETComplex of a real value is the real value");
+
+        // The plain GET takes real values only: a complex one is the server's
+        // error naming it, not half the data, and the session goes on.
+        expectError(() -> s.GET("Z"), "'Z' is complex", "plain GET of a complex value");
+        expectError(() -> s.GET(new ColumnVector(n), "xz"), "'xz' is complex", "GET into a vector of a complex value");
+        expectError(() -> s.PUT("bad", new ComplexCRS(2, 2, new int[] {0, 2, 2}, new int[] {1, 0},
+                                                        new double[] {1, 1, 2, 2})),
+                    "row 0", "unsorted complex CSR row named by the server");
+        check(s.GETComplex("Z") instanceof ComplexMatrix, "the session goes on");
     }
 
     /*
@@ -222,6 +305,8 @@ public final class TestClient {
             s.cancel(); // nothing running: nothing sent
             s.EXEC("ci = 2");
             check(s.GETScalar("ci") == 2, "an EXEC after cancel()");
+
+            complexCases(s);
         }
 
         // Names never leak between sessions; FINALIZE twice is harmless.

@@ -1,7 +1,7 @@
 /*
  * ClientsJava.java -- the Java client as tests/security/clients.py drives it
- * against its fake silcd: per case, INIT on URL, each call (get:NAME,
- * exec:TEXT), one line per call, "OK <format> <shape> ..." or "ERROR
+ * against its fake silcd: per case, INIT on URL, each call (get:NAME with
+ * GET, getc:NAME with GETComplex, exec:TEXT), one line per call, "OK <format> <shape> ..." or "ERROR
  * <exception>: <message>"; anything but a SILCException (an
  * OutOfMemoryError, a runtime exception) is printed as "ERROR not
  * SILCException ..." for the test to catch.
@@ -18,6 +18,7 @@ import java.util.Arrays;
 import java.util.List;
 
 import silc.CRS;
+import silc.ComplexMatrix;
 import silc.DenseMatrix;
 import silc.SILC;
 import silc.SILCException;
@@ -63,9 +64,12 @@ public final class ClientsJava {
                     System.out.println("OK exec");
                     continue;
                 }
-                Value v = s.GET(call.substring(4));
+                Value v = call.startsWith("getc:") ? s.GETComplex(call.substring(5)) : s.GET(call.substring(4));
                 if (v instanceof CRS c)
                     System.out.println("OK csr " + c.m + "x" + c.n + " nnz " + c.nnz());
+                else if (v instanceof ComplexMatrix z)
+                    System.out.println("OK complex dense " + z.m + "x" + z.n + " "
+                            + (z.a.length > 0 ? number(z.a[0]) + " " + number(z.a[1]) : "-"));
                 else if (v instanceof DenseMatrix d)
                     System.out.println("OK dense " + d.m + "x" + d.n + " " + (d.a.length > 0 ? number(d.a[0]) : "-"));
                 else

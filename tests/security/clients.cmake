@@ -4,9 +4,10 @@
 # bad nnz, a length that disagrees with its descriptor, a TEXT header
 # claiming 1 GiB, a 240 KB band value of 30000 x 30000, a value over the
 # client's cap, silence at the hello, before a reply, inside a frame and
-# after an EXEC, an unknown opcode, a hang-up mid-frame -- to the C client,
-# the Python client and the Java client (one check per reply per client), and
-# the CSR one to the Fortran binding.
+# after an EXEC, an unknown opcode, a hang-up mid-frame, a complex value whose
+# arrays have a real value's size, a complex value sent to a plain GET -- to
+# the C client, the Python client and the Java client (one check per reply
+# per client), and the CSR and complex ones to the Fortran binding.
 if(NOT SILC_SYSTEM_PYTHON)
   message(STATUS "SILC: client attack tests skipped (/usr/bin/python3 missing)")
   return()

@@ -1,7 +1,9 @@
 """clients.py -- hostile replies against every client (docs/security.md,
 "Replies a client gets"; issue 33): a fake silcd on a Unix socket in the
 build directory speaks the handshake, then answers each request with the
-case's hostile reply.  The client under test runs as its own process (the
+case's hostile reply (complex values too: a complex descriptor whose arrays
+have a real value's size, and a complex value sent to a plain GET, which
+asks for real values only).  The client under test runs as its own process (the
 C runner clients_c and the Fortran runner once per case, one Python child
 and one JVM for all cases), does the calls the case names and prints one line per call, "OK ..." or
 "ERROR <type>: <message>"; this script checks the exact error, that it is
@@ -51,6 +53,8 @@ def f64(*xs):
 
 
 SCALAR = value(0, 1, 1, 1, arrays=f64(7.0))
+COMPLEX = 16                     # the format bit of a complex value
+ZSCALAR = value(0 | COMPLEX, 1, 1, 1, arrays=f64(1.0, 2.0))
 # 512 x 512 dense, 2 MiB: over the 1 MiB cap the runner sets for over_cap.
 BIG = value(0, 512, 512, 512 * 512, arrays=bytes(8 * 512 * 512))
 
@@ -84,6 +88,21 @@ CASES = {
     "silent_exec": (["exec:x = 1"], [None], ["sent nothing for 1 s (SILC_EXEC_TIMEOUT"],
                     {"SILC_EXEC_TIMEOUT": "1"}),
     "unknown_op": (["get:A"], [frame(77, b"zz")], ["unknown reply opcode 77"], {}),
+    # Complex values (issue 31): "getc:" asks GET_COMPLEX.  A complex
+    # descriptor counts 16 bytes an entry, so arrays sized for a real value
+    # contradict it; a plain GET must never receive a complex value.
+    "complex_size": (["getc:Z"], [value(0 | COMPLEX, 2, 2, 4, arrays=f64(1, 2, 3, 4), length=DESC.size + 32)],
+                     ["VALUE reply carries 32 bytes of arrays, its descriptor needs 64"], {}),
+    "complex_csr_size": (["getc:Z"], [value(1 | COMPLEX, 2, 2, 1, arrays=i64(0, 1, 1) + i64(0) + f64(1.0),
+                                            length=DESC.size + 40)],
+                         ["VALUE reply carries 40 bytes of arrays, its descriptor needs 48"], {}),
+    "complex_to_get": (["get:Z"], [ZSCALAR], ["a complex value in reply to a GET"], {}),
+    "complex_ok": (["getc:Z"], [ZSCALAR], ["OK complex dense 1x1 1 2"], {}),
+    # Not hostile: a server older than complex values refuses GET_COMPLEX;
+    # Python's get, which always asks it, then asks the plain GET, and the
+    # session goes on.
+    "old_server": (["get:k", "get:k"], [frame(ERROR, b"unknown request opcode 10"), SCALAR, SCALAR],
+                   ["OK dense 1x1 7", "OK dense 1x1 7"], {}),
     # Not hostile: an EXEC that computes longer than the I/O timeout must
     # not be cut off by it (only SILC_EXEC_TIMEOUT bounds that wait).
     "slow_exec": (["exec:x = 1"], [("delay", 1.5, frame(OK, b""))], ["OK exec"],
@@ -93,10 +112,16 @@ CASES = {
 }
 
 
+# Cases for some clients only (the others have no such behaviour to test).
+ONLY = {"old_server": ("python",)}
+
 # Where a client's answer differs by design: Java has no band type, so a
 # band value comes back dense only under the cap, and this one (7.2 GB
 # dense) is refused, the session going on.
-WANT_FOR = {("java", "band_huge"): ["(SILC_MAX_REPLY_BYTES"]}
+WANT_FOR = {("java", "band_huge"): ["(SILC_MAX_REPLY_BYTES"],
+            # The Python client's get always asks GET_COMPLEX (it takes
+            # either field), so a complex reply to it is welcome.
+            ("python", "complex_to_get"): ["OK complex dense 1x1 1 2"]}
 
 
 class FakeServer:
@@ -202,11 +227,13 @@ for name, url, *rest in groups:
                 s.exec(arg, [])
                 print("OK exec")
                 continue
-            v = s._s.get(arg)                # the back end: no shape convention
+            v = s._s.get(arg)                # the back end: no shape convention (get and getc alike)
             if hasattr(v, "offsets"):
                 print("OK band %dx%d kl=%d ku=%d" % (v.shape + (-min(v.offsets), max(v.offsets))))
             elif hasattr(v, "tocsr"):
                 print("OK csr %dx%d nnz %d" % (v.shape + (v.nnz,)))
+            elif v.dtype.kind == "c":
+                print("OK complex dense %dx%d %g %g" % (v.shape + (v.flat[0].real, v.flat[0].imag)))
             else:
                 print("OK dense %dx%d %g" % (v.shape + (v.flat[0],)))
         except silc.Error as e:
@@ -260,7 +287,8 @@ def judge(client, case, path, rc, out, err):
 def main(argv):
     client, workdir, tail = argv[1], argv[2], argv[3:]
     os.makedirs(workdir, exist_ok=True)
-    cases = list(CASES) if client != "fortran" else ["csr_index"]
+    cases = ([case for case in CASES if client in ONLY.get(case, (client,))] if client != "fortran"
+             else ["csr_index", "complex_size", "complex_to_get"])
     paths = {case: os.path.join(workdir, "%s-%s.sock" % (client, case)) for case in cases}
     if client in ("python", "java"):
         # Every case in one process; Java's limits then come as setters, so

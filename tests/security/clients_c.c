@@ -1,9 +1,10 @@
 /*
  * clients_c.c -- the C client (libsilc's remote mode) as clients.py drives
  * it against its fake silcd: opens a remote context on URL, makes each call
- * (get:NAME, exec:TEXT) and prints one line per call, "OK <format> <shape>
- * ..." or "ERROR silc: <message>", and exits 0 by itself whatever the
- * server sent (a signal exit is what the test catches).
+ * (get:NAME with silc_get, getc:NAME with silc_get_complex, exec:TEXT) and
+ * prints one line per call, "OK <format> <shape> ..." or "ERROR silc:
+ * <message>", and exits 0 by itself whatever the server sent (a signal exit
+ * is what the test catches).
  *
  *     clients_c URL CALL...
  */
@@ -20,6 +21,9 @@ static void print_value(const silc_envelope_t *e)
     else if (e->format == SILC_CSR)
         printf("OK csr %lldx%lld nnz %lld\n", (long long)e->m, (long long)e->n,
                (long long)e->nnz);
+    else if (silc_envelope_is_complex(e))
+        printf("OK complex dense %lldx%lld %g %g\n", (long long)e->m, (long long)e->n,
+               e->m * e->n > 0 ? e->values[0] : 0.0, e->m * e->n > 0 ? e->values[1] : 0.0);
     else
         printf("OK dense %lldx%lld %g\n", (long long)e->m, (long long)e->n,
                e->m * e->n > 0 ? e->values[0] : 0.0);
@@ -43,7 +47,9 @@ int main(int argc, char **argv)
             else printf("OK exec\n");
         } else {
             silc_envelope_t e;
-            if (silc_get(ctx, &e, argv[i] + 4)) {
+            int complex_ok = strncmp(argv[i], "getc:", 5) == 0;
+            const char *name = strchr(argv[i], ':') + 1;
+            if (complex_ok ? silc_get_complex(ctx, &e, name) : silc_get(ctx, &e, name)) {
                 printf("ERROR silc: %s\n", silc_context_errmsg(ctx));
                 continue;
             }

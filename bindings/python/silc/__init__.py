@@ -15,7 +15,11 @@ computed n x 1 value is 1-D (as scipy.sparse.linalg.spsolve returns), a
 1 x 1 value is a Python float (unless it was put as a 2-D array, which comes
 back 2-D), CSR is a scipy.sparse csr_array (csr_matrix once the program
 puts csr_matrix values, or Session(sparse="matrix")), band is a dia_array.
-Complex input is refused.  Errors are silc.Error (KeyError too for a missing
+Complex values go in and come out as NumPy keeps them: a complex array
+(complex64 promoted to complex128) or a scipy.sparse matrix with complex data
+is stored complex, and a complex value comes back complex128 (a 1 x 1 one a
+Python complex); real values stay float64.  Arrays of other dtypes (object,
+strings) are refused, never converted by guess.  Errors are silc.Error (KeyError too for a missing
 name: silc.UndefinedName); a remote session's errors name the server.
 """
 import os
@@ -145,9 +149,11 @@ class Session:
     def put(self, name, value):
         """Deposits value under name (a copy): a number, a 1-D or 2-D numpy
         array, a scipy.sparse matrix or array, or (indptr, indices, data,
-        (m, n)).  ``s["A"] = value`` is the same.
+        (m, n)); float64, or complex128 when the dtype is complex.
+        ``s["A"] = value`` is the same.
 
         >>> s.put("b", np.ones(3))         # 3 x 1 in SILC, comes back 1-D
+        >>> s.put("z", np.array([1 + 2j, 3 - 1j]))   # complex 2 x 1
         """
         self._s.put(name, value)
         self._ndim[name] = _ndim_of(value)
@@ -164,7 +170,8 @@ class Session:
     def get(self, name):
         """The value bound to name: dense as numpy (1-D for an n x 1 value
         unless it was put 2-D, a float for 1 x 1 unless put 2-D), CSR as
-        csr_array (or csr_matrix, see the class), band as dia_array.
+        csr_array (or csr_matrix, see the class), band as dia_array; a
+        complex value as complex128 (1 x 1: a Python complex).
         ``s["x"]`` is the same; a missing name raises silc.UndefinedName,
         a KeyError.
 
@@ -178,7 +185,7 @@ class Session:
         if put_ndim == 2:
             return v
         if v.shape == (1, 1) and put_ndim != 1:
-            return float(v[0, 0])
+            return complex(v[0, 0]) if v.dtype.kind == "c" else float(v[0, 0])
         if v.shape[1] == 1:
             return v[:, 0]
         return v

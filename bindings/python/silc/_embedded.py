@@ -13,7 +13,7 @@ import threading
 
 import numpy as np
 
-from ._values import CSR, DENSE, SilcError, UndefinedName, from_parts, to_parts
+from ._values import COMPLEX, CSR, SilcError, UndefinedName, entry_dtype, from_parts, to_parts
 
 
 class _Envelope(ctypes.Structure):
@@ -73,7 +73,7 @@ def _library():
     for name, res, args in (("silc_open", ctypes.c_int, [ctypes.POINTER(vp), cp]),
                             ("silc_close", None, [ctypes.POINTER(vp)]),
                             ("silc_put", ctypes.c_int, [vp, cp, env]),
-                            ("silc_get", ctypes.c_int, [vp, env, cp]),
+                            ("silc_get_complex", ctypes.c_int, [vp, env, cp]),
                             ("silc_exec", ctypes.c_int, [vp, cp]),
                             ("silc_cancel", ctypes.c_int, [vp]),
                             ("silc_context_errmsg", cp, [vp]),
@@ -179,23 +179,26 @@ class EmbeddedSession:
 
     def put(self, name, value):
         fmt, m, n, arrays = to_parts(name, value)
+        # A complex128 array is already silc.h's interleaved doubles.
         e = _Envelope(m=m, n=n, format=fmt, nnz=len(arrays[-1]))
         dbl, i64 = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int64)
         e.values = arrays[-1].ctypes.data_as(dbl)
-        if fmt == CSR:
+        if fmt & ~COMPLEX == CSR:
             e.rowptr, e.colind = arrays[0].ctypes.data_as(i64), arrays[1].ctypes.data_as(i64)
         # silc_put copies: the arrays only need to live through the call
         self._check(self._lib.silc_put(self._ctx, name.encode(), ctypes.byref(e)))
 
     def get(self, name, sparse="array"):
+        # Either field: this client takes complex values (as complex128).
         e = _Envelope()
-        self._check(self._lib.silc_get(self._ctx, ctypes.byref(e), name.encode()))
+        self._check(self._lib.silc_get_complex(self._ctx, ctypes.byref(e), name.encode()))
         try:
-            if e.format == CSR:
-                arrays = [_copy(e.rowptr, e.m + 1, np.int64), _copy(e.colind, e.nnz, np.int64),
-                          _copy(e.values, e.nnz, np.float64)]
+            width = 2 if e.format & COMPLEX else 1
+            values = _copy(e.values, width * e.nnz, np.float64).view(entry_dtype(e.format))
+            if e.format & ~COMPLEX == CSR:
+                arrays = [_copy(e.rowptr, e.m + 1, np.int64), _copy(e.colind, e.nnz, np.int64), values]
             else:
-                arrays = [_copy(e.values, e.nnz, np.float64)]
+                arrays = [values]
             return from_parts(e.format, e.m, e.n, e.kl, e.ku, arrays, sparse)
         finally:
             self._lib.silc_envelope_free(ctypes.byref(e))

@@ -26,12 +26,13 @@ import threading
 
 import numpy as np
 
-from ._values import (CSR, DEFAULT_MAX_VALUE_BYTES, Error, ProtocolError, Timeout,
-                      UndefinedName, check_csr, from_parts, layout, over_cap, to_parts)
+from ._values import (COMPLEX, CSR, DEFAULT_MAX_VALUE_BYTES, Error, ProtocolError, Timeout,
+                      UndefinedName, as_doubles, check_csr, entry_dtype, from_parts, layout,
+                      over_cap, to_parts)
 
 SilcError = Error
 PROTOCOL_VERSION = 1
-PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE, CANCEL = range(1, 10)
+PUT, GET, EXEC, DELETE, LIST, INFO, EXPLAIN, BYE, CANCEL, GET_COMPLEX = range(1, 11)
 OK, ERROR, VALUE, TEXT, WARN = range(128, 133)
 _HEADER = struct.Struct("<IIQ")
 _HELLO = struct.Struct("<4sII")
@@ -123,6 +124,7 @@ class RemoteSession:
         # critical section.
         self._cancel_lock = threading.RLock()
         self._awaiting = False
+        self._old_server = False          # answers GET_COMPLEX "unknown request opcode"
         try:
             self.sock = self._connect(url)
         except OSError as e:
@@ -254,12 +256,14 @@ class RemoteSession:
             self._recv_exact(k)
             n -= k
 
-    def _read_value(self, length, sparse):
+    def _read_value(self, length, sparse, complex_ok):
         if length < _DESC.size:
             self._bad("VALUE reply shorter than its descriptor")
         fmt, namelen, m, n, nnz, kl, ku = _DESC.unpack(self._recv_exact(_DESC.size))
         if namelen != 0:
             self._bad("VALUE reply with a name length")
+        if fmt & COMPLEX and not complex_ok:
+            self._bad("a complex value in reply to a GET, which asks for real values only")
         try:
             rowptr_bytes, colind_bytes, values_bytes = layout(fmt, m, n, nnz, kl, ku)
         except ProtocolError as e:
@@ -273,29 +277,32 @@ class RemoteSession:
             # Well framed: skipped, so that the session keeps its values.
             self._skip(total)
             raise ProtocolError("silc server %s: reply refused: %s" % (self.url, refusal))
-        if fmt == CSR:
-            arrays = [np.empty(m + 1, dtype=np.int64), np.empty(nnz, dtype=np.int64),
-                      np.empty(nnz, dtype=np.float64)]
+        # Received as doubles (a complex value's interleaved), then viewed.
+        values = np.empty(values_bytes // 8, dtype=np.float64)
+        if fmt & ~COMPLEX == CSR:
+            arrays = [np.empty(m + 1, dtype=np.int64), np.empty(nnz, dtype=np.int64), values]
         else:
-            arrays = [np.empty(nnz, dtype=np.float64)]
+            arrays = [values]
         for a in arrays:
             self._recv_into(a)
-        if fmt == CSR:
+        arrays[-1] = values.view(entry_dtype(fmt))
+        if fmt & ~COMPLEX == CSR:
             try:
                 check_csr(arrays[0], arrays[1], m, n, nnz)
             except ProtocolError as e:
                 self._bad("'VALUE': %s" % e)
         return from_parts(fmt, m, n, kl, ku, arrays, sparse, self.max_value_bytes)
 
-    def _reply(self, out=None, first_wait=_IO, sparse="array"):
-        """Reads replies up to the final one; returns its text or value.  The
+    def _reply(self, out=None, first_wait=_IO, sparse="array", complex_ok=False):
+        """Reads replies up to the final one; returns its text or value (a
+        complex one only when complex_ok: the request was GET_COMPLEX).  The
         first byte of each reply may take first_wait seconds (exec)."""
         while True:
             op, flags, length = _HEADER.unpack(self._recv_exact(_HEADER.size, first_wait, False))
             if flags != 0:
                 self._bad("frame flags %d are not 0 (protocol version 1)" % flags)
             if op == VALUE:
-                return self._read_value(length, sparse)
+                return self._read_value(length, sparse, complex_ok)
             if op not in _OPS:
                 self._bad("unknown reply opcode %d" % op)
             if length > _MAX_TEXT:
@@ -322,11 +329,22 @@ class RemoteSession:
         nm = name.encode()
         fmt, m, n, arrays = to_parts(name, value)
         desc = _DESC.pack(fmt, len(nm), m, n, len(arrays[-1]), 0, 0)
-        self._send(PUT, desc, nm, *arrays)
+        self._send(PUT, desc, nm, *[as_doubles(a) for a in arrays])
         self._reply()
 
     def get(self, name, sparse="array"):
-        """The value bound to name (numpy array, or CSR as described above)."""
+        """The value bound to name (numpy array, or CSR as described above),
+        complex128 when it is complex: asked with GET_COMPLEX, which takes
+        either field.  A server older than complex values answers that
+        "unknown request opcode 10"; then the plain GET is asked."""
+        if not self._old_server:
+            self._send(GET_COMPLEX, name.encode())
+            try:
+                return self._reply(sparse=sparse, complex_ok=True)
+            except Error as e:
+                if str(e) != "unknown request opcode %d" % GET_COMPLEX:
+                    raise
+                self._old_server = True
         self._send(GET, name.encode())
         return self._reply(sparse=sparse)
 

@@ -3,7 +3,13 @@ both back ends (_remote, _embedded), and the package's errors.
 
 A value goes as its format, shape and arrays (CSR: int64 indptr, int64
 indices, float64 data; dense: float64 column-major), without a copy where
-the caller's arrays already are so.  What comes back is checked before any
+the caller's arrays already are so.  A complex value (any complex dtype,
+promoted to complex128) goes with the format's COMPLEX bit and its entries
+as NumPy stores complex128: real and imaginary part interleaved, SILC's own
+layout (silc.h).  The dtype decides the field; other dtypes than bool,
+integers, floats and complex (object, strings, dates) are refused, never
+converted by guess (forcing every array to float64 is what once dropped
+imaginary parts, issue 31).  What comes back is checked before any
 array is allocated or trusted, as silcd checks what it receives (the same
 rules and messages as core/client/protocol.c and core/store/envelope.c): a
 descriptor's sizes against its format and the client's cap, CSR structure
@@ -13,6 +19,7 @@ so that a hostile server cannot make scipy read out of bounds.
 import numpy as np
 
 DENSE, CSR, BAND = 0, 1, 2
+COMPLEX = 16               # the format bit of a complex value (docs/protocol.md)
 _FORMAT_NAMES = {DENSE: "dense", CSR: "csr", BAND: "band"}
 MAX_DIM = 1 << 40          # rows or columns of one value (docs/protocol.md)
 DEFAULT_MAX_VALUE_BYTES = 2 << 30
@@ -53,28 +60,24 @@ class Timeout(Error, TimeoutError):
     reply); the connection is closed."""
 
 
-def _is_complex(value):
-    dtype = getattr(value, "dtype", None)
-    if dtype is not None:
-        return np.dtype(dtype).kind == "c"
-    if isinstance(value, complex):
-        return True
-    if isinstance(value, (list, tuple)):
-        try:
-            return np.asarray(value).dtype.kind == "c"
-        except (TypeError, ValueError):
-            return False
-    return False
+def _stored_dtype(name, what, dtype):
+    """float64 for bool, integer and float dtypes, complex128 for complex
+    ones (complex64 promoted); anything else is refused naming it."""
+    kind = np.dtype(dtype).kind
+    if kind in "biuf":
+        return np.float64
+    if kind == "c":
+        return np.complex128
+    raise Error("'%s': cannot store a %s of dtype %s: SILC's values are float64 or complex128 "
+                "(convert it with .astype(float) or .astype(complex))" % (name, what, np.dtype(dtype)))
 
 
 def to_parts(name, value):
     """(format, m, n, arrays) of value: numpy (0-D: 1x1, 1-D: n x 1, 2-D),
-    a scipy.sparse matrix or array, or an (indptr, indices, data, (m, n))
-    tuple.  Complex values are refused: SILC's values are real."""
-    if _is_complex(value) or (isinstance(value, tuple) and len(value) == 4
-                              and _is_complex(value[2])):
-        raise Error("'%s': complex values are not supported (SILC's values are real); "
-                    "pass the real and imaginary parts as two values" % name)
+    a Python number or list, a scipy.sparse matrix or array (any format,
+    converted to CSR), or an (indptr, indices, data, (m, n)) tuple.  The
+    values array is float64, or complex128 with format | COMPLEX."""
+    what = type(value).__name__
     try:
         if hasattr(value, "tocsr") and hasattr(value, "shape"):
             c = value.tocsr()
@@ -82,12 +85,16 @@ def to_parts(name, value):
             value = (c.indptr, c.indices, c.data, c.shape)
         if isinstance(value, tuple) and len(value) == 4:
             indptr, indices, data, (m, n) = value
-            return CSR, int(m), int(n), [np.ascontiguousarray(indptr, dtype=np.int64),
-                                         np.ascontiguousarray(indices, dtype=np.int64),
-                                         np.ascontiguousarray(data, dtype=np.float64)]
-        a = np.asarray(value, dtype=np.float64)
+            data = np.asarray(data)
+            dtype = _stored_dtype(name, "sparse matrix", data.dtype)
+            return (CSR | (COMPLEX if dtype is np.complex128 else 0), int(m), int(n),
+                    [np.ascontiguousarray(indptr, dtype=np.int64),
+                     np.ascontiguousarray(indices, dtype=np.int64),
+                     np.ascontiguousarray(data, dtype=dtype)])
+        a = np.asarray(value)
+        a = a.astype(_stored_dtype(name, what, a.dtype), copy=False)
     except (TypeError, ValueError) as e:
-        raise Error("'%s': cannot store a %s: %s" % (name, type(value).__name__, e)) from None
+        raise Error("'%s': cannot store a %s: %s" % (name, what, e)) from None
     if a.ndim == 0:
         a = a.reshape(1, 1)
     elif a.ndim == 1:
@@ -96,17 +103,31 @@ def to_parts(name, value):
         raise Error("'%s': only scalars, vectors and matrices can be stored (got %d "
                     "dimensions)" % (name, a.ndim))
     m, n = a.shape
+    fmt = DENSE | (COMPLEX if a.dtype == np.complex128 else 0)
     # Column-major without a copy when it already is.
-    return DENSE, m, n, [a.reshape(-1, order="F") if a.flags.f_contiguous else
-                         np.asfortranarray(a).reshape(-1, order="F")]
+    return fmt, m, n, [a.reshape(-1, order="F") if a.flags.f_contiguous else
+                       np.asfortranarray(a).reshape(-1, order="F")]
+
+
+def as_doubles(a):
+    """A values array as the doubles that travel: complex128 viewed as
+    interleaved float64 (no copy), anything else as it is."""
+    return a.view(np.float64) if a.dtype == np.complex128 else a
+
+
+def entry_dtype(fmt):
+    """The dtype of a value's entries: complex128 when fmt has COMPLEX."""
+    return np.complex128 if fmt & COMPLEX else np.float64
 
 
 def layout(fmt, m, n, nnz, kl, ku):
     """(rowptr, colind, values) byte counts of a value descriptor, checked
-    as protocol.c's proto_layout_of checks it (same messages); raises
-    ProtocolError."""
-    if fmt not in _FORMAT_NAMES:
+    as protocol.c's proto_layout_of checks it (same messages); a complex
+    value (fmt | COMPLEX) has 16 bytes an entry; raises ProtocolError."""
+    entry = 16 if fmt & COMPLEX else 8
+    if fmt & ~COMPLEX not in _FORMAT_NAMES:
         raise ProtocolError("unknown value format %d" % fmt)
+    fmt &= ~COMPLEX
     if m < 0 or n < 0 or nnz < 0 or kl < 0 or ku < 0:
         raise ProtocolError("negative size in value descriptor (m = %d, n = %d, nnz = %d, "
                             "kl = %d, ku = %d)" % (m, n, nnz, kl, ku))
@@ -117,17 +138,17 @@ def layout(fmt, m, n, nnz, kl, ku):
             raise ProtocolError("dense %dx%d value declares %d entries" % (m, n, nnz))
         if kl or ku:
             raise ProtocolError("dense value with band widths")
-        return 0, 0, 8 * nnz
+        return 0, 0, entry * nnz
     if fmt == CSR:
         if kl or ku:
             raise ProtocolError("csr value with band widths")
         if nnz > (1 << 64) // 32:
             raise ProtocolError("csr value declares %d entries" % nnz)
-        return 8 * (m + 1), 8 * nnz, 8 * nnz
+        return 8 * (m + 1), 8 * nnz, entry * nnz
     if kl > 2**31 - 1 or ku > 2**31 - 1 or nnz != (kl + ku + 1) * n:
         raise ProtocolError("band %dx%d value with kl = %d, ku = %d declares %d entries"
                             % (m, n, kl, ku, nnz))
-    return 0, 0, 8 * nnz
+    return 0, 0, entry * nnz
 
 
 def over_cap(fmt, m, n, nbytes, cap):
@@ -136,7 +157,7 @@ def over_cap(fmt, m, n, nbytes, cap):
         return None
     return ("a %dx%d %s value of %d bytes, over the client's limit of %d bytes per value "
             "(SILC_MAX_REPLY_BYTES, Session(max_value_bytes=...))"
-            % (m, n, _FORMAT_NAMES[fmt], nbytes, cap))
+            % (m, n, _FORMAT_NAMES[fmt & ~COMPLEX], nbytes, cap))
 
 
 def check_csr(indptr, indices, m, n, nnz):
@@ -175,8 +196,10 @@ def from_parts(fmt, m, n, kl, ku, arrays, sparse="array", max_bytes=DEFAULT_MAX_
     array; CSR as scipy.sparse.csr_array (csr_matrix when sparse is
     "matrix"; the (indptr, indices, data, shape) tuple without scipy); band
     kept as band, scipy.sparse.dia_array (dia_matrix), whose data is the
-    LAPACK band storage itself -- without scipy, dense only if m*n doubles
-    fit max_bytes."""
+    LAPACK band storage itself -- without scipy, dense only if m*n entries
+    fit max_bytes.  The values array holds entry_dtype(fmt) entries
+    (complex128 for a complex value: its interleaved doubles viewed)."""
+    fmt &= ~COMPLEX
     if fmt == CSR:
         indptr, indices, data = arrays
         try:
@@ -198,10 +221,11 @@ def from_parts(fmt, m, n, kl, ku, arrays, sparse="array", max_bytes=DEFAULT_MAX_
         return kind((band, ku - np.arange(ld)), shape=(m, n))
     except ImportError:
         pass
-    if 8 * m * n > max_bytes:
+    dense_bytes = band.itemsize * m * n
+    if dense_bytes > max_bytes:
         raise Error("a %dx%d band value is %d bytes dense, over the client's limit of %d "
-                    "bytes (install scipy to get it as a dia_array)" % (m, n, 8 * m * n, max_bytes))
-    a = np.zeros((m, n))
+                    "bytes (install scipy to get it as a dia_array)" % (m, n, dense_bytes, max_bytes))
+    a = np.zeros((m, n), dtype=band.dtype)
     for j in range(n):
         for i in range(max(0, j - ku), min(m, j + kl + 1)):
             a[i, j] = band[ku + i - j, j]

@@ -8,8 +8,6 @@
  */
 package silc;
 
-import java.util.Arrays;
-
 /** A sparse m x n matrix in 0-based compressed rows; nnz = rowptr[m]. */
 public final class CRS implements Value {
     public final int m, n;
@@ -27,15 +25,7 @@ public final class CRS implements Value {
      * row) and names the row that is wrong.
      */
     public CRS(int m, int n, int[] rowptr, int[] colind, double[] val) {
-        if (m < 0 || n < 0) throw new IllegalArgumentException("CRS: negative size " + m + "x" + n);
-        if (rowptr == null || rowptr.length < m + 1)
-            throw new IllegalArgumentException("CRS: rowptr needs " + (m + 1) + " entries, got "
-                    + (rowptr == null ? "null" : rowptr.length));
-        int nnz = rowptr[m];
-        if (nnz < 0 || colind == null || val == null || colind.length < nnz || val.length < nnz)
-            throw new IllegalArgumentException("CRS: rowptr[m] = " + nnz + " entries, but colind has "
-                    + (colind == null ? "null" : colind.length) + " and val "
-                    + (val == null ? "null" : val.length));
+        Triplets.checkArrays("CRS", m, n, rowptr, colind, val, 1);
         this.m = m;
         this.n = n;
         this.rowptr = rowptr;
@@ -54,51 +44,14 @@ public final class CRS implements Value {
      * (a counting sort by row, then a sort within each row).
      */
     public static CRS fromTriplets(int m, int n, int[] i, int[] j, double[] v, int count) {
-        if (m < 0 || n < 0) throw new IllegalArgumentException("CRS.fromTriplets: negative size " + m + "x" + n);
-        if (count < 0 || count > i.length || count > j.length || count > v.length)
-            throw new IllegalArgumentException("CRS.fromTriplets: " + count + " entries, arrays hold "
-                    + Math.min(i.length, Math.min(j.length, v.length)));
-        int[] start = new int[m + 1];
-        for (int k = 0; k < count; k++) {
-            if (i[k] < 0 || i[k] >= m || j[k] < 0 || j[k] >= n)
-                throw new IllegalArgumentException("CRS.fromTriplets: entry " + k + " at (" + i[k] + ", " + j[k]
-                        + ") lies outside " + m + "x" + n);
-            start[i[k] + 1]++;
-        }
-        for (int r = 0; r < m; r++) start[r + 1] += start[r];
-        int[] fill = Arrays.copyOf(start, m);
-        long[] keyed = new long[count]; // column << 32 | entry, sorted within each row
-        for (int k = 0; k < count; k++) keyed[fill[i[k]]++] = ((long) j[k] << 32) | k;
-        int[] rowptr = new int[m + 1], colind = new int[count];
-        double[] val = new double[count];
-        int at = 0;
-        for (int r = 0; r < m; r++) {
-            Arrays.sort(keyed, start[r], start[r + 1]);
-            rowptr[r] = at;
-            for (int q = start[r]; q < start[r + 1]; q++) {
-                int col = (int) (keyed[q] >>> 32), k = (int) (keyed[q] & 0xffffffffL);
-                if (at > rowptr[r] && colind[at - 1] == col) {
-                    val[at - 1] += v[k];
-                } else {
-                    colind[at] = col;
-                    val[at++] = v[k];
-                }
-            }
-        }
-        rowptr[m] = at;
-        return new CRS(m, n, rowptr, colind, val);
+        Triplets.Rows r = Triplets.compress("CRS.fromTriplets", m, n, i, j, v, 1, count);
+        return new CRS(m, n, r.rowptr(), r.colind(), r.val());
     }
 
     /** Entry (i, j); 0 where nothing is stored. */
     public double get(int i, int j) {
-        int lo = rowptr[i], hi = rowptr[i + 1] - 1;
-        while (lo <= hi) {
-            int mid = (lo + hi) >>> 1;
-            if (colind[mid] == j) return val[mid];
-            if (colind[mid] < j) lo = mid + 1;
-            else hi = mid - 1;
-        }
-        return 0;
+        int at = Triplets.find(rowptr, colind, i, j);
+        return at < 0 ? 0 : val[at];
     }
 
     /** y = A x. */

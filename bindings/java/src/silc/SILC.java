@@ -10,6 +10,11 @@
  *         client.GET(sol, "x");                      // into an existing ColumnVector
  *     }
  *
+ * Complex values go in as ComplexMatrix or ComplexCRS (real and imaginary
+ * part interleaved, SILC's layout) and come out of GETComplex, which takes
+ * either field; the plain GET takes real values only, and a complex one is
+ * a SILCException naming it ("'z' is complex ..."), never half the data.
+ *
  * No JNI and no C library: any JVM that can open a socket can use SILC, and
  * this file is a third implementation of the protocol beside the C one and
  * bindings/python/silc.py.  Every failure is a checked SILCException whose
@@ -53,9 +58,11 @@ import java.util.function.Consumer;
 public final class SILC implements AutoCloseable {
     static final int PROTOCOL_VERSION = 1;
     static final int PUT = 1, GET = 2, EXEC = 3, DELETE = 4, LIST = 5, INFO = 6, EXPLAIN = 7, BYE = 8,
-            CANCEL = 9;
+            CANCEL = 9, GET_COMPLEX = 10;
     static final int OK = 128, ERROR = 129, VALUE = 130, TEXT = 131, WARN = 132;
     static final int DENSE = 0, CSR_FORMAT = 1, BAND = 2;
+    /** The format bit of a complex value: 2 doubles (re, im) an entry. */
+    static final int COMPLEX = 16;
     static final int DESCRIPTOR_BYTES = 48;
     /** Longest text reply accepted (the server's own limit on text). */
     static final long MAX_TEXT = 64L << 20;
@@ -242,16 +249,19 @@ public final class SILC implements AutoCloseable {
     public void PUT(String name, Value v) throws SILCException {
         if (v == null) throw new SILCException("PUT '" + name + "': null value");
         byte[] nm = text(name, "PUT");
-        int format, nnz;
+        int format, nnz, width = v instanceof ComplexMatrix || v instanceof ComplexCRS ? 2 : 1;
         long m = v.rows(), n = v.cols();
         if (v instanceof CRS a) {
             format = CSR_FORMAT;
             nnz = a.nnz();
+        } else if (v instanceof ComplexCRS a) {
+            format = CSR_FORMAT | COMPLEX;
+            nnz = a.nnz();
         } else {
-            format = DENSE;
+            format = width == 2 ? DENSE | COMPLEX : DENSE;
             nnz = (int) (m * n);
         }
-        long arrays = (format == CSR_FORMAT ? 8L * (m + 1) + 8L * nnz : 0) + 8L * nnz;
+        long arrays = ((format & ~COMPLEX) == CSR_FORMAT ? 8L * (m + 1) + 8L * nnz : 0) + 8L * width * nnz;
         try {
             header(PUT, DESCRIPTOR_BYTES + nm.length + arrays);
             buf.putInt(format).putInt(nm.length).putLong(m).putLong(n).putLong(nnz).putLong(0).putLong(0);
@@ -260,8 +270,14 @@ public final class SILC implements AutoCloseable {
                 putInts(a.rowptr, m + 1);
                 putInts(a.colind, nnz);
                 putDoubles(a.val, nnz);
+            } else if (v instanceof ComplexCRS a) {
+                putInts(a.rowptr, m + 1);
+                putInts(a.colind, nnz);
+                putDoubles(a.val, 2L * nnz);
             } else if (v instanceof DenseMatrix d) {
                 putDoubles(d.a, nnz);
+            } else if (v instanceof ComplexMatrix z) {
+                putDoubles(z.a, 2L * nnz);
             } else {
                 putDoubles(((ColumnVector) v).v, nnz);
             }
@@ -277,10 +293,20 @@ public final class SILC implements AutoCloseable {
         PUT(name, new DenseMatrix(1, 1, new double[] {x}));
     }
 
-    /** The value bound to name: a CRS, or a DenseMatrix (band values come dense). */
+    /** The real value bound to name: a CRS, or a DenseMatrix (band values come
+     *  dense); a complex value is refused (SILCException "'z' is complex ..."):
+     *  fetch it with GETComplex. */
     public Value GET(String name) throws SILCException {
         request(GET, text(name, "GET"));
         return (Value) reply(null, null);
+    }
+
+    /** The value bound to name, either field: a ComplexCRS or ComplexMatrix
+     *  (band values come dense) when it is complex, else as GET returns it.
+     *  A server older than complex values answers "unknown request opcode 10". */
+    public Value GETComplex(String name) throws SILCException {
+        request(GET_COMPLEX, text(name, "GETComplex"));
+        return (Value) reply(null, null, ioTimeoutMs, "SILC_IO_TIMEOUT", true);
     }
 
     /** Fills out with the n x 1 value bound to name (the seeds' GET(sol, "x")). */
@@ -304,7 +330,7 @@ public final class SILC implements AutoCloseable {
             awaitingExec = true;
         }
         try {
-            reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT");
+            reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT", false);
         } finally {
             synchronized (cancelLock) {
                 awaitingExec = false;
@@ -589,7 +615,7 @@ public final class SILC implements AutoCloseable {
      * ERROR's message.
      */
     private Object reply(Consumer<String> out, ColumnVector into) throws SILCException {
-        return reply(out, into, ioTimeoutMs, "SILC_IO_TIMEOUT");
+        return reply(out, into, ioTimeoutMs, "SILC_IO_TIMEOUT", false);
     }
 
     private static String opName(int op) {
@@ -602,7 +628,9 @@ public final class SILC implements AutoCloseable {
         };
     }
 
-    private Object reply(Consumer<String> out, ColumnVector into, long firstWaitMs, String var) throws SILCException {
+    /* complexOk: the request was GET_COMPLEX (a complex VALUE is welcome). */
+    private Object reply(Consumer<String> out, ColumnVector into, long firstWaitMs, String var, boolean complexOk)
+            throws SILCException {
         need();
         try {
             for (;;) {
@@ -610,7 +638,7 @@ public final class SILC implements AutoCloseable {
                 int op = buf.getInt(), flags = buf.getInt();
                 long length = buf.getLong();
                 if (flags != 0) throw bad("frame flags " + flags + " are not 0 (protocol version 1)");
-                if (op == VALUE) return readValue(length, into);
+                if (op == VALUE) return readValue(length, into, complexOk);
                 if (op != OK && op != ERROR && op != TEXT && op != WARN)
                     throw bad("unknown reply opcode " + op);
                 if (length < 0 || length > MAX_TEXT)
@@ -642,29 +670,32 @@ public final class SILC implements AutoCloseable {
         }
     }
 
-    /* A descriptor's array bytes, checked as protocol.c checks it (same messages). */
+    /* A descriptor's array bytes, checked as protocol.c checks it (same
+     * messages); a complex value (format | COMPLEX) has 16 bytes an entry. */
     private long layout(int format, long m, long n, long nnz, long kl, long ku) throws BadReply {
-        if (format < DENSE || format > BAND) throw bad("unknown value format " + format);
+        long entry = (format & COMPLEX) != 0 ? 16 : 8;
+        int base = format & ~COMPLEX;
+        if (base < DENSE || base > BAND) throw bad("unknown value format " + Integer.toUnsignedString(format));
         if (m < 0 || n < 0 || nnz < 0 || kl < 0 || ku < 0)
             throw bad("negative size in value descriptor (m = " + m + ", n = " + n + ", nnz = " + nnz
                     + ", kl = " + kl + ", ku = " + ku + ")");
         if (m > (1L << 40) || n > (1L << 40))
             throw bad("dimensions " + m + "x" + n + " exceed the protocol's limit of 2^40");
-        if (format == DENSE) {
-            if (Math.multiplyHigh(m, n) != 0 || m * n != nnz || nnz > Long.MAX_VALUE / 8)
+        if (base == DENSE) {
+            if (Math.multiplyHigh(m, n) != 0 || m * n != nnz || nnz > Long.MAX_VALUE / 16)
                 throw bad("dense " + m + "x" + n + " value declares " + nnz + " entries");
             if (kl != 0 || ku != 0) throw bad("dense value with band widths");
-            return 8 * nnz;
+            return entry * nnz;
         }
-        if (format == CSR_FORMAT) {
+        if (base == CSR_FORMAT) {
             if (kl != 0 || ku != 0) throw bad("csr value with band widths");
             if (nnz > Long.MAX_VALUE / 32) throw bad("csr value declares " + nnz + " entries");
-            return 8 * (m + 1) + 16 * nnz;
+            return 8 * (m + 1) + (8 + entry) * nnz;
         }
         if (kl > Integer.MAX_VALUE || ku > Integer.MAX_VALUE || Math.multiplyHigh(kl + ku + 1, n) != 0
-                || (kl + ku + 1) * n != nnz || nnz > Long.MAX_VALUE / 8)
+                || (kl + ku + 1) * n != nnz || nnz > Long.MAX_VALUE / 16)
             throw bad("band " + m + "x" + n + " value with kl = " + kl + ", ku = " + ku + " declares " + nnz + " entries");
-        return 8 * nnz;
+        return entry * nnz;
     }
 
     /* CSR arrays as the C library checks them, in its order and words. */
@@ -686,30 +717,35 @@ public final class SILC implements AutoCloseable {
             }
     }
 
-    private Value readValue(long length, ColumnVector into) throws IOException, SILCException {
+    private Value readValue(long length, ColumnVector into, boolean complexOk) throws IOException, SILCException {
         if (length < DESCRIPTOR_BYTES) throw bad("VALUE reply shorter than its descriptor");
         readFully(DESCRIPTOR_BYTES);
         int format = buf.getInt();
         int namelen = buf.getInt();
         long m = buf.getLong(), n = buf.getLong(), nnz = buf.getLong(), kl = buf.getLong(), ku = buf.getLong();
         if (namelen != 0) throw bad("VALUE reply with a name length");
+        boolean complex = (format & COMPLEX) != 0;
+        if (complex && !complexOk) throw bad("a complex value in reply to a GET, which asks for real values only");
         long arrays = layout(format, m, n, nnz, kl, ku);
+        int width = complex ? 2 : 1;
+        format &= ~COMPLEX;
         if (length - DESCRIPTOR_BYTES != arrays)
             throw bad("VALUE reply carries " + Long.toUnsignedString(length - DESCRIPTOR_BYTES)
                     + " bytes of arrays, its descriptor needs " + arrays);
         String shape = m + "x" + n;
         String name = format == CSR_FORMAT ? "csr" : format == BAND ? "band" : "dense";
         String refuse = null;
-        if (arrays > maxValueBytes || format == BAND && 8.0 * m * n > maxValueBytes)
+        if (arrays > maxValueBytes || format == BAND && 8.0 * width * m * n > maxValueBytes)
             refuse = "silc server " + url + ": reply refused: a " + shape + " " + name + " value of "
-                    + (format == BAND ? (long) (8.0 * m * n) + " bytes as a DenseMatrix" : arrays + " bytes")
+                    + (format == BAND ? (long) (8.0 * width * m * n) + " bytes as a "
+                            + (complex ? "ComplexMatrix" : "DenseMatrix") : arrays + " bytes")
                     + ", over the client's limit of " + maxValueBytes
                     + " bytes per value (SILC_MAX_REPLY_BYTES, setMaxValueBytes)";
         else if (into != null && (format != DENSE || n != 1 || m != into.v.length))
             refuse = "GET: the value is " + shape + (format == CSR_FORMAT ? " sparse" : "")
                     + ", the ColumnVector has " + into.v.length + " rows";
-        else if (nnz > Integer.MAX_VALUE - 8 || m > Integer.MAX_VALUE - 8
-                || format != CSR_FORMAT && m * n > Integer.MAX_VALUE - 8)
+        else if (width * nnz > Integer.MAX_VALUE - 8 || m > Integer.MAX_VALUE - 8
+                || format != CSR_FORMAT && width * m * n > Integer.MAX_VALUE - 8)
             refuse = "GET: a " + shape + " value does not fit a Java array";
         if (refuse != null) {
             skip(arrays); // the stream stays in step; the session goes on
@@ -717,30 +753,33 @@ public final class SILC implements AutoCloseable {
         }
         if (format == CSR_FORMAT) {
             int[] rowptr = new int[(int) m + 1], colind = new int[(int) nnz];
-            double[] val = new double[(int) nnz];
+            double[] val = new double[(int) (width * nnz)];
             readInts(rowptr, m + 1);
             readInts(colind, nnz);
-            readDoubles(val, nnz);
+            readDoubles(val, width * nnz);
             checkCsr(rowptr, colind, (int) m, (int) n, (int) nnz);
-            return new CRS((int) m, (int) n, rowptr, colind, val);
+            return complex ? new ComplexCRS((int) m, (int) n, rowptr, colind, val)
+                           : new CRS((int) m, (int) n, rowptr, colind, val);
         }
         if (format == DENSE) {
             if (into != null) {
                 readDoubles(into.v, nnz);
                 return into;
             }
-            double[] a = new double[(int) nnz];
-            readDoubles(a, nnz);
-            return new DenseMatrix((int) m, (int) n, a);
+            double[] a = new double[(int) (width * nnz)];
+            readDoubles(a, width * nnz);
+            return complex ? new ComplexMatrix((int) m, (int) n, a) : new DenseMatrix((int) m, (int) n, a);
         }
-        // Band, LAPACK layout: A(i, j) = band[ku + i - j + j * ld], dense under the cap (checked above).
-        double[] band = new double[(int) nnz];
-        readDoubles(band, nnz);
-        DenseMatrix d = new DenseMatrix((int) m, (int) n);
+        // Band, LAPACK layout: A(i, j) = band[ku + i - j + j * ld], dense under the cap (checked above);
+        // each entry is width doubles.
+        double[] band = new double[(int) (width * nnz)];
+        readDoubles(band, width * nnz);
+        double[] a = new double[(int) (width * m * n)];
         long ld = kl + ku + 1;
         for (int j = 0; j < n; j++)
             for (long i = Math.max(0, j - ku); i < Math.min(m, j + kl + 1); i++)
-                d.a[(int) (i + (long) j * m)] = band[(int) (ku + i - j + j * ld)];
-        return d;
+                for (int w = 0; w < width; w++)
+                    a[(int) (width * (i + (long) j * m) + w)] = band[(int) (width * (ku + i - j + j * ld) + w)];
+        return complex ? new ComplexMatrix((int) m, (int) n, a) : new DenseMatrix((int) m, (int) n, a);
     }
 }
