@@ -54,18 +54,21 @@ typedef struct silc_h5_file silc_h5_file;
 typedef struct silc_h5_api {
     size_t struct_size;         /* sizeof(silc_h5_api) of the module's build */
     int version;                /* SILC_H5_VERSION */
-    /* save: a new file at fd_path (the core's temporary, opened); one value
-     * written under name; closed (-1 when closing failed: the file is bad).
-     * path is the user's name of the file, for messages. */
+    /* save: create_file makes a new file at fd_path (the core's temporary,
+     * opened); write_value writes one value under name; close_file closes
+     * a file of either kind (-1 when closing a saved file failed: it is
+     * bad).  path is the user's name of the file, for messages. */
     silc_h5_file *(*create_file)(const char *fd_path, const char *path, char *err, size_t errlen);
     int (*write_value)(silc_h5_file *f, const char *name, const silc_h5_value *v, char *err, size_t errlen);
     int (*close_file)(silc_h5_file *f, char *err, size_t errlen);
-    /* load: opens a file read-only ("load: 'x' is not an HDF5 file");
-     * each calls each(ctx, name) for the names of the root group in name
-     * order, stopping at the first non-zero return; describe fills v's
-     * format, field and shape (no array) and sets *foreign when the object
-     * is none of SILC's layouts (a load of the whole file skips those);
-     * read fills the arrays of v, allocated by the caller for that claim. */
+    /* load: open_file opens a file read-only ("load: 'x' is not an HDF5
+     * file"); each_name calls each(ctx, name) for the names of the root
+     * group in name order, failing at the first non-zero return; describe
+     * fills v's format, field and shape (no array) and sets *foreign when
+     * the object is none of SILC's layouts (a load of the whole file skips
+     * those); read_value fills the arrays of v -- the claim describe gave,
+     * unchanged, with arrays the caller made for it -- and fails when the
+     * object no longer matches that claim. */
     silc_h5_file *(*open_file)(const char *fd_path, const char *path, char *err, size_t errlen);
     int (*each_name)(silc_h5_file *f, int (*each)(void *ctx, const char *name), void *ctx, char *err, size_t errlen);
     int (*describe)(silc_h5_file *f, const char *name, silc_h5_value *v, int *foreign, char *err, size_t errlen);
