@@ -7,7 +7,7 @@ if(SILC_SYSTEM_PYTHON AND TARGET silc_cli)
   if(_no_h5py EQUAL 0)
     add_test(NAME test_h5_python COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/test_h5.py
              $<TARGET_FILE:silc_cli>)
-    set_tests_properties(test_h5_python PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 120)
+    set_tests_properties(test_h5_python PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 300)
   else()
     message(STATUS "SILC: test_h5_python skipped (apt-get install python3-h5py)")
   endif()

@@ -343,10 +343,7 @@ static void test_language(void)
     expect_scalar(c, "t2", 0, 1, 0);
     expect_scalar(c, "t3", 3, 0, 0);
     expect_scalar(c, "last", 2, -3, 0);
-    /* HDF5 does not take complex values yet: refused, naming the value */
-    CHECK(silc_exec(c, "save \"complex_core.h5\" z") != 0 &&
-              (strstr(silc_context_errmsg(c), "'z' is complex") || strstr(silc_context_errmsg(c), "without HDF5")),
-          "save of a complex value: %s", silc_context_errmsg(c));
+    /* (complex values saved to and loaded from HDF5: tests/test_h5.c, test_h5.py) */
 
     /* complex dense and sparse solves, and a real A against a complex b */
     run(c, "A = [2+1i, 1, 0; -1, 3-2i, 1i; 0, 2, 4+1i]; b = [3+1i; 3+10i; 12+7i];"

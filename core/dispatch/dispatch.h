@@ -115,6 +115,11 @@ void ld_open_all(const silc_engine *E);
  * libsilc.so, or beside the bindir of a program that links the engine), if
  * there is one: 0 and the path in out, else -1 (a build tree). */
 int ld_installed_plugin_dir(char *out, size_t len);
+/* The plugin directories no session can change, ':'-separated: the
+ * installed one, or else the build tree's and the configured install
+ * directory.  The engine loads plugins from them first; the HDF5 module
+ * (lang/h5io.c) is opened from them only. */
+void ld_fixed_plugin_dirs(char *out, size_t len);
 const ld_backend *ld_find(const silc_engine *E, const char *full_name);
 size_t ld_backend_names(const silc_engine *E, const char ***names); /* malloc'd array */
 const ld_plugin *ld_find_plugin(const silc_engine *E, const char *plugin_name);

@@ -572,6 +572,22 @@ int ld_installed_plugin_dir(char *out, size_t len)
     return -1;
 }
 
+#ifndef SILC_PLUGIN_BUILD_DIR
+#define SILC_PLUGIN_BUILD_DIR "./plugins"
+#endif
+#ifndef SILC_PLUGIN_INSTALL_DIR
+#define SILC_PLUGIN_INSTALL_DIR "/usr/local/lib/silc"
+#endif
+
+void ld_fixed_plugin_dirs(char *out, size_t len)
+{
+    /* An installed engine's own install, wherever `cmake --install --prefix`
+     * put it; a build tree's engine the build tree's, then the configured
+     * install directory. */
+    if (ld_installed_plugin_dir(out, len) != 0)
+        snprintf(out, len, "%s", SILC_PLUGIN_BUILD_DIR ":" SILC_PLUGIN_INSTALL_DIR);
+}
+
 int ld_load_path(silc_engine *E, const char *dirs)
 {
     const char *p = dirs;

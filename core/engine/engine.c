@@ -17,12 +17,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#ifndef SILC_PLUGIN_BUILD_DIR
-#define SILC_PLUGIN_BUILD_DIR "./plugins"
-#endif
-#ifndef SILC_PLUGIN_INSTALL_DIR
-#define SILC_PLUGIN_INSTALL_DIR "/usr/local/lib/silc"
-#endif
 #include <limits.h>
 
 /* Seed of rand(): fixed so that scripts are reproducible run to run. */
@@ -63,9 +57,9 @@ static int eng_setup(silc_engine *E, const char *config_path)
      * build tree, then of the configured install directory.  These may
      * legitimately be absent; a directory the user named must work. */
     {
-        char here[PATH_MAX];
-        if (ld_installed_plugin_dir(here, sizeof here) == 0) ld_load_path(E, here);
-        else ld_load_path(E, SILC_PLUGIN_BUILD_DIR ":" SILC_PLUGIN_INSTALL_DIR);
+        char fixed[2 * PATH_MAX + 2];
+        ld_fixed_plugin_dirs(fixed, sizeof fixed);
+        ld_load_path(E, fixed);
     }
     E->err[0] = '\0';
     path = getenv("SILC_PLUGIN_PATH");
@@ -136,4 +130,5 @@ void eng_destroy(silc_engine **pE)
 void eng_open_plugins(silc_engine *E)
 {
     ld_open_all(E);
+    h5_module_open(); /* the HDF5 module too, when installed (silcd's sessions inherit it) */
 }

@@ -201,6 +201,10 @@ int h5_save(silc_engine *E, const char *path, const char *const *names, size_t n
 /* names[0..n) (n = 0: every object at the file's root) from path, bound
  * all or none.  0, or -1 with E->err naming the object. */
 int h5_load(silc_engine *E, const char *path, const char *const *names, size_t n);
+/* Opens the HDF5 module (libsilc_h5.so) now rather than at the first save
+ * or load, when it is installed (silcd's parent, before it forks sessions);
+ * says nothing when it is not: the statements do. */
+void h5_module_open(void);
 
 /*
  * ---- the memo (memo.c): repeated operations on unchanged operands return

@@ -57,6 +57,26 @@ if [ -f "$PREFIX/lib/silc/plugins/libsilc_plugin_lapack.so" ]; then
 fi
 echo "test_install: silc -e from the moved prefix, no environment: x = [1; 1]"
 
+# HDF5: libsilc does not link it; the installed module beside the plugins
+# is opened by the first save / load (found from the moved prefix), and
+# without it both say so, naming the directory searched.
+if readelf -d "$PREFIX/lib/libsilc.so.1" | grep -q "NEEDED.*libhdf5"; then
+  fail "libsilc links libhdf5 (save / load must open libsilc_h5.so on first use)"
+fi
+if [ -f "$PREFIX/lib/silc/plugins/libsilc_h5.so" ]; then
+  out=$(cd "$TOP" && env -i "$PREFIX/bin/silc" -e 'z = [1/3 + 2i; -7]; save "h5.h5" z; w = z; clear z; load "h5.h5"; d = max(abs(z - w))' --get d 2>&1) ||
+    { echo "$out"; fail "save / load from the moved prefix"; }
+  echo "$out" | grep -qx '0' || { echo "$out"; fail "a complex z saved and loaded from the moved prefix changed"; }
+  mv "$PREFIX/lib/silc/plugins/libsilc_h5.so" "$TOP/libsilc_h5.so.away"
+  out=$(cd "$TOP" && env -i "$PREFIX/bin/silc" -e 'z = 1; save "h5.h5" z' 2>&1) && fail "save without the module succeeded"
+  echo "$out" | grep -qF "save: HDF5 support is not installed (libsilc_h5.so not found in $PREFIX/lib/silc/plugins)" ||
+    { echo "$out"; fail "save without the module: wrong message"; }
+  mv "$TOP/libsilc_h5.so.away" "$PREFIX/lib/silc/plugins/libsilc_h5.so"
+  echo "test_install: save / load open the installed libsilc_h5.so from the moved prefix; without it, they say so"
+else
+  echo "test_install: SILC built without HDF5: the module's install not checked"
+fi
+
 SOCK=$TOP/silcd.sock
 env -i "$PREFIX/bin/silcd" --listen "unix:$SOCK" --ready-file "$TOP/ready" >"$TOP/silcd.log" 2>&1 &
 SILCD_PID=$!

@@ -52,7 +52,7 @@ run() {
 
 # ---- HDF5 in this build? (save/load say so without it) --------------------------
 have_h5=1
-if (cd "$D/w" && "$CLI" -e 'x = 1; save "probe.h5"' 2>&1 | grep -q "without HDF5"); then have_h5=0; fi
+if (cd "$D/w" && "$CLI" -e 'x = 1; save "probe.h5"' 2>&1 | grep -q "HDF5 support is not installed"); then have_h5=0; fi
 rm -f "$D/w/probe.h5"
 
 # ---- embedded: the temporary-file race (and the control for the canary) -----------
