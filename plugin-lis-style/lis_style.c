@@ -645,7 +645,9 @@ static const silc_backend lis_backends[] = {
 
 static const silc_option_spec lis_option_specs[] = {
     {"options", SILC_OPT_STRING, "",
-     "Lis option string, e.g. '-i bicgstab -p ilu -ilu_fill 1 -tol 1e-10 -maxiter 2000 -f quad'"},
+     "Lis option string, e.g. '-i bicgstab -p ilu -ilu_fill 1 -tol 1e-10 -maxiter 2000 -f quad'; complex "
+     "systems take -i cg (Hermitian), cocg (complex symmetric), bicgstab, gmres, fgmres with -p none, jacobi, "
+     "ilu, ilut, ssor"},
 };
 
 /* SOLVE takes complex values (the methods and preconditioners of lis.h's
