@@ -36,10 +36,11 @@
  * Complex values (ABI 1.8: complex_ops declares SOLVE): A, b and x hold
  * complex entries and the methods of lis.h's complex list run in complex
  * arithmetic (c.cplx).  The Hermitian-only CG and the complex symmetric
- * COCG look at A's properties first and decline a matrix that is not of
+ * COCG look at A's properties first and refuse a matrix that is not of
  * their kind, naming it, so the dispatcher's list moves on to the next
  * backend; a method or preconditioner with no complex form is refused by
- * name.  Without options a complex system gets CG (Hermitian, under an SPD
+ * name.  A real A never comes with a complex b (the host splits such a
+ * solve into two real ones); if it did, it is refused too.  Without options a complex system gets CG (Hermitian, under an SPD
  * class), COCG (complex symmetric) or BiCGSTAB, each with ILU(0).
  * Outcomes and messages are the real path's.
  *
@@ -223,8 +224,8 @@ static lis_solver_fn solver_fn_complex(int id)
     }
 }
 
-/* Column j of B (any format, sw doubles an entry) into b[0..m) of w doubles
- * an entry. */
+/* Column j of B (any format, sw doubles an entry) into b[0..m) of w >= sw
+ * doubles an entry. */
 static void column(const silc_view *B, int sw, int64_t j, double *b, int w)
 {
     int64_t i;
@@ -441,7 +442,7 @@ static int solve_run(silc_call *call)
             return H->error(call, SILC_EUNSUP, "lis-style: -f quad does not take complex values (double only)");
         pr = silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY);
         /* A method for another kind of matrix would break down or wander:
-         * decline it, so that the list's next backend takes the system. */
+         * refuse it, so that the list's next backend takes the system. */
         if (opt.solver == LIS_CG && !pr->hermitian)
             return H->error(call, SILC_EUNSUP, "lis-style CG needs a Hermitian matrix (A = A'), and this complex "
                             "one is not%s", pr->symmetric ? " (it is complex symmetric: -i cocg)"
@@ -450,6 +451,9 @@ static int solve_run(silc_call *call)
             return H->error(call, SILC_EUNSUP, "lis-style COCG needs a complex symmetric matrix (A = A.'), "
                             "and this one is not%s", pr->hermitian ? " (it is Hermitian: -i cg)"
                                                                    : " (-i bicgstab or gmres)");
+    } else if (is_complex(call->in[1]) || (call->nin >= 3 && is_complex(call->in[2]))) {
+        return H->error(call, SILC_EARG, "lis-style: a real matrix with a complex right-hand side or initial "
+                        "guess (the host splits such a solve into real ones)");
     } else if (opt.solver == LIS_COCG) {
         return H->error(call, SILC_EUNSUP, "lis-style: -i cocg is for complex symmetric matrices, and this one "
                         "is real (-i cg for a symmetric positive definite one)");
