@@ -6,13 +6,15 @@
  * Truth is independent of the code under test:
  *   - the 2-D Helmholtz problem of examples/helmholtz (complex symmetric,
  *     absorbing boundary; its assembly is linked, not copied) solved by
- *     lis-style's COCG, BiCGSTAB and GMRES, against the reference plugin's
+ *     lis-style's COCG, BiCGSTAB, GMRES and FGMRES with Jacobi, ILU(0),
+ *     ILU(1) and SSOR, against the reference plugin's
  *     direct complex LU of the same system, within 10 cond_1 tol (cond_1
  *     from that direct solve's estimate), and against the exact plane wave,
  *     whose discretization error (4.576e-02 at n = 32, k = 10,
  *     docs/complex.md) the iterative solution must reproduce;
  *   - the shared complex matrices with b = A x_true: young1c (general) by
- *     BiCGSTAB and GMRES, mhd1280b (Hermitian positive definite, cond_1
+ *     BiCGSTAB and GMRES with ILU(0) and ILUT (also as a dense A, which
+ *     lis-style converts), mhd1280b (Hermitian positive definite, cond_1
  *     6e12) by CG, each checked by a backward error this file computes
  *     itself and a forward error within 10 cond_1 tol; a method for another
  *     kind of matrix (CG on a non-Hermitian one, COCG on a general one) is
@@ -152,8 +154,9 @@ static void test_helmholtz(void)
     enum { N = 32 };
     const double k = 10, tol = 1e-10;
     const int64_t n = (N + 1) * (N + 1);
-    static const char *const methods[] = {"-i cocg -p ilu", "-i cocg -p jacobi", "-i bicgstab -p ilu",
-                                          "-i gmres -p ilu", "-i fgmres -p ilu"};
+    static const char *const methods[] = {"-i cocg -p ilu",       "-i cocg -p jacobi", "-i cocg -p ssor",
+                                          "-i cocg -p ilu -ilu_fill 1", "-i bicgstab -p ilu", "-i gmres -p ilu",
+                                          "-i gmres -p ssor",     "-i fgmres -p ilu"};
     silc_context *c = open_ctx();
     silc_envelope_t A;
     double complex *b = malloc((size_t)n * sizeof *b), *xd = malloc((size_t)n * sizeof *xd),
@@ -295,6 +298,13 @@ static void test_shared(void)
         check_method(c, &A, xt, b, cond, "young1c", "-i bicgstab -p ilu", 1e-10);
         check_method(c, &A, xt, b, cond, "young1c", "-i gmres -p ilu", 1e-10);
         check_method(c, &A, xt, b, cond, "young1c", "-i bicgstab -p ilut", 1e-10);
+        /* A dense complex A is converted to CSR (kept with A) and solved alike. */
+        run(c, "set dispatch.solve.dense = lis-style");
+        if (run(c, "x = solve(dense(A), b, \"lis-style.options = -i bicgstab -p ilu -tol 1e-10\")") == 0 &&
+            get_cvec(c, "x", x, A.n) == 0)
+            CHECK(cbackward(&A, x, b) <= 1e-9 && crel(x, xt, A.n) <= 10 * cond * 1e-10,
+                  "young1c dense by lis-style: backward error %.2g, forward %.2g", cbackward(&A, x, b),
+                  crel(x, xt, A.n));
         /* COCG needs A = A.': refused, the reference solves.  (A refusal
          * is a failure on A, which the dispatcher remembers: lis-style is
          * then skipped for A while a fallback is listed, so the next
