@@ -5,7 +5,8 @@
  *
  * The pieces, one file each:
  *   lis_options.c     the option string -> lis_options (Lis names and numbers)
- *   lis_kernels.c     double SpMV and vector kernels (OpenMP), host-free
+ *   lis_kernels.c     double SpMV and vector kernels (OpenMP), host-free,
+ *                     real and complex from one text (lis_kernels_t.h)
  *   lis_dd.c          double-double scalars and vector kernels
  *   lis_space.c       the solver's arithmetic: scalars and vectors that are
  *                     double or double-double depending on -f, convergence test
@@ -17,6 +18,14 @@
  *   lis_style.c       the plugin table, the SOLVE op, attachments, reports
  * Every solver is written once against the lis_space.c operations declared
  * here, so each one runs in double and in double-double.
+ *
+ * Complex values (ABI 1.8): CG (Hermitian positive definite), COCG (complex
+ * symmetric), BiCGSTAB, GMRES(m) and FGMRES(m), with no preconditioner,
+ * Jacobi, ILU(k), ILUT or SSOR, in double.  Those methods and the
+ * preconditioners are written once over lis_field.h's names
+ * (lis_krylov_t.h, lis_gmres_t.h, lis_precond_t.h) and included once per
+ * field; a complex vector is a lis_vec whose h holds n complex entries
+ * (2n doubles, interleaved) and the lvz_* operations below.
  */
 #ifndef LIS_H
 #define LIS_H
@@ -37,13 +46,13 @@ extern const silc_host_api *lis_host;
  * bicgstab 4, bicgstabl 5, gpbicg 6, tfqmr 7, orthomin 8, gmres 9, jacobi 10,
  * gs 11, sor 12, bicgsafe 13, cr 14, bicr 15, crs 16, bicrstab 17, gpbicr 18,
  * bicrsafe 19, fgmres 20, idrs 21, idr1 22, minres 23, cocg 24, cocr 25.
- * Not implemented here, and refused by name: bicgsafe, bicrsafe, and cocg
- * and cocr, which are for complex symmetric matrices. */
+ * Not implemented here, and refused by name: bicgsafe, bicrsafe and cocr.
+ * cocg (complex symmetric matrices) runs on complex values only. */
 enum lis_solver_id {
     LIS_CG = 1, LIS_BICG = 2, LIS_CGS = 3, LIS_BICGSTAB = 4, LIS_BICGSTABL = 5,
     LIS_GPBICG = 6, LIS_TFQMR = 7, LIS_ORTHOMIN = 8, LIS_GMRES = 9, LIS_JACOBI = 10,
     LIS_GS = 11, LIS_SOR = 12, LIS_CR = 14, LIS_BICR = 15, LIS_CRS = 16, LIS_BICRSTAB = 17,
-    LIS_GPBICR = 18, LIS_FGMRES = 20, LIS_IDRS = 21, LIS_IDR1 = 22, LIS_MINRES = 23
+    LIS_GPBICR = 18, LIS_FGMRES = 20, LIS_IDRS = 21, LIS_IDR1 = 22, LIS_MINRES = 23, LIS_COCG = 24
 };
 
 /* The BiCR family (BiCR, CRS, BiCRSTAB, GPBiCR) runs the code of BiCG, CGS,
@@ -122,6 +131,7 @@ void lis_precon_label(const lis_options *o, char *buf, size_t len);
  * entry in row r" in err (lis_precond.c). */
 void *lis_array(size_t count, size_t size);
 int lis_diagonal(const lk_csr *A, double *d, const char *what, char *err, size_t errlen);
+int lis_diagonal_z(const lk_csr *A, double complex *d, const char *what, char *err, size_t errlen);
 
 /* The SA-AMG hierarchy (lis_amg.c): symmetric A, or any with -saamg_unsym. */
 typedef struct lis_amg lis_amg;
@@ -138,6 +148,7 @@ void lis_amg_free(lis_amg *G);
 
 typedef struct lis_pc {
     int kind;                   /* enum lis_precon_id */
+    int cplx;                   /* 1: every value array below holds complex entries (2 doubles each) */
     int64_t n;
     double *dinv;               /* Jacobi: 1/a_ii; factors: 1/u_ii; SSOR: 1/a_ii */
     /* Factors of ILU(k), ILUT, IC(0): M = (I + L) D (I + D^-1 U) with L strictly
@@ -166,9 +177,14 @@ lis_matrix *lis_matrix_transpose(const lk_csr *A);
  * SILC_EBREAKDOWN with a message in err (zero diagonal; pivots that stay bad
  * even after diagonal shifts). */
 int lis_pc_build(const lk_csr *A, const lis_options *o, lis_pc **out, char *err, size_t errlen);
+/* The same for a complex A (values interleaved): Jacobi, ILU(k), ILUT, SSOR
+ * in complex arithmetic. */
+int lis_pc_build_z(const lk_csr *A, const lis_options *o, lis_pc **out, char *err, size_t errlen);
 void lis_pc_free(void *pc);
-void lis_pc_apply(const lis_pc *P, const double *x, double *y);   /* y = M^-1 x   */
-void lis_pc_apply_t(const lis_pc *P, const double *x, double *y); /* y = M^-T x   */
+/* y = M^-1 x, y = M^-T x; for a complex P (P->cplx) x and y hold complex
+ * entries, and only lis_pc_apply is defined (the complex methods need no M^-T). */
+void lis_pc_apply(const lis_pc *P, const double *x, double *y);
+void lis_pc_apply_t(const lis_pc *P, const double *x, double *y);
 
 /* ---- the solver's arithmetic (lis_space.c) ------------------------------------ */
 
@@ -186,6 +202,7 @@ typedef struct lis_ctx {
     const lis_options *o;
     int64_t n;
     int quad;
+    int cplx;                   /* 1: complex system (vectors of n complex entries; quad is 0) */
     lis_vec b;
     double den;                 /* denominator of the relative residual */
     double anorm;               /* ||A||inf, for -conv_cond backward */
@@ -228,6 +245,21 @@ dd lv_axpy2_nrm2(const lis_ctx *c, dd a, const lis_vec *p, const lis_vec *q, lis
                  lis_vec *r);                                 /* x += a p, r -= a q; ||r|| */
 dd lv_psolve_dot(lis_ctx *c, const lis_vec *r, lis_vec *z);             /* z = M^-1 r; r'z */
 
+/* The complex operations (lis_field.h's complex instance): scalars double
+ * complex; the dots conjugate x, or not when hermitian is 0 (COCG).  The
+ * vector-only operations above (new, copy, zero, nrm2, matvec, residual,
+ * psolve) serve both fields, by c->cplx. */
+double complex lvz_dot(const lis_ctx *c, const lis_vec *x, const lis_vec *y);        /* x^H y */
+void lvz_scale(const lis_ctx *c, double complex a, lis_vec *x);
+void lvz_axpy(const lis_ctx *c, double complex a, const lis_vec *x, lis_vec *y);
+void lvz_xpay(const lis_ctx *c, const lis_vec *x, double complex a, lis_vec *y);
+void lvz_waxpby(const lis_ctx *c, double complex a, const lis_vec *x, double complex b, const lis_vec *y,
+                lis_vec *w);
+double complex lvz_matvec_dot(const lis_ctx *c, const lis_vec *x, lis_vec *y, int hermitian);
+dd lvz_axpy2_nrm2(const lis_ctx *c, double complex a, const lis_vec *p, const lis_vec *q, lis_vec *x,
+                  lis_vec *r);
+double complex lvz_psolve_dot(lis_ctx *c, const lis_vec *r, lis_vec *z, int hermitian);
+
 /* One iteration finished with residual norm rnorm (absolute, 2-norm):
  * counts it, logs it under -print out, and returns LIS_CONVERGED, LIS_NAN or
  * -1 (go on).  lis_limit() says whether the iteration budget is spent. */
@@ -260,5 +292,12 @@ int lis_orthomin(lis_ctx *c, lis_vec *x);
 int lis_jacobi(lis_ctx *c, lis_vec *x);
 int lis_gs(lis_ctx *c, lis_vec *x);
 int lis_sor(lis_ctx *c, lis_vec *x);
+/* The complex instances (c->cplx): CG needs A Hermitian positive definite,
+ * COCG complex symmetric (A = A.'). */
+int lis_cg_z(lis_ctx *c, lis_vec *x);
+int lis_cocg_z(lis_ctx *c, lis_vec *x);
+int lis_bicgstab_z(lis_ctx *c, lis_vec *x);
+int lis_gmres_z(lis_ctx *c, lis_vec *x);
+int lis_fgmres_z(lis_ctx *c, lis_vec *x);
 
 #endif

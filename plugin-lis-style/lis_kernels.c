@@ -1,6 +1,9 @@
 /*
- * lis_kernels.c -- CSR SpMV and vector kernels in double precision, each a
- * `#pragma omp parallel for` over rows or entries.
+ * lis_kernels.c -- CSR SpMV and vector kernels in double precision, real
+ * and complex, each a `#pragma omp parallel for` over rows or entries.  The
+ * kernels whose arithmetic depends on the field are written once, in
+ * lis_kernels_t.h, and included here twice; the norm, copy and zero work on
+ * doubles alone and serve a complex vector as 2n doubles.
  *
  * Static scheduling with the same row split in every kernel keeps each
  * thread on the same part of every vector (first-touch locality); a 2-D
@@ -76,32 +79,6 @@ int lk_threads(void)
 #endif
 }
 
-void lk_spmv(const lk_csr *A, const double *x, double *y)
-{
-    const int64_t *rp = A->rp, *ci = A->ci;
-    const double *v = A->v;
-    int64_t i, m = A->m;
-    LK_FOR(m, i, double s = 0.0; for (int64_t k = rp[i]; k < rp[i + 1]; k++) s += v[k] * x[ci[k]];
-           y[i] = s);
-}
-
-void lk_residual(const lk_csr *A, const double *b, const double *x, double *r)
-{
-    const int64_t *rp = A->rp, *ci = A->ci;
-    const double *v = A->v;
-    int64_t i, m = A->m;
-    LK_FOR(m, i, double s = b[i]; for (int64_t k = rp[i]; k < rp[i + 1]; k++) s -= v[k] * x[ci[k]];
-           r[i] = s);
-}
-
-double lk_dot(int64_t n, const double *x, const double *y)
-{
-    double s = 0.0;
-    int64_t i;
-    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(+ : s)", s += x[i] * y[i]);
-    return s;
-}
-
 /* ||x||_2 that neither overflows nor underflows (as LAPACK's dnrm2).  The
  * plain sum of squares is exact enough whenever it lands in [1e-290, 1e290]:
  * squares that underflowed were then below 1e-18 of it.  Outside that range
@@ -140,60 +117,10 @@ void lk_zero(int64_t n, double *y)
     LK_FOR(n, i, y[i] = 0.0);
 }
 
-void lk_scale(int64_t n, double a, double *x)
-{
-    int64_t i;
-    LK_FOR(n, i, x[i] *= a);
-}
-
-void lk_axpy(int64_t n, double a, const double *x, double *y)
-{
-    int64_t i;
-    LK_FOR(n, i, y[i] += a * x[i]);
-}
-
-void lk_xpay(int64_t n, const double *x, double a, double *y)
-{
-    int64_t i;
-    LK_FOR(n, i, y[i] = x[i] + a * y[i]);
-}
-
-void lk_waxpby(int64_t n, double a, const double *x, double b, const double *y, double *w)
-{
-    int64_t i;
-    LK_FOR(n, i, w[i] = a * x[i] + b * y[i]);
-}
-
-/* The fused kernels.  A CG iteration with Jacobi made of the single
- * kernels above sweeps its vectors eight times; these make it four, which
- * is what a hand-written CG does (docs/cloth.md measured the difference on
- * the cloth: 1.3x). */
-double lk_spmv_dot(const lk_csr *A, const double *x, double *y)
-{
-    const int64_t *rp = A->rp, *ci = A->ci;
-    const double *v = A->v;
-    int64_t i, m = A->m;
-    double d = 0.0;
-    LK_REDUCE(m, i, "omp parallel for schedule(static) reduction(+ : d)", double s = 0.0;
-              for (int64_t k = rp[i]; k < rp[i + 1]; k++) s += v[k] * x[ci[k]];
-              y[i] = s; d += x[i] * s);
-    return d;
-}
-
-double lk_axpy2_sumsq(int64_t n, double a, const double *p, const double *q, double *x, double *r)
-{
-    double s = 0.0;
-    int64_t i;
-    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(+ : s)", x[i] += a * p[i];
-              r[i] -= a * q[i]; s += r[i] * r[i]);
-    return s;
-}
-
-double lk_mul_dot(int64_t n, const double *d, const double *r, double *z)
-{
-    double s = 0.0;
-    int64_t i;
-    LK_REDUCE(n, i, "omp parallel for schedule(static) reduction(+ : s)", z[i] = d[i] * r[i];
-              s += r[i] * z[i]);
-    return s;
-}
+/* The kernels whose arithmetic depends on the field, once real, once complex. */
+#include <complex.h>
+#undef LK_COMPLEX
+#include "lis_kernels_t.h"
+#define LK_COMPLEX
+#include "lis_kernels_t.h"
+#undef LK_COMPLEX

@@ -1,7 +1,7 @@
 /*
  * lis_kernels.h -- the double-precision kernels of plugin-lis-style: CSR
  * matrix-vector product and the BLAS-1 vector operations the Krylov solvers
- * are made of, parallel with OpenMP.
+ * are made of, parallel with OpenMP, real and (the _z names) complex.
  *
  * The kernels know nothing of SILC (plain arrays and an int64 CSR), so
  * bench/iterative.c compiles this file on its own to time the very kernel the
@@ -10,9 +10,11 @@
 #ifndef LIS_KERNELS_H
 #define LIS_KERNELS_H
 
+#include <complex.h>
 #include <stdint.h>
 
-/* A borrowed CSR matrix: rp[m+1], ci[nnz] (0-based, sorted per row), v[nnz]. */
+/* A borrowed CSR matrix: rp[m+1], ci[nnz] (0-based, sorted per row), v[nnz]
+ * (2 nnz doubles, re and im interleaved, for the complex kernels). */
 typedef struct lk_csr {
     int64_t m, n;
     const int64_t *rp;
@@ -41,5 +43,24 @@ double lk_spmv_dot(const lk_csr *A, const double *x, double *y);        /* y = A
 double lk_axpy2_sumsq(int64_t n, double a, const double *p, const double *q, double *x,
                       double *r);                       /* x += a p, r -= a q; r'r */
 double lk_mul_dot(int64_t n, const double *d, const double *r, double *z); /* z = d.*r; r'z */
+
+/* The complex twins (lis_kernels_t.h), vectors of n complex entries: the
+ * inner products conjugate their first operand (x^H y) except lk_dotu_z
+ * (x.' y) and the fused ones with conjugate = 0.  Norms, copies and zeroing
+ * are the real kernels over 2n doubles. */
+void lk_spmv_z(const lk_csr *A, const double complex *x, double complex *y);
+void lk_residual_z(const lk_csr *A, const double complex *b, const double complex *x, double complex *r);
+double complex lk_dot_z(int64_t n, const double complex *x, const double complex *y);
+double complex lk_dotu_z(int64_t n, const double complex *x, const double complex *y);
+void lk_scale_z(int64_t n, double complex a, double complex *x);
+void lk_axpy_z(int64_t n, double complex a, const double complex *x, double complex *y);
+void lk_xpay_z(int64_t n, const double complex *x, double complex a, double complex *y);
+void lk_waxpby_z(int64_t n, double complex a, const double complex *x, double complex b, const double complex *y,
+                 double complex *w);
+double complex lk_spmv_dot_z(const lk_csr *A, const double complex *x, double complex *y, int conjugate);
+double lk_axpy2_sumsq_z(int64_t n, double complex a, const double complex *p, const double complex *q,
+                        double complex *x, double complex *r);
+double complex lk_mul_dot_z(int64_t n, const double complex *d, const double complex *r, double complex *z,
+                            int conjugate);
 
 #endif

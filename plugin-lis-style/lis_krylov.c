@@ -4,7 +4,8 @@
  * shadow residual (initial_shadow) BiCR, CRS, BiCRSTAB and GPBiCR.
  *
  * Each is written once in the arithmetic of lis_space.c, so it runs in double or
- * double-double (-f quad).  Preconditioning follows the usual formulations:
+ * double-double (-f quad); CG, COCG and BiCGSTAB are in lis_krylov_t.h,
+ * included here once real and once complex.  Preconditioning follows the usual formulations:
  * CG, BiCG, CGS, BiCGSTAB, MINRES and IDR(s) as in the Templates book and the
  * original papers (the iterate x is updated directly); BiCGSTAB(l), GPBiCG
  * and TFQMR are run on the right-preconditioned operator A M^-1 with the
@@ -40,6 +41,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lis_field.h" /* real: the methods below; the templates are included once per field */
+
 /* Every solver loop is: work, then `STEP(norm)`, which leaves the loop with
  * the outcome when the method converged or produced NaN. */
 #define STEP(nrm)                                  \
@@ -50,13 +53,13 @@
     } while (0)
 #define FAIL(v, why)                               \
     do {                                           \
-        st = lis_fail(c, (v), (why));              \
+        st = lis_fail(c, S_DD(v), (why));          \
         goto out;                                  \
     } while (0)
 /* Breakdown: a quantity the method divides by is zero or NaN. */
 #define FAIL_IF_ZERO(v, why)                       \
     do {                                           \
-        if (s_zero(v) || (v).hi != (v).hi) FAIL((v), (why)); \
+        if (S_BAD(v)) FAIL((v), (why));            \
     } while (0)
 
 /* y = A M^-1 x (right preconditioning); t is scratch. */
@@ -93,31 +96,14 @@ static void initial_shadow(lis_ctx *c, const lis_vec *r, lis_vec *rt, lis_vec *t
     }
 }
 
-/* ---- CG ---------------------------------------------------------------------- */
+/* ---- CG, COCG and BiCGSTAB, real and complex (lis_krylov_t.h) ---------------- */
 
-int lis_cg(lis_ctx *c, lis_vec *x)
-{
-    lis_vec v[4], *r = &v[0], *z = &v[1], *p = &v[2], *q = &v[3];
-    dd rho, rho1, pq, alpha;
-    int st = LIS_MAXITER;
-    if (lv_new_many(c, v, 4)) return LIS_NOMEM;
-    lv_residual(c, x, r);
-    rho = lv_psolve_dot(c, r, z);
-    lv_copy(c, z, p);
-    while (!lis_limit(c)) {
-        pq = lv_matvec_dot(c, p, q);
-        if (!(pq.hi > 0)) FAIL(pq, "p'Ap <= 0: A or the preconditioner is not positive definite");
-        alpha = s_div(c, rho, pq);
-        STEP(lv_axpy2_nrm2(c, alpha, p, q, x, r));
-        rho1 = lv_psolve_dot(c, r, z);
-        FAIL_IF_ZERO(rho1, "r'M^-1 r = 0");
-        lv_xpay(c, z, s_div(c, rho1, rho), p);
-        rho = rho1;
-    }
-out:
-    lv_free_many(v, 4);
-    return st;
-}
+#define LIS_COMPLEX
+#include "lis_field.h"
+#include "lis_krylov_t.h"
+#undef LIS_COMPLEX
+#include "lis_field.h"
+#include "lis_krylov_t.h"
 
 /* ---- CR ------------------------------------------------------------------------ */
 
@@ -237,58 +223,6 @@ int lis_cgs(lis_ctx *c, lis_vec *x)
         lv_axpy(c, dd_neg(alpha), t, r);
         rho_old = rho;
         STEP(lv_nrm2(c, r));
-    }
-out:
-    lv_free_many(v, 8);
-    return st;
-}
-
-/* ---- BiCGSTAB ------------------------------------------------------------------ */
-
-int lis_bicgstab(lis_ctx *c, lis_vec *x)
-{
-    lis_vec v[8];
-    lis_vec *r = &v[0], *rt = &v[1], *p = &v[2], *ph = &v[3], *w = &v[4], *s = &v[5],
-            *sh = &v[6], *t = &v[7];
-    dd rho, rho_old = dd_d(1), alpha = dd_d(1), omega = dd_d(1), sig, tt, beta, snrm;
-    int st = LIS_MAXITER, first = 1;
-    if (lv_new_many(c, v, 8)) return LIS_NOMEM;
-    lv_residual(c, x, r);
-    initial_shadow(c, r, rt, t, 0);
-    while (!lis_limit(c)) {
-        rho = lv_dot(c, rt, r);
-        FAIL_IF_ZERO(rho, "rho = (r~, r) = 0");
-        if (first) {
-            lv_copy(c, r, p);
-            first = 0;
-        } else {
-            beta = s_mul(c, s_div(c, rho, rho_old), s_div(c, alpha, omega));
-            lv_axpy(c, dd_neg(omega), w, p);        /* p = r + beta (p - omega v) */
-            lv_xpay(c, r, beta, p);
-        }
-        lv_psolve(c, p, ph);
-        lv_matvec(c, ph, w);
-        sig = lv_dot(c, rt, w);
-        FAIL_IF_ZERO(sig, "(r~, A M^-1 p) = 0");
-        alpha = s_div(c, rho, sig);
-        lv_waxpby(c, dd_d(1), r, dd_neg(alpha), w, s);
-        snrm = lv_nrm2(c, s);
-        if (snrm.hi / c->den <= c->o->tol) {       /* converged half way */
-            lv_axpy(c, alpha, ph, x);
-            lv_copy(c, s, r);
-            STEP(snrm);
-        }
-        lv_psolve(c, s, sh);
-        lv_matvec(c, sh, t);
-        tt = lv_dot(c, t, t);
-        FAIL_IF_ZERO(tt, "(t, t) = 0");
-        omega = s_div(c, lv_dot(c, t, s), tt);
-        lv_axpy(c, alpha, ph, x);
-        lv_axpy(c, omega, sh, x);
-        lv_waxpby(c, dd_d(1), s, dd_neg(omega), t, r);
-        rho_old = rho;
-        STEP(lv_nrm2(c, r));
-        if (s_zero(omega)) FAIL(omega, "omega = 0");
     }
 out:
     lv_free_many(v, 8);

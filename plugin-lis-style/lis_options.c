@@ -31,7 +31,7 @@ static const named solvers[] = {
     {"bicgsafe", 13, 0},         {"cr", 14, LIS_CR},          {"bicr", 15, LIS_BICR},
     {"crs", 16, LIS_CRS},        {"bicrstab", 17, LIS_BICRSTAB}, {"gpbicr", 18, LIS_GPBICR},
     {"bicrsafe", 19, 0},         {"fgmres", 20, LIS_FGMRES},  {"idrs", 21, LIS_IDRS},
-    {"idr1", 22, LIS_IDR1},      {"minres", 23, LIS_MINRES},  {"cocg", 24, 0},
+    {"idr1", 22, LIS_IDR1},      {"minres", 23, LIS_MINRES},  {"cocg", 24, LIS_COCG},
     {"cocr", 25, 0},             {NULL, 0, 0}};
 
 static const named precons[] = {
@@ -387,6 +387,7 @@ const char *lis_solver_name(int solver)
     case LIS_IDRS: return "IDR(s)";
     case LIS_IDR1: return "IDR(1)";
     case LIS_MINRES: return "MINRES";
+    case LIS_COCG: return "COCG";
     case LIS_ORTHOMIN: return "Orthomin(m)";
     case LIS_CR: return "CR";
     case LIS_BICR: return "BiCR";

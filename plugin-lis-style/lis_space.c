@@ -7,6 +7,11 @@
  * lis_dd.c counterpart.  The preconditioner is always applied in double (as
  * Lis does): in quad mode its input is the high part of the vector and its
  * output is promoted with a zero low part.
+ *
+ * A complex system (c->cplx) has vectors of n complex entries, 2n doubles
+ * interleaved in h (never quad): the operations on vectors alone branch on
+ * the field; those with complex scalars are the lvz_* ones at the end,
+ * one call each into lis_kernels_t.h's complex instance.
  */
 #include "lis.h"
 
@@ -18,9 +23,15 @@ static double *alloc_zero(int64_t n)
     return lis_host->calloc(n > 0 ? (size_t)n : 1, sizeof(double));
 }
 
+/* Doubles in a vector's h. */
+static int64_t doubles(const lis_ctx *c)
+{
+    return c->cplx ? 2 * c->n : c->n;
+}
+
 int lv_new(lis_ctx *c, lis_vec *v)
 {
-    v->h = alloc_zero(c->n);
+    v->h = alloc_zero(doubles(c));
     v->l = c->quad ? alloc_zero(c->n) : NULL;
     if (!v->h || (c->quad && !v->l)) {
         lv_free(v);
@@ -56,13 +67,13 @@ void lv_free_many(lis_vec *v, int count)
 
 void lv_copy(const lis_ctx *c, const lis_vec *x, lis_vec *y)
 {
-    lk_copy(c->n, x->h, y->h);
+    lk_copy(doubles(c), x->h, y->h);
     if (c->quad) lk_copy(c->n, x->l, y->l);
 }
 
 void lv_zero(const lis_ctx *c, lis_vec *y)
 {
-    lk_zero(c->n, y->h);
+    lk_zero(doubles(c), y->h);
     if (c->quad) lk_zero(c->n, y->l);
 }
 
@@ -101,15 +112,20 @@ dd lv_dot(const lis_ctx *c, const lis_vec *x, const lis_vec *y)
 dd lv_nrm2(const lis_ctx *c, const lis_vec *x)
 {
     dd s;
-    if (!c->quad) return dd_d(lk_nrm2(c->n, x->h));
+    if (!c->quad) return dd_d(lk_nrm2(doubles(c), x->h)); /* complex: sqrt(sum |re|^2 + |im|^2) */
     s = lv_dot(c, x, x);
     if (s.hi >= 1e-290 && s.hi <= 1e290) return s_sqrt(c, s);
     return dd_d(lk_nrm2(c->n, x->h));
 }
 
+/* The interleaved doubles of a complex vector as its entries. */
+#define Z(v) ((double complex *)(v)->h)
+#define CZ(v) ((const double complex *)(v)->h)
+
 void lv_matvec(const lis_ctx *c, const lis_vec *x, lis_vec *y)
 {
-    if (c->quad) ldd_spmv(c->A, x->h, x->l, y->h, y->l);
+    if (c->cplx) lk_spmv_z(c->A, CZ(x), Z(y));
+    else if (c->quad) ldd_spmv(c->A, x->h, x->l, y->h, y->l);
     else lk_spmv(c->A, x->h, y->h);
 }
 
@@ -149,7 +165,8 @@ void lv_matvec_t(const lis_ctx *c, const lis_vec *x, lis_vec *y)
 
 void lv_residual(const lis_ctx *c, const lis_vec *x, lis_vec *r)
 {
-    if (c->quad) ldd_residual(c->A, c->b.h, c->b.l, x->h, x->l, r->h, r->l);
+    if (c->cplx) lk_residual_z(c->A, CZ(&c->b), CZ(x), Z(r));
+    else if (c->quad) ldd_residual(c->A, c->b.h, c->b.l, x->h, x->l, r->h, r->l);
     else lk_residual(c->A, c->b.h, x->h, r->h);
 }
 
@@ -184,6 +201,52 @@ void lv_psolve_t(lis_ctx *c, const lis_vec *x, lis_vec *y)
 /* The iteration limit, or a request to stop (an interrupt, silcd's time
  * limit: host->cancelled, ABI 1.7), asked once an iteration: the solver
  * then ends as at -maxiter, and the host reports why it stopped. */
+/* ---- complex scalars -------------------------------------------------------- */
+
+double complex lvz_dot(const lis_ctx *c, const lis_vec *x, const lis_vec *y)
+{
+    return lk_dot_z(c->n, CZ(x), CZ(y));
+}
+
+void lvz_scale(const lis_ctx *c, double complex a, lis_vec *x)
+{
+    lk_scale_z(c->n, a, Z(x));
+}
+
+void lvz_axpy(const lis_ctx *c, double complex a, const lis_vec *x, lis_vec *y)
+{
+    lk_axpy_z(c->n, a, CZ(x), Z(y));
+}
+
+void lvz_xpay(const lis_ctx *c, const lis_vec *x, double complex a, lis_vec *y)
+{
+    lk_xpay_z(c->n, CZ(x), a, Z(y));
+}
+
+void lvz_waxpby(const lis_ctx *c, double complex a, const lis_vec *x, double complex b, const lis_vec *y,
+                lis_vec *w)
+{
+    lk_waxpby_z(c->n, a, CZ(x), b, CZ(y), Z(w));
+}
+
+double complex lvz_matvec_dot(const lis_ctx *c, const lis_vec *x, lis_vec *y, int hermitian)
+{
+    return lk_spmv_dot_z(c->A, CZ(x), Z(y), hermitian);
+}
+
+dd lvz_axpy2_nrm2(const lis_ctx *c, double complex a, const lis_vec *p, const lis_vec *q, lis_vec *x, lis_vec *r)
+{
+    return dd_d(lk_nrm2_sumsq(2 * c->n, r->h, lk_axpy2_sumsq_z(c->n, a, CZ(p), CZ(q), Z(x), Z(r))));
+}
+
+double complex lvz_psolve_dot(lis_ctx *c, const lis_vec *r, lis_vec *z, int hermitian)
+{
+    if (c->pc && c->pc->kind == LIS_PC_JACOBI)
+        return lk_mul_dot_z(c->n, (const double complex *)c->pc->dinv, CZ(r), Z(z), hermitian);
+    lv_psolve(c, r, z);
+    return hermitian ? lk_dot_z(c->n, CZ(r), CZ(z)) : lk_dotu_z(c->n, CZ(r), CZ(z));
+}
+
 int lis_limit(const lis_ctx *c)
 {
     if (c->iter >= c->o->maxiter) return 1;

@@ -33,6 +33,17 @@
  * says otherwise; the tolerance then applies to ||r|| / ||b|| unless
  * -conv_cond says otherwise, and `info` says so.
  *
+ * Complex values (ABI 1.8: complex_ops declares SOLVE): A, b and x hold
+ * complex entries and the methods of lis.h's complex list run in complex
+ * arithmetic (c.cplx).  The Hermitian-only CG and the complex symmetric
+ * COCG look at A's properties first and refuse a matrix that is not of
+ * their kind, naming it, so the dispatcher's list moves on to the next
+ * backend; a method or preconditioner with no complex form is refused by
+ * name.  A real A never comes with a complex b (the host splits such a
+ * solve into two real ones); if it did, it is refused too.  Without options a complex system gets CG (Hermitian, under an SPD
+ * class), COCG (complex symmetric) or BiCGSTAB, each with ILU(0).
+ * Outcomes and messages are the real path's.
+ *
  * Norms are scaled (lk_nrm2), but the methods' inner products (r, r),
  * (p, A p) would under- or overflow once entries leave about 1e+-100: systems
  * that far from 1 arrive here already scaled by powers of two by the core
@@ -58,13 +69,14 @@ void lis_matrix_free(void *p)
     lis_host->free(M);
 }
 
-lis_matrix *lis_matrix_alloc(int64_t m, int64_t n, int64_t nnz)
+/* w doubles per entry: 1, or 2 for a complex matrix. */
+static lis_matrix *matrix_alloc_w(int64_t m, int64_t n, int64_t nnz, int w)
 {
     lis_matrix *M = lis_host->calloc(1, sizeof *M);
     if (!M) return NULL;
     M->rp = lis_host->calloc((size_t)m + 1, sizeof(int64_t));
     M->ci = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int64_t));
-    M->v = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
+    M->v = lis_host->alloc((size_t)(nnz > 0 ? nnz : 1) * (size_t)w * sizeof(double));
     if (!M->rp || !M->ci || !M->v) {
         lis_matrix_free(M);
         return NULL;
@@ -77,15 +89,29 @@ lis_matrix *lis_matrix_alloc(int64_t m, int64_t n, int64_t nnz)
     return M;
 }
 
-static double entry(const silc_view *a, int64_t i, int64_t j)
+lis_matrix *lis_matrix_alloc(int64_t m, int64_t n, int64_t nnz)
 {
-    if (a->format == SILC_FMT_DENSE) return a->val[i + j * a->m];
-    if (i - j > a->kl || j - i > a->ku) return 0.0;
-    return a->val[(a->ku + i - j) + j * a->ld];
+    return matrix_alloc_w(m, n, nnz, 1);
 }
 
-/* CSR of a dense or band value, zeros dropped. */
-static lis_matrix *matrix_from_full(const silc_view *a)
+/* Entry (i, j) of a dense or band value of sw doubles an entry (1 real, 2
+ * complex) into out[0..w), w >= sw (a real entry read as complex gets a
+ * zero imaginary part); returns 1 when it is nonzero. */
+static int entry(const silc_view *a, int sw, int64_t i, int64_t j, double *out, int w)
+{
+    const double *e = NULL;
+    int nz = 0;
+    if (a->format == SILC_FMT_DENSE) e = a->val + sw * (i + j * a->m);
+    else if (!(i - j > a->kl || j - i > a->ku)) e = a->val + sw * ((a->ku + i - j) + j * a->ld);
+    for (int k = 0; k < w; k++) {
+        out[k] = e && k < sw ? e[k] : 0.0;
+        nz |= out[k] != 0.0;
+    }
+    return nz;
+}
+
+/* CSR of a dense or band value of w doubles an entry, zeros dropped. */
+static lis_matrix *matrix_from_full(const silc_view *a, int w)
 {
     int64_t i, j, nnz = 0;
     lis_matrix *M;
@@ -98,14 +124,17 @@ static lis_matrix *matrix_from_full(const silc_view *a)
                 hi = i + a->ku + 1 < a->n ? i + a->ku + 1 : a->n;
             }
             for (j = lo; j < hi; j++) {
-                double x = entry(a, i, j);
-                if (x == 0.0) continue;
-                if (pass) M->ci[nnz] = j, M->v[nnz] = x;
+                double x[2];
+                if (!entry(a, w, i, j, x, w)) continue;
+                if (pass) {
+                    M->ci[nnz] = j;
+                    for (int k = 0; k < w; k++) M->v[w * nnz + k] = x[k];
+                }
                 nnz++;
             }
             if (pass) M->rp[i + 1] = nnz;
         }
-        if (!pass && !(M = lis_matrix_alloc(a->m, a->n, nnz))) return NULL;
+        if (!pass && !(M = matrix_alloc_w(a->m, a->n, nnz, w))) return NULL;
     }
     return M;
 }
@@ -132,6 +161,12 @@ lis_matrix *lis_matrix_transpose(const lk_csr *A)
         }
     lis_host->free(next);
     return T;
+}
+
+/* 1 when v holds complex values (a host older than ABI 1.8 has none). */
+static int is_complex(const silc_value *v)
+{
+    return v && lis_host->struct_size >= SILC_HOST_NEEDS(field) && lis_host->field(v) == SILC_FIELD_COMPLEX;
 }
 
 /* ---- accepts ---------------------------------------------------------------------- */
@@ -176,18 +211,33 @@ static lis_solver_fn solver_fn(int id)
     }
 }
 
-/* Column j of B (any format) into b[0..m). */
-static void column(const silc_view *B, int64_t j, double *b)
+/* The complex methods (c.cplx): those with a complex form, NULL for the rest. */
+static lis_solver_fn solver_fn_complex(int id)
+{
+    switch (id) {
+    case LIS_CG: return lis_cg_z;
+    case LIS_COCG: return lis_cocg_z;
+    case LIS_BICGSTAB: return lis_bicgstab_z;
+    case LIS_GMRES: return lis_gmres_z;
+    case LIS_FGMRES: return lis_fgmres_z;
+    default: return NULL;
+    }
+}
+
+/* Column j of B (any format, sw doubles an entry) into b[0..m) of w >= sw
+ * doubles an entry. */
+static void column(const silc_view *B, int sw, int64_t j, double *b, int w)
 {
     int64_t i;
     if (B->format == SILC_FMT_CSR) {
         for (i = 0; i < B->m; i++) {
-            b[i] = 0;
+            for (int q = 0; q < w; q++) b[w * i + q] = 0;
             for (int64_t k = B->rowptr[i]; k < B->rowptr[i + 1]; k++)
-                if (B->colind[k] == j) b[i] = B->val[k];
+                if (B->colind[k] == j)
+                    for (int q = 0; q < sw; q++) b[w * i + q] = B->val[sw * k + q];
         }
     } else {
-        for (i = 0; i < B->m; i++) b[i] = entry(B, i, j);
+        for (i = 0; i < B->m; i++) entry(B, sw, i, j, b + w * i, w);
     }
 }
 
@@ -208,14 +258,19 @@ typedef struct col_result {
 
 /* ||r||inf / (||A||inf ||x||inf + ||b||inf), r = b - A x: the normwise
  * backward error that -conv_cond backward stops on (lis.h). */
+static double modulus(const lis_ctx *c, const double *v, int64_t i)
+{
+    return c->cplx ? hypot(v[2 * i], v[2 * i + 1]) : fabs(v[i]);
+}
+
 static double backward_error(const lis_ctx *c, const lis_vec *x, const lis_vec *r, const double *b)
 {
     double rn = 0, xn = 0, bn = 0;
     int64_t i;
     for (i = 0; i < c->n; i++) {
-        if (fabs(r->h[i]) > rn) rn = fabs(r->h[i]);
-        if (fabs(x->h[i]) > xn) xn = fabs(x->h[i]);
-        if (fabs(b[i]) > bn) bn = fabs(b[i]);
+        rn = fmax(rn, modulus(c, r->h, i));
+        xn = fmax(xn, modulus(c, x->h, i));
+        bn = fmax(bn, modulus(c, b, i));
     }
     return rn / (c->anorm * xn + bn);
 }
@@ -228,6 +283,7 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
     lis_vec x = {NULL, NULL}, work = {NULL, NULL};
     double r0n, bn, prev = 1.0 / 0.0, tr = 0;
     int st, rc = SILC_OK;
+    int64_t nd = c->cplx ? 2 * c->n : c->n; /* doubles of a vector */
     c->b.h = bcol;
     c->b.l = NULL;
     c->iter = 0;
@@ -239,10 +295,10 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
         return lis_host->error(call, SILC_ENOMEM, "lis-style: out of memory for %lld-vectors",
                                (long long)c->n);
     }
-    if (x0) lk_copy(c->n, x0, x.h);
+    if (x0) lk_copy(nd, x0, x.h);
     c->den = 1;
     r0n = lis_true_resid(c, &x, &work);
-    bn = lk_nrm2(c->n, bcol);
+    bn = lk_nrm2(nd, bcol);
     if (x0 && !(r0n < bn)) {
         /* A guess no better than zero (another system's solution) would
          * only cost iterations, or trip a divergence test: start from 0. */
@@ -324,7 +380,7 @@ static int solve_column(silc_call *call, lis_ctx *c, lis_solver_fn fn, double *b
     res->iterations = c->iter;
     res->resid = tr;
 copy_out:
-    lk_copy(c->n, x.h, xout); /* the double rounding of hi + lo is hi */
+    lk_copy(nd, x.h, xout); /* the double rounding of hi + lo is hi */
 done:
     lv_free(&x);
     lv_free(&work);
@@ -347,6 +403,7 @@ static int solve_run(silc_call *call)
     const char *text = H->option_string(call, "options", "");
     double t0 = H->now(), *bcol = NULL, *x0col = NULL;
     int rc = SILC_OK, reused = 0, use_x0 = 0, restarts = 0, guesses = 0;
+    int cplx = is_complex(call->in[0]), w = cplx ? 2 : 1; /* doubles an entry */
     int64_t j, max_iter = 0;
     double max_resid = 0, max_backward = 0;
 
@@ -355,13 +412,54 @@ static int solve_run(silc_call *call)
         return H->error(call, SILC_EARG, "lis-style options: %s (in '%s')", err, text);
     lis_options_finish(&opt, ends_with(call->op_class, ".spd"),
                        call->op_class && !strcmp(call->op_class, "solve.sparse.mmatrix.spd"));
+    if (cplx && !opt.given) {
+        /* the complex defaults: the method A's structure admits, ILU(0) */
+        const silc_props *pr = silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY);
+        opt.solver = ends_with(call->op_class, ".spd") && pr->hermitian ? LIS_CG
+                     : pr->symmetric                                   ? LIS_COCG
+                                                                       : LIS_BICGSTAB;
+        opt.precon = LIS_PC_ILU;
+        opt.conv_cond = -1;
+        opt.maxiter = 1000;
+    }
     lis_solver_label(&opt, slabel, sizeof slabel);
     lis_precon_label(&opt, plabel, sizeof plabel);
     if ((opt.solver == LIS_JACOBI || opt.solver == LIS_GS || opt.solver == LIS_SOR) &&
         opt.precon != LIS_PC_NONE)
         return H->error(call, SILC_EARG, "lis-style options: -i %s takes no preconditioner (got -p %s)",
                         lis_solver_name(opt.solver), plabel);
-    fn = solver_fn(opt.solver);
+    if (cplx) {
+        const silc_props *pr;
+        if (!(fn = solver_fn_complex(opt.solver)))
+            return H->error(call, SILC_EUNSUP, "lis-style: -i %s does not take complex values (complex: cg for "
+                            "Hermitian positive definite, cocg for complex symmetric, bicgstab, gmres, fgmres)",
+                            lis_solver_name(opt.solver));
+        if (opt.precon != LIS_PC_NONE && opt.precon != LIS_PC_JACOBI && opt.precon != LIS_PC_ILU &&
+            opt.precon != LIS_PC_ILUT && opt.precon != LIS_PC_SSOR)
+            return H->error(call, SILC_EUNSUP, "lis-style: -p %s does not take complex values (complex: none, "
+                            "jacobi, ilu, ilut, ssor)", plabel);
+        if (opt.quad)
+            return H->error(call, SILC_EUNSUP, "lis-style: -f quad does not take complex values (double only)");
+        pr = silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY);
+        /* A method for another kind of matrix would break down or wander:
+         * refuse it, so that the list's next backend takes the system. */
+        if (opt.solver == LIS_CG && !pr->hermitian)
+            return H->error(call, SILC_EUNSUP, "lis-style CG needs a Hermitian matrix (A = A'), and this complex "
+                            "one is not%s", pr->symmetric ? " (it is complex symmetric: -i cocg)"
+                                                          : " (-i bicgstab or gmres)");
+        if (opt.solver == LIS_COCG && !pr->symmetric)
+            return H->error(call, SILC_EUNSUP, "lis-style COCG needs a complex symmetric matrix (A = A.'), "
+                            "and this one is not%s", pr->hermitian ? " (it is Hermitian: -i cg)"
+                                                                   : " (-i bicgstab or gmres)");
+    } else if (is_complex(call->in[1]) || (call->nin >= 3 && is_complex(call->in[2]))) {
+        return H->error(call, SILC_EARG, "lis-style: a real matrix with a complex right-hand side or initial "
+                        "guess (the host splits such a solve into real ones)");
+    } else if (opt.solver == LIS_COCG) {
+        return H->error(call, SILC_EUNSUP, "lis-style: -i cocg is for complex symmetric matrices, and this one "
+                        "is real (-i cg for a symmetric positive definite one)");
+    } else {
+        fn = solver_fn(opt.solver);
+    }
     if (!fn) return H->error(call, SILC_EINTERNAL, "lis-style: no solver %d", opt.solver);
 
     /* The matrix as CSR. */
@@ -371,7 +469,7 @@ static int solve_run(silc_call *call)
     } else {
         lis_matrix *M = H->attach_get(call->in[0], "lis-style.csr");
         if (!M) {
-            if (!(M = matrix_from_full(&a)))
+            if (!(M = matrix_from_full(&a, w)))
                 return H->error(call, SILC_ENOMEM, "lis-style: out of memory converting A to CSR");
             if (H->attach_set(call->in[0], "lis-style.csr", M, lis_matrix_free)) {
                 lis_matrix_free(M);
@@ -380,7 +478,7 @@ static int solve_run(silc_call *call)
         }
         A = M->A;
     }
-    if (lis_needs_transpose(opt.solver)) {
+    if (!cplx && lis_needs_transpose(opt.solver)) {
         if (silc_props_of(H, call->in[0], SILC_PROPS_SYMMETRY)->symmetric) {
             At = &A;
         } else {
@@ -413,7 +511,7 @@ static int solve_run(silc_call *call)
         if (pc) {
             reused = 1;
         } else {
-            rc = lis_pc_build(&A, &opt, &pc, err, sizeof err);
+            rc = cplx ? lis_pc_build_z(&A, &opt, &pc, err, sizeof err) : lis_pc_build(&A, &opt, &pc, err, sizeof err);
             if (rc) return H->error(call, rc, "%s", err);
             if (H->attach_set(call->in[0], key, pc, lis_pc_free)) {
                 lis_pc_free(pc);
@@ -432,9 +530,9 @@ static int solve_run(silc_call *call)
             return H->error(call, SILC_EARG, "lis-style: the initial guess is %lldx%lld, the solution %lldx%lld",
                             (long long)X0.m, (long long)X0.n, (long long)a.n, (long long)B.n);
     }
-    out = H->dense_new(a.n, B.n);
-    bcol = H->alloc((size_t)(a.n > 0 ? a.n : 1) * sizeof(double));
-    x0col = H->alloc((size_t)(a.n > 0 ? a.n : 1) * sizeof(double));
+    out = cplx ? H->dense_new_complex(a.n, B.n) : H->dense_new(a.n, B.n);
+    bcol = H->alloc((size_t)(a.n > 0 ? a.n : 1) * (size_t)w * sizeof(double));
+    x0col = H->alloc((size_t)(a.n > 0 ? a.n : 1) * (size_t)w * sizeof(double));
     memset(&c, 0, sizeof c);
     c.w1 = H->alloc((size_t)(a.n > 0 ? a.n : 1) * sizeof(double));
     if (!out || !bcol || !x0col || !c.w1) {
@@ -449,11 +547,12 @@ static int solve_run(silc_call *call)
     c.o = &opt;
     c.n = a.n;
     c.call = call;
+    c.cplx = cplx;
     if (opt.conv_cond == LIS_CONV_BACKWARD)
         for (j = 0; j < A.m; j++) {
             double row = 0;
             int64_t k;
-            for (k = A.rp[j]; k < A.rp[j + 1]; k++) row += fabs(A.v[k]);
+            for (k = A.rp[j]; k < A.rp[j + 1]; k++) row += modulus(&c, A.v, k);
             if (row > c.anorm) c.anorm = row;
         }
     c.quad = opt.quad;
@@ -462,13 +561,13 @@ static int solve_run(silc_call *call)
         char tag[32] = "";
         col_result res = {0, 0, 0, 0, 0};
         if (B.n > 1) snprintf(tag, sizeof tag, " (column %lld)", (long long)j + 1);
-        column(&B, j, bcol);
+        column(&B, is_complex(call->in[1]) ? 2 : 1, j, bcol, w);
         if (use_x0) {
             silc_view X0;
             H->view(call->in[2], &X0);
-            column(&X0, j, x0col);
+            column(&X0, is_complex(call->in[2]) ? 2 : 1, j, x0col, w);
         }
-        rc = solve_column(call, &c, fn, bcol, use_x0 ? x0col : NULL, o.val + j * a.n, tag, &res);
+        rc = solve_column(call, &c, fn, bcol, use_x0 ? x0col : NULL, o.val + j * a.n * w, tag, &res);
         if (rc) goto done;
         if (res.iterations > max_iter) max_iter = res.iterations;
         if (res.resid > max_resid) max_resid = res.resid;
@@ -550,8 +649,14 @@ static const silc_backend lis_backends[] = {
 
 static const silc_option_spec lis_option_specs[] = {
     {"options", SILC_OPT_STRING, "",
-     "Lis option string, e.g. '-i bicgstab -p ilu -ilu_fill 1 -tol 1e-10 -maxiter 2000 -f quad'"},
+     "Lis option string, e.g. '-i bicgstab -p ilu -ilu_fill 1 -tol 1e-10 -maxiter 2000 -f quad'; complex "
+     "systems take -i cg (Hermitian), cocg (complex symmetric), bicgstab, gmres, fgmres with -p none, jacobi, "
+     "ilu, ilut, ssor"},
 };
+
+/* SOLVE takes complex values (the methods and preconditioners of lis.h's
+ * complex list). */
+static const uint32_t lis_complex_ops[] = {SILC_COMPLEX_OPS(SILC_OP_SOLVE)};
 
 static const silc_plugin lis_plugin = {
     SILC_ABI_MAJOR, SILC_ABI_MINOR, sizeof(silc_plugin), (int)sizeof(silc_index),
@@ -561,7 +666,7 @@ static const silc_plugin lis_plugin = {
     lis_set_threads,
     NULL,
     NULL,
-    NULL,
+    lis_complex_ops,
 };
 
 SILC_PLUGIN_EXPORT int silc_plugin_init(const silc_host_api *host, const silc_plugin **out,

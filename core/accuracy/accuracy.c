@@ -341,6 +341,28 @@ out:
     return be;
 }
 
+/* The complex residual's pieces for refine.c (accuracy.h): the same kernels
+ * as the complex backward error, so refinement and the report measure alike. */
+double complex *acc_dense_copy_complex(const silc_value *v)
+{
+    return complex_dense_copy(v);
+}
+
+double acc_norm_inf_complex(const double complex *z, int64_t m, int64_t k)
+{
+    return complex_norm_inf(z, m, k);
+}
+
+void acc_residual_complex(const silc_value *A, const double complex *B, const double complex *X, int64_t k,
+                          double complex *R)
+{
+    memcpy(R, B, (size_t)(A->m * k) * sizeof *R);
+    for (int64_t c = 0; c < k; c++) {
+        complex_residual cr = {A, X + c * A->n, R + c * A->m, NULL};
+        complex_residual_pass(&cr);
+    }
+}
+
 /* 1 when a solve's operands or result are complex. */
 static int complex_system(const silc_value *A, const silc_value *B, const silc_value *X)
 {

@@ -48,6 +48,14 @@ void acc_residual(const silc_value *A, const double *B, const double *X, int64_t
 double acc_norm_inf(const double *x, int64_t m, int64_t k);
 /* Dense copy of any value (m x n, column-major); NULL when out of memory. */
 double *acc_dense_copy(const silc_value *v);
+/* The same three for complex systems (A of either field; B, X, R complex,
+ * m x k and n x k column-major): R = B - A X, the infinity norm by moduli
+ * (the complex backward error's), and a complex dense copy of any value
+ * (double _Complex: this header does not pull in <complex.h>'s I). */
+void acc_residual_complex(const silc_value *A, const double _Complex *B, const double _Complex *X, int64_t k,
+                          double _Complex *R);
+double acc_norm_inf_complex(const double _Complex *z, int64_t m, int64_t k);
+double _Complex *acc_dense_copy_complex(const silc_value *v);
 
 /* Normwise backward error of X as a solution of A X = B (infinity norm; the
  * normal equations' residual for rectangular A).  -1 when it cannot be

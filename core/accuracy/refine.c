@@ -28,6 +28,13 @@
  * solve.refine and solve.refine_residual it read.  Least-squares and
  * iterative solves are left alone with a note: the first has no square
  * residual equation, the second is better served by a tighter tolerance.
+ *
+ * A complex system (complex A) is refined the same way in complex
+ * arithmetic: x, r and d are complex arrays (two doubles an entry,
+ * interleaved), r = b - A x and the norms are accuracy.c's complex ones
+ * (moduli), so the backward error it stops on is the one the report shows.
+ * Its residual is always in double: solve.refine_residual = extended has
+ * no complex double-double kernel, and a note says so.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "accuracy.h"
@@ -100,6 +107,35 @@ static void add_note(silc_report *r, const char *text)
     snprintf(r->note + len, sizeof r->note - len, "%s%s", len ? "; " : "", text);
 }
 
+/* The arrays of the loop hold n x k entries of A's field: w doubles each
+ * (1 real, 2 complex interleaved).  These four pick the field's kernel. */
+static double *field_copy(const silc_value *v, int w)
+{
+    return w == 2 ? (double *)acc_dense_copy_complex(v) : acc_dense_copy(v);
+}
+
+static double field_norm_inf(const double *x, int64_t n, int64_t k, int w)
+{
+    return w == 2 ? acc_norm_inf_complex((const double complex *)x, n, k) : acc_norm_inf(x, n, k);
+}
+
+/* R = B - A X (lo: the double-double low parts, real and extended only). */
+static void field_residual(const silc_value *A, const double *B, const double *X, int64_t k, int extended,
+                           double *R, double *lo, int w)
+{
+    if (w == 2)
+        acc_residual_complex(A, (const double complex *)B, (const double complex *)X, k, (double complex *)R);
+    else
+        acc_residual(A, B, X, k, extended, R, lo);
+}
+
+static silc_value *field_dense_new(int64_t n, int64_t k, int w, const double *from)
+{
+    silc_value *v = w == 2 ? val_dense_new_complex(n, k) : val_dense_new(n, k);
+    if (v) memcpy(v->val, from, (size_t)(w * n * k) * sizeof *from);
+    return v;
+}
+
 void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_t at_least)
 {
     silc_report *r = call->report;
@@ -107,7 +143,7 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
     double *B = NULL, *X = NULL, *R = NULL, *lo = NULL, nA, nB, be, be0, dprev = INFINITY;
     double t0 = util_now();
     int64_t want, step, kept = 0, n = A->n, k = Bv->n;
-    int extended;
+    int extended, w = A->field == SILC_FIELD_COMPLEX ? 2 : 1;
     char note[200], why[REFINE_WHY_MAX];
     const char *stop = "step limit";
     r->backward_error_unrefined = -1;
@@ -119,26 +155,31 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
         if (A->m != A->n) add_note(r, "refinement skipped: least-squares solve");
         return;
     }
-    if (A->field == SILC_FIELD_COMPLEX || Bv->field == SILC_FIELD_COMPLEX) {
-        add_note(r, "refinement skipped: complex system (not implemented)");
+    if (w == 1 && (Bv->field == SILC_FIELD_COMPLEX || call->out->field == SILC_FIELD_COMPLEX)) {
+        /* the dispatcher splits such a solve into real ones (disp_run), which are refined */
+        add_note(r, "refinement skipped: real matrix with a complex right-hand side");
         return;
     }
     if (r->iterations > 0 && !r->single_factor) {
         add_note(r, "refinement skipped: iterative solver (tighten its tolerance instead)");
         return;
     }
-    B = acc_dense_copy(Bv);
-    X = acc_dense_copy(call->out);
-    R = malloc((size_t)(n * k) * sizeof *R);
+    if (w == 2 && extended) {
+        add_note(r, "complex system: refinement residual in double (no complex double-double kernel)");
+        extended = 0;
+    }
+    B = field_copy(Bv, w);
+    X = field_copy(call->out, w);
+    R = malloc((size_t)(w * n * k) * sizeof *R);
     lo = extended ? malloc((size_t)(n * k) * sizeof *lo) : NULL;
     if (!B || !X || !R || (extended && !lo)) {
         add_note(r, "refinement skipped: out of memory");
         goto done;
     }
     nA = val_props(A)->norminf;
-    nB = acc_norm_inf(B, n, k);
-    acc_residual(A, B, X, k, extended, R, lo);
-    be = be0 = acc_norm_inf(R, n, k) / (nA * acc_norm_inf(X, n, k) + nB);
+    nB = field_norm_inf(B, n, k, w);
+    field_residual(A, B, X, k, extended, R, lo, w);
+    be = be0 = field_norm_inf(R, n, k, w) / (nA * field_norm_inf(X, n, k, w) + nB);
     for (step = 0; step < want; step++) {
         silc_value *Rv, *D;
         double *Xn, ben, dn;
@@ -151,28 +192,27 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
             stop = "residual is not finite";
             break;
         }
-        Rv = val_dense_new(n, k);
+        Rv = field_dense_new(n, k, w, R);
         if (!Rv) {
             stop = "out of memory";
             break;
         }
-        memcpy(Rv->val, R, (size_t)(n * k) * sizeof *R);
         D = how->correct(how->ctx, E, call, Rv, why, sizeof why);
         val_release(Rv);
         if (!D) {
             stop = why;
             break;
         }
-        Xn = acc_dense_copy(D); /* becomes the candidate x + d */
+        Xn = field_copy(D, w); /* becomes the candidate x + d */
         val_release(D);
         if (!Xn) {
             stop = "out of memory";
             break;
         }
-        dn = acc_norm_inf(Xn, n, k) / acc_norm_inf(X, n, k);
-        for (i = 0; i < n * k; i++) Xn[i] += X[i];
-        acc_residual(A, B, Xn, k, extended, R, lo);
-        ben = acc_norm_inf(R, n, k) / (nA * acc_norm_inf(Xn, n, k) + nB);
+        dn = field_norm_inf(Xn, n, k, w) / field_norm_inf(X, n, k, w);
+        for (i = 0; i < w * n * k; i++) Xn[i] += X[i];
+        field_residual(A, B, Xn, k, extended, R, lo, w);
+        ben = field_norm_inf(R, n, k, w) / (nA * field_norm_inf(Xn, n, k, w) + nB);
         if (extended ? !(dn < dprev) : !(ben < be)) {
             /* Not an improvement: the previous x stays. */
             free(Xn);
@@ -193,9 +233,8 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
         dprev = dn;
     }
     if (kept > 0) {
-        silc_value *out = val_dense_new(n, k);
+        silc_value *out = field_dense_new(n, k, w, X);
         if (out) {
-            memcpy(out->val, X, (size_t)(n * k) * sizeof *X);
             val_release(call->out);
             call->out = out;
         } else {

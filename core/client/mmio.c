@@ -615,19 +615,21 @@ int silc_mm_write(const silc_envelope_t *e, FILE *out)
     case SILC_BAND: {
         /* Only the nonzeros: the zero corners of band storage are not entries. */
         int64_t ld = e->kl + e->ku + 1;
-        if (w == 2) return env_error("silc_mm_write: complex band values are written as CSR (sparse(A))");
         for (k = 0; k < 2; k++) {
             if (k == 1)
-                fprintf(out, "%%%%MatrixMarket matrix coordinate real general\n%lld %lld %lld\n",
+                fprintf(out, "%%%%MatrixMarket matrix coordinate %s general\n%lld %lld %lld\n", field,
                         (long long)e->m, (long long)e->n, (long long)count);
             for (j = 0; j < e->n; j++) {
                 int64_t lo = j - e->ku > 0 ? j - e->ku : 0;
                 int64_t hi = j + e->kl < e->m - 1 ? j + e->kl : e->m - 1;
                 for (i = lo; i <= hi; i++) {
-                    double x = e->values[(e->ku + i - j) + j * ld];
-                    if (x == 0) continue;
+                    /* entry (i, j) of the band: w doubles (re, im for a complex one) */
+                    const double *x = e->values + w * ((e->ku + i - j) + j * ld);
+                    if (x[0] == 0 && (w == 1 || x[1] == 0)) continue;
                     if (k == 0) count++;
-                    else fprintf(out, "%lld %lld %.17g\n", (long long)i + 1, (long long)j + 1, x);
+                    else if (w == 2)
+                        fprintf(out, "%lld %lld %.17g %.17g\n", (long long)i + 1, (long long)j + 1, x[0], x[1]);
+                    else fprintf(out, "%lld %lld %.17g\n", (long long)i + 1, (long long)j + 1, x[0]);
                 }
             }
         }

@@ -142,7 +142,7 @@ SILC_API void silc_envelope_free(silc_envelope_t *e);
  * Write: dense as array, CSR/band as coordinate general, %.17g. */
 SILC_API int silc_mm_read(silc_envelope_t *e, const char *path, char *err, size_t errlen);
 /* (Write: a complex envelope as `complex general`, "re im" on each line; a
- * complex band envelope is refused: write sparse(A).) */
+ * complex band envelope as coordinate complex, its nonzero entries.) */
 SILC_API int silc_mm_write(const silc_envelope_t *e, FILE *out);
 
 /* ---- contexts -------------------------------------------------------------- */
