@@ -79,7 +79,11 @@ static silc_value *complex_value(silc_call *call, int64_t m, int64_t k, const do
 
 /* The condition estimate of a complex factorization, once, when wanted:
  * apply(ctx, x, trans, work) overwrites the n complex entries of x with
- * A^{-1} x (trans 0) or A^{-H} x (trans 1). */
+ * A^{-1} x (trans 0) or A^{-H} x (trans 1).  Owed like the real one's
+ * (ss.h, ABI 1.8) when the host asks to leave it out: made by the
+ * condest_only call (complex_estimate_alone) when the host finds it urgent
+ * (the pivot ratio) or cheap, or when the report is read. */
+#define SS_COMPLEX_EST_SOLVES 5 /* zlacn2: the start, two steps (A^-H, A^-1), the alternating vector */
 static void complex_cond(silc_call *call, int mode, int64_t n,
                          int (*apply)(void *ctx, double *x, int trans, double *work), void *ctx,
                          ss_factor_info *fi)
@@ -87,6 +91,7 @@ static void complex_cond(silc_call *call, int mode, int64_t n,
     double inv;
     size_t len;
     if (fi->estimated || !ss_condest_wanted(call, mode) || n <= 0) return;
+    if (ss_condest_later(call) && !ss_condest_only(call)) return; /* owed: complex_report_owed */
     if (ss_host->struct_size < SILC_HOST_NEEDS(inv_norm1_est_complex) || !ss_host->inv_norm1_est_complex)
         return; /* an older host: "not estimated" */
     inv = ss_host->inv_norm1_est_complex(n, apply, ctx, NULL);
@@ -117,6 +122,26 @@ typedef struct z_apply {
     const z_ops *ops;
 } z_apply;
 
+/* The condest_only call: the estimate alone with the factorization attached
+ * to A (none: a decline, nothing is factored); its note alone in the report. */
+static int complex_estimate_alone(silc_call *call, const z_ops *ops, const silc_view *a, int mode)
+{
+    void *F = a->n > 0 ? ss_host->attach_get(call->in[0], ops->key) : NULL;
+    ss_factor_info *fi;
+    size_t before;
+    if (!F) return ss_no_factor(call, "suitesparse (complex)");
+    fi = ops->info(F);
+    before = strlen(fi->note);
+    {
+        z_apply u = {F, a, ops};
+        complex_cond(call, mode, a->n, ops->apply, &u, fi);
+    }
+    call->report->cond_est = fi->estimated ? fi->cond : -1;
+    snprintf(call->report->note, sizeof call->report->note, "%s",
+             fi->note + before + (before && fi->note[before] == ';' ? 2 : 0));
+    return SILC_OK;
+}
+
 static int complex_solve(silc_call *call, const z_ops *ops)
 {
     silc_report *r = call->report;
@@ -125,6 +150,7 @@ static int complex_solve(silc_call *call, const z_ops *ops)
     double *x, t0;
     int rc, condest;
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
+    if (ss_condest_only(call)) return complex_estimate_alone(call, ops, &a, condest);
     if (!ss_is_complex(call->in[1]))
         return ss_host->error(call, SILC_EARG, "suitesparse: A is complex but b is real");
     if (a.n > 0 && (rc = ss_attached_factor(call, &a, ops->key, ops->make, ops->destroy, ops->what, &F)))
@@ -141,8 +167,13 @@ static int complex_solve(silc_call *call, const z_ops *ops)
     r->solve_seconds = ss_host->now() - t0;
     if (F) {
         z_apply u = {F, &a, ops};
-        complex_cond(call, condest, a.n, ops->apply, &u, ops->info(F));
-        ss_report_factor(r, ops->info(F));
+        ss_factor_info *fi = ops->info(F);
+        complex_cond(call, condest, a.n, ops->apply, &u, fi);
+        ss_report_factor(r, fi);
+        if (!fi->estimated && ss_condest_wanted(call, condest) && ss_condest_later(call)) {
+            r->condest_deferred = 1;
+            r->condest_solves = (double)SS_COMPLEX_EST_SOLVES / (double)(b.n > 0 ? b.n : 1);
+        }
     }
     return SILC_OK;
 }
