@@ -1060,6 +1060,15 @@ static void note_add(silc_report *r, const char *fmt, ...)
     va_end(ap);
 }
 
+/* How F's estimate was made, in r's note (nothing when it has none). */
+static void note_estimate(silc_report *r, const mumps_factor *F)
+{
+    if (F->cond_est >= 0 && F->cplx)
+        note_add(r, "1-norm condition estimate: complex Hager-Higham (zmumps_c solves)");
+    else if (F->cond_est >= 0)
+        note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+}
+
 static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *c)
 {
     int sym = (int)ID_SYM(F);
@@ -1092,10 +1101,7 @@ static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *
     if (F->analysed && ICNTL(F, 11) == 1)
         note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
                  F->rinfog[8]);
-    if (F->cond_est >= 0 && F->cplx)
-        note_add(r, "1-norm condition estimate: complex Hager-Higham (zmumps_c solves)");
-    else if (F->cond_est >= 0)
-        note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+    note_estimate(r, F);
     if (F->retries)
         note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
                  F->retries, F->retries == 1 ? "y" : "ies");
@@ -1381,8 +1387,7 @@ static int solve_run(silc_call *call)
         rc = !condest_wanted(call, &s, F) ? SILC_OK : F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, NULL);
         ICNTL(F, 11) = icntl11;
         r->cond_est = F->cond_est;
-        if (F->cond_est >= 0) /* the note says how the estimate was made, and only that */
-            note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+        note_estimate(r, F); /* the note says how the estimate was made, and only that */
         return rc;
     }
     if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {

@@ -298,5 +298,12 @@ int ss_cholmod_solve(silc_call *call)
     r->solve_seconds = ss_host->now() - t0;
     ss_report_factor(r, &F->info);
     ss_report_owed(call, condest, &F->info, k);
+    /* A = L L' (final_ll), so L_ii^2 <= a_ii <= lambda_max, and L_ii^2, a
+     * pivot of Cholesky, is 1 / (A_k^-1)_kk >= lambda_min(A_k) >=
+     * lambda_min(A) for the leading block A_k: CHOLMOD's ratio (max L_ii /
+     * min L_ii)^2 is at most cond_2(A) <= cond_1(A) (A symmetric), a
+     * rigorous lower bound that tells the host whether the owed estimate
+     * is urgent (docs/accuracy.md). */
+    if (r->condest_deferred == 1 && F->info.pivot_ratio > 0) r->condest_lower = F->info.pivot_ratio;
     return SILC_OK;
 }
