@@ -121,6 +121,8 @@ typedef struct ss_factor_info {
     double cond;                /* the condition estimate, valid when estimated */
     int estimated;              /* cond holds a Hager/Higham estimate */
     double pivot_ratio;         /* the library's max/min factor diagonal (1/rcond), 0 = none */
+    double *start_solved;       /* complex A^-1 e/n solved for an owed estimate's lower bound,
+                                   its estimator's first step (ss_complex.c); NULL when none */
     char method[64];
     char note[160];
 } ss_factor_info;

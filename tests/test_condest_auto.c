@@ -3,10 +3,11 @@
  * condition estimate is deferred (accuracy.condest = auto, the default;
  * docs/accuracy.md "When the estimate is made").
  *
- * Over every real square shared matrix (../shared/matrices/index.tsv, the
- * singular and near-singular ones included) and every backend that defers
- * its estimate and takes the matrix (reference up to AU_REF_MAX unknowns,
- * for the test's time; UMFPACK, KLU, MUMPS; CHOLMOD on the spd class), the
+ * Over every square shared matrix (../shared/matrices/index.tsv, the
+ * singular and near-singular ones and the complex ones included) and every
+ * backend that defers its estimate and takes the matrix (reference up to
+ * AU_REF_MAX unknowns, for the test's time; UMFPACK, KLU, MUMPS; CHOLMOD
+ * on the spd and hpd classes), the
  * same system b = A * ones is solved twice, each time with a fresh copy of
  * A (nothing reused):
  *
@@ -134,7 +135,7 @@ static int lines_within(const char *sub, const char *whole)
 static void run_matrix(silc_context *c, const tl_index_row *row, const int *have)
 {
     silc_envelope_t A;
-    int spd = !strcmp(row->cls, "spd");
+    int spd = !strcmp(row->cls, "spd") || !strcmp(row->cls, "hpd");
     if (tl_read_shared(row->file, &A)) return;
     for (size_t k = 0; k < NBACKENDS; k++) {
         const deferring *be = &backends[k];
@@ -185,7 +186,7 @@ int main(void)
         return check_done();
     }
     while (tl_index_next(f, &row))
-        if (row.rows == row.cols && strcmp(row.field, "complex") && strcmp(row.field, "pattern"))
+        if (row.rows == row.cols && strcmp(row.field, "pattern"))
             run_matrix(c, &row, have);
     fclose(f);
     silc_close(&c);
