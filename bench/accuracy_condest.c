@@ -16,8 +16,10 @@
  *            over factor, as a share;
  *   auto     the default, accuracy.condest = auto: the same share at solve
  *            time, where the estimate is made when it costs at most 15 % of
- *            the factorization (predicted by the backend's timings) or the
- *            matrix looks ill-conditioned, and is otherwise deferred;
+ *            the factorization (predicted by the backend's timings) or its
+ *            condition warnings could fire (a lower bound of cond_1 from
+ *            the estimator's start block, or the pivot ratio: docs/
+ *            accuracy.md), and is otherwise deferred;
  *   at       where auto made it: "solve", "read" (deferred), or "N/M" when
  *            the prediction (from the call's wall-clock timings) deferred
  *            it in N of the M repetitions only (auto's share is the best

@@ -474,6 +474,9 @@ typedef struct mumps_factor {
     const char *fallback;       /* why mumps.precision = single factored in double */
     settings opts;              /* the options it was computed with */
     double cond_est;            /* 1-norm condition estimate, -1 = not computed */
+    double *est_y0;             /* A^-1 X0, the estimator's start block solved with the first
+                                   solve of an owed estimate (real, n x EST_COLS), which the
+                                   estimate goes on from when made: NULL when none is kept */
     int analysed;               /* the error analysis ran (on the first 1-column solve) */
     double rinfog[11];          /* its RINFOG(1..11) */
     double factor_seconds;
@@ -517,9 +520,11 @@ static void factor_end(mumps_factor *F)
     host->free(F->jcn);
     host->free(F->a);
     host->free(F->af);
+    host->free(F->est_y0);
     F->irn = F->jcn = NULL;
     F->a = NULL;
     F->af = NULL;
+    F->est_y0 = NULL;
 }
 
 static void factor_free(void *p)
@@ -764,8 +769,12 @@ static int estimate_cond(silc_call *call, mumps_factor *F, const double *Y0)
     double inv;
     est_ctx c = {call, F, host->alloc((size_t)ID_N(F) * EST_COLS * sizeof(double)), 0};
     if (!c.keep) return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
-    inv = host->inv_norm1_est_block(ID_N(F), EST_COLS, EST_STEPS, apply_block, &c, Y0);
+    /* an owed estimate goes on from the start block its solve kept: one
+     * solve phase less, and the same estimate as one made at solve time */
+    inv = host->inv_norm1_est_block(ID_N(F), EST_COLS, EST_STEPS, apply_block, &c, Y0 ? Y0 : F->est_y0);
     host->free(c.keep);
+    host->free(F->est_y0);
+    F->est_y0 = NULL;
     if (inv < 0)
         return c.rc ? c.rc : host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     F->cond_est = silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1 * inv;
@@ -825,21 +834,32 @@ static int condest_later(const silc_call *call)
     return host->abi_minor >= 8 && call->report->condest_later;
 }
 
-/* The 1-norms of the n x EST_COLS block X (into sums). */
-static void column_sums(int64_t n, const double *X, double sums[EST_COLS])
+/* The 1-norms of the n x EST_COLS block X of w doubles per entry (into
+ * sums; w = 2: complex, by modulus). */
+static void column_sums(int64_t n, int w, const double *X, double sums[EST_COLS])
 {
     for (int j = 0; j < EST_COLS; j++) {
+        const double *x = X + j * n * w;
         sums[j] = 0;
-        for (int64_t i = 0; i < n; i++) sums[j] += fabs(X[i + j * n]);
+        for (int64_t i = 0; i < n; i++) sums[j] += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
     }
+}
+
+/* The estimator's start block (e/n and the alternating vector, the host's)
+ * into X, n x EST_COLS entries of w doubles (complex: imaginary parts 0). */
+static void start_block(int64_t n, int w, double *X)
+{
+    host->inv_norm1_start(n, EST_COLS, X);
+    if (w == 2)
+        for (int64_t i = n * EST_COLS - 1; i >= 0; i--) X[2 * i] = X[i], X[2 * i + 1] = 0;
 }
 
 /* ||A||_1 max_j ||Y_j||_1 / ||X0_j||_1 for the start block X0 (column sums
  * x0) solved into Y: a lower bound of cond_1(A) (condest_lower). */
-static double start_bound(silc_call *call, int64_t n, const double *Y, const double x0[EST_COLS])
+static double start_bound(silc_call *call, int64_t n, int w, const double *Y, const double x0[EST_COLS])
 {
     double y[EST_COLS], best = 0;
-    column_sums(n, Y, y);
+    column_sums(n, w, Y, y);
     for (int j = 0; j < EST_COLS; j++)
         if (x0[j] > 0 && y[j] / x0[j] > best) best = y[j] / x0[j];
     return best * silc_props_of(host, call->in[0], SILC_PROPS_NORMS)->norm1;
@@ -1040,6 +1060,15 @@ static void note_add(silc_report *r, const char *fmt, ...)
     va_end(ap);
 }
 
+/* How F's estimate was made, in r's note (nothing when it has none). */
+static void note_estimate(silc_report *r, const mumps_factor *F)
+{
+    if (F->cond_est >= 0 && F->cplx)
+        note_add(r, "1-norm condition estimate: complex Hager-Higham (zmumps_c solves)");
+    else if (F->cond_est >= 0)
+        note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+}
+
 static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *c)
 {
     int sym = (int)ID_SYM(F);
@@ -1072,10 +1101,7 @@ static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *
     if (F->analysed && ICNTL(F, 11) == 1)
         note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
                  F->rinfog[8]);
-    if (F->cond_est >= 0 && F->cplx)
-        note_add(r, "1-norm condition estimate: complex Hager-Higham (zmumps_c solves)");
-    else if (F->cond_est >= 0)
-        note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+    note_estimate(r, F);
     if (F->retries)
         note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
                  F->retries, F->retries == 1 ? "y" : "ies");
@@ -1171,32 +1197,38 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     analyse = analysis_due(F, b->n);
     /* The first solve of a factorization carries the estimator's first block
      * along (MUMPS analyses one column only, so not with the analysis). */
-    /* A complex factorization makes its estimate at once: the start block
-     * (and the lower bound it gives, start_bound) is real-only. */
-    estimate = condest_wanted(call, s, F) && (F->cplx || !condest_later(call));
+    estimate = condest_wanted(call, s, F) && !condest_later(call);
     /* Owed (condest_later), the start block still rides along: a solve phase
-     * costs about the same for a few more columns, and A^-1 X0 gives the
-     * host a lower bound of cond_1 that warns of ill-conditioning at once. */
-    fold = condest_wanted(call, s, F) && !analyse && !F->cplx; /* the complex estimator takes no block */
+     * costs about the same for a few more columns, A^-1 X0 gives the host a
+     * lower bound of cond_1 that tells whether the estimate is urgent, and a
+     * real estimate made later goes on from it (est_y0).  The complex
+     * estimator takes no block: its start rides along only for the bound. */
+    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate);
     rhs = o.val;
-    if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * sizeof *rhs))) {
+    if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * (size_t)w * sizeof *rhs))) {
         host->release(X);
         return host->error(call, SILC_ENOMEM, "mumps: out of memory for the condition estimate");
     }
     if (!analyse) ICNTL(F, 11) = 0; /* restored below, after the estimate */
     do {
         dense_copy(b, rhs, w);
-        if (fold) host->inv_norm1_start(n, EST_COLS, rhs + n * b->n);
-        if (fold) column_sums(n, rhs + n * b->n, x0); /* the solve overwrites the block */
+        if (fold) start_block(n, w, rhs + n * b->n * w);
+        if (fold) column_sums(n, w, rhs + n * b->n * w, x0); /* the solve overwrites the block */
     } while ((rc = run_solve(call, F, rhs, b->n + (fold ? EST_COLS : 0))) == SOLVE_AGAIN);
     if (!rc && analyse) keep_analysis(F);
-    if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n) * sizeof *rhs);
+    if (!rc && fold) memcpy(o.val, rhs, (size_t)(n * b->n * w) * sizeof *rhs);
     r->solve_seconds = host->now() - t0;
     ICNTL(F, 11) = 0; /* the estimate's solves, if any, without it */
     if (!rc && estimate)
         rc = F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, fold ? rhs + n * b->n : NULL);
     ICNTL(F, 11) = icntl11;
-    if (!rc && fold && !estimate) lower = start_bound(call, n, rhs + n * b->n, x0);
+    if (!rc && fold && !estimate) {
+        lower = start_bound(call, n, w, rhs + n * b->n * w, x0);
+        host->free(F->est_y0);
+        F->est_y0 = NULL;
+        if (!F->cplx && (F->est_y0 = host->alloc((size_t)n * EST_COLS * sizeof *rhs)))
+            memcpy(F->est_y0, rhs + n * b->n, (size_t)n * EST_COLS * sizeof *rhs); /* else solved again */
+    }
     if (rhs != o.val) host->free(rhs);
     if (rc) {
         host->release(X);
@@ -1204,7 +1236,9 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
     }
     if (condest_wanted(call, s, F) && condest_later(call)) {
         r->condest_deferred = 1;
-        r->condest_solves = EST_PHASES; /* a solve phase costs about the same for 1 or 2 columns */
+        /* a solve phase costs about the same for 1 or 2 columns; a kept
+         * start block saves one */
+        r->condest_solves = EST_PHASES - (F->est_y0 ? 1 : 0);
     }
     if (fold && !estimate) r->condest_lower = lower;
     *out = X;
@@ -1353,8 +1387,7 @@ static int solve_run(silc_call *call)
         rc = !condest_wanted(call, &s, F) ? SILC_OK : F->cplx ? estimate_cond_complex(call, F) : estimate_cond(call, F, NULL);
         ICNTL(F, 11) = icntl11;
         r->cond_est = F->cond_est;
-        if (F->cond_est >= 0) /* the note says how the estimate was made, and only that */
-            note_add(r, "1-norm condition estimate: block Hager-Higham (%d columns, %d steps)", EST_COLS, EST_STEPS);
+        note_estimate(r, F); /* the note says how the estimate was made, and only that */
         return rc;
     }
     if (all_ranks(&c, F && F->live && same_settings(&F->opts, &s))) {

@@ -135,6 +135,9 @@ typedef struct ref_factor {
     int64_t work_len;       /* doubles of scratch solve() needs */
     int w;                  /* doubles per entry: 1 real, 2 complex */
     double cond, rcond;     /* 1-norm estimate, computed once at factor time */
+    double *est_start;      /* ref_solve.c: M^-1 [e/n, alternating] (n x 2, real) solved for an
+                               owed estimate's lower bound, which the estimate goes on from;
+                               NULL when none is kept */
     char method[64];
     char note[256];
 } ref_factor;
@@ -145,6 +148,10 @@ void ref_factor_free(void *f);  /* attachment destructor */
  * inverse applied in place (trans selects M^{-T}).  Returns -1 on failure. */
 double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                          void *ctx, double *work);
+/* The same with Y = M^{-1} [e/n, alternating vector] (n x 2, the vectors
+ * it starts from and ends with) already solved; NULL solves them. */
+double ref_inv_norm1_est_from(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                              void *ctx, double *work, const double *Y);
 /* The block form (silc_plugin.h, ABI 1.3): t columns per solve (t <= 64),
  * at most itmax solves with M^{-1}; Y0, if not NULL, is M^{-1} times the
  * starting block that ref_inv_norm1_start writes. */

@@ -205,10 +205,20 @@ static int apply_one(void *ctx, double *X, int t, int trans)
 double ref_inv_norm1_est(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                          void *ctx, double *work)
 {
+    return ref_inv_norm1_est_from(n, apply, ctx, work, NULL);
+}
+
+double ref_inv_norm1_est_from(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
+                              void *ctx, double *work, const double *Y)
+{
     one_column c = {apply, ctx, work};
-    double est = ref_inv_norm1_est_block(n, 1, 5, apply_one, &c, NULL), alt;
+    double est = ref_inv_norm1_est_block(n, 1, 5, apply_one, &c, Y), alt;
     double *x;
     if (est < 0 || n < 2 || !isfinite(est)) return est;
+    if (Y) { /* the alternating vector was solved with the start */
+        alt = sum_abs(n, Y + n);
+        return alt > est || !isfinite(alt) ? alt : est;
+    }
     if (!(x = ref_alloc((size_t)n, sizeof(double)))) return -1.0;
     alternating(n, x);
     if (apply(ctx, x, 0, work)) est = -1.0;

@@ -93,8 +93,12 @@ static void set_rcond(ref_factor *F)
 static int make_estimate(ref_factor *F, int64_t n, int w, double norm1)
 {
     double *work = ref_alloc((size_t)(F->work_len + w * n + 1), sizeof(double)), est = -1;
-    if (work) est = (w == 2 ? ref_inv_norm1_est_complex : ref_inv_norm1_est)(n, F->solve, F->data, work);
+    /* an owed estimate goes on from the start its lower bound solved */
+    if (work && w == 2) est = ref_inv_norm1_est_complex(n, F->solve, F->data, work);
+    else if (work) est = ref_inv_norm1_est_from(n, F->solve, F->data, work, F->est_start);
     ref_free(work);
+    ref_free(F->est_start);
+    F->est_start = NULL;
     if (est < 0) return -1;
     F->cond = ref_cond_from(norm1, est);
     set_rcond(F);
@@ -102,27 +106,36 @@ static int make_estimate(ref_factor *F, int64_t n, int w, double norm1)
 }
 
 /* ||A||_1 max_j ||A^-1 x_j||_1 / ||x_j||_1 over the estimator's two start
- * vectors (e/n and the alternating one): a lower bound of cond_1(A) for two
- * column solves, a fraction of the estimate's, that tells the host whether
- * an owed estimate must be made at once (condest_lower); -1 when out of
- * memory.  work: F's solve workspace.  Real factors only: a complex one
- * makes its estimate at once (ref_op_solve). */
-static double start_bound(ref_factor *F, int64_t n, double norm1, double *work)
+ * vectors (e/n and the alternating one; complex: with imaginary parts 0,
+ * norms by modulus): a lower bound of cond_1(A) for two column solves, a
+ * fraction of the estimate's, that tells the host whether an owed estimate
+ * must be made at once (condest_lower); -1 when out of memory.  A real
+ * factor keeps the solved vectors (F->est_start), which the estimate, when
+ * made, starts from instead of solving them again.  work: F's solve
+ * workspace. */
+static double start_bound(ref_factor *F, int64_t n, int w, double norm1, double *work)
 {
-    double *X = ref_alloc((size_t)(2 * n), sizeof(double)), best = 0;
+    double *X = ref_alloc((size_t)(2 * n * w), sizeof(double)), best = 0;
+    int solved = 0;
     if (!X || n == 0) {
         ref_free(X);
         return n ? -1 : 0;
     }
     ref_inv_norm1_start(n, 2, X);
+    if (w == 2)
+        for (int64_t i = 2 * n - 1; i >= 0; i--) X[2 * i] = X[i], X[2 * i + 1] = 0;
     for (int j = 0; j < 2 && n > 1; j++) {
-        double *x = X + j * n, sx = 0, sy = 0;
-        for (int64_t i = 0; i < n; i++) sx += fabs(x[i]);
+        double *x = X + j * n * w, sx = 0, sy = 0;
+        for (int64_t i = 0; i < n; i++) sx += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
         if (F->solve(F->data, x, 0, work)) break;
-        for (int64_t i = 0; i < n; i++) sy += fabs(x[i]);
+        solved++;
+        for (int64_t i = 0; i < n; i++) sy += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
         if (sy / sx > best) best = sy / sx;
     }
-    ref_free(X);
+    ref_free(F->est_start);
+    F->est_start = NULL;
+    if (w == 1 && solved == 2) F->est_start = X;
+    else ref_free(X);
     return best * norm1;
 }
 
@@ -153,11 +166,9 @@ int ref_op_solve(silc_call *call)
 
     /* accuracy.condest = off skips the estimate (ABI 1.7); condest_later
      * leaves it owed, condest_only makes it alone (ABI 1.8, see
-     * make_estimate).  A complex factor makes it at once: the lower bound
-     * that decides whether an owed estimate is urgent (start_bound) is
-     * written for real factors. */
+     * make_estimate), real or complex alike. */
     int wanted = !(ref_host->abi_minor >= 7 && rep->condest_off);
-    int later = ref_host->abi_minor >= 8 && rep->condest_later && w == 1;
+    int later = ref_host->abi_minor >= 8 && rep->condest_later;
     if (ref_host->abi_minor >= 8 && rep->condest_only) {
         ref_factor *F = ref_host->attach_get(call->in[0], alg_key[alg]);
         if (!F && by_structure && (alg == ALG_DENSE_SPD || alg == ALG_SPARSE_SPD)) /* Cholesky had failed */
@@ -266,7 +277,7 @@ int ref_op_solve(silc_call *call)
     if (F->cond == 0.0 && wanted && later && attached) {
         rep->condest_deferred = 1;
         rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
-        if ((rep->condest_lower = start_bound(F, n, P->norm1, work)) < 0) {
+        if ((rep->condest_lower = start_bound(F, n, w, P->norm1, work)) < 0) {
             st = ref_nomem(call); /* without the hint an ill-conditioned matrix could go unwarned */
             goto done;
         }

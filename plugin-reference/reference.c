@@ -346,6 +346,7 @@ void ref_factor_free(void *p)
     ref_factor *F = p;
     if (!F) return;
     if (F->destroy) F->destroy(F->data);
+    ref_free(F->est_start);
     ref_free(F);
 }
 

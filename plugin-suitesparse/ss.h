@@ -121,6 +121,8 @@ typedef struct ss_factor_info {
     double cond;                /* the condition estimate, valid when estimated */
     int estimated;              /* cond holds a Hager/Higham estimate */
     double pivot_ratio;         /* the library's max/min factor diagonal (1/rcond), 0 = none */
+    double *start_solved;       /* complex A^-1 e/n solved for an owed estimate's lower bound,
+                                   its estimator's first step (ss_complex.c); NULL when none */
     char method[64];
     char note[160];
 } ss_factor_info;
@@ -136,11 +138,13 @@ typedef struct ss_factor_info {
  * factors, a sixth of a refactorization on 494_bus), so a column less is
  * a sixth less; the estimates are those of the block form on the shared
  * matrices but west0067 (0.69 of cond_1 against 0.97, as dlacon's: the
- * test allows 10x).  The first application rides along with the user's
+ * test allows 10x).  The first application rides along with KLU's user
  * solve when it is due (ss_cond_due): the solve takes ss_rhs_with_start's
  * array, B with the starting block after it, and passes the solved block
- * as Y0; Y0 = NULL makes ss_square_cond solve the start itself (UMFPACK,
- * one column per call anyway).  apply(ctx, X, t, trans) overwrites the
+ * as Y0 (KLU's solve rounds each column alike however many ride along);
+ * Y0 = NULL makes ss_square_cond solve the start itself (UMFPACK, one
+ * column per call anyway; CHOLMOD, whose supernodal solve of more columns
+ * would round the user's otherwise).  apply(ctx, X, t, trans) overwrites the
  * n x t X with A^-1 X (A^-T X).  Sets fi->cond = norm1(A) ||A^{-1}||_1 and
  * fi->estimated; nothing when not due or when a solve fails. */
 #define SS_EST_COLS 2

@@ -446,15 +446,17 @@ double acc_cond_lower_bound(const silc_value *A, const silc_value *B, const silc
 {
     double best = -1, nA1;
     int64_t i, j;
+    int w = X->field == SILC_FIELD_COMPLEX ? 2 : 1; /* doubles per entry; complex: by modulus */
     if (A->m != A->n || A->dist || B->dist || X->dist || B->format != SILC_FMT_DENSE ||
-        X->format != SILC_FMT_DENSE || B->m != X->m || B->n != X->n)
+        X->format != SILC_FMT_DENSE || B->m != X->m || B->n != X->n ||
+        (B->field == SILC_FIELD_COMPLEX) != (w == 2))
         return -1;
     for (j = 0; j < X->n; j++) {
-        const double *b = B->val + j * B->m, *x = X->val + j * X->m;
+        const double *b = B->val + j * B->m * w, *x = X->val + j * X->m * w;
         double sb = 0, sx = 0;
         for (i = 0; i < X->m; i++) {
-            sb += fabs(b[i]);
-            sx += fabs(x[i]);
+            sb += w == 2 ? hypot(b[2 * i], b[2 * i + 1]) : fabs(b[i]);
+            sx += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
         }
         if (sb > 0 && sx / sb > best) best = sx / sb; /* NaN compares false: skipped */
     }

@@ -101,8 +101,8 @@ double acc_verify_limit(const char *verify, const silc_report *r);
 
 /* A lower bound of cond_1(A) that a solve gives for free: A X = B, so
  * ||A^-1||_1 >= ||x_j||_1 / ||b_j||_1 for every column, times ||A||_1 (A's
- * properties).  One pass over B and X; -1 when not computed (not square,
- * distributed, or B not dense).  The dispatcher's hint that a matrix may be
+ * properties; complex operands by modulus).  One pass over B and X; -1
+ * when not computed (not square, distributed, or B not dense).  The dispatcher's hint that a matrix may be
  * ill-conditioned, when it weighs deferring the condition estimate. */
 double acc_cond_lower_bound(const silc_value *A, const silc_value *B, const silc_value *X);
 

@@ -548,32 +548,44 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * it just made, and condest_settle makes it at once -- a condest_only call to
  * the same backend, whose factorization is attached to A -- when that costs
  * at most DISP_CONDEST_BUDGET of the factorization the call made, or when
- * what the solve knows for free hints at ill-conditioning, so that the
- * warnings come at solve time: the library's pivot ratio (UMFPACK, KLU,
- * CHOLMOD), the lower bound ||A||_1 ||A^-1 x0||_1 / ||x0||_1 of the
- * estimator's start block x0 solved with the user's columns (MUMPS, where
- * a few more columns cost a solve phase nothing; the reference, two column
- * solves), or else the solve's own ||A||_1 ||x||_1 / ||b||_1
- * (acc_cond_lower_bound), above DISP_CONDEST_PIVOT_HINT or _BOUND_HINT.
- * Otherwise the estimate is owed and made when the report is read
- * (disp_condest_resolve, from `info`).  A solve that reused a factorization
- * made none to weigh the cost against: its estimate is owed.
+ * the condition warnings could fire (condest_urgent), so that they come at
+ * solve time.  Otherwise the estimate is owed and made when the report is
+ * read (disp_condest_resolve, from `info`).  A solve that reused a
+ * factorization made none to weigh the cost against: its estimate is owed.
  * accuracy.condest = now keeps every estimate at solve time (the backend
  * then folds its first block into the user's solve, as before);
- * on_request owes every estimate that costs solves, hints or not (its
- * warnings then come when the report is read), for a program of many
- * solves that reads few reports. */
+ * on_request owes every estimate that costs solves, whatever it could
+ * warn (its warnings then come when the report is read), for a program of
+ * many solves that reads few reports. */
 #define DISP_CONDEST_BUDGET 0.15
-/* The hints, against the "fewer than 4 correct digits" warning at cond_1 =
- * 4.5e11 (docs/accuracy.md gives them on the shared matrices).  The pivot
- * ratio is no bound (3.8 against 840 on the 1-D Laplacian, 2 against 1.5e11
- * on fs_183_6), but the matrices that warn have ratios of 1.2e7 and more:
- * 1e6 keeps them with a margin of 12.  The start block's bound is rigorous
- * and at most 8000x below cond_1 on the shared matrices (bayer10): 1e7
- * keeps a margin of 4.5e4 below the warning, and leaves the estimates of
- * the merely ill-conditioned (494_bus, 3.9e6) owed. */
+/* When an owed estimate is urgent.  The warnings (warn_condition) depend on
+ * the estimate alone: cond_est eps > 1e-4, i.e. cond_est > DISP_CONDEST_WARN_AT
+ * = 4.5e11.  What the solve knows for free:
+ *   L, a rigorous lower bound of cond_1, and of the estimate too (the
+ *     estimator starts from the same vectors and keeps its best): the
+ *     estimator's start block solved with the user's columns (MUMPS, the
+ *     reference: condest_lower), else the solve's own ||A||_1 ||x||_1 /
+ *     ||b||_1 (acc_cond_lower_bound);
+ *   the library's pivot ratio (UMFPACK, KLU, CHOLMOD), no bound at all.
+ * The estimate is at most DISP_CONDEST_LOWER_SLACK x the start block's L
+ * on every shared matrix (docs/accuracy.md, measured with MUMPS and the
+ * reference: 7900 on bayer10, where L alone is over the threshold; 620 on
+ * west0479, the largest where it is not), so it is skipped only when L x
+ * the slack cannot reach the threshold: below L = 5.6e7 the warning
+ * cannot fire on any matrix like the shared ones.  The solve's own bound
+ * is far weaker (1e3 to 1e12 below the estimate with b = A * ones): it
+ * serves only where a backend gives neither of the others (MUMPS's solve
+ * that runs its error analysis), and rarely proves anything.
+ * UMFPACK's and KLU's pivot ratio is no bound (3.8 against 840 on the 1-D
+ * Laplacian, 2 against 1.5e11 on fs_183_6), but every shared matrix that
+ * warns has one of 1.2e7 or more: 1e6 keeps a margin of 12 (a heuristic,
+ * documented as such; `now` is the setting that never relies on it).
+ * CHOLMOD's, (max L_ii / min L_ii)^2 of A = L L', is a rigorous lower
+ * bound of cond_2(A) <= cond_1(A) and comes as condest_lower (cholmod.c);
+ * the estimate is at most 740 times it on the shared spd matrices. */
+#define DISP_CONDEST_WARN_AT (1e-4 / DBL_EPSILON)
+#define DISP_CONDEST_LOWER_SLACK 8000.0
 #define DISP_CONDEST_PIVOT_HINT 1e6
-#define DISP_CONDEST_BOUND_HINT 1e7
 
 /* The estimate's cost as a share of the factorization the solve made
  * (INFINITY when it made none). */
@@ -624,6 +636,23 @@ static int estimate_only(silc_engine *E, const ld_backend *b, const silc_call *l
     return SILC_OK;
 }
 
+/* 1 when the warnings could fire on the estimate the solve left owed (the
+ * rule above DISP_CONDEST_WARN_AT). */
+static int condest_urgent(const silc_call *call)
+{
+    const silc_report *r = call->report;
+    double lower = r->condest_lower;
+    /* a backend that gives a rigorous bound is judged by it, not by the
+     * pivot heuristic (CHOLMOD's ratio is one: see the rule above) */
+    if (lower > 0) return !(lower * DISP_CONDEST_LOWER_SLACK < DISP_CONDEST_WARN_AT);
+    if (r->pivot_ratio > DISP_CONDEST_PIVOT_HINT) return 1;
+    /* The solve's own lower bound costs a pass over A (for ||A||_1) and
+     * the operands, a few per cent of a KLU factorization: only where the
+     * backend gives no hint of its own. */
+    if (r->pivot_ratio == 0 && lower == 0) lower = acc_cond_lower_bound(call->in[0], call->in[1], call->out);
+    return !(lower * DISP_CONDEST_LOWER_SLACK < DISP_CONDEST_WARN_AT); /* NaN: urgent */
+}
+
 /* A solve whose backend left its estimate out (condest_deferred = 1): made
  * now when it is cheap or the matrix may be ill-conditioned, else owed.
  * -1 when that estimate ran out of memory: the solve fails, as it did when
@@ -637,14 +666,7 @@ static int condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
         return 0;
     }
     if (mode && !strcmp(mode, "on_request")) return 0; /* owed, whatever it costs */
-    /* The solve's own lower bound costs a pass over A (for ||A||_1) and
-     * the operands, a few per cent of a KLU factorization: only where the
-     * backend gives no hint of its own. */
-    if (condest_share(r) > DISP_CONDEST_BUDGET && !(r->pivot_ratio > DISP_CONDEST_PIVOT_HINT) &&
-        !(r->condest_lower > DISP_CONDEST_BOUND_HINT) &&
-        !(r->pivot_ratio == 0 && r->condest_lower == 0 &&
-          acc_cond_lower_bound(call->in[0], call->in[1], call->out) > DISP_CONDEST_BOUND_HINT))
-        return 0; /* owed */
+    if (condest_share(r) > DISP_CONDEST_BUDGET && !condest_urgent(call)) return 0; /* owed */
     r->condest_deferred = 0;
     return estimate_only(E, b, call, r) == SILC_ENOMEM ? -1 : 0; /* else none: "the backend gives none" */
 }
