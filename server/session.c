@@ -9,9 +9,11 @@
  * session's slot (server.h): if this process dies, the parent then knows
  * whether the client can still be told why.
  *
- * Session memory (the val_bytes of every bound value, and what the memo
- * keeps without a name: memo_charge) is kept under max_session_bytes; the
- * memo gives way first (memo_shrink).  A PUT is checked from its descriptor
+ * Session memory (the val_bytes of every bound value, what the memo keeps
+ * without a name, and the factorizations solves attached to what the
+ * session holds: memo_held) is kept under max_session_bytes; the memo and
+ * then the factorizations give way first (memo_release), so only the
+ * values themselves can make a request fail.  A PUT is checked from its descriptor
  * before its arrays are read; an EXEC runs against a snapshot of the
  * bindings (eng_snapshot: names to retained values, which is cheap because
  * values are immutable) and is rolled back whole if it leaves the session
@@ -108,30 +110,20 @@ static void capture_output(void *user, const char *text)
     out_frame(&((session *)user)->out, PROTO_TEXT, text);
 }
 
-static uint64_t bound_bytes(const silc_engine *E)
-{
-    uint64_t total = 0;
-    size_t b;
-    const store_entry *e;
-    for (b = 0; b < E->store.nbuckets; b++)
-        for (e = E->store.buckets[b]; e; e = e->next) total += val_bytes(e->value);
-    return total;
-}
-
-/* What the session holds: its bound values, and what the memo keeps for it
- * (results no name holds, factorizations hung on results: memo.c). */
+/* What the session holds: its bound values, what the memo keeps for it,
+ * and the factorizations hung on either (memo.c: memo_held). */
 static uint64_t session_bytes(const silc_engine *E)
 {
-    return bound_bytes(E) + memo_charge(E, NULL);
+    return memo_held(E, NULL);
 }
 
-/* At the limit the memo goes first: it is trimmed to what the bound values
- * and more bytes about to be bound leave. */
+/* At the limit the memo and the factorizations go first: they are let go
+ * until they fit what the bound values and more bytes about to be bound
+ * leave. */
 static void memo_give_way(silc_engine *E, double more)
 {
-    double left = (double)srv_cfg.max_session_bytes - (double)bound_bytes(E) - more;
     if (!srv_cfg.max_session_bytes) return;
-    memo_shrink(E, left > 0 ? (uint64_t)left : 0);
+    memo_release(E, (double)srv_cfg.max_session_bytes - more);
 }
 
 static void part_done(reply_part *r)
@@ -257,15 +249,15 @@ static int exec_guarded(void)
  * session's under silcd --mpi, the engine's caches). */
 static void exec_budget(const silc_engine *E, int on)
 {
-    uint64_t memo_arrays;
+    memo_holdings h;
     if (!on || !srv_cfg.max_session_bytes) {
         val_budget_set(0, 0, NULL);
         return;
     }
-    /* The memo's results are values alive: the budget counts them (what
-     * hangs off them it cannot see: memo_make_room adds that). */
-    memo_charge(E, &memo_arrays);
-    val_budget_set(val_live_bytes() - (int64_t)(bound_bytes(E) + memo_arrays), srv_cfg.max_session_bytes,
+    /* The memo's results are values alive: the budget counts them (the
+     * factorizations it cannot see: memo_make_room adds them). */
+    memo_held(E, &h);
+    val_budget_set(val_live_bytes() - (int64_t)(h.bound + h.memo_arrays), srv_cfg.max_session_bytes,
                    "the session's limit, silcd --max-session-bytes");
 }
 

@@ -21,12 +21,15 @@ foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_
                    ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
   set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endforeach()
-# The memo's kept results and their UMFPACK factorizations (issue 33).
+# The memo's kept results and their UMFPACK factorizations (issue 33); the
+# CHOLMOD factorizations of bound values (issue 27).
 if(TARGET silc_plugin_suitesparse)
-  add_test(NAME security_limits_memo
-           COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
-                   ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} memo $<TARGET_FILE:silcd>)
-  set_tests_properties(security_limits_memo PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+  foreach(case memo attached)
+    add_test(NAME security_limits_${case}
+             COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
+                     ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
+    set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+  endforeach()
 endif()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
   foreach(case request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi

@@ -484,6 +484,92 @@ def case_memo():
     srv.stop_cleanly()
 
 
+def case_attached():
+    """Issue 27: a factorization hung on a bound value counts against
+    --max-session-bytes.  16 distinct 2-D Laplacians (SPD: CHOLMOD), each
+    PUT under its own name and solved once, used to keep 16 factorizations
+    (several times each matrix) that only RLIMIT_DATA bounded: the session
+    grew past its limit with every value inside it.  Now the session's
+    charge (INFO's bytes: values, memo, attached state) stays under the
+    limit, the least recently used factorizations are released, every
+    solve is right, a re-solve of a released one factors again and is
+    right, and an estimate owed on a released factorization says so."""
+    import scipy.sparse
+    k, count = 60, 16
+    n = k * k
+    limit = 8 * MiB
+    srv = Server("--max-session-bytes", str(limit))
+    s = srv.session()
+    s.exec("set accuracy.condest = on_request")    # every estimate owed until `info` reads it
+    pid = session_pids(srv, 1)[0]
+    I = scipy.sparse.identity(k)
+    values = 0
+    rss = []
+    for i in range(count):
+        T = scipy.sparse.diags([-1.0, 2.0 + 0.01 * i, -1.0], [-1, 0, 1], shape=(k, k))
+        A = (scipy.sparse.kron(T, I) + scipy.sparse.kron(I, T)).tocsr()
+        b = A @ np.arange(1.0, n + 1.0)
+        s.put("A%d" % i, A)
+        s.put("b%d" % i, b.reshape(-1, 1))
+        s.exec("x%d = A%d \\ b%d" % (i, i, i))
+        x = s.get("x%d" % i).ravel()
+        res = np.abs(A @ x - b).max() / np.abs(b).max()
+        if not res < 1e-12:
+            fail("round %d: relative residual %g" % (i, res))
+        csr = (n + 1) * 8 + A.nnz * 16
+        values += csr + 2 * n * 8          # A, b and x, as the session stores them
+        info = dict(line.split(": ", 1) for line in s.info().splitlines() if ": " in line)
+        charge = int(info["bytes"])
+        if charge > limit:
+            fail("round %d: the session holds %d bytes, over its limit of %d" % (i, charge, limit))
+        if i == 0:
+            # What the solve attached, as measured: the factorization is
+            # several times the matrix; kept for all 16 matrices, the
+            # session would hold far more than its limit.
+            attached = charge - values
+            unbounded = count * (csr + 2 * n * 8 + attached)
+            print("one matrix: %d bytes, its factorization: %d bytes; kept for all: %.1f MiB"
+                  % (csr, attached, unbounded / MiB))
+            if attached < 2 * csr:
+                fail("the factorization of A0 is charged %d bytes, under twice the matrix (%d)"
+                     % (attached, csr))
+            if unbounded < 2 * limit:
+                fail("the case cannot fail: every factorization kept holds %d bytes" % unbounded)
+        rss.append(proc_status(pid, "VmRSS"))
+        print("round %2d: charge %.2f MiB (values %.2f), VmRSS %.1f MiB"
+              % (i, charge / MiB, values / MiB, rss[-1] / MiB))
+    # The estimate owed on A0's released factorization says so; the last
+    # one, still attached, is computed when read.
+    first = s.info("x0")
+    if "deferred at solve time, and the factorization was released before the report was read" \
+            not in first:
+        fail("info x0 after its factorization was released:\n" + first)
+    last = s.info("x%d" % (count - 1))
+    if "computed when the report was first read" not in last:
+        fail("info of the last solve, its factorization still attached:\n" + last)
+    # Re-solves: the last matrix reuses its factorization; A0 is factored again.
+    for i, reused in ((count - 1, "yes"), (0, "no")):
+        s.exec("y = A%d \\ (2 * b%d)" % (i, i))
+        y = s.get("y").ravel()
+        if not np.abs(y - 2 * np.arange(1.0, n + 1.0)).max() < 1e-8 * n:
+            fail("the re-solve of A%d is wrong" % i)
+        if "reused factorization: %s" % reused not in s.info("y"):
+            fail("re-solve of A%d: expected 'reused factorization: %s':\n%s" % (i, reused, s.info("y")))
+    # Resident memory from round 1 on (CHOLMOD's workspace is made in round
+    # 0): the values grow it, and every factorization kept would grow it
+    # by as much again as they (measured 21 MiB, against 10 MiB now).  It
+    # must stay under the values' growth plus half the factorizations'.
+    # Under AddressSanitizer freed memory sits in its quarantine: the
+    # charge above holds there.
+    grown, kept_values = rss[-1] - rss[1], (count - 2) * (csr + 2 * n * 8)
+    if not SANITIZED and grown > kept_values + (count - 2) * attached / 2:
+        fail("the session grew by %.1f MiB from round 1, its values by %.1f MiB, the "
+             "factorizations kept would add %.1f MiB" % (grown / MiB, kept_values / MiB,
+                                                          (count - 2) * attached / MiB))
+    s.close()
+    srv.stop_cleanly()
+
+
 def case_statement_cap():
     srv = Server()
     s = srv.session()
