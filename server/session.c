@@ -261,6 +261,22 @@ static void exec_budget(const silc_engine *E, int on)
                    "the session's limit, silcd --max-session-bytes");
 }
 
+/* What libraries printed during the request (output.c) goes to its client
+ * with the request's own output, not to silcd's log. */
+static void library_output(session *S)
+{
+    unsigned long long dropped;
+    const char *text = srv_output_end(&dropped);
+    char note[160];
+    if (!text) return;
+    if (*text) out_frame(&S->out, PROTO_TEXT, text);
+    if (dropped) {
+        snprintf(note, sizeof note, "silcd: %llu more bytes of library output dropped (at most 1 MiB a request)\n",
+                 dropped);
+        out_frame(&S->out, PROTO_TEXT, note);
+    }
+}
+
 static int do_exec(session *S, const char *text)
 {
     silc_engine *E = S->E;
@@ -276,7 +292,9 @@ static int do_exec(session *S, const char *text)
     *S->state = SLOT_RUNNING;
     exec_budget(E, 1);
     srv_watch_begin(&S->watch, S->fd);
+    srv_output_begin();
     rc = api_exec(E, text, S->err, sizeof S->err);
+    library_output(S);
     srv_watch_end(&S->watch);
     refused = val_budget_refused();
     exec_budget(E, 0);
@@ -709,6 +727,9 @@ static session *session_open(int fd, unsigned long id, volatile int *state,
     }
     *S->state = SLOT_READY;
     srv_log(LOG_INFO, "session %lu: open", id);
+    if (srv_output_init()) /* once per process: a session's, or rank 0's under --mpi */
+        srv_log(LOG_WARN, "session %lu: no pipe for library output: what libraries print goes to silcd's "
+                "standard output", id);
     return S;
 }
 
@@ -849,6 +870,12 @@ int srv_follow(void)
 {
     follower *list = NULL, **pp, *f;
     char err[4096];
+    /* What a library prints on this rank during a request is not the
+     * operator's: it is caught and dropped (a replicated solve prints on
+     * every rank; rank 0 sends its copy). */
+    if (srv_output_init())
+        srv_log(LOG_WARN, "rank %d: no pipe for library output: what libraries print goes to silcd's "
+                "standard output", srv_mpi->rank);
     for (;;) {
         int cmd;
         unsigned long id;
@@ -900,9 +927,12 @@ int srv_follow(void)
             eng_snapshot snap;
             int guarded = exec_guarded(), have = 0;
             int64_t over = 0;
+            unsigned long long dropped;
             if (guarded) have = eng_snapshot_take(E, &snap) == 0;
             exec_budget(E, 1);
+            srv_output_begin();
             api_exec(E, text, err, sizeof err);
+            srv_output_end(&dropped); /* rank 0's copy is the client's; this one is dropped */
             exec_budget(E, 0);
             if (guarded) {
                 srv_mpi->word(srv_mpi, &over);

@@ -570,6 +570,48 @@ def case_attached():
     srv.stop_cleanly()
 
 
+def library_output(mpi):
+    """What a library prints during a request goes to its client, not to
+    silcd's standard output (the operator's log): PETSc's
+    -ksp_converged_reason and a deprecated option's warning used to land
+    in silcd's log.  -log_view and -help stay refused (a session must not
+    read PETSc's process-wide table, nor name a file)."""
+    srv = Server("--max-session-bytes", "64M", mpi=mpi)
+    s = srv.session()
+    s.exec("A = sparse(eye(50) * 4 - 1); b = ones(50, 1)")
+    out = []
+    s.exec('set petsc.options = -ksp_type cg -ksp_converged_reason -ksp_compute_eigenvalues\n'
+           'x = solve(A, b, "backend = petsc")\nr = norm(A * x - b, inf)', out=out)
+    text = "".join(out)
+    for said in ("Linear solve converged due to", "-ksp_compute_eigenvalues is deprecated"):
+        if said not in text:
+            fail("the client did not get PETSc's %r: %r" % (said, text))
+        if said in srv.text():
+            fail("PETSc's %r reached silcd's log:\n%s" % (said, srv.text()))
+    if not s.get("r")[0, 0] < 1e-8:
+        fail("the PETSc solve is wrong: |A x - b| = %g" % s.get("r")[0, 0])
+    # A request that prints nothing gets no library text.
+    out = []
+    s.exec("y = 2 * 3", out=out)
+    if out:
+        fail("library output for a request that printed nothing: %r" % out)
+    for opt in ("-log_view", "-help"):
+        expect_error(lambda: s.exec("set petsc.options = %s" % opt),
+                     "petsc.options: '%s' is refused in a silcd session: options that "
+                     "view, monitor, log, dump, name a file, load code or set threads are server "
+                     "settings (set them in silcd's config)" % opt)
+    s.close()
+    srv.stop_cleanly()
+
+
+def case_library_output():
+    library_output(False)
+
+
+def case_library_output_mpi():
+    library_output(True)
+
+
 def case_statement_cap():
     srv = Server()
     s = srv.session()
