@@ -411,12 +411,12 @@ def case_parent_killed():
     srv.log.close()
 
 
-def case_peak():
+def peak(mpi):
     """Temporaries count: zeros(1000) holds 8 MB; with a 20 MB session
     limit, a statement that ends binding a scalar but holds 24 MB at once
     (a, d, ones(1000), their sum) is refused, and its whole request rolled
     back."""
-    srv = Server("--max-session-bytes", "20M")
+    srv = Server("--max-session-bytes", "20M", mpi=mpi)
     s = srv.session()
     s.exec("a = zeros(1000)")
     expect_error(lambda: s.exec("d = 5\nb = sum(a + ones(1000) + ones(1000))"),
@@ -431,6 +431,14 @@ def case_peak():
         fail("the entries of sum(a + 1) do not add up to 1e6")
     s.close()
     srv.stop_cleanly()
+
+
+def case_peak():
+    peak(False)
+
+
+def case_peak_mpi():
+    peak(True)
 
 
 def case_memo():
@@ -612,8 +620,8 @@ def case_library_output_mpi():
     library_output(True)
 
 
-def case_statement_cap():
-    srv = Server()
+def statement_cap(mpi):
+    srv = Server(mpi=mpi)
     s = srv.session()
     text = "a = [" + ",".join(["1"] * (2 << 20)) + "]"    # 4 MiB of text
     expect_error(lambda: s.exec(text), "statement text of %d bytes is over the limit of %d "
@@ -621,6 +629,14 @@ def case_statement_cap():
     s.exec("a = [1, 2, 3]")
     s.close()
     srv.stop_cleanly()
+
+
+def case_statement_cap():
+    statement_cap(False)
+
+
+def case_statement_cap_mpi():
+    statement_cap(True)
 
 
 def stuck_server(*args, mpi=False):
