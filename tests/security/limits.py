@@ -578,6 +578,47 @@ def case_attached():
     srv.stop_cleanly()
 
 
+def data_limit(pid):
+    """The soft RLIMIT_DATA of pid, in bytes (/proc/PID/limits)."""
+    with open("/proc/%d/limits" % pid) as f:
+        for line in f:
+            if line.startswith("Max data size"):
+                soft = line.split()[3]
+                if soft == "unlimited":
+                    fail("process %d has no RLIMIT_DATA" % pid)
+                return int(soft)
+    fail("no 'Max data size' in /proc/%d/limits" % pid)
+
+
+def data_cap(mpi):
+    """Issue 27, item 4: each session process (under --mpi, each rank) has
+    an RLIMIT_DATA cap: what it had mapped at its start (at most its
+    VmData now) + 2 x --max-session-bytes for each session it may hold
+    + --array-pool + 256 MiB."""
+    limit, pool, clients = 64 * MiB, 32 * MiB, 4
+    srv = Server("--max-session-bytes", str(limit), "--array-pool", str(pool),
+                 "--max-clients", str(clients), mpi=mpi)
+    s = srv.session()
+    s.exec("x = 1")
+    pids = rank_pids(srv).values() if mpi else session_pids(srv, 1)
+    for pid in pids:
+        want = (clients if mpi else 1) * 2 * limit + pool + 256 * MiB
+        cap, base = data_limit(pid), proc_status(pid, "VmData")
+        if not want <= cap <= want + base:
+            fail("process %d: RLIMIT_DATA %d, expected %d + its start's data (at most %d)"
+                 % (pid, cap, want, base))
+    s.close()
+    srv.stop_cleanly()
+
+
+def case_data_cap():
+    data_cap(False)
+
+
+def case_data_cap_mpi():
+    data_cap(True)
+
+
 def library_output(mpi):
     """What a library prints during a request goes to its client, not to
     silcd's standard output (the operator's log): PETSc's
