@@ -246,6 +246,7 @@ int srv_watch_check(void *user, char *why, size_t whylen)
     /* The clock is cheap (vDSO), system calls are not: poll every 20 ms. */
     if (now < w->next_poll) return 0;
     w->next_poll = now + SRV_WATCH_POLL_S;
+    srv_output_drain(); /* room in the pipe for what a library prints next */
     if (client_gone(w->fd)) return stop_because(w, SRV_STOP_GONE, why, whylen);
     if (cancel_arrived(w->fd)) {
         w->cancelled = 1;

@@ -146,6 +146,14 @@ typedef struct srv_watch {
     char why[256];   /* the client's message once stop is set */
 } srv_watch;
 void srv_watch_begin(srv_watch *w, int fd);
+/* A request's library output (output.c): while it runs, descriptor 1 is a
+ * pipe the watch empties; srv_output_end gives what it held (NULL: none),
+ * at most 1 MiB, and how many bytes beyond were dropped.  Without
+ * srv_output_init (once per process; -1 if it failed) nothing is caught. */
+int srv_output_init(void);
+void srv_output_begin(void);
+void srv_output_drain(void);
+const char *srv_output_end(unsigned long long *dropped);
 void srv_watch_end(srv_watch *w);
 int srv_watch_check(void *user, char *why, size_t whylen);
 

@@ -9,9 +9,11 @@
  * session's slot (server.h): if this process dies, the parent then knows
  * whether the client can still be told why.
  *
- * Session memory (the val_bytes of every bound value, and what the memo
- * keeps without a name: memo_charge) is kept under max_session_bytes; the
- * memo gives way first (memo_shrink).  A PUT is checked from its descriptor
+ * Session memory (the val_bytes of every bound value, what the memo keeps
+ * without a name, and the factorizations solves attached to what the
+ * session holds: memo_held) is kept under max_session_bytes; the memo and
+ * then the factorizations give way first (memo_release), so only the
+ * values themselves can make a request fail.  A PUT is checked from its descriptor
  * before its arrays are read; an EXEC runs against a snapshot of the
  * bindings (eng_snapshot: names to retained values, which is cheap because
  * values are immutable) and is rolled back whole if it leaves the session
@@ -108,30 +110,20 @@ static void capture_output(void *user, const char *text)
     out_frame(&((session *)user)->out, PROTO_TEXT, text);
 }
 
-static uint64_t bound_bytes(const silc_engine *E)
-{
-    uint64_t total = 0;
-    size_t b;
-    const store_entry *e;
-    for (b = 0; b < E->store.nbuckets; b++)
-        for (e = E->store.buckets[b]; e; e = e->next) total += val_bytes(e->value);
-    return total;
-}
-
-/* What the session holds: its bound values, and what the memo keeps for it
- * (results no name holds, factorizations hung on results: memo.c). */
+/* What the session holds: its bound values, what the memo keeps for it,
+ * and the factorizations hung on either (memo.c: memo_held). */
 static uint64_t session_bytes(const silc_engine *E)
 {
-    return bound_bytes(E) + memo_charge(E, NULL);
+    return memo_held(E, NULL);
 }
 
-/* At the limit the memo goes first: it is trimmed to what the bound values
- * and more bytes about to be bound leave. */
+/* At the limit the memo and the factorizations go first: they are let go
+ * until they fit what the bound values and more bytes about to be bound
+ * leave. */
 static void memo_give_way(silc_engine *E, double more)
 {
-    double left = (double)srv_cfg.max_session_bytes - (double)bound_bytes(E) - more;
     if (!srv_cfg.max_session_bytes) return;
-    memo_shrink(E, left > 0 ? (uint64_t)left : 0);
+    memo_release(E, (double)srv_cfg.max_session_bytes - more);
 }
 
 static void part_done(reply_part *r)
@@ -257,16 +249,32 @@ static int exec_guarded(void)
  * session's under silcd --mpi, the engine's caches). */
 static void exec_budget(const silc_engine *E, int on)
 {
-    uint64_t memo_arrays;
+    memo_holdings h;
     if (!on || !srv_cfg.max_session_bytes) {
         val_budget_set(0, 0, NULL);
         return;
     }
-    /* The memo's results are values alive: the budget counts them (what
-     * hangs off them it cannot see: memo_make_room adds that). */
-    memo_charge(E, &memo_arrays);
-    val_budget_set(val_live_bytes() - (int64_t)(bound_bytes(E) + memo_arrays), srv_cfg.max_session_bytes,
+    /* The memo's results are values alive: the budget counts them (the
+     * factorizations it cannot see: memo_make_room adds them). */
+    memo_held(E, &h);
+    val_budget_set(val_live_bytes() - (int64_t)(h.bound + h.memo_arrays), srv_cfg.max_session_bytes,
                    "the session's limit, silcd --max-session-bytes");
+}
+
+/* What libraries printed during the request (output.c) goes to its client
+ * with the request's own output, not to silcd's log. */
+static void library_output(session *S)
+{
+    unsigned long long dropped;
+    const char *text = srv_output_end(&dropped);
+    char note[160];
+    if (!text) return;
+    if (*text) out_frame(&S->out, PROTO_TEXT, text);
+    if (dropped) {
+        snprintf(note, sizeof note, "silcd: %llu more bytes of library output dropped (at most 1 MiB a request)\n",
+                 dropped);
+        out_frame(&S->out, PROTO_TEXT, note);
+    }
 }
 
 static int do_exec(session *S, const char *text)
@@ -284,7 +292,9 @@ static int do_exec(session *S, const char *text)
     *S->state = SLOT_RUNNING;
     exec_budget(E, 1);
     srv_watch_begin(&S->watch, S->fd);
+    srv_output_begin();
     rc = api_exec(E, text, S->err, sizeof S->err);
+    library_output(S);
     srv_watch_end(&S->watch);
     refused = val_budget_refused();
     exec_budget(E, 0);
@@ -717,6 +727,9 @@ static session *session_open(int fd, unsigned long id, volatile int *state,
     }
     *S->state = SLOT_READY;
     srv_log(LOG_INFO, "session %lu: open", id);
+    if (srv_output_init()) /* once per process: a session's, or rank 0's under --mpi */
+        srv_log(LOG_WARN, "session %lu: no pipe for library output: what libraries print goes to silcd's "
+                "standard output", id);
     return S;
 }
 
@@ -857,6 +870,12 @@ int srv_follow(void)
 {
     follower *list = NULL, **pp, *f;
     char err[4096];
+    /* What a library prints on this rank during a request is not the
+     * operator's: it is caught and dropped (a replicated solve prints on
+     * every rank; rank 0 sends its copy). */
+    if (srv_output_init())
+        srv_log(LOG_WARN, "rank %d: no pipe for library output: what libraries print goes to silcd's "
+                "standard output", srv_mpi->rank);
     for (;;) {
         int cmd;
         unsigned long id;
@@ -908,9 +927,12 @@ int srv_follow(void)
             eng_snapshot snap;
             int guarded = exec_guarded(), have = 0;
             int64_t over = 0;
+            unsigned long long dropped;
             if (guarded) have = eng_snapshot_take(E, &snap) == 0;
             exec_budget(E, 1);
+            srv_output_begin();
             api_exec(E, text, err, sizeof err);
+            srv_output_end(&dropped); /* rank 0's copy is the client's; this one is dropped */
             exec_budget(E, 0);
             if (guarded) {
                 srv_mpi->word(srv_mpi, &over);

@@ -717,8 +717,10 @@ int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
  * growth is charged to the attachments the call added (val_attach_charge),
  * shared if it added several.  What else the call kept for itself (a
  * plugin's pattern cache) is charged with them: an overestimate, on the
- * safe side.  The memo counts these charges against silcd's session limit
- * (memo.c).  Elsewhere (no mallinfo2) nothing is charged. */
+ * safe side.  silcd counts these charges against a session's limit, on
+ * whatever value the session holds, and releases the least recently used
+ * first when it is reached (lang/memo.c: memo_held, memo_release).
+ * Elsewhere (no mallinfo2) nothing is charged. */
 static int64_t heap_in_use(void)
 {
 #if defined(SILC_HEAP_FROM_SANITIZER)

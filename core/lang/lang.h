@@ -216,16 +216,26 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call);
 /* After call ran and gave result: remember it (warned: the call warned, so
  * it is never handed out).  Failing to remember loses nothing. */
 void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int warned);
-/* The memory the memo holds for the session: the arrays of results no
- * name holds (also in *arrays when not NULL) and everything attached to
- * every result (factorizations of later solves). */
-uint64_t memo_charge(const silc_engine *E, uint64_t *arrays);
-/* Drops kept results, least recently used first, until memo_charge(E) <=
- * room (silcd: its limit less the bound values). */
-void memo_shrink(silc_engine *E, uint64_t room);
-/* Under a value budget (val_budget_set: inside a silcd request), drops kept
- * results, least recently used first, until what hangs off them and need
- * more bytes fit what the budget has left.  Nothing without a budget. */
+/* What a session holds (silcd's --max-session-bytes): the arrays of its
+ * bound values, per name; those of the memo's results no name holds; and
+ * the plugin state (factorizations) that solves attached to any of these
+ * or to the operands an `info` record keeps, each value's once, as the
+ * dispatcher measured it (none on an SPMD engine). */
+typedef struct memo_holdings {
+    uint64_t bound, memo_arrays, attached;
+} memo_holdings;
+/* The sum of the three; h (if not NULL) gets each. */
+uint64_t memo_held(const silc_engine *E, memo_holdings *h);
+/* Lets go until memo_held(E) <= room, or nothing is left to let go: the
+ * memo's results first, then attached state (no name's before a bound
+ * value's), least recently used first.  Bound values stay; when they alone
+ * are over room nothing is let go (the caller refuses). */
+void memo_release(silc_engine *E, double room);
+/* Under a value budget (val_budget_set: inside a silcd request), lets go as
+ * memo_release does until the attached state and need more bytes fit what
+ * the budget has left (it counts the values themselves).  Nothing without
+ * a budget.  memo_lookup does it before every call, sparing the call's
+ * operands. */
 void memo_make_room(silc_engine *E, double need);
 /* At the engine's end. */
 void memo_free(silc_engine *E);

@@ -23,12 +23,12 @@
  * to it -- a solve with it leaves its factorization there, often many
  * times the matrix (issue 33: 30 rounds of `B = A * c` kept, solved and
  * cleared grew a 16 MiB silcd session to 629 MiB).  So it counts against
- * silcd's --max-session-bytes (memo_charge, session.c) and is the first
+ * silcd's --max-session-bytes (memo_held, session.c) and is the first
  * thing to go when the limit is reached: at the end of every request and
- * before a PUT (memo_shrink), before every call of a request and before a
- * load (memo_make_room), least recently used first.  An attachment's bytes
- * are what the dispatcher measured the plugin call that made it keep
- * (val_attach_charge, disp_run).  Not used: for solves (their
+ * before a PUT (memo_release), before every call of a request and before a
+ * load (memo_make_room), least recently used first; the factorizations
+ * hung on bound values are counted and let go by the same walk, after the
+ * memo's results (below).  Not used: for solves (their
  * report and warnings belong to each statement), in explain, for calls
  * that warned, on SPMD engines (ranks number values differently, and every
  * rank must take the same path).  A result handed out is shared, so an
@@ -101,6 +101,8 @@ static int key_of(const silc_engine *E, const silc_call *call, memo_key *k)
     return 0;
 }
 
+static void room_for_call(silc_engine *E, double need, const silc_call *keep);
+
 static int same_key(const memo_key *a, const memo_key *b)
 {
     /* Coefficients compare by bits: -0.0 and 0.0 scale differently. */
@@ -150,13 +152,12 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call)
     memo_slot *s;
     double need = 0;
     int i;
-    if (!E->memo) return NULL;
     /* Before a call under a session's limit: room for what is kept and,
      * as a guess at what the call makes, its largest operand. */
     for (i = 0; i < call->nin && i < 3; i++)
         if (call->in[i] && (double)val_bytes(call->in[i]) > need) need = (double)val_bytes(call->in[i]);
-    memo_make_room(E, need);
-    if (key_of(E, call, &k)) return NULL;
+    room_for_call(E, need, call);
+    if (!E->memo || key_of(E, call, &k)) return NULL;
     s = find(E->memo, &k);
     if (!s || !s->result) return NULL;
     s->used = ++E->memo->clock;
@@ -197,40 +198,152 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
     s->result = val_retain(result);
 }
 
-uint64_t memo_charge(const silc_engine *E, uint64_t *arrays)
+/* ---- what a session holds ------------------------------------------------------
+ * silcd's --max-session-bytes checks everything a session keeps alive: the
+ * arrays of its bound values (per name, as bound), the arrays of the
+ * memo's results no name holds, and the plugin state solves attached to
+ * any value it holds -- a bound A's factorization as much as a memo
+ * result's, and those of the operands an `info` record keeps for a
+ * deferred estimate (eng_pending), which no name may hold any more.  One
+ * walk measures all three and picks what goes first when the limit is
+ * reached: the memo's results, least recently used first; then attached
+ * state, least recently used first, that of values no name holds before
+ * that of bound ones.  A released factorization is made again by the next
+ * solve that needs it; an estimate owed on it says it was released
+ * (DISP_CONDEST_LOST).  An attachment's bytes are what the dispatcher
+ * measured across the plugin call that made it (val_attach_charge,
+ * dispatch.c).  A value held twice (two names, a name and a record) has
+ * its attachments counted once: the walk stamps each value it counted.
+ * On an SPMD engine attached state is neither counted nor let go here: a
+ * distributed factorization is released collectively, by every rank at
+ * once, which this walk of one rank cannot arrange. */
+
+typedef struct holder_walk {
+    memo_holdings h;
+    const silc_call *keep;    /* the operands of the call about to run: not let go */
+    int slot;                 /* the memo result to drop first, -1: none */
+    const silc_value *value;  /* else the value whose attachments go first, NULL: none */
+    int value_bound;
+    uint64_t value_used;
+} holder_walk;
+
+static uint64_t holder_walks; /* stamps values counted by the current walk (silc_value.counted) */
+
+static int operand_of(const silc_call *call, const silc_value *v)
 {
-    const eng_memo *M = E->memo;
-    uint64_t own = 0, attached = 0;
     int i;
-    for (i = 0; M && i < M->n; i++) {
-        const silc_value *v = M->slot[i].result;
-        if (!v) continue;
-        if (v->bindings <= 0) own += val_bytes(v);
-        attached += (uint64_t)val_attach_bytes(v);
-    }
-    if (arrays) *arrays = own;
-    return own + attached;
+    for (i = 0; call && i < call->nin && i < 3; i++)
+        if (call->in[i] == v) return 1;
+    return 0;
 }
 
-void memo_shrink(silc_engine *E, uint64_t room)
+/* Counts v's attachments once per walk; a candidate to let go unless the
+ * coming call needs it.  own: it is a memo result (dropped as a whole). */
+static void count_attached(holder_walk *w, const silc_value *v, uint64_t stamp, int bound, int own)
 {
-    eng_memo *M = E->memo;
-    int old;
-    while (M && memo_charge(E, NULL) > room && (old = oldest_result(M, NULL)) >= 0) drop(M, &M->slot[old]);
+    int64_t attached;
+    uint64_t used;
+    if (!v || v->counted == stamp) return;
+    ((silc_value *)v)->counted = stamp; /* bookkeeping, not contents */
+    if ((attached = val_attach_bytes(v)) <= 0) return;
+    w->h.attached += (uint64_t)attached;
+    if (own || operand_of(w->keep, v)) return;
+    used = val_attach_last_use(v);
+    if (!w->value || (w->value_bound && !bound) || (w->value_bound == bound && used < w->value_used)) {
+        w->value = v;
+        w->value_bound = bound;
+        w->value_used = used;
+    }
+}
+
+static void walk(const silc_engine *E, holder_walk *w)
+{
+    const eng_memo *M = E->memo;
+    const eng_info_entry *r;
+    const store_entry *e;
+    uint64_t stamp = ++holder_walks;
+    int attached = !E->dist;
+    size_t b;
+    int i;
+    memset(&w->h, 0, sizeof w->h);
+    w->slot = -1;
+    w->value = NULL;
+    for (b = 0; b < E->store.nbuckets; b++)
+        for (e = E->store.buckets[b]; e; e = e->next) {
+            w->h.bound += val_bytes(e->value);
+            if (attached) count_attached(w, e->value, stamp, 1, 0);
+        }
+    for (i = 0; M && i < M->n; i++) {
+        const memo_slot *s = &M->slot[i];
+        if (!s->result || s->result->bindings > 0) continue; /* a name holds it: counted above */
+        w->h.memo_arrays += val_bytes(s->result);
+        if (attached) count_attached(w, s->result, stamp, 0, 1);
+        if (!operand_of(w->keep, s->result) && (w->slot < 0 || s->used < M->slot[w->slot].used)) w->slot = i;
+    }
+    for (r = attached ? E->infos : NULL; r; r = r->next) {
+        count_attached(w, r->info.pending.A, stamp, 0, 0);
+        count_attached(w, r->info.pending.B, stamp, 0, 0);
+        count_attached(w, r->info.pending.X, stamp, 0, 0);
+    }
+}
+
+static uint64_t held_total(const memo_holdings *h)
+{
+    return h->bound + h->memo_arrays + h->attached;
+}
+
+/* Drops the walk's first candidate: 0 if there was none. */
+static int let_go(silc_engine *E, const holder_walk *w)
+{
+    if (w->slot >= 0) {
+        drop(E->memo, &E->memo->slot[w->slot]);
+        return 1;
+    }
+    if (w->value) {
+        val_attach_release(w->value);
+        return 1;
+    }
+    return 0;
+}
+
+uint64_t memo_held(const silc_engine *E, memo_holdings *h)
+{
+    holder_walk w;
+    memset(&w, 0, sizeof w);
+    walk(E, &w);
+    if (h) *h = w.h;
+    return held_total(&w.h);
+}
+
+void memo_release(silc_engine *E, double room)
+{
+    holder_walk w;
+    memset(&w, 0, sizeof w);
+    walk(E, &w);
+    /* The values alone over: the caller refuses; letting go would lose
+     * the factorizations for nothing. */
+    if ((double)w.h.bound > room) return;
+    while ((double)held_total(&w.h) > room && let_go(E, &w)) walk(E, &w);
+}
+
+/* Inside a request the budget counts the values alive (bound, temporary,
+ * the memo's): what it cannot see is the attached state, which must fit
+ * with need more bytes in what it has left. */
+static void room_for_call(silc_engine *E, double need, const silc_call *keep)
+{
+    holder_walk w;
+    if (val_budget_room() == INT64_MAX || E->dist) return;
+    /* Every attachment alive in the process fits: no walk needed. */
+    if ((double)val_attach_live_bytes() + need <= (double)val_budget_room()) return;
+    memset(&w, 0, sizeof w);
+    w.keep = keep;
+    do walk(E, &w);
+    while ((double)w.h.attached + need > (double)val_budget_room() && let_go(E, &w));
 }
 
 void memo_make_room(silc_engine *E, double need)
 {
-    eng_memo *M = E->memo;
-    int old;
-    /* The budget counts the results' arrays already (they are values
-     * alive, and silcd's budget does not exempt them); what hangs off them
-     * it cannot see. */
-    while (M && val_budget_room() != INT64_MAX) {
-        uint64_t arrays, attached = memo_charge(E, &arrays) - arrays;
-        if ((double)attached + need <= (double)val_budget_room() || (old = oldest_result(M, NULL)) < 0) return;
-        drop(M, &M->slot[old]);
-    }
+    room_for_call(E, need, NULL);
 }
 
 void memo_free(silc_engine *E)

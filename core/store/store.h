@@ -36,6 +36,10 @@ typedef struct val_attachment {
     void *data;
     void (*destroy)(void *);
     int64_t bytes;              /* the memory it holds, as charged (val_attach_charge); 0 = not known */
+    int charged;                /* made by a plugin call the dispatcher measured: a plugin's state
+                                   (a factorization), which val_attach_release may let go */
+    uint64_t used;              /* when last set or looked up (a process-wide clock): least
+                                   recently used goes first */
     struct val_attachment *next;
 } val_attachment;
 
@@ -84,6 +88,8 @@ struct silc_value {
     val_dist *dist;          /* NULL: the value is whole here (val_dist, below) */
     int64_t bindings;        /* names of a store bound to it (store_set, store_remove): a
                                 cache holding a value no name holds pays for its arrays */
+    uint64_t counted;        /* the last walk of lang/memo.c's accounting that counted its
+                                attachments (so a value held twice is counted once) */
 };
 
 /* Doubles per entry of v's val: 1 real, 2 complex. */
@@ -237,6 +243,14 @@ int val_attach_set(const silc_value *v, const char *key, void *data, void (*dest
  * dispatcher, around the plugin call that attached it: disp_run): 0, or -1
  * if v has no attachment key.  A replaced attachment keeps its charge. */
 int val_attach_charge(const silc_value *v, const char *key, int64_t bytes);
+/* Lets go of v's charged attachments (a plugin's factorization: the next
+ * solve makes it again); returns the bytes they were charged. */
+int64_t val_attach_release(const silc_value *v);
+/* When v's charged attachments were last used (val_attach_get/_set); 0 if
+ * it has none. */
+uint64_t val_attach_last_use(const silc_value *v);
+/* The charges of every attachment alive in the process. */
+int64_t val_attach_live_bytes(void);
 /* The charges of all of v's attachments: what a cache keeping v holds
  * beyond its arrays (the memo's session charge, memo.c). */
 int64_t val_attach_bytes(const silc_value *v);

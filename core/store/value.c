@@ -156,6 +156,10 @@ static int size_allowed(int format, int64_t m, int64_t n, double bytes)
  * whose arrays would bring the count, less what was exempt, over the limit
  * is refused before it allocates, as an oversized value is. */
 static _Atomic int64_t live_value_bytes;
+/* The charges of the attachments alive (val_attach_live_bytes), and the
+ * clock that orders their uses (val_attach_last_use). */
+static _Atomic int64_t live_attach_bytes;
+static _Atomic uint64_t attach_clock;
 static int64_t budget_exempt;
 static uint64_t budget_limit;   /* 0: no budget */
 static const char *budget_source = "";
@@ -465,6 +469,7 @@ void val_release(silc_value *v)
     /* Attachments first: a factorization may still point into the arrays. */
     for (a = v->attach; a; a = next) {
         next = a->next;
+        atomic_fetch_sub(&live_attach_bytes, a->bytes);
         if (a->destroy) a->destroy(a->data);
         free(a->key);
         free(a);
@@ -635,10 +640,13 @@ const char *val_format_name(int format)
 
 void *val_attach_get(const silc_value *v, const char *key)
 {
-    const val_attachment *a;
+    val_attachment *a;
     if (!v || !key) return NULL;
     for (a = v->attach; a; a = a->next)
-        if (strcmp(a->key, key) == 0) return a->data;
+        if (strcmp(a->key, key) == 0) {
+            a->used = atomic_fetch_add(&attach_clock, 1) + 1; /* derived data: see val_attach_set */
+            return a->data;
+        }
     return NULL;
 }
 
@@ -655,6 +663,7 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
             if (a->data != data && a->destroy) a->destroy(a->data);
             a->data = data;
             a->destroy = destroy;
+            a->used = atomic_fetch_add(&attach_clock, 1) + 1;
             return 0;
         }
     }
@@ -668,6 +677,8 @@ int val_attach_set(const silc_value *cv, const char *key, void *data, void (*des
     a->data = data;
     a->destroy = destroy;
     a->bytes = 0;
+    a->charged = 0;
+    a->used = atomic_fetch_add(&attach_clock, 1) + 1;
     a->next = v->attach;
     v->attach = a;
     return 0;
@@ -679,10 +690,48 @@ int val_attach_charge(const silc_value *cv, const char *key, int64_t bytes)
     if (!cv || !key) return -1;
     for (a = cv->attach; a; a = a->next)
         if (strcmp(a->key, key) == 0) {
+            atomic_fetch_sub(&live_attach_bytes, a->bytes);
             a->bytes = bytes > 0 ? bytes : 0;
+            a->charged = 1;
+            atomic_fetch_add(&live_attach_bytes, a->bytes);
             return 0;
         }
     return -1;
+}
+
+int64_t val_attach_release(const silc_value *cv)
+{
+    silc_value *v = (silc_value *)cv; /* derived data, as in val_attach_set */
+    val_attachment **pa, *a;
+    int64_t freed = 0;
+    if (!v) return 0;
+    for (pa = &v->attach; (a = *pa) != NULL;) {
+        if (!a->charged) {
+            pa = &a->next;
+            continue;
+        }
+        *pa = a->next; /* out of the list before its destructor runs */
+        freed += a->bytes;
+        atomic_fetch_sub(&live_attach_bytes, a->bytes);
+        if (a->destroy) a->destroy(a->data);
+        free(a->key);
+        free(a);
+    }
+    return freed;
+}
+
+uint64_t val_attach_last_use(const silc_value *v)
+{
+    const val_attachment *a;
+    uint64_t last = 0;
+    for (a = v ? v->attach : NULL; a; a = a->next)
+        if (a->charged && a->used > last) last = a->used;
+    return last;
+}
+
+int64_t val_attach_live_bytes(void)
+{
+    return live_attach_bytes;
 }
 
 int64_t val_attach_bytes(const silc_value *v)

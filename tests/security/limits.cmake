@@ -15,22 +15,37 @@ endif()
 set(_limits_dir ${CMAKE_CURRENT_BINARY_DIR}/security-limits)
 set(_limits_env "${SILC_TEST_ENV};STUCK_PLUGIN_DIR=${CMAKE_CURRENT_BINARY_DIR}/crash-plugin")
 foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_clients sigterm
-        parent_killed stuck_forced stuck_cooperative stuck_disconnect)
+        parent_killed stuck_forced stuck_cooperative stuck_disconnect data_cap)
   add_test(NAME security_limits_${case}
            COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
                    ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
   set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endforeach()
-# The memo's kept results and their UMFPACK factorizations (issue 33).
+# The memo's kept results and their UMFPACK factorizations (issue 33); the
+# CHOLMOD factorizations of bound values (issue 27).
 if(TARGET silc_plugin_suitesparse)
-  add_test(NAME security_limits_memo
+  foreach(case memo attached)
+    add_test(NAME security_limits_${case}
+             COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
+                     ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)
+    set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+  endforeach()
+endif()
+# PETSc's printing reaches the client, not silcd's log.
+if(TARGET silc_plugin_petsc)
+  add_test(NAME security_limits_library_output
            COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
-                   ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} memo $<TARGET_FILE:silcd>)
-  set_tests_properties(security_limits_memo PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
+                   ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} library_output $<TARGET_FILE:silcd>)
+  set_tests_properties(security_limits_library_output PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endif()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
-  foreach(case request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
-               admission_mpi announce_mpi unread_get_mpi idle_timeout_mpi peer_share_mpi)
+  set(_limits_mpi_cases request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
+                        admission_mpi announce_mpi unread_get_mpi idle_timeout_mpi peer_share_mpi
+                        peak_mpi statement_cap_mpi data_cap_mpi)
+  if(TARGET silc_plugin_petsc)
+    list(APPEND _limits_mpi_cases library_output_mpi)
+  endif()
+  foreach(case ${_limits_mpi_cases})
     add_test(NAME security_limits_${case}
              COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
                      ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case}

@@ -411,12 +411,12 @@ def case_parent_killed():
     srv.log.close()
 
 
-def case_peak():
+def peak(mpi):
     """Temporaries count: zeros(1000) holds 8 MB; with a 20 MB session
     limit, a statement that ends binding a scalar but holds 24 MB at once
     (a, d, ones(1000), their sum) is refused, and its whole request rolled
     back."""
-    srv = Server("--max-session-bytes", "20M")
+    srv = Server("--max-session-bytes", "20M", mpi=mpi)
     s = srv.session()
     s.exec("a = zeros(1000)")
     expect_error(lambda: s.exec("d = 5\nb = sum(a + ones(1000) + ones(1000))"),
@@ -431,6 +431,14 @@ def case_peak():
         fail("the entries of sum(a + 1) do not add up to 1e6")
     s.close()
     srv.stop_cleanly()
+
+
+def case_peak():
+    peak(False)
+
+
+def case_peak_mpi():
+    peak(True)
 
 
 def case_memo():
@@ -484,8 +492,177 @@ def case_memo():
     srv.stop_cleanly()
 
 
-def case_statement_cap():
-    srv = Server()
+def case_attached():
+    """Issue 27: a factorization hung on a bound value counts against
+    --max-session-bytes.  16 distinct 2-D Laplacians (SPD: CHOLMOD), each
+    PUT under its own name and solved once, used to keep 16 factorizations
+    (several times each matrix) that only RLIMIT_DATA bounded: the session
+    grew past its limit with every value inside it.  Now the session's
+    charge (INFO's bytes: values, memo, attached state) stays under the
+    limit, the least recently used factorizations are released, every
+    solve is right, a re-solve of a released one factors again and is
+    right, and an estimate owed on a released factorization says so."""
+    import scipy.sparse
+    k, count = 60, 16
+    n = k * k
+    limit = 8 * MiB
+    srv = Server("--max-session-bytes", str(limit))
+    s = srv.session()
+    s.exec("set accuracy.condest = on_request")    # every estimate owed until `info` reads it
+    pid = session_pids(srv, 1)[0]
+    I = scipy.sparse.identity(k)
+    values = 0
+    rss = []
+    for i in range(count):
+        T = scipy.sparse.diags([-1.0, 2.0 + 0.01 * i, -1.0], [-1, 0, 1], shape=(k, k))
+        A = (scipy.sparse.kron(T, I) + scipy.sparse.kron(I, T)).tocsr()
+        b = A @ np.arange(1.0, n + 1.0)
+        s.put("A%d" % i, A)
+        s.put("b%d" % i, b.reshape(-1, 1))
+        s.exec("x%d = A%d \\ b%d" % (i, i, i))
+        x = s.get("x%d" % i).ravel()
+        res = np.abs(A @ x - b).max() / np.abs(b).max()
+        if not res < 1e-12:
+            fail("round %d: relative residual %g" % (i, res))
+        csr = (n + 1) * 8 + A.nnz * 16
+        values += csr + 2 * n * 8          # A, b and x, as the session stores them
+        info = dict(line.split(": ", 1) for line in s.info().splitlines() if ": " in line)
+        charge = int(info["bytes"])
+        if charge > limit:
+            fail("round %d: the session holds %d bytes, over its limit of %d" % (i, charge, limit))
+        if i == 0:
+            # What the solve attached, as measured: the factorization is
+            # several times the matrix; kept for all 16 matrices, the
+            # session would hold far more than its limit.
+            attached = charge - values
+            unbounded = count * (csr + 2 * n * 8 + attached)
+            print("one matrix: %d bytes, its factorization: %d bytes; kept for all: %.1f MiB"
+                  % (csr, attached, unbounded / MiB))
+            if attached < 2 * csr:
+                fail("the factorization of A0 is charged %d bytes, under twice the matrix (%d)"
+                     % (attached, csr))
+            if unbounded < 2 * limit:
+                fail("the case cannot fail: every factorization kept holds %d bytes" % unbounded)
+        rss.append(proc_status(pid, "VmRSS"))
+        print("round %2d: charge %.2f MiB (values %.2f), VmRSS %.1f MiB"
+              % (i, charge / MiB, values / MiB, rss[-1] / MiB))
+    # The estimate owed on A0's released factorization says so; the last
+    # one, still attached, is computed when read.
+    first = s.info("x0")
+    if "deferred at solve time, and the factorization was released before the report was read" \
+            not in first:
+        fail("info x0 after its factorization was released:\n" + first)
+    last = s.info("x%d" % (count - 1))
+    if "computed when the report was first read" not in last:
+        fail("info of the last solve, its factorization still attached:\n" + last)
+    # Re-solves: the last matrix reuses its factorization; A0 is factored again.
+    for i, reused in ((count - 1, "yes"), (0, "no")):
+        s.exec("y = A%d \\ (2 * b%d)" % (i, i))
+        y = s.get("y").ravel()
+        if not np.abs(y - 2 * np.arange(1.0, n + 1.0)).max() < 1e-8 * n:
+            fail("the re-solve of A%d is wrong" % i)
+        if "reused factorization: %s" % reused not in s.info("y"):
+            fail("re-solve of A%d: expected 'reused factorization: %s':\n%s" % (i, reused, s.info("y")))
+    # Resident memory from round 1 on (CHOLMOD's workspace is made in round
+    # 0): the values grow it, and every factorization kept would grow it
+    # by as much again as they (measured 21 MiB, against 10 MiB now).  It
+    # must stay under the values' growth plus half the factorizations'.
+    # Under AddressSanitizer freed memory sits in its quarantine: the
+    # charge above holds there.
+    grown, kept_values = rss[-1] - rss[1], (count - 2) * (csr + 2 * n * 8)
+    if not SANITIZED and grown > kept_values + (count - 2) * attached / 2:
+        fail("the session grew by %.1f MiB from round 1, its values by %.1f MiB, the "
+             "factorizations kept would add %.1f MiB" % (grown / MiB, kept_values / MiB,
+                                                          (count - 2) * attached / MiB))
+    s.close()
+    srv.stop_cleanly()
+
+
+def data_limit(pid):
+    """The soft RLIMIT_DATA of pid, in bytes (/proc/PID/limits)."""
+    with open("/proc/%d/limits" % pid) as f:
+        for line in f:
+            if line.startswith("Max data size"):
+                soft = line.split()[3]
+                if soft == "unlimited":
+                    fail("process %d has no RLIMIT_DATA" % pid)
+                return int(soft)
+    fail("no 'Max data size' in /proc/%d/limits" % pid)
+
+
+def data_cap(mpi):
+    """Issue 27, item 4: each session process (under --mpi, each rank) has
+    an RLIMIT_DATA cap: what it had mapped at its start (at most its
+    VmData now) + 2 x --max-session-bytes for each session it may hold
+    + --array-pool + 256 MiB."""
+    limit, pool, clients = 64 * MiB, 32 * MiB, 4
+    srv = Server("--max-session-bytes", str(limit), "--array-pool", str(pool),
+                 "--max-clients", str(clients), mpi=mpi)
+    s = srv.session()
+    s.exec("x = 1")
+    pids = rank_pids(srv).values() if mpi else session_pids(srv, 1)
+    for pid in pids:
+        want = (clients if mpi else 1) * 2 * limit + pool + 256 * MiB
+        cap, base = data_limit(pid), proc_status(pid, "VmData")
+        if not want <= cap <= want + base:
+            fail("process %d: RLIMIT_DATA %d, expected %d + its start's data (at most %d)"
+                 % (pid, cap, want, base))
+    s.close()
+    srv.stop_cleanly()
+
+
+def case_data_cap():
+    data_cap(False)
+
+
+def case_data_cap_mpi():
+    data_cap(True)
+
+
+def library_output(mpi):
+    """What a library prints during a request goes to its client, not to
+    silcd's standard output (the operator's log): PETSc's
+    -ksp_converged_reason and a deprecated option's warning used to land
+    in silcd's log.  -log_view and -help stay refused (a session must not
+    read PETSc's process-wide table, nor name a file)."""
+    srv = Server("--max-session-bytes", "64M", mpi=mpi)
+    s = srv.session()
+    s.exec("A = sparse(eye(50) * 4 - 1); b = ones(50, 1)")
+    out = []
+    s.exec('set petsc.options = -ksp_type cg -ksp_converged_reason -ksp_compute_eigenvalues\n'
+           'x = solve(A, b, "backend = petsc")\nr = norm(A * x - b, inf)', out=out)
+    text = "".join(out)
+    for said in ("Linear solve converged due to", "-ksp_compute_eigenvalues is deprecated"):
+        if said not in text:
+            fail("the client did not get PETSc's %r: %r" % (said, text))
+        if said in srv.text():
+            fail("PETSc's %r reached silcd's log:\n%s" % (said, srv.text()))
+    if not s.get("r")[0, 0] < 1e-8:
+        fail("the PETSc solve is wrong: |A x - b| = %g" % s.get("r")[0, 0])
+    # A request that prints nothing gets no library text.
+    out = []
+    s.exec("y = 2 * 3", out=out)
+    if out:
+        fail("library output for a request that printed nothing: %r" % out)
+    for opt in ("-log_view", "-help"):
+        expect_error(lambda: s.exec("set petsc.options = %s" % opt),
+                     "petsc.options: '%s' is refused in a silcd session: options that "
+                     "view, monitor, log, dump, name a file, load code or set threads are server "
+                     "settings (set them in silcd's config)" % opt)
+    s.close()
+    srv.stop_cleanly()
+
+
+def case_library_output():
+    library_output(False)
+
+
+def case_library_output_mpi():
+    library_output(True)
+
+
+def statement_cap(mpi):
+    srv = Server(mpi=mpi)
     s = srv.session()
     text = "a = [" + ",".join(["1"] * (2 << 20)) + "]"    # 4 MiB of text
     expect_error(lambda: s.exec(text), "statement text of %d bytes is over the limit of %d "
@@ -493,6 +670,14 @@ def case_statement_cap():
     s.exec("a = [1, 2, 3]")
     s.close()
     srv.stop_cleanly()
+
+
+def case_statement_cap():
+    statement_cap(False)
+
+
+def case_statement_cap_mpi():
+    statement_cap(True)
 
 
 def stuck_server(*args, mpi=False):
