@@ -6,6 +6,7 @@
  *     cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]
  *     cloth_bench SCENE... --trade [--steps N] [--svg DIR]
  *     cloth_bench SCENE... --energy [--steps N] [--svg DIR]
+ *     cloth_bench SCENE... --seed-statements [--steps N] [--rounds R] [--label TEXT]
  *
  * For each scene it runs original (plain C, its own CG), ltd and cmp from the
  * scene's start for N steps (default 50), R rounds (default 3), the drivers
@@ -36,15 +37,27 @@
  * pins' dv dropped after: cloth_model.pins_after_solve, reachable only
  * here) and with the pins constrained in the solve: the largest spring
  * stretch and the total energy, a table and DIR/cloth_energy.svg.
+ *
+ * --seed-statements (issue 30 item 1): the cmp mode's statements against a
+ * plain-C step doing the same arithmetic written for speed
+ * (cloth_c_step.c), both with CG + Jacobi at 1e-10 from the last step's dv:
+ * N steps (default 50) per run, R timed rounds (default 5), C and SILC
+ * alternating, after a first round that checks the two end at the same
+ * positions (to the solver's tolerance) after the same iterations.  One row
+ * per scene: best and median ms per step of each, their ratios, and the
+ * phases of SILC's best run.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "progress.h"
+#include "timing.h"
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cloth.h"
+#include "cloth_c_step.h"
 
 typedef struct variant {
     cloth_mode mode;
@@ -485,13 +498,224 @@ static int energy(const char *const *paths, int np, int steps, const char *svg_d
     return rc;
 }
 
+/* ---- --seed-statements: the statements against plain C ---------------------- */
+
+/* CG + Jacobi at the issue's tolerance, with room for its iterations. */
+#define SEED_TOL 1e-10
+#define SEED_MAXITER 20000
+static const char seed_solver[] = "backend = lis-style; lis-style.options = -i cg -p jacobi -tol 1e-10 -maxiter 20000";
+
+/* The silcd session serving this process: silcd forks one per connection,
+ * so it is the youngest child of CLOTH_BENCH_SERVER_PID (found once per
+ * run, after the connection is made, outside the timed steps); 0 when
+ * there is none or the variable is not set. */
+static long session_pid;
+
+static void find_session(void)
+{
+    const char *server = getenv("CLOTH_BENCH_SERVER_PID");
+    unsigned long long newest = 0;
+    DIR *dir;
+    struct dirent *e;
+    session_pid = 0;
+    if (!server || !*server || !(dir = opendir("/proc"))) return;
+    while ((e = readdir(dir))) {
+        char path[300], buf[1024], *close_paren;
+        long ppid = 0;
+        unsigned long long start = 0;
+        FILE *f;
+        size_t got;
+        if (e->d_name[0] < '1' || e->d_name[0] > '9') continue;
+        snprintf(path, sizeof path, "/proc/%s/stat", e->d_name);
+        if (!(f = fopen(path, "r"))) continue;
+        got = fread(buf, 1, sizeof buf - 1, f);
+        fclose(f);
+        buf[got] = '\0';
+        /* pid (comm) state ppid ... field 22 starttime; comm may hold spaces */
+        if (!(close_paren = strrchr(buf, ')'))) continue;
+        if (sscanf(close_paren + 2, "%*c %ld %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %llu",
+                   &ppid, &start) != 2)
+            continue;
+        if (ppid == atol(server) && start >= newest) newest = start, session_pid = atol(e->d_name);
+    }
+    closedir(dir);
+}
+
+/* CPU seconds of this process and of the silcd session serving it
+ * (/proc/PID/task/T/schedstat, nanoseconds, over its threads): on a
+ * shared machine the wall clock measures the load as much as the work,
+ * the CPU time only the work. */
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    double sum;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    sum = (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    if (session_pid > 0) {
+        char path[256];
+        DIR *dir;
+        struct dirent *e;
+        snprintf(path, sizeof path, "/proc/%ld/task", session_pid);
+        if ((dir = opendir(path))) {
+            while ((e = readdir(dir))) {
+                char file[1024];
+                unsigned long long ns;
+                FILE *f;
+                if (e->d_name[0] == '.') continue;
+                snprintf(file, sizeof file, "%s/%s/schedstat", path, e->d_name);
+                if ((f = fopen(file, "r"))) {
+                    if (fscanf(f, "%llu", &ns) == 1) sum += 1e-9 * (double)ns;
+                    fclose(f);
+                }
+            }
+            closedir(dir);
+        }
+    }
+    return sum;
+}
+
+/* What a timed run of either side gives back: per-step wall and CPU
+ * seconds, the phases (wall), the iterations, the final positions. */
+typedef struct seed_run {
+    double wall, cpu;
+    cloth_times t;
+    long iterations;
+    double *x;
+} seed_run;
+
+/* `steps` steps from the scene's start, by the C step (c_step) or the cmp
+ * statements; only the steps are timed (not the set-up).  count asks every
+ * SILC solve's iterations (outside the timed phases: a checking run). */
+static int seed_run_one(const cloth_scene *s, int c_step, int steps, int count, seed_run *o, char *err, size_t errlen)
+{
+    cloth_model m;
+    cloth_c_step c;
+    cloth_driver *d = NULL;
+    double w0, c0, w = 0, cpu = 0;
+    int k, rc = 0;
+    memset(&o->t, 0, sizeof o->t);
+    o->iterations = 0;
+    if (cloth_model_init(&m, s, err, errlen)) return -1;
+    if (c_step) {
+        rc = cloth_c_step_open(&c, &m, SEED_TOL, err, errlen);
+        c.maxiter = SEED_MAXITER;
+    } else {
+        rc = !(d = cloth_driver_open(&m, CLOTH_CMP, seed_solver, SEED_TOL, err, errlen));
+        if (!rc) find_session();
+    }
+    for (k = 0; k < steps && !rc; k++) {
+        w0 = bench_now(), c0 = cpu_seconds();
+        rc = c_step ? cloth_c_step_run(&c, &o->t, err, errlen) : cloth_driver_step(d, &o->t, err, errlen);
+        cpu += cpu_seconds() - c0, w += bench_now() - w0;
+        if (!rc && count && !c_step) {
+            double berr, cond;
+            long it = 0;
+            rc = cloth_driver_solve_report(d, &berr, &cond, &it, err, errlen);
+            o->iterations += it;
+        }
+    }
+    if (c_step && !rc) o->iterations = c.iterations;
+    if (!c_step && !rc) rc = cloth_driver_sync(d, err, errlen);
+    if (!rc && o->x) memcpy(o->x, m.x, (size_t)3 * m.n * sizeof *o->x);
+    if (c_step) {
+        if (c.m) cloth_c_step_close(&c);
+    } else {
+        cloth_driver_close(d);
+        session_pid = 0;
+    }
+    cloth_model_free(&m);
+    o->wall = w / steps, o->cpu = cpu / steps;
+    return rc ? -1 : 0;
+}
+
+static double min_of(const double *v, int n)
+{
+    double b = INFINITY;
+    int i;
+    for (i = 0; i < n; i++) b = fmin(b, v[i]);
+    return b;
+}
+
+static int seed_statements(const char *const *paths, int np, int steps, int rounds, const char *label)
+{
+    int i, r, rc = 0;
+    printf("| scene | where | clock | C step ms/step best | median | statements best | median | ratio best | "
+           "ratio median | statements: assembly | solve | update | iterations/step C, SILC | max |x_C - x_SILC| |\n"
+           "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (i = 0; i < np && !rc; i++) {
+        cloth_scene s;
+        char err[1024];
+        double *xc = NULL, *xs = NULL, *t[4] = {NULL, NULL, NULL, NULL}, split[3] = {0, 0, 0}, diff, best = INFINITY;
+        long itc = 0, its = 0;
+        seed_run o;
+        int n3, k;
+        if (scene_read(paths[i], &s, err, sizeof err)) {
+            fprintf(stderr, "cloth_bench: %s\n", err);
+            return -1;
+        }
+        n3 = 3 * s.nx * s.ny;
+        xc = malloc((size_t)n3 * sizeof *xc), xs = malloc((size_t)n3 * sizeof *xs);
+        for (k = 0; k < 4; k++) t[k] = malloc((size_t)rounds * sizeof(double)); /* C wall, C cpu, SILC wall, cpu */
+        if (!xc || !xs || !t[0] || !t[1] || !t[2] || !t[3]) rc = -1;
+        /* Round 0: the same work?  Positions and iterations, untimed. */
+        progress_show(&bar, "cloth bench --seed-statements: %s, checking", s.name);
+        o.x = xc;
+        rc = rc || seed_run_one(&s, 1, steps, 0, &o, err, sizeof err);
+        itc = o.iterations;
+        o.x = xs;
+        rc = rc || seed_run_one(&s, 0, steps, 1, &o, err, sizeof err);
+        its = o.iterations;
+        diff = rc ? NAN : max_diff(xc, xs, n3);
+        o.x = NULL;
+        for (r = 0; r < rounds && !rc; r++) {
+            progress_show(&bar, "cloth bench --seed-statements: %s, round %d of %d", s.name, r + 1, rounds);
+            rc = seed_run_one(&s, 1, steps, 0, &o, err, sizeof err);
+            t[0][r] = o.wall, t[1][r] = o.cpu;
+            rc = rc || seed_run_one(&s, 0, steps, 0, &o, err, sizeof err);
+            t[2][r] = o.wall, t[3][r] = o.cpu;
+            if (!rc && o.cpu < best) {
+                best = o.cpu;
+                split[0] = o.t.assembly / steps, split[1] = o.t.solve / steps, split[2] = o.t.update / steps;
+            }
+        }
+        progress_done(&bar);
+        if (rc) {
+            fprintf(stderr, "cloth_bench: %s: %s\n", s.name, err);
+        } else {
+            for (k = 0; k < 2; k++) {
+                double bc = min_of(t[k], rounds), bs = min_of(t[k + 2], rounds);
+                double mc = bench_median(t[k], rounds), ms = bench_median(t[k + 2], rounds);
+                printf("| %s %dx%d | %s | %s | %.3f | %.3f | %.3f | %.3f | %.2f | %.2f |", s.name, s.nx, s.ny, label,
+                       k ? "CPU" : "wall", 1e3 * bc, 1e3 * mc, 1e3 * bs, 1e3 * ms, bs / bc, ms / mc);
+                if (k) printf(" %.3f | %.3f | %.3f | %.1f, %.1f | %.2g |\n", 1e3 * split[0], 1e3 * split[1],
+                              1e3 * split[2], (double)itc / steps, (double)its / steps, diff);
+                else printf(" | | | | |\n");
+            }
+            /* The baseline must do the statements' work: the same positions
+             * to the solver's tolerance, the same iterations. */
+            if (!(diff <= 1e-6 * fmax(s.width, s.height)) || labs(itc - its) > steps) {
+                fprintf(stderr, "cloth_bench: %s: the C step and the statements disagree (positions %.2g m apart, "
+                                "%ld against %ld iterations)\n", s.name, diff, itc, its);
+                rc = -1;
+            }
+        }
+        free(xc), free(xs);
+        for (k = 0; k < 4; k++) free(t[k]);
+    }
+    printf("(%d steps per run, %d timed rounds, C and SILC alternating; CG + Jacobi at %g from the last step's dv, "
+           "lis-style's stopping test in both; CPU: this process%s; phases: wall, SILC's run of least CPU)\n",
+           steps, rounds, SEED_TOL, getenv("CLOTH_BENCH_SERVER_PID") ? " + its silcd session's" : "");
+    return rc;
+}
+
 static const char usage_text[] = "usage: cloth_bench SCENE... [--steps N] [--rounds R] [--label TEXT]\n"
                                  "       cloth_bench SCENE... --trade [--steps N] [--svg DIR]\n"
-                                 "       cloth_bench SCENE... --energy [--steps N] [--svg DIR]\n";
+                                 "       cloth_bench SCENE... --energy [--steps N] [--svg DIR]\n"
+                                 "       cloth_bench SCENE... --seed-statements [--steps N] [--rounds R] [--label TEXT]\n";
 
 int main(int argc, char **argv)
 {
-    int steps = 0, rounds = 3, a, sc, nscenes = 0, trading = 0, energies = 0;
+    int steps = 0, rounds = 0, a, sc, nscenes = 0, trading = 0, energies = 0, seeds = 0;
     const char *label = "embedded", *scenes[16], *svg_dir = NULL;
     for (a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--steps") && a + 1 < argc) steps = atoi(argv[++a]);
@@ -499,6 +723,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--label") && a + 1 < argc) label = argv[++a];
         else if (!strcmp(argv[a], "--trade")) trading = 1;
         else if (!strcmp(argv[a], "--energy")) energies = 1;
+        else if (!strcmp(argv[a], "--seed-statements")) seeds = 1;
         else if (!strcmp(argv[a], "--svg") && a + 1 < argc) svg_dir = argv[++a];
         else if (argv[a][0] != '-' && nscenes < 16) scenes[nscenes++] = argv[a];
         else {
@@ -506,11 +731,13 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (!nscenes || steps < 0 || rounds < 1) {
+    if (!nscenes || steps < 0 || rounds < 0) {
         fputs(usage_text, stderr);
         return 2;
     }
     if (energies) return energy(scenes, nscenes, steps, svg_dir) ? 1 : 0;
+    if (seeds) return seed_statements(scenes, nscenes, steps ? steps : 50, rounds ? rounds : 5, label) ? 1 : 0;
+    if (!rounds) rounds = 3;
     if (trading) {
         for (sc = 0; sc < nscenes; sc++)
             if (trade(scenes[sc], steps, svg_dir)) return 1;

@@ -668,6 +668,18 @@ int ref_op_reduce(silc_call *call)
         D[0] = r;
         return out_dense(call, 1, 1, D);
     }
+    if (sub == SILC_RED_SUM && !vec && a.format == SILC_FMT_CSR) {
+        /* Column sums of CSR scattered row by row: each column's entries
+         * are added in row order from 0, as the compressed-column path
+         * below adds them (the same bits), without converting the matrix
+         * (the cloth's diagvec(P' * P), eval.c, runs this every step). */
+        double *D = ref_alloc((size_t)(a.n ? a.n : 1), sizeof(double));
+        if (!D) return ref_nomem(call);
+        for (int64_t j = 0; j < a.n; j++) D[j] = 0.0;
+        for (int64_t i = 0; i < a.m; i++)
+            for (int64_t k = a.rowptr[i]; k < a.rowptr[i + 1]; k++) D[a.colind[k]] += a.val[k];
+        return out_dense(call, 1, a.n, D);
+    }
     ref_sp C;
     if (ref_sp_from_view(&a, &C)) return ref_nomem(call);
     int64_t nz = ref_sp_nnz(&C), st = 0;

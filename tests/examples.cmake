@@ -34,6 +34,14 @@ if(TARGET silc_cloth)
   add_dependencies(test_cloth_physics cloth)
   set_tests_properties(test_cloth_physics PROPERTIES
     ENVIRONMENT "${SILC_TEST_ENV};SILC_CLOTH_SCENES=${PROJECT_SOURCE_DIR}/examples/cloth/scenes")
+  # The plain-C step cloth_bench --seed-statements measures the cmp
+  # statements against does their work (bench/cloth_c_step.c).
+  silc_add_test(test_cloth_c_step SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_cloth_c_step.c
+                ${PROJECT_SOURCE_DIR}/bench/cloth_c_step.c)
+  target_link_libraries(test_cloth_c_step PRIVATE silc_cloth)
+  target_include_directories(test_cloth_c_step PRIVATE ${PROJECT_SOURCE_DIR}/bench)
+  set_tests_properties(test_cloth_c_step PROPERTIES
+    ENVIRONMENT "${SILC_TEST_ENV};SILC_CLOTH_SCENES=${PROJECT_SOURCE_DIR}/examples/cloth/scenes")
   add_test(NAME example_cloth COMMAND cloth ${PROJECT_SOURCE_DIR}/examples/cloth/scenes/hanging.scene
            --mode cmp --steps 20 --frames ${CMAKE_CURRENT_BINARY_DIR}/cloth-frames)
   set_tests_properties(example_cloth PROPERTIES ENVIRONMENT "${SILC_TEST_ENV}" TIMEOUT 600)

@@ -657,6 +657,8 @@ int bi_call(lang_ev *V, const ast_node *call, silc_value **out)
                              f->min == 1 ? "" : "s", n);
         return eng_error(V->E, "%s takes %d or %d arguments, got %d", f->name, f->min, f->max, n);
     }
+    if (f->fn == bi_diag && call->name[4] && !V->E->dist && ev_is_diagvec_of_product(call))
+        return ev_diagvec_of_product(V, call, out);
     for (i = 0; i < n; i++) {
         const ast_node *k = call->kids[i];
         if (k->kind == AST_STRING) {

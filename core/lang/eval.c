@@ -656,6 +656,52 @@ static int eval_unary(lang_ev *V, const ast_node *n, silc_value **out)
     return unary_of(V, n, a, out);
 }
 
+/* diagvec(L' * R): entry j is sum_k L(k, j) R(k, j), the column sums of
+ * L .* R, so for real L and R of the same shape (m x n, m > 1) it is formed
+ * as that, without L' or the n x n product -- for the cloth's
+ * sqrt(diagvec(P' * P)), the spring lengths, a transpose and a sparse
+ * product a step become an element-wise product and a column sum.  For
+ * CSR operands the sums run in the product's order (k ascending), so the
+ * bits are the product's; dense ones differ from BLAS's order by rounding.
+ * Any other operands (complex, other shapes, scalars) take the general
+ * path: the transpose, the product and its diagonal. */
+int ev_is_diagvec_of_product(const ast_node *call)
+{
+    const ast_node *p = call->nkids == 1 ? call->kids[0] : NULL;
+    return p && p->kind == AST_BINARY && p->op == TK_STAR && p->kids[0]->kind == AST_TRANSPOSE;
+}
+
+int ev_diagvec_of_product(lang_ev *V, const ast_node *call, silc_value **out)
+{
+    const ast_node *prod = call->kids[0], *tr = prod->kids[0];
+    silc_value *l, *r, *e = NULL, *sums = NULL, *p = NULL;
+    char what[256];
+    int rc;
+    *out = NULL;
+    if (ev_expr(V, tr->kids[0], &l)) return -1;
+    if (ev_expr(V, prod->kids[1], &r)) {
+        val_release(l);
+        return -1;
+    }
+    node_text(V, call, what, sizeof what);
+    if (l->field != SILC_FIELD_COMPLEX && r->field != SILC_FIELD_COMPLEX && l->m == r->m && l->n == r->n &&
+        l->m > 1) {
+        rc = ev_run_op(V, SILC_OP_EWISE, SILC_EW_MUL, l, r, 0, 0, what, &e) ||
+             ev_run_op(V, SILC_OP_REDUCE, SILC_RED_SUM, e, NULL, 0, 0, what, &sums) ||
+             ev_run_op(V, SILC_OP_TRANSPOSE, 1, sums, NULL, 0, 0, what, out);
+        val_release(l), val_release(r), val_release(e), val_release(sums);
+        return rc ? -1 : 0;
+    }
+    if (unary_of(V, tr, l, &l)) { /* releases l */
+        val_release(r);
+        return -1;
+    }
+    if (binary_of(V, prod, l, r, &p)) return -1; /* releases l and r */
+    rc = ev_run_op(V, SILC_OP_DIAG, 1, p, NULL, 0, 0, what, out);
+    val_release(p);
+    return rc;
+}
+
 /* base[subscripts]: the subscripts are evaluated by ix_extract. */
 static UTIL_NOINLINE int eval_index(lang_ev *V, const ast_node *n, silc_value **out)
 {

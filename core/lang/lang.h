@@ -146,6 +146,10 @@ int ev_run_op(lang_ev *V, int op, int sub, const silc_value *a, const silc_value
               double alpha, double beta, const char *what, silc_value **out);
 /* "3x4" */
 void ev_shape(const silc_value *v, char *out, size_t outlen);
+/* diagvec(L' * R) as the column sums of L .* R (eval.c says when): whether
+ * the call has that form, and its value. */
+int ev_is_diagvec_of_product(const ast_node *call);
+int ev_diagvec_of_product(lang_ev *V, const ast_node *call, silc_value **out);
 
 /* ---- built-in functions (builtins.c) ------------------------------------------ */
 /* Names of every built-in function and constant (for suggestions), NULL-ended. */

@@ -18,6 +18,16 @@
  * table.  The table is small and bounded (MEMO_SLOTS entries, MEMO_BYTES of
  * results with what hangs off them), least recently used first out.
  *
+ * Chains settle in one step.  The first sighting's result is not kept, so
+ * the next step computes the operation again as a new value; an operation
+ * on that result (X * sqrt(K) after sqrt(K)) would then see a new operand
+ * id every step until its input settled, and a chain of d operations took
+ * 2d steps to settle (the cloth's A: 12 levels, 40 sparse products in its
+ * first 25 steps).  So the slot notes its first result's id, and when the
+ * result is kept the keys naming that id are renamed to the kept one: the
+ * two are the same operation on the same operands, the premise of the
+ * table, and the whole chain is kept in its second step.
+ *
  * A kept result is memory the session holds without a name: its arrays
  * (unless a name holds it too) and, above all, what later calls attached
  * to it -- a solve with it leaves its factorization there, often many
@@ -53,6 +63,7 @@ typedef struct memo_key {
 typedef struct memo_slot {
     memo_key key;
     silc_value *result;   /* NULL: seen once, no result kept */
+    uint64_t first_id;    /* the id of the first sighting's result (not kept), or 0 */
     uint64_t used;        /* for least-recently-used eviction */
 } memo_slot;
 
@@ -146,6 +157,15 @@ static memo_slot *make_room(eng_memo *M)
     return &M->slot[M->n++];
 }
 
+/* Keys naming the value `from` name `to` instead (see the top of the file). */
+static void rename_operand(eng_memo *M, uint64_t from, uint64_t to)
+{
+    int i, j;
+    for (i = 0; i < M->n; i++)
+        for (j = 0; j < M->slot[i].key.nin; j++)
+            if (M->slot[i].key.ids[j] == from) M->slot[i].key.ids[j] = to;
+}
+
 silc_value *memo_lookup(silc_engine *E, const silc_call *call)
 {
     memo_key k;
@@ -182,6 +202,7 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
         s = make_room(M);
         memset(s, 0, sizeof *s);
         s->key = k;
+        s->first_id = result ? result->id : 0;
         s->used = ++M->clock;
         return;
     }
@@ -196,6 +217,8 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
         drop(M, &M->slot[old]);
     }
     s->result = val_retain(result);
+    if (s->first_id && s->first_id != result->id) rename_operand(M, s->first_id, result->id);
+    s->first_id = 0;
 }
 
 /* ---- what a session holds ------------------------------------------------------
