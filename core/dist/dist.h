@@ -77,6 +77,11 @@ int dist_make_whole(silc_engine *E, silc_value **v);
 /* Whether v is distributed (whatever rank we are). */
 #define dist_is(v) ((v) && (v)->dist != NULL)
 
+/* A complex copy of the distributed real value v, each rank promoting its
+ * own block (nothing moves).  Collective; NULL on every rank when one ran
+ * out of memory. */
+silc_value *dist_promote(silc_engine *E, const silc_value *v);
+
 /* SPMD: binds name to the value whose rows [first_row, first_row +
  * block->m) this rank holds (block taken over).  Collective. */
 int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_value *block);
