@@ -9,7 +9,9 @@
 #     bench/mpi.sh [--quick] [BUILD_DIR]       (default BUILD_DIR: build)
 #     env: NPS="1 2" (rank counts; more than the cores is oversubscribed and
 #          labelled so), ROUNDS (repetitions, default 3; quick 1), KEEP=dir
-#          (keep the raw RESULT lines and logs there)
+#          (keep the raw RESULT lines and logs there), METHODS (SILC's,
+#          default mumps,petsc-mumps,petsc-cg-hypre; the direct rows run for
+#          those given), LOOP=0 (one-shot rows only)
 #
 # Full: one-shot x = A \ b on 500^2 and 1000^2, the Crank-Nicolson loop on
 # 400^2 for 100 steps; --quick: 100^2/200^2 and 100^2 for 10 steps.  Each
@@ -47,7 +49,9 @@ RES=$WORK/results.txt
 LOG=$WORK/log.txt
 : >"$RES"; : >"$LOG"
 SOCK=$WORK/silcd.sock
-SILC_METHODS="mumps,petsc-mumps,petsc-cg-hypre"
+SILC_METHODS=${METHODS:-mumps,petsc-mumps,petsc-cg-hypre}
+LOOP=${LOOP:-1}
+has_method() { case ",$SILC_METHODS," in *",$1,"*) return 0;; esac; return 1; }
 
 # Runs a command, its RESULT lines to $RES, everything to $LOG.  A non-zero
 # exit is logged, not fatal: a failed row simply has no RESULT line.
@@ -102,7 +106,7 @@ PETSC=yes
 record mpirun -np 2 "$MPI_BIN" spmd -n 60 -methods petsc-mumps
 if ! grep -q 'method=petsc-mumps .*status=ok' "$RES"; then
   PETSC="n/a (petsc collective not available)"
-  SILC_METHODS="mumps"
+  SILC_METHODS=$(has_method mumps && echo mumps)
 fi
 : >"$RES"
 
@@ -114,7 +118,7 @@ for round in $(seq "$ROUNDS"); do
       for n in $NS; do
         record "$MPI_BIN" client -server "unix:$SOCK" -n "$n" -methods "$SILC_METHODS"
       done
-      record "$MPI_BIN" client -server "unix:$SOCK" -n "$LOOP_N" -steps "$STEPS" -methods "$SILC_METHODS"
+      [ "$LOOP" = 1 ] && record "$MPI_BIN" client -server "unix:$SOCK" -n "$LOOP_N" -steps "$STEPS" -methods "$SILC_METHODS"
       stop_server
     fi
     # One process per method, as the direct rows: a solve that follows
@@ -125,20 +129,22 @@ for round in $(seq "$ROUNDS"); do
       for n in $NS; do
         record mpirun -np "$np" "$MPI_BIN" spmd -n "$n" -methods "$m"
       done
-      record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
+      [ "$LOOP" = 1 ] && record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
     done
     for n in $NS; do
-      direct "$np" mumps oneshot "$n" -method mumps
-      direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky
-      direct "$np" cg-hypre oneshot "$n" -method cg-hypre
-      direct "$np" dmumps oneshot "$n" -method dmumps
+      has_method petsc-mumps && direct "$np" mumps oneshot "$n" -method mumps
+      has_method mumps && direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky
+      has_method petsc-cg-hypre && direct "$np" cg-hypre oneshot "$n" -method cg-hypre
+      has_method mumps && direct "$np" dmumps oneshot "$n" -method dmumps
     done
-    direct "$np" mumps loop "$LOOP_N" -method mumps
-    direct "$np" mumps-chol loop "$LOOP_N" -method mumps -pc_type cholesky
-    direct "$np" cg-hypre loop "$LOOP_N" -method cg-hypre
+    if [ "$LOOP" = 1 ]; then
+      has_method petsc-mumps && direct "$np" mumps loop "$LOOP_N" -method mumps
+      has_method mumps && direct "$np" mumps-chol loop "$LOOP_N" -method mumps -pc_type cholesky
+      has_method petsc-cg-hypre && direct "$np" cg-hypre loop "$LOOP_N" -method cg-hypre
+    fi
     if [ "$np" = 1 ]; then
       for n in $NS; do record "$MPI_BIN" embedded -n "$n" -methods default; done
-      record "$MPI_BIN" embedded -n "$LOOP_N" -steps "$STEPS" -methods default
+      [ "$LOOP" = 1 ] && record "$MPI_BIN" embedded -n "$LOOP_N" -steps "$STEPS" -methods default
     fi
   done
 done
@@ -166,7 +172,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     status[k] = st
   }
   function base_of(method, kind) {
-    # one-shot: SILC's mumps against MUMPS called itself with the same ICNTLs
+    # one-shot: the mumps backend against MUMPS called directly, same ICNTLs
     if (method == "mumps" && kind == "oneshot") return "dmumps"
     if (method == "mumps" || method == "default") return "mumps-chol"
     if (method == "petsc-mumps") return "mumps"
