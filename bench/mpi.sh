@@ -11,7 +11,8 @@
 #          labelled so), ROUNDS (repetitions, default 3; quick 1), KEEP=dir
 #          (keep the raw RESULT lines and logs there), METHODS (SILC's,
 #          default mumps,petsc-mumps,petsc-cg-hypre; the direct rows run for
-#          those given), LOOP=0 (one-shot rows only)
+#          those given), LOOP=0 (one-shot rows only), NS (the one-shot
+#          grid sides)
 #
 # Full: one-shot x = A \ b on 500^2 and 1000^2, the Crank-Nicolson loop on
 # 400^2 for 100 steps; --quick: 100^2/200^2 and 100^2 for 10 steps.  Each
@@ -37,9 +38,9 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 \
 unset SILC_SERVER
 
 if [ $QUICK = 1 ]; then
-  NS="100 200"; LOOP_N=100; STEPS=10; ROUNDS=${ROUNDS:-1}
+  NS=${NS:-"100 200"}; LOOP_N=100; STEPS=10; ROUNDS=${ROUNDS:-1}
 else
-  NS="500 1000"; LOOP_N=400; STEPS=100; ROUNDS=${ROUNDS:-3}
+  NS=${NS:-"500 1000"}; LOOP_N=400; STEPS=100; ROUNDS=${ROUNDS:-3}
 fi
 NPS=${NPS:-"1 2"}
 CORES=$(getconf _NPROCESSORS_ONLN)  # not nproc: it honours OMP_NUM_THREADS

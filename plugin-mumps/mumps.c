@@ -1431,34 +1431,37 @@ static int solve_dist_loc(silc_call *call, solve_ctx *c, mumps_factor *F, const 
     } else if (F->cplx && !is_complex(X)) {
         /* ABI 1.8 makes a distributed result of like's field (silc_plugin.h) */
         rc = local_error(c, SILC_EUNSUP, "mumps: the host made a real distributed result for a complex solve");
-    } else if (!(rhs = host->alloc((size_t)(m * nrhs * w > 0 ? m * nrhs * w : 1) * sizeof *rhs)) ||
-               loc_arrays(c, F, nrhs)) {
-        rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for this rank's %lld rows of the right-hand side "
-                                         "and solution", (long long)m);
-    } else if ((F->lsol_loc + m) * nrhs * w > INT_MAX) {
-        rc = local_error(c, SILC_EARG, "mumps: %lld right-hand sides of %lld local rows exceed MPI's int counts",
-                         (long long)nrhs, (long long)m);
+    } else if (!(rhs = host->alloc((size_t)(m * nrhs * w > 0 ? m * nrhs * w : 1) * sizeof *rhs))) {
+        rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for this rank's %lld rows of the right-hand side",
+                         (long long)m);
     }
     if ((rc = agree(call, c, rc))) goto done;
     host->view(X, &o);
     t0 = host->now();
     ICNTL(F, 20) = 10; /* distributed dense right-hand side */
     ICNTL(F, 21) = 1;  /* distributed solution */
-    ID_SET(F, nloc_rhs, (MUMPS_INT)m);
-    ID_SET(F, lrhs_loc, (MUMPS_INT)(m ? m : 1));
-    ID_SET(F, irhs_loc, F->irhs_loc);
-    ID_SET(F, isol_loc, F->isol_loc);
-    ID_SET(F, lsol_loc, (MUMPS_INT)F->lsol_loc);
-    if (F->cplx) {
-        F->id.z.rhs_loc = (ZMUMPS_COMPLEX *)rhs;
-        F->id.z.sol_loc = (ZMUMPS_COMPLEX *)F->sol_loc;
-    } else {
-        F->id.d.rhs_loc = rhs;
-        F->id.d.sol_loc = F->sol_loc;
-    }
-    do /* b's rows, copied again after a refactorization (SOLVE_AGAIN) */
+    do { /* b's rows and the solution's room, again after a refactorization (SOLVE_AGAIN) */
+        rc = SILC_OK;
+        if (loc_arrays(c, F, nrhs))
+            rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for this rank's part of the solution");
+        else if ((F->lsol_loc + m) * nrhs * w > INT_MAX)
+            rc = local_error(c, SILC_EARG, "mumps: %lld right-hand sides of %lld local rows exceed MPI's int "
+                                           "counts", (long long)nrhs, (long long)m);
+        if ((rc = agree(call, c, rc))) break;
+        ID_SET(F, nloc_rhs, (MUMPS_INT)m);
+        ID_SET(F, lrhs_loc, (MUMPS_INT)(m ? m : 1));
+        ID_SET(F, irhs_loc, F->irhs_loc);
+        ID_SET(F, isol_loc, F->isol_loc);
+        ID_SET(F, lsol_loc, (MUMPS_INT)F->lsol_loc);
+        if (F->cplx) {
+            F->id.z.rhs_loc = (ZMUMPS_COMPLEX *)rhs;
+            F->id.z.sol_loc = (ZMUMPS_COMPLEX *)F->sol_loc;
+        } else {
+            F->id.d.rhs_loc = rhs;
+            F->id.d.sol_loc = F->sol_loc;
+        }
         memcpy(rhs, b->val, (size_t)(m * nrhs * w) * sizeof *rhs);
-    while ((rc = run_solve(call, F, NULL, nrhs)) == SOLVE_AGAIN);
+    } while ((rc = run_solve(call, F, NULL, nrhs)) == SOLVE_AGAIN);
     ICNTL(F, 20) = 0;
     ICNTL(F, 21) = 0;
     if (rc) goto done;

@@ -466,6 +466,17 @@ static void check_faults(silc_context *c)
     CHECK(all_ok(rc != 0 && strstr(silc_context_errmsg(c), "rank 1")), "bad block on rank 1: rc %d '%s'",
           rc, silc_context_errmsg(c));
     silc_envelope_free(&blk);
+    /* Rank 1's block complex, rank 0's real: refused on every rank, naming the field. */
+    {
+        double z[4] = {1, 2, 3, 4};
+        memset(&blk, 0, sizeof blk);
+        rc = rank == 1 ? silc_envelope_dense_complex(&blk, 2, 1, z) : silc_envelope_dense(&blk, 2, 1, z);
+        if (rc == 0) rc = silc_put_rows(c, "mixed", 2 * rank, &blk);
+        CHECK(all_ok(rc != 0 && strstr(silc_context_errmsg(c), "rank 1's block is complex") &&
+                     strstr(silc_context_errmsg(c), "field")),
+              "a complex block among real ones: rc %d '%s'", rc, silc_context_errmsg(c));
+        silc_envelope_free(&blk);
+    }
     /* Blocks that overlap (every rank's row 0): the same verdict everywhere. */
     memset(&blk, 0, sizeof blk);
     silc_envelope_scalar(&blk, 1.0);
