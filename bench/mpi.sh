@@ -156,7 +156,7 @@ echo
 echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED} s"
 echo "(bench/mpi.sh $([ $QUICK = 1 ] && echo --quick) $BUILD; raw lines: $RES)"
 echo "petsc collective: $PETSC"
-awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
+awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v partial="${METHODS:+1}" -v loop="$LOOP" '
   function field(line, key,   i, s) {
     if (match(line, " " key "=\"[^\"]*\"")) { s = substr(line, RSTART + length(key) + 3, RLENGTH - length(key) - 4); return s }
     if (match(line, " " key "=[^ ]*")) return substr(line, RSTART + length(key) + 2, RLENGTH - length(key) - 2)
@@ -194,6 +194,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     if (method ~ /^petsc/ && petsc != "yes") {
       printf "| %s | %s | %s | %s%s\n", n, np, label(mode, method) note, petsc, empty; return
     }
+    if (!(k in best) && !(k in failmsg) && partial) return # a method METHODS left out
     if (!(k in best)) {
       printf "| %s | %s | %s | %s%s\n", n, np, label(mode, method) note,
              (k in failmsg) ? "failed: " substr(failmsg[k], 1, 80) : "not run", empty; return
@@ -219,7 +220,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     split(nps, P, " ")
     split("mumps petsc-mumps petsc-cg-hypre", M, " ")
     split("mumps mumps-chol cg-hypre dmumps", D, " ")
-    for (kind = 1; kind <= 2; kind++) {
+    for (kind = 1; kind <= (loop == 1 ? 2 : 1); kind++) {
       K = kind == 1 ? "oneshot" : "loop"
       delete Ns; nn = 0
       for (k in best) { split(k, f, "|"); if (f[1] == K && !(f[2] in Ns)) { Ns[f[2]] = 1; order[++nn] = f[2] + 0 } }

@@ -9,7 +9,8 @@
  * table: libsilc never links MPI).
  *
  * A value is whole (an ordinary value, the same on every rank) or
- * distributed by contiguous row blocks (store.h: val_dist, PETSc's layout).
+ * distributed by contiguous row blocks (store.h: val_dist, PETSc's layout),
+ * real or complex alike (a complex entry moves, and is counted, as 2 doubles).
  * Data moves only where the layout must change, and each move is counted:
  *   - an operation whose operands are all whole runs on every rank, moving
  *     nothing (scalars, small values: the same bits everywhere);
