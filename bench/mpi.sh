@@ -9,7 +9,10 @@
 #     bench/mpi.sh [--quick] [BUILD_DIR]       (default BUILD_DIR: build)
 #     env: NPS="1 2" (rank counts; more than the cores is oversubscribed and
 #          labelled so), ROUNDS (repetitions, default 3; quick 1), KEEP=dir
-#          (keep the raw RESULT lines and logs there)
+#          (keep the raw RESULT lines and logs there), METHODS (SILC's,
+#          default mumps,petsc-mumps,petsc-cg-hypre; the direct rows run for
+#          those given), LOOP=0 (one-shot rows only), NS (the one-shot
+#          grid sides)
 #
 # Full: one-shot x = A \ b on 500^2 and 1000^2, the Crank-Nicolson loop on
 # 400^2 for 100 steps; --quick: 100^2/200^2 and 100^2 for 10 steps.  Each
@@ -35,9 +38,9 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 \
 unset SILC_SERVER
 
 if [ $QUICK = 1 ]; then
-  NS="100 200"; LOOP_N=100; STEPS=10; ROUNDS=${ROUNDS:-1}
+  NS=${NS:-"100 200"}; LOOP_N=100; STEPS=10; ROUNDS=${ROUNDS:-1}
 else
-  NS="500 1000"; LOOP_N=400; STEPS=100; ROUNDS=${ROUNDS:-3}
+  NS=${NS:-"500 1000"}; LOOP_N=400; STEPS=100; ROUNDS=${ROUNDS:-3}
 fi
 NPS=${NPS:-"1 2"}
 CORES=$(getconf _NPROCESSORS_ONLN)  # not nproc: it honours OMP_NUM_THREADS
@@ -47,7 +50,9 @@ RES=$WORK/results.txt
 LOG=$WORK/log.txt
 : >"$RES"; : >"$LOG"
 SOCK=$WORK/silcd.sock
-SILC_METHODS="mumps,petsc-mumps,petsc-cg-hypre"
+SILC_METHODS=${METHODS:-mumps,petsc-mumps,petsc-cg-hypre}
+LOOP=${LOOP:-1}
+has_method() { case ",$SILC_METHODS," in *",$1,"*) return 0;; esac; return 1; }
 
 # Runs a command, its RESULT lines to $RES, everything to $LOG.  A non-zero
 # exit is logged, not fatal: a failed row simply has no RESULT line.
@@ -102,7 +107,7 @@ PETSC=yes
 record mpirun -np 2 "$MPI_BIN" spmd -n 60 -methods petsc-mumps
 if ! grep -q 'method=petsc-mumps .*status=ok' "$RES"; then
   PETSC="n/a (petsc collective not available)"
-  SILC_METHODS="mumps"
+  SILC_METHODS=$(has_method mumps && echo mumps)
 fi
 : >"$RES"
 
@@ -114,7 +119,7 @@ for round in $(seq "$ROUNDS"); do
       for n in $NS; do
         record "$MPI_BIN" client -server "unix:$SOCK" -n "$n" -methods "$SILC_METHODS"
       done
-      record "$MPI_BIN" client -server "unix:$SOCK" -n "$LOOP_N" -steps "$STEPS" -methods "$SILC_METHODS"
+      [ "$LOOP" = 1 ] && record "$MPI_BIN" client -server "unix:$SOCK" -n "$LOOP_N" -steps "$STEPS" -methods "$SILC_METHODS"
       stop_server
     fi
     # One process per method, as the direct rows: a solve that follows
@@ -125,19 +130,22 @@ for round in $(seq "$ROUNDS"); do
       for n in $NS; do
         record mpirun -np "$np" "$MPI_BIN" spmd -n "$n" -methods "$m"
       done
-      record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
+      [ "$LOOP" = 1 ] && record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
     done
     for n in $NS; do
-      direct "$np" mumps oneshot "$n" -method mumps
-      direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky
-      direct "$np" cg-hypre oneshot "$n" -method cg-hypre
+      has_method petsc-mumps && direct "$np" mumps oneshot "$n" -method mumps
+      has_method mumps && direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky
+      has_method petsc-cg-hypre && direct "$np" cg-hypre oneshot "$n" -method cg-hypre
+      has_method mumps && direct "$np" dmumps oneshot "$n" -method dmumps
     done
-    direct "$np" mumps loop "$LOOP_N" -method mumps
-    direct "$np" mumps-chol loop "$LOOP_N" -method mumps -pc_type cholesky
-    direct "$np" cg-hypre loop "$LOOP_N" -method cg-hypre
+    if [ "$LOOP" = 1 ]; then
+      has_method petsc-mumps && direct "$np" mumps loop "$LOOP_N" -method mumps
+      has_method mumps && direct "$np" mumps-chol loop "$LOOP_N" -method mumps -pc_type cholesky
+      has_method petsc-cg-hypre && direct "$np" cg-hypre loop "$LOOP_N" -method cg-hypre
+    fi
     if [ "$np" = 1 ]; then
       for n in $NS; do record "$MPI_BIN" embedded -n "$n" -methods default; done
-      record "$MPI_BIN" embedded -n "$LOOP_N" -steps "$STEPS" -methods default
+      [ "$LOOP" = 1 ] && record "$MPI_BIN" embedded -n "$LOOP_N" -steps "$STEPS" -methods default
     fi
   done
 done
@@ -148,7 +156,7 @@ echo
 echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED} s"
 echo "(bench/mpi.sh $([ $QUICK = 1 ] && echo --quick) $BUILD; raw lines: $RES)"
 echo "petsc collective: $PETSC"
-awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
+awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v partial="${METHODS:+1}" -v loop="$LOOP" '
   function field(line, key,   i, s) {
     if (match(line, " " key "=\"[^\"]*\"")) { s = substr(line, RSTART + length(key) + 3, RLENGTH - length(key) - 4); return s }
     if (match(line, " " key "=[^ ]*")) return substr(line, RSTART + length(key) + 2, RLENGTH - length(key) - 2)
@@ -164,7 +172,9 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     if (!(k in worst) || t > worst[k]) worst[k] = t
     status[k] = st
   }
-  function base_of(method) {
+  function base_of(method, kind) {
+    # one-shot: the mumps backend against MUMPS called directly, same ICNTLs
+    if (method == "mumps" && kind == "oneshot") return "dmumps"
     if (method == "mumps" || method == "default") return "mumps-chol"
     if (method == "petsc-mumps") return "mumps"
     if (method == "petsc-cg-hypre") return "cg-hypre"
@@ -174,6 +184,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     if (mode == "client") return "(a) silcd --mpi client, " method
     if (mode == "spmd") return "(b) SILC SPMD, " method
     if (mode == "embedded") return "(d) embedded SILC, default (CHOLMOD)"
+    if (method == "dmumps") return "(c) direct MUMPS, dmumps_c (same ICNTLs as mumps)"
     return "(c) direct PETSc, " method
   }
   function row(kind, n, np, mode, method,   k, b, bk, r, sp, L, note) {
@@ -183,6 +194,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     if (method ~ /^petsc/ && petsc != "yes") {
       printf "| %s | %s | %s | %s%s\n", n, np, label(mode, method) note, petsc, empty; return
     }
+    if (!(k in best) && !(k in failmsg) && partial) return # a method METHODS left out
     if (!(k in best)) {
       printf "| %s | %s | %s | %s%s\n", n, np, label(mode, method) note,
              (k in failmsg) ? "failed: " substr(failmsg[k], 1, 80) : "not run", empty; return
@@ -192,8 +204,8 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
     sp = best[k] > 0 ? sprintf("%.0f%%", 100 * (worst[k] - best[k]) / best[k]) : "-"
     r = "-"
     if (mode != "direct") {
-      bk = kind "|" n "|" np "|direct|" base_of(method)
-      if (bk in best) r = sprintf("%.2f (vs %s)", best[k] / best[bk], base_of(method))
+      bk = kind "|" n "|" np "|direct|" base_of(method, kind)
+      if (bk in best) r = sprintf("%.2f (vs %s)", best[k] / best[bk], base_of(method, kind))
     }
     if (kind == "oneshot")
       printf "| %s | %s | %s | %.3f | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
@@ -207,8 +219,8 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
   END {
     split(nps, P, " ")
     split("mumps petsc-mumps petsc-cg-hypre", M, " ")
-    split("mumps mumps-chol cg-hypre", D, " ")
-    for (kind = 1; kind <= 2; kind++) {
+    split("mumps mumps-chol cg-hypre dmumps", D, " ")
+    for (kind = 1; kind <= (loop == 1 ? 2 : 1); kind++) {
       K = kind == 1 ? "oneshot" : "loop"
       delete Ns; nn = 0
       for (k in best) { split(k, f, "|"); if (f[1] == K && !(f[2] in Ns)) { Ns[f[2]] = 1; order[++nn] = f[2] + 0 } }
@@ -227,7 +239,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" '
       }
       for (i = 1; i <= nn; i++) for (p = 1; p in P; p++) {
         n = order[i]; np = P[p]
-        for (d = 1; d <= 3; d++) row(K, n, np, "direct", D[d])
+        for (d = 1; d <= 4; d++) if (K == "oneshot" || D[d] != "dmumps") row(K, n, np, "direct", D[d])
         for (m = 1; m <= 3; m++) row(K, n, np, "client", M[m])
         for (m = 1; m <= 3; m++) row(K, n, np, "spmd", M[m])
         if (np == 1) row(K, n, np, "embedded", "default")

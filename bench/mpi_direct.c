@@ -4,7 +4,7 @@
  * a small MPI program at the same number of ranks, with no SILC in between,
  * so the server bench can report what SILC's layer costs on top of them.
  *
- *     mpirun -np P mpi_direct [-n N] [-method cg-hypre|gmres-bjacobi|mumps|all]
+ *     mpirun -np P mpi_direct [-n N] [-method cg-hypre|gmres-bjacobi|mumps|dmumps|all]
  *                             [-steps S] [-dt DT] [-oneshot 0|1] [-amf 0|1]
  *                             [-header 0|1] [any PETSc option]
  *         defaults: N = 500, method mumps, S = 0, DT = 2e-4, one-shot on,
@@ -33,6 +33,16 @@
  * these can still be overridden by PETSc options on the command line, which
  * are applied last.  A method PETSc was built without is reported and skipped.
  *
+ * dmumps (one-shot only) is MUMPS called directly, no PETSc: dmumps_c with
+ * the ICNTLs SILC's mumps backend uses for a distributed SPD solve (output
+ * off, AMF ordering ICNTL(7)=2, LDL' SYM=1 on the lower triangle,
+ * distributed assembled triplets ICNTL(18)=3, distributed right-hand side
+ * ICNTL(20)=10 and solution ICNTL(21)=1), each rank passing its own rows.
+ * setup_s is JOB=-1 and JOB=4 (analysis + factorization), solve_s JOB=3;
+ * the error is read where MUMPS leaves the solution (SILC also moves it to
+ * the row blocks, which this baseline does not: SILC's ratio against it is
+ * an upper bound).
+ *
  * Times are MPI_Wtime between barriers, max over ranks by construction:
  *   asm_s    assembling A and b (one-shot)
  *   setup_s  KSPSetUp + KSPSetUpOnBlocks (AMG hierarchy, block ILU(0), or
@@ -45,6 +55,9 @@
  * litis); ord is the ordering MUMPS actually used, INFOG(7) (2 = AMF,
  * 4 = PORD, 5 = METIS, 3 = SCOTCH, 0 = AMD, 6 = QAMD; - for other methods).
  */
+#if BENCH_HAVE_DMUMPS
+#include <dmumps_c.h>
+#endif
 #include <petscksp.h>
 #include <string.h>
 
@@ -161,6 +174,97 @@ static PetscErrorCode check_reason(KSP ksp, const char *what)
                               KSPConvergedReasons[reason]));
     PetscFunctionReturn(0);
 }
+
+/* The dmumps method (see the top): this rank's rows of the stencil's lower
+ * triangle as 1-based triplets, b = A * ones by rows, one JOB=4 and one
+ * JOB=3 with the right-hand side and solution distributed. */
+#if BENCH_HAVE_DMUMPS
+static PetscErrorCode oneshot_dmumps(PetscInt n, Result *r)
+{
+    DMUMPS_STRUC_C id;
+    PetscInt N = n * n, first, rows, k;
+    MUMPS_INT *irn, *jcn, *irhs, *isol;
+    double *a, *rhs, *sol, t0, t1, t2, t3, err = 0;
+    int64_t nz = 0;
+    PetscMPIInt rank, size;
+
+    PetscFunctionBeginUser;
+    PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+    rows = N / size + (rank < N % size); /* PETSC_DECIDE's split, as SILC's */
+    first = rank * (N / size) + (rank < N % size ? rank : N % size);
+    PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+    t0 = MPI_Wtime();
+    PetscCall(PetscMalloc4(3 * rows + 1, &irn, 3 * rows + 1, &jcn, 3 * rows + 1, &a, rows + 1, &rhs));
+    PetscCall(PetscMalloc1(rows + 1, &irhs));
+    for (k = first; k < first + rows; k++) {
+        PetscInt i = k / n, j = k % n;
+        double s = 4;
+        /* lower triangle: the neighbours above and to the left, then the diagonal */
+        if (i > 0) irn[nz] = (MUMPS_INT)(k + 1), jcn[nz] = (MUMPS_INT)(k - n + 1), a[nz++] = -1, s -= 1;
+        if (j > 0) irn[nz] = (MUMPS_INT)(k + 1), jcn[nz] = (MUMPS_INT)(k), a[nz++] = -1, s -= 1;
+        irn[nz] = (MUMPS_INT)(k + 1), jcn[nz] = (MUMPS_INT)(k + 1), a[nz++] = 4;
+        if (j < n - 1) s -= 1;
+        if (i < n - 1) s -= 1;
+        rhs[k - first] = s; /* (A * ones)_k */
+        irhs[k - first] = (MUMPS_INT)(k + 1);
+    }
+    PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+    t1 = MPI_Wtime();
+    memset(&id, 0, sizeof id);
+    id.comm_fortran = (MUMPS_INT)MPI_Comm_c2f(PETSC_COMM_WORLD);
+    id.par = 1;
+    id.sym = 1;
+    id.job = -1;
+    dmumps_c(&id);
+    PetscCheck(id.infog[0] >= 0, PETSC_COMM_WORLD, PETSC_ERR_LIB, "dmumps_c JOB=-1: INFOG(1)=%d", (int)id.infog[0]);
+    id.icntl[0] = id.icntl[1] = id.icntl[2] = -1, id.icntl[3] = 0; /* silent */
+    id.icntl[6] = 2;                                                 /* AMF */
+    id.icntl[17] = 3;                                                /* distributed triplets */
+    id.n = (MUMPS_INT)N;
+    id.nnz_loc = nz;
+    id.irn_loc = irn, id.jcn_loc = jcn, id.a_loc = a;
+    id.job = 4;
+    dmumps_c(&id);
+    PetscCheck(id.infog[0] >= 0, PETSC_COMM_WORLD, PETSC_ERR_LIB, "dmumps_c JOB=4: INFOG(1)=%d", (int)id.infog[0]);
+    PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+    t2 = MPI_Wtime();
+    PetscCall(PetscMalloc2(id.info[22] + 1, &isol, id.info[22] + 1, &sol));
+    id.icntl[19] = 10, id.icntl[20] = 1; /* distributed right-hand side and solution */
+    id.nrhs = 1;
+    id.nloc_rhs = (MUMPS_INT)rows, id.lrhs_loc = (MUMPS_INT)(rows ? rows : 1);
+    id.irhs_loc = irhs, id.rhs_loc = rhs;
+    id.lsol_loc = id.info[22], id.isol_loc = isol, id.sol_loc = sol;
+    id.job = 3;
+    dmumps_c(&id);
+    PetscCheck(id.infog[0] >= 0, PETSC_COMM_WORLD, PETSC_ERR_LIB, "dmumps_c JOB=3: INFOG(1)=%d", (int)id.infog[0]);
+    PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+    t3 = MPI_Wtime();
+    for (k = 0; k < id.info[22]; k++) err = PetscMax(err, PetscAbsReal(sol[k] - 1));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &err, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD));
+    r->ord = id.infog[6];
+    id.job = -2;
+    dmumps_c(&id);
+    r->asm_s = t1 - t0;
+    r->setup_s = t2 - t1;
+    r->solve_s = t3 - t2;
+    r->err = err;
+    r->its = 0;
+    r->did_oneshot = PETSC_TRUE;
+    PetscCall(PetscFree2(isol, sol));
+    PetscCall(PetscFree(irhs));
+    PetscCall(PetscFree4(irn, jcn, a, rhs));
+    PetscFunctionReturn(0);
+}
+#else
+static PetscErrorCode oneshot_dmumps(PetscInt n, Result *r)
+{
+    PetscFunctionBeginUser;
+    (void)n, (void)r;
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "mpi_direct: skipping dmumps: built without MPI MUMPS's dmumps_c.h\n"));
+    PetscFunctionReturn(0);
+}
+#endif
 
 static PetscErrorCode oneshot(const char *method, PetscInt n, Result *r)
 {
@@ -300,7 +404,7 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
 
 int main(int argc, char **argv)
 {
-    static const char *all[] = {"cg-hypre", "gmres-bjacobi", "mumps"};
+    static const char *all[] = {"cg-hypre", "gmres-bjacobi", "mumps", "dmumps"};
     char method[64] = "mumps";
     PetscInt n = 500, steps = 0;
     PetscReal dt = 2e-4;
@@ -325,11 +429,11 @@ int main(int argc, char **argv)
     PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_mumps_icntl_7", &has));
     if (amf && !has) PetscCall(PetscOptionsSetValue(NULL, "-mat_mumps_icntl_7", "2"));
 
-    int first = 0, last = 2;
+    int first = 0, last = 3;
     if (strcmp(method, "all")) {
-        for (first = 0; first < 3 && strcmp(method, all[first]); first++) {}
-        PetscCheck(first < 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
-                   "-method %s: expected cg-hypre, gmres-bjacobi, mumps or all", method);
+        for (first = 0; first < 4 && strcmp(method, all[first]); first++) {}
+        PetscCheck(first < 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+                   "-method %s: expected cg-hypre, gmres-bjacobi, mumps, dmumps or all", method);
         last = first;
     }
     if (header)
@@ -342,8 +446,8 @@ int main(int argc, char **argv)
         memset(&r, 0, sizeof r);
         r.name = all[m];
         r.ord = -1;
-        if (do_oneshot) PetscCall(oneshot(all[m], n, &r));
-        if (steps > 0) PetscCall(loop(all[m], n, steps, dt, &r));
+        if (do_oneshot) PetscCall(strcmp(all[m], "dmumps") ? oneshot(all[m], n, &r) : oneshot_dmumps(n, &r));
+        if (steps > 0 && strcmp(all[m], "dmumps")) PetscCall(loop(all[m], n, steps, dt, &r)); /* one-shot only */
         if (r.did_oneshot || r.did_loop) PetscCall(print_row(&r, n, np));
     }
     PetscCall(PetscFinalize());

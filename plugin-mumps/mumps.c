@@ -49,9 +49,13 @@
  * whole-operand call runs as above on MPI_COMM_SELF, and SOLVE is also a
  * collective op: with A and B distributed by row blocks, every rank calls
  * MUMPS on the call's communicator (PAR=1) with its own rows as distributed
- * assembled triplets (ICNTL(18)=3, global indices), B is gathered onto rank
- * 0 (MUMPS's centralized right-hand side and solution) and X scattered back
- * into the ranks' blocks.  The instance is cached on A per rank as above; its
+ * assembled triplets (ICNTL(18)=3, global indices), hands MUMPS its own rows
+ * of B (distributed right-hand side, ICNTL(20)=10) and gets back the part of
+ * X that MUMPS's mapping leaves on it (distributed solution, ICNTL(21)=1),
+ * which one MPI_Alltoallv moves into the ranks' row blocks: nothing is
+ * gathered on rank 0 (B was, and X scattered, before; that path remains for
+ * MUMPS's error analysis and iterative refinement, which need a centralized
+ * solution).  The instance is cached on A per rank as above; its
  * JOB=-2 is collective (an allreduce and MPI_Comm_free), so a distributed A
  * must die on all ranks together.  MUMPS's INFOG is the same on every rank,
  * so its failures give every rank the same status; local failures
@@ -141,8 +145,8 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
     IC(17, "", "reserved"),
     IC(18, "0", "matrix distribution (the plugin chooses: 0 centralized, 3 for distributed operands)"),
     IC(19, "0", "Schur complement (not supported: 0)"),
-    IC(20, "0", "right-hand side format (dense: 0)"),
-    IC(21, "0", "solution distribution (centralized: 0)"),
+    IC(20, "0", "right-hand side format (the plugin chooses: dense 0, distributed 10 for distributed operands)"),
+    IC(21, "0", "solution distribution (the plugin chooses: centralized 0, distributed 1 for distributed operands)"),
     IC(22, "", "out-of-core factorization (1: factors on disk)"),
     IC(23, "", "maximum working memory per process in MB (0: no limit)"),
     IC(24, "", "null pivot detection (1: on)"),
@@ -195,8 +199,8 @@ static const struct {
     {9, 1, "'\\' solves A x = b"},
     {18, 0, "the plugin chooses (centralized, or distributed for distributed operands)"},
     {19, 0, "no Schur complement is returned"},
-    {20, 0, "the right-hand side is dense"},
-    {21, 0, "the solution is returned centralized"},
+    {20, 0, "the plugin chooses (dense, or distributed for distributed operands)"},
+    {21, 0, "the plugin chooses (centralized, or distributed for distributed operands)"},
     {25, 0, "no null-space basis is returned"},
     {26, 0, "no Schur complement is returned"},
     {30, 0, "'\\' computes a solution, not entries of the inverse"},
@@ -481,6 +485,18 @@ typedef struct mumps_factor {
     double rinfog[11];          /* its RINFOG(1..11) */
     double factor_seconds;
     int retries;                /* ICNTL(14) doublings that were needed */
+    /* Distributed right-hand side and solution (ICNTL(20)=10, ICNTL(21)=1;
+     * MPI build, distributed operands: solve_dist_loc). */
+    MUMPS_INT *irhs_loc;        /* this rank's rows of b, 1-based global (Nloc_RHS of them) */
+    MUMPS_INT *isol_loc;        /* the rows of x MUMPS leaves on this rank (INFO(23)), set by JOB=3 */
+    MUMPS_INT *isol_plan;       /* isol_loc as the redistribution plan was made for */
+    double *sol_loc;            /* INFO(23) x nrhs entries */
+    int64_t lsol_loc, sol_cap;  /* INFO(23); entries sol_loc holds */
+    int *send_n, *recv_n;       /* entries of x to / from each rank, per column */
+    int64_t *send_at;           /* positions in sol_loc, grouped by destination rank */
+    int64_t *recv_row;          /* local rows of what arrives, grouped by source rank */
+    int64_t plan_moved;         /* entries per column received from another rank, summed over ranks */
+    int loc_solved;             /* the last solve ran with them (for the report) */
 } mumps_factor;
 
 /* One MUMPS call (JOB=job) in the arithmetic F was set up for. */
@@ -525,6 +541,18 @@ static void factor_end(mumps_factor *F)
     F->a = NULL;
     F->af = NULL;
     F->est_y0 = NULL;
+    host->free(F->irhs_loc);
+    host->free(F->isol_loc);
+    host->free(F->isol_plan);
+    host->free(F->sol_loc);
+    host->free(F->send_n);
+    host->free(F->send_at);
+    host->free(F->recv_row);
+    F->irhs_loc = F->isol_loc = F->isol_plan = NULL;
+    F->sol_loc = NULL;
+    F->send_n = F->recv_n = NULL;
+    F->send_at = F->recv_row = NULL;
+    F->sol_cap = 0;
 }
 
 static void factor_free(void *p)
@@ -1084,9 +1112,14 @@ static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *
     r->rcond = -1;
     r->iterations = 0;
     r->note[0] = '\0';
-    if (c->dist)
+    if (c->dist && F->loc_solved) /* test_mpi reads the count */
+        note_add(r, "MUMPS on %d ranks: distributed assembled matrix (ICNTL(18)=3), right-hand side and "
+                    "solution distributed (ICNTL(20)=10, ICNTL(21)=1), %lld entries of each column moved "
+                    "to their row blocks, no condition estimate", c->size, (long long)F->plan_moved);
+    else if (c->dist)
         note_add(r, "MUMPS on %d ranks: distributed assembled matrix (ICNTL(18)=3), right-hand side "
-                    "and solution centralized on rank 0, no condition estimate", c->size);
+                    "and solution centralized on rank 0 (for ICNTL(10)/ICNTL(11)), no condition estimate",
+                 c->size);
     if (F->single) {
         if (host->abi_minor >= 2) r->single_factor = 1;
         note_add(r, "SYM=%d, %s order", sym, ordering_name((int)INFOG(F, 7)));
@@ -1246,13 +1279,16 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
 }
 
 #if SILC_MUMPS_MPI
-/* x = A \ b on distributed operands, collectively: b's blocks are gathered
- * onto rank 0, MUMPS's host (centralized right-hand side, ICNTL(20)=0), all
- * ranks take part in the solve, and the solution, centralized on rank 0
- * (ICNTL(21)=0), is scattered back into this rank's block of a new X.  One
- * MPI_Gatherv / MPI_Scatterv per column: the blocks are column-major. */
-static int solve_dist(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
-                      silc_value **out)
+/* x = A \ b on distributed operands, collectively, with a centralized
+ * right-hand side and solution: b's blocks are gathered onto rank 0, MUMPS's
+ * host (ICNTL(20)=0), all ranks take part in the solve, and the solution,
+ * centralized on rank 0 (ICNTL(21)=0), is scattered back into this rank's
+ * block of a new X.  One MPI_Gatherv / MPI_Scatterv per column: the blocks
+ * are column-major.  Only for what MUMPS does on a centralized solution
+ * alone: its error analysis (ICNTL(11)) and iterative refinement
+ * (ICNTL(10)); solve_dist_loc serves every other solve. */
+static int solve_dist_central(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
+                              silc_value **out)
 {
     /* A complex entry travels as 2 MPI_DOUBLEs: n, m, counts and offsets are in doubles. */
     int64_t w = ID_W(F), n = c->layout.m_global * w, m = c->layout.m_local * w, j;
@@ -1309,6 +1345,227 @@ done:
     if (rc && X) host->release(X);
     if (!rc) *out = X;
     return rc;
+}
+
+/* The rank whose row block holds global row g (the starts are sorted). */
+static int row_owner(const solve_ctx *c, int64_t g)
+{
+    int lo = 0, hi = c->size - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (c->layout.starts[mid] <= g) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* The plan that moves the solution from MUMPS's mapping (isol_loc, which
+ * the factorization fixes) to the row blocks: what this rank sends to each
+ * rank (positions in sol_loc) and, from one MPI_Alltoallv of the indices,
+ * which local row each arriving entry is.  Collective; made again only
+ * when some rank's isol_loc changed (a refactorization).  Returns the
+ * bytes of indices it moved, summed over the ranks, or -1 (local). */
+static int64_t plan_solution(solve_ctx *c, mumps_factor *F)
+{
+    int size = c->size, r, *sd = NULL, *rd = NULL, *fill = NULL;
+    int64_t i, nsend = 0, nrecv = 0, moved[2] = {0, 0};
+    MUMPS_INT *gsend = NULL, *grecv = NULL;
+    int failed = 0;
+    host->free(F->send_n), host->free(F->send_at), host->free(F->recv_row);
+    F->send_n = F->recv_n = NULL;
+    F->send_at = F->recv_row = NULL;
+    F->send_n = host->calloc((size_t)size * 2, sizeof *F->send_n);
+    sd = host->calloc((size_t)size * 3, sizeof *sd);
+    if (!F->send_n || !sd) failed = 1;
+    else {
+        F->recv_n = F->send_n + size;
+        rd = sd + size;
+        fill = rd + size;
+        for (i = 0; i < F->lsol_loc; i++) F->send_n[row_owner(c, F->isol_loc[i] - 1)]++;
+    }
+    if (!all_ranks(c, !failed)) goto fail;
+    if (MPI_Alltoall(F->send_n, 1, MPI_INT, F->recv_n, 1, MPI_INT, c->comm) != MPI_SUCCESS) goto fail;
+    for (r = 0; r < size; r++) {
+        sd[r] = (int)nsend, rd[r] = (int)nrecv;
+        nsend += F->send_n[r], nrecv += F->recv_n[r];
+        if (r != c->rank) moved[0] += F->recv_n[r];
+    }
+    F->send_at = host->alloc((size_t)(nsend ? nsend : 1) * sizeof *F->send_at);
+    F->recv_row = host->alloc((size_t)(nrecv ? nrecv : 1) * sizeof *F->recv_row);
+    gsend = host->alloc((size_t)(nsend ? nsend : 1) * sizeof *gsend);
+    grecv = host->alloc((size_t)(nrecv ? nrecv : 1) * sizeof *grecv);
+    if (!all_ranks(c, F->send_at && F->recv_row && gsend && grecv)) goto fail;
+    for (i = 0; i < F->lsol_loc; i++) {
+        r = row_owner(c, F->isol_loc[i] - 1);
+        F->send_at[sd[r] + fill[r]] = i;
+        gsend[sd[r] + fill[r]++] = F->isol_loc[i];
+    }
+    if (MPI_Alltoallv(gsend, F->send_n, sd, MPI_INT, grecv, F->recv_n, rd, MPI_INT, c->comm) != MPI_SUCCESS)
+        goto fail;
+    for (i = 0; i < nrecv; i++) F->recv_row[i] = grecv[i] - 1 - c->layout.first_row;
+    moved[1] = moved[0] * (int64_t)sizeof(MUMPS_INT);
+    if (MPI_Allreduce(MPI_IN_PLACE, moved, 2, MPI_INT64_T, MPI_SUM, c->comm) != MPI_SUCCESS) goto fail;
+    F->plan_moved = moved[0];
+    host->free(gsend), host->free(grecv), host->free(sd);
+    return moved[1];
+fail:
+    host->free(gsend), host->free(grecv), host->free(sd);
+    host->free(F->send_n), host->free(F->send_at), host->free(F->recv_row);
+    F->send_n = F->recv_n = NULL;
+    F->send_at = F->recv_row = NULL;
+    return -1;
+}
+
+/* Room for INFO(23) x nrhs entries of the distributed solution and its
+ * indices, and this rank's rows of b as 1-based indices; 0 or -1 (local). */
+static int loc_arrays(solve_ctx *c, mumps_factor *F, int64_t nrhs)
+{
+    int64_t lsol = F->cplx ? F->id.z.info[22] : F->id.d.info[22], w = ID_W(F), i, m = c->layout.m_local;
+    if (!F->irhs_loc) {
+        if (!(F->irhs_loc = host->alloc((size_t)(m ? m : 1) * sizeof *F->irhs_loc))) return -1;
+        for (i = 0; i < m; i++) F->irhs_loc[i] = (MUMPS_INT)(c->layout.first_row + i + 1);
+    }
+    if (lsol != F->lsol_loc || !F->isol_loc) {
+        host->free(F->isol_loc);
+        host->free(F->isol_plan);
+        F->isol_plan = NULL; /* a plan for another size is no plan */
+        F->lsol_loc = lsol;
+        F->isol_loc = host->calloc((size_t)(lsol ? lsol : 1), sizeof *F->isol_loc);
+        if (!F->isol_loc) return -1;
+    }
+    if (lsol * nrhs * w > F->sol_cap) {
+        host->free(F->sol_loc);
+        F->sol_cap = 0;
+        if (!(F->sol_loc = host->alloc((size_t)(lsol * nrhs * w > 0 ? lsol * nrhs * w : 1) * sizeof *F->sol_loc)))
+            return -1;
+        F->sol_cap = lsol * nrhs * w;
+    }
+    return 0;
+}
+
+/* x = A \ b on distributed operands, collectively, nothing gathered: each
+ * rank hands MUMPS its own rows of b (ICNTL(20)=10: IRHS_loc, RHS_loc,
+ * Nloc_RHS, LRHS_loc) and gets back the part of x that MUMPS's own mapping
+ * leaves on it (ICNTL(21)=1: ISOL_loc, SOL_loc, LSOL_loc = INFO(23)), which
+ * one MPI_Alltoallv of all columns moves into this rank's rows of a new X
+ * (plan_solution).  The entries that change rank are counted
+ * (host->dist_moved); MUMPS's own messages are not. */
+static int solve_dist_loc(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
+                          silc_value **out)
+{
+    int64_t w = ID_W(F), m = c->layout.m_local, nrhs = b->n, i, j, k, t, at, nsend = 0, nrecv = 0, moved = 0;
+    int rc = SILC_OK, r, size = c->size, *sc = NULL, *sd = NULL, *rcv = NULL, *rd = NULL, changed;
+    double *rhs = NULL, *send = NULL, *recv = NULL, t0;
+    silc_value *X = host->dist_dense_new(call->in[1], nrhs);
+    silc_view o;
+    *out = NULL;
+    if (!X) {
+        rc = local_error(c, SILC_ENOMEM, "mumps: cannot allocate this rank's %lldx%lld block of the solution",
+                         (long long)m, (long long)nrhs);
+    } else if (F->cplx && !is_complex(X)) {
+        /* ABI 1.8 makes a distributed result of like's field (silc_plugin.h) */
+        rc = local_error(c, SILC_EUNSUP, "mumps: the host made a real distributed result for a complex solve");
+    } else if (!(rhs = host->alloc((size_t)(m * nrhs * w > 0 ? m * nrhs * w : 1) * sizeof *rhs))) {
+        rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for this rank's %lld rows of the right-hand side",
+                         (long long)m);
+    }
+    if ((rc = agree(call, c, rc))) goto done;
+    host->view(X, &o);
+    t0 = host->now();
+    ICNTL(F, 20) = 10; /* distributed dense right-hand side */
+    ICNTL(F, 21) = 1;  /* distributed solution */
+    do { /* b's rows and the solution's room, again after a refactorization (SOLVE_AGAIN) */
+        rc = SILC_OK;
+        if (loc_arrays(c, F, nrhs))
+            rc = local_error(c, SILC_ENOMEM, "mumps: out of memory for this rank's part of the solution");
+        else if ((F->lsol_loc + m) * nrhs * w > INT_MAX)
+            rc = local_error(c, SILC_EARG, "mumps: %lld right-hand sides of %lld local rows exceed MPI's int "
+                                           "counts", (long long)nrhs, (long long)m);
+        if ((rc = agree(call, c, rc))) break;
+        ID_SET(F, nloc_rhs, (MUMPS_INT)m);
+        ID_SET(F, lrhs_loc, (MUMPS_INT)(m ? m : 1));
+        ID_SET(F, irhs_loc, F->irhs_loc);
+        ID_SET(F, isol_loc, F->isol_loc);
+        ID_SET(F, lsol_loc, (MUMPS_INT)F->lsol_loc);
+        if (F->cplx) {
+            F->id.z.rhs_loc = (ZMUMPS_COMPLEX *)rhs;
+            F->id.z.sol_loc = (ZMUMPS_COMPLEX *)F->sol_loc;
+        } else {
+            F->id.d.rhs_loc = rhs;
+            F->id.d.sol_loc = F->sol_loc;
+        }
+        memcpy(rhs, b->val, (size_t)(m * nrhs * w) * sizeof *rhs);
+    } while ((rc = run_solve(call, F, NULL, nrhs)) == SOLVE_AGAIN);
+    ICNTL(F, 20) = 0;
+    ICNTL(F, 21) = 0;
+    if (rc) goto done;
+    /* The plan, made once per factorization: every rank asks whether any
+     * rank's isol_loc differs from the one its plan was made for. */
+    changed = !F->isol_plan || memcmp(F->isol_plan, F->isol_loc, (size_t)F->lsol_loc * sizeof *F->isol_loc);
+    if (!all_ranks(c, !changed)) {
+        int64_t idx = plan_solution(c, F);
+        host->free(F->isol_plan);
+        F->isol_plan = idx < 0 ? NULL : host->alloc((size_t)(F->lsol_loc ? F->lsol_loc : 1) * sizeof *F->isol_plan);
+        if (F->isol_plan) memcpy(F->isol_plan, F->isol_loc, (size_t)F->lsol_loc * sizeof *F->isol_loc);
+        rc = idx < 0 || !F->isol_plan ? local_error(c, SILC_ENOMEM, "mumps: out of memory planning the solution's "
+                                                                    "redistribution")
+                                      : SILC_OK;
+        if ((rc = agree(call, c, rc))) goto done;
+        moved += idx;
+    }
+    /* All columns in one MPI_Alltoallv: to each rank its entries, column by column. */
+    sc = host->alloc((size_t)size * 4 * sizeof *sc);
+    if (sc) {
+        sd = sc + size, rcv = sd + size, rd = rcv + size;
+        for (r = 0; r < size; r++) {
+            sc[r] = (int)(F->send_n[r] * nrhs * w), rcv[r] = (int)(F->recv_n[r] * nrhs * w);
+            sd[r] = (int)nsend, rd[r] = (int)nrecv;
+            nsend += sc[r], nrecv += rcv[r];
+        }
+        send = host->alloc((size_t)(nsend ? nsend : 1) * sizeof *send);
+        recv = host->alloc((size_t)(nrecv ? nrecv : 1) * sizeof *recv);
+    }
+    if ((rc = agree(call, c, sc && send && recv ? SILC_OK
+                                                 : local_error(c, SILC_ENOMEM, "mumps: out of memory moving the solution"))))
+        goto done;
+    /* send_at and recv_row are grouped by rank as the counts; at: the rank's first */
+    for (k = 0, at = 0, r = 0; r < size; at += F->send_n[r++])
+        for (j = 0; j < nrhs; j++)
+            for (i = 0; i < F->send_n[r]; i++)
+                for (t = 0; t < w; t++) send[k++] = F->sol_loc[(F->send_at[at + i] + j * F->lsol_loc) * w + t];
+    if (MPI_Alltoallv(send, sc, sd, MPI_DOUBLE, recv, rcv, rd, MPI_DOUBLE, c->comm) != MPI_SUCCESS)
+        rc = local_error(c, SILC_ELIB, "mumps: MPI_Alltoallv of the solution failed");
+    if ((rc = agree(call, c, rc))) goto done;
+    for (k = 0, at = 0, r = 0; r < size; at += F->recv_n[r++])
+        for (j = 0; j < nrhs; j++)
+            for (i = 0; i < F->recv_n[r]; i++)
+                for (t = 0; t < w; t++) o.val[(F->recv_row[at + i] + j * m) * w + t] = recv[k++];
+    moved += F->plan_moved * nrhs * w * (int64_t)sizeof(double);
+    F->loc_solved = 1;
+    if (host->struct_size >= SILC_HOST_NEEDS(dist_moved)) host->dist_moved(call, 0, (uint64_t)moved);
+    call->report->solve_seconds = host->now() - t0;
+done:
+    if (F->cplx) F->id.z.rhs_loc = NULL, F->id.z.sol_loc = NULL;
+    else F->id.d.rhs_loc = NULL, F->id.d.sol_loc = NULL;
+    host->free(rhs);
+    host->free(send);
+    host->free(recv);
+    host->free(sc);
+    if (rc && X) host->release(X);
+    if (!rc) *out = X;
+    return rc;
+}
+
+/* The distributed solve: right-hand side and solution distributed
+ * (solve_dist_loc), unless the options ask for what MUMPS does only on a
+ * centralized solution (solve_dist_central).  Every rank decides alike:
+ * the options and the factorization's state are the same on all. */
+static int solve_dist(silc_call *call, solve_ctx *c, mumps_factor *F, const silc_view *b,
+                      silc_value **out)
+{
+    F->loc_solved = 0;
+    if (analysis_due(F, b->n) || ICNTL(F, 10) > 0) return solve_dist_central(call, c, F, b, out);
+    return solve_dist_loc(call, c, F, b, out);
 }
 #endif
 

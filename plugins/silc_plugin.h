@@ -415,6 +415,12 @@ typedef struct silc_host_api {
      * (the modulus 1-norm) * estimate. */
     double (*inv_norm1_est_complex)(int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                                     void *ctx, double *work);
+    /* A collective backend that moves a value's entries between ranks
+     * itself (its own MPI calls, not its library's) counts them here, so
+     * that `info` shows them with the core's own: bytes received by all the
+     * ranks together (the same number on every rank), of vectors (matrix 0)
+     * or matrices (1).  Check struct_size >= SILC_HOST_NEEDS(dist_moved). */
+    void (*dist_moved)(silc_call *call, int matrix, uint64_t bytes);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

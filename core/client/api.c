@@ -317,9 +317,6 @@ int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const 
     else if (env_not_constructed(e, err, sizeof err))
         rc = ctx_error(ctx, "envelope '%s' was not constructed: %s", name, err);
     else if (first_row < 0) rc = ctx_error(ctx, "silc_put_rows '%s': first row %lld is negative", name, (long long)first_row);
-    else if (silc_envelope_is_complex(e) && ctx->E && ctx->E->dist)
-        rc = ctx_error(ctx, "silc_put_rows '%s': complex values are not distributed (put the whole value "
-                            "with silc_put)", name);
     else if (env_to_value(e, &v, err, sizeof err)) rc = ctx_error(ctx, "'%s': %s", name, err);
     if (!ctx->E || !ctx->E->dist) {
         /* One process: the block is the whole value. */

@@ -1290,7 +1290,7 @@ static int run_promoted(silc_engine *E, silc_call *call)
         if (!call->in[i] || call->in[i]->field == SILC_FIELD_COMPLEX) continue;
         if (i > 0 && call->in[i] == saved[0]) { /* the same operand twice: one copy */
             copies[i] = val_retain(copies[0]);
-        } else if (!(copies[i] = val_promote(call->in[i]))) {
+        } else if (!(copies[i] = dist_is(call->in[i]) ? dist_promote(E, call->in[i]) : val_promote(call->in[i]))) {
             rc = SILC_ENOMEM;
             eng_error(E, "%s", *val_refusal() ? val_refusal() : "out of memory promoting a real operand to complex");
             break;
@@ -1310,13 +1310,9 @@ int disp_run(silc_engine *E, silc_call *call)
     int i, any_real = 0;
     if (!E || !call) return SILC_EARG;
     if (!call_complex(call)) return run_call(E, call);
-    if (E->dist || dist_call_has(call)) {
-        call->out = NULL;
-        eng_error(E, "%s: complex values are not distributed (issue 31)",
-                  call->op >= 0 && call->op < SILC_OP_COUNT ? op_names[call->op] : "operation");
-        return SILC_EUNSUP;
-    }
-    if (call->op == SILC_OP_SOLVE && call->nin >= 2 && call->in[0] && call->in[1] &&
+    /* Distributed operands: a real one is promoted block by block
+     * (dist_promote), never split into parts, which would gather it. */
+    if (call->op == SILC_OP_SOLVE && call->nin >= 2 && call->in[0] && call->in[1] && !dist_call_has(call) &&
         call->in[0]->field == SILC_FIELD_REAL && call->in[1]->field == SILC_FIELD_COMPLEX)
         return run_split_solve(E, call);
     for (i = 0; i < call->nin; i++) any_real |= call->in[i] && call->in[i]->field == SILC_FIELD_REAL;

@@ -274,6 +274,15 @@ static silc_value *h_dist_dense_new(const silc_value *like, int64_t n)
     return val_dist_new(like->m, n, SILC_FMT_DENSE, like->dist->ctx, like->dist->part, blk);
 }
 
+/* Bytes a collective backend moved itself, summed over the ranks by it. */
+static void h_dist_moved(silc_call *call, int matrix, uint64_t bytes)
+{
+    const host_call_ctx *ctx = call ? call->host_private : NULL;
+    if (!ctx || !ctx->collective || !ctx->E->dist) return;
+    if (matrix) ctx->E->dist->moved_matrix += bytes;
+    else ctx->E->dist->moved_vector += bytes;
+}
+
 /* The estimator lives in the built-in reference plugin (plugin-reference/
  * ref_cond.c); lending it through the host keeps one implementation for every
  * backend that needs it. */
@@ -337,6 +346,7 @@ static const silc_host_api host_table = {
     h_csr_new_complex,
     h_band_new_complex,
     ref_inv_norm1_est_complex,
+    h_dist_moved,
 };
 
 int host_check_result(silc_call *call)

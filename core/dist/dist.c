@@ -14,6 +14,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "dist.h"
 
+#include <complex.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -268,6 +269,12 @@ static void layout_counts(const dist_part *P, int64_t per_row, int64_t *counts, 
     }
 }
 
+/* A zero-filled CSR value of either field. */
+static silc_value *csr_new_field(int field, int64_t m, int64_t n, int64_t nnz)
+{
+    return field == SILC_FIELD_COMPLEX ? val_csr_new_complex(m, n, nnz) : val_csr_new(m, n, nnz);
+}
+
 /* Gathers v's blocks into a new whole value on the receiving ranks
  * (root < 0: all).  NULL where nothing was received; on failure every
  * rank returns -1 with E->err. */
@@ -281,41 +288,46 @@ static int gather_blocks(silc_engine *E, const silc_value *v, int root, silc_val
     silc_value *w = NULL;
     double *tmp = NULL;
     int failed = 0, r;
+    int64_t wd = val_width(v); /* doubles per entry: a complex entry moves as 2 */
     *out = NULL;
     if (!counts) die(D, "out of memory gathering a value");
     displs = counts + D->size;
     if (v->format == SILC_FMT_DENSE) {
         if (receives) {
-            w = val_new_unset(SILC_FMT_DENSE, v->m, v->n, 0, 0, 0);
-            if (w && v->n > 1 && !(tmp = malloc((size_t)(v->m * v->n) * sizeof *tmp))) failed = 1;
+            w = val_new_unset_field(SILC_FMT_DENSE, v->field, v->m, v->n, 0, 0, 0);
+            if (w && v->n > 1 && !(tmp = malloc((size_t)(v->m * v->n * wd) * sizeof *tmp))) failed = 1;
             if (!w) failed = 1;
         }
         if (any_rank(D, failed)) goto oom;
-        layout_counts(P, v->n, counts, displs);
-        gatherv(D, blk->val, blk->m * blk->n, receives ? (tmp ? tmp : w->val) : NULL, counts, displs,
+        layout_counts(P, v->n * wd, counts, displs);
+        gatherv(D, blk->val, blk->m * blk->n * wd, receives ? (tmp ? tmp : w->val) : NULL, counts, displs,
                 root);
         count_moved(D, SILC_FMT_DENSE, counts, root < 0, root);
         if (tmp) { /* rank blocks, each column-major, into one column-major array */
             for (r = 0; r < D->size; r++) {
-                int64_t mr = part_rows(P, r), f = part_first(P, r), i, j;
+                int64_t mr = part_rows(P, r), f = part_first(P, r), j;
                 for (j = 0; j < v->n; j++)
-                    for (i = 0; i < mr; i++) w->val[f + i + j * v->m] = tmp[displs[r] + i + j * mr];
+                    memcpy(w->val + (f + j * v->m) * wd, tmp + displs[r] + j * mr * wd,
+                           (size_t)(mr * wd) * sizeof *tmp);
             }
         }
     } else {
         int64_t nnz = blk->rowptr[blk->m], *nnzs = calloc((size_t)D->size, sizeof *nnzs), total = 0;
-        int64_t *ndispls;
+        int64_t *ndispls, *vcounts, *vdispls;
         if (!nnzs) die(D, "out of memory gathering a value");
         allgather(D, &nnz, 1, nnzs);
         for (r = 0; r < D->size; r++) total += nnzs[r];
-        if (receives && !(w = val_csr_new(v->m, v->n, total))) failed = 1;
+        if (receives && !(w = csr_new_field(v->field, v->m, v->n, total))) failed = 1;
         if (any_rank(D, failed)) {
             free(nnzs);
             goto oom;
         }
-        ndispls = calloc((size_t)D->size, sizeof *ndispls);
+        ndispls = calloc((size_t)D->size * 3, sizeof *ndispls);
         if (!ndispls) die(D, "out of memory gathering a value");
+        vcounts = ndispls + D->size; /* the values' words: wd per entry */
+        vdispls = vcounts + D->size;
         for (r = 1; r < D->size; r++) ndispls[r] = ndispls[r - 1] + nnzs[r - 1];
+        for (r = 0; r < D->size; r++) vcounts[r] = nnzs[r] * wd, vdispls[r] = ndispls[r] * wd;
         /* Row lengths into rowptr[1..m], then their running sum. */
         {
             int64_t *len = malloc((size_t)(blk->m ? blk->m : 1) * sizeof *len), i;
@@ -328,10 +340,10 @@ static int gather_blocks(silc_engine *E, const silc_value *v, int root, silc_val
                 for (i = 0; i < v->m; i++) w->rowptr[i + 1] += w->rowptr[i];
         }
         gatherv(D, blk->colind, nnz, receives ? w->colind : NULL, nnzs, ndispls, root);
-        gatherv(D, blk->val, nnz, receives ? w->val : NULL, nnzs, ndispls, root);
+        gatherv(D, blk->val, nnz * wd, receives ? w->val : NULL, vcounts, vdispls, root);
         count_moved(D, SILC_FMT_CSR, counts, root < 0, root < 0 ? 0 : root);
         count_moved(D, SILC_FMT_CSR, nnzs, root < 0, root < 0 ? 0 : root);
-        count_moved(D, SILC_FMT_CSR, nnzs, root < 0, root < 0 ? 0 : root);
+        count_moved(D, SILC_FMT_CSR, vcounts, root < 0, root < 0 ? 0 : root);
         if (receives) val_csr_set_nnz(w, total);
         free(nnzs);
         free(ndispls);
@@ -384,23 +396,39 @@ int dist_make_whole(silc_engine *E, silc_value **pv)
 static silc_value *rows_of_whole(const silc_value *w, int64_t first, int64_t rows)
 {
     silc_value *b;
-    int64_t i, j;
+    int64_t i, j, wd = val_width(w);
     if (w->format == SILC_FMT_DENSE) {
-        if (!(b = val_new_unset(SILC_FMT_DENSE, rows, w->n, 0, 0, 0))) return NULL;
+        if (!(b = val_new_unset_field(SILC_FMT_DENSE, w->field, rows, w->n, 0, 0, 0))) return NULL;
         for (j = 0; j < w->n; j++)
-            memcpy(b->val + j * rows, w->val + first + j * w->m, (size_t)rows * sizeof(double));
+            memcpy(b->val + j * rows * wd, w->val + (first + j * w->m) * wd, (size_t)(rows * wd) * sizeof(double));
         return b;
     }
     if (w->format == SILC_FMT_CSR) {
         int64_t lo = w->rowptr[first], hi = w->rowptr[first + rows];
-        if (!(b = val_csr_new(rows, w->n, hi - lo))) return NULL;
+        if (!(b = csr_new_field(w->field, rows, w->n, hi - lo))) return NULL;
         for (i = 0; i <= rows; i++) b->rowptr[i] = w->rowptr[first + i] - lo;
         memcpy(b->colind, w->colind + lo, (size_t)(hi - lo) * sizeof(silc_index));
-        memcpy(b->val, w->val + lo, (size_t)(hi - lo) * sizeof(double));
+        memcpy(b->val, w->val + lo * wd, (size_t)((hi - lo) * wd) * sizeof(double));
         val_csr_set_nnz(b, hi - lo);
         return b;
     }
     return NULL; /* band values are never split: their rows are not contiguous */
+}
+
+silc_value *dist_promote(silc_engine *E, const silc_value *v)
+{
+    dist_ctx *D = E->dist;
+    silc_value *b = val_promote(v->dist->block), *w;
+    if (any_rank(D, !b)) {
+        val_release(b);
+        return NULL;
+    }
+    if (!(w = val_dist_new(v->m, v->n, v->format, D, v->dist->part, b))) die(D, "out of memory");
+    /* a real value's properties hold for its complex copy (Hermitian when symmetric) */
+    w->props = v->props;
+    w->props.hermitian = v->props.symmetric;
+    w->props_have = v->props_have;
+    return w;
 }
 
 /* A distributed value with partition P made from a whole value every rank
@@ -445,12 +473,12 @@ int dist_rows_of(silc_engine *E, const silc_value *v, silc_value **block, int64_
 }
 
 /* Header of a value every rank must know before moving its arrays. */
-enum { H_FORMAT, H_M, H_N, H_NNZ, H_KL, H_KU, H_WORDS };
+enum { H_FORMAT, H_M, H_N, H_NNZ, H_KL, H_KU, H_FIELD, H_WORDS };
 
 int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_value *block)
 {
     dist_ctx *D = E->dist;
-    int64_t mine[4], *all;
+    int64_t mine[5], *all;
     dist_part *P;
     silc_value *v;
     int r, rc = 0;
@@ -458,11 +486,12 @@ int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_valu
     mine[1] = block->m;
     mine[2] = block->n;
     mine[3] = block->format;
-    if (!(all = calloc((size_t)D->size * 4, sizeof *all))) die(D, "out of memory");
-    allgather(D, mine, 4, all);
+    mine[4] = block->field;
+    if (!(all = calloc((size_t)D->size * 5, sizeof *all))) die(D, "out of memory");
+    allgather(D, mine, 5, all);
     /* Every rank checks the same gathered numbers: the same verdict everywhere. */
     for (r = 0; r < D->size && !rc; r++) {
-        const int64_t *a = all + 4 * r;
+        const int64_t *a = all + 5 * r;
         if (a[3] != SILC_FMT_DENSE && a[3] != SILC_FMT_CSR)
             rc = eng_error(E, "silc_put_rows '%s': rank %d's block is %s; blocks are dense or CSR", name,
                            r, val_format_name((int)a[3]));
@@ -471,11 +500,16 @@ int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_valu
                               "with %lld: every block has the value's columns and format",
                            name, r, val_format_name((int)a[3]), (long long)a[2],
                            val_format_name((int)all[3]), (long long)all[2]);
-        else if (a[0] != (r ? all[4 * (r - 1)] + all[4 * (r - 1) + 1] : 0))
+        else if (a[4] != all[4])
+            rc = eng_error(E, "silc_put_rows '%s': rank %d's block is %s, rank 0's %s: every block has the "
+                              "value's field",
+                           name, r, a[4] == SILC_FIELD_COMPLEX ? "complex" : "real",
+                           all[4] == SILC_FIELD_COMPLEX ? "complex" : "real");
+        else if (a[0] != (r ? all[5 * (r - 1)] + all[5 * (r - 1) + 1] : 0))
             rc = r ? eng_error(E, "silc_put_rows '%s': rank %d's rows start at %lld, but rank %d's end "
                                   "before row %lld: the blocks must tile the rows in rank order",
                                name, r, (long long)a[0], r - 1,
-                               (long long)(all[4 * (r - 1)] + all[4 * (r - 1) + 1]))
+                               (long long)(all[5 * (r - 1)] + all[5 * (r - 1) + 1]))
                    : eng_error(E, "silc_put_rows '%s': rank 0's rows start at %lld, not 0", name,
                                (long long)a[0]);
     }
@@ -485,8 +519,8 @@ int dist_put_rows(silc_engine *E, const char *name, int64_t first_row, silc_valu
         return -1;
     }
     if (!(P = part_new(D->size))) die(D, "out of memory");
-    for (r = 0; r < D->size; r++) P->starts[r] = all[4 * r];
-    P->starts[D->size] = all[4 * (D->size - 1)] + all[4 * (D->size - 1) + 1];
+    for (r = 0; r < D->size; r++) P->starts[r] = all[5 * r];
+    P->starts[D->size] = all[5 * (D->size - 1)] + all[5 * (D->size - 1) + 1];
     v = val_dist_new(P->starts[D->size], all[2], (int)all[3], D, P, block);
     dist_part_unref(P);
     free(all);
@@ -525,6 +559,7 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
     silc_value *w = NULL, *blk = NULL;
     dist_part *P;
     int failed = 0;
+    int64_t wd;
     *out = NULL;
     memset(h, 0, sizeof h);
     memset(&pw, 0, sizeof pw);
@@ -535,6 +570,7 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
         h[H_NNZ] = v->format == SILC_FMT_CSR ? v->rowptr[v->m] : v->nnz;
         h[H_KL] = v->kl;
         h[H_KU] = v->ku;
+        h[H_FIELD] = v->field;
         /* What the engine will ask first, computed where the data is. */
         val_props_part(v, SILC_PROPS_ALL);
         val_max_abs(v);
@@ -546,19 +582,23 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
     }
     bcast(D, h, H_WORDS, 0);
     bcast(D, pw.w, (int64_t)(sizeof pw.w / 8), 0);
+    wd = h[H_FIELD] == SILC_FIELD_COMPLEX ? 2 : 1; /* doubles per entry */
     if (h[H_FORMAT] == SILC_FMT_BAND || h[H_M] < min_rows || h[H_M] < D->size) {
         /* Whole on every rank. */
-        if (D->rank) failed = !(w = val_new_unset((int)h[H_FORMAT], h[H_M], h[H_N], h[H_NNZ], h[H_KL], h[H_KU]));
+        if (D->rank)
+            failed = !(w = val_new_unset_field((int)h[H_FORMAT], (int)h[H_FIELD], h[H_M], h[H_N], h[H_NNZ],
+                                               h[H_KL], h[H_KU]));
         else w = val_retain(v);
         if (any_rank(D, failed)) goto oom;
-        bcast(D, w->val, w->format == SILC_FMT_CSR ? h[H_NNZ] : w->nnz, 0);
+        bcast(D, w->val, (w->format == SILC_FMT_CSR ? h[H_NNZ] : w->nnz) * wd, 0);
         if (w->format == SILC_FMT_CSR) {
             bcast(D, w->rowptr, h[H_M] + 1, 0);
             bcast(D, w->colind, h[H_NNZ], 0);
             if (D->rank) val_csr_set_nnz(w, h[H_NNZ]);
         }
         {
-            int64_t c[1] = {h[H_NNZ] * (w->format == SILC_FMT_CSR ? 2 : 1) + (w->format == SILC_FMT_CSR ? h[H_M] + 1 : 0)};
+            int64_t c[1] = {(w->format == SILC_FMT_CSR ? h[H_NNZ] : w->nnz) * wd +
+                            (w->format == SILC_FMT_CSR ? h[H_NNZ] + h[H_M] + 1 : 0)};
             int64_t *counts = calloc((size_t)D->size, sizeof *counts);
             if (!counts) die(D, "out of memory");
             counts[0] = c[0];
@@ -577,40 +617,44 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
         if (!(counts = calloc((size_t)D->size * 2, sizeof *counts))) die(D, "out of memory");
         displs = counts + D->size;
         if (h[H_FORMAT] == SILC_FMT_DENSE) {
-            failed = !(blk = val_new_unset(SILC_FMT_DENSE, rows, h[H_N], 0, 0, 0));
-            if (D->rank == 0 && h[H_N] > 1 && !(packed = malloc((size_t)(h[H_M] * h[H_N]) * sizeof *packed)))
+            failed = !(blk = val_new_unset_field(SILC_FMT_DENSE, (int)h[H_FIELD], rows, h[H_N], 0, 0, 0));
+            if (D->rank == 0 && h[H_N] > 1 && !(packed = malloc((size_t)(h[H_M] * h[H_N] * wd) * sizeof *packed)))
                 failed = 1;
             if (any_rank(D, failed)) {
                 free(counts);
                 dist_part_unref(P);
                 goto oom;
             }
-            layout_counts(P, h[H_N], counts, displs);
+            layout_counts(P, h[H_N] * wd, counts, displs);
             if (packed) {
                 int r;
                 for (r = 0; r < D->size; r++) {
                     int64_t mr = part_rows(P, r), f = part_first(P, r), j;
                     for (j = 0; j < h[H_N]; j++)
-                        memcpy(packed + displs[r] + j * mr, v->val + f + j * h[H_M], (size_t)mr * sizeof(double));
+                        memcpy(packed + displs[r] + j * mr * wd, v->val + (f + j * h[H_M]) * wd,
+                               (size_t)(mr * wd) * sizeof(double));
                 }
             }
             scatterv(D, packed ? packed : (D->rank == 0 ? v->val : NULL), counts, displs, blk->val,
-                     rows * h[H_N], 0);
+                     rows * h[H_N] * wd, 0);
             count_moved(D, SILC_FMT_DENSE, counts, 0, 0);
             free(packed);
         } else {
-            int64_t *nnzs = calloc((size_t)D->size * 2, sizeof *nnzs), *ndispls, one[1];
+            int64_t *nnzs = calloc((size_t)D->size * 4, sizeof *nnzs), *ndispls, *vcounts, *vdispls;
             int r;
             if (!nnzs) die(D, "out of memory");
             ndispls = nnzs + D->size;
+            vcounts = ndispls + D->size; /* the values' words: wd per entry */
+            vdispls = vcounts + D->size;
             if (D->rank == 0)
                 for (r = 0; r < D->size; r++) {
                     nnzs[r] = v->rowptr[P->starts[r + 1]] - v->rowptr[P->starts[r]];
                     ndispls[r] = v->rowptr[P->starts[r]];
                 }
             bcast(D, nnzs, 2 * D->size, 0);
+            for (r = 0; r < D->size; r++) vcounts[r] = nnzs[r] * wd, vdispls[r] = ndispls[r] * wd;
             nloc = nnzs[D->rank];
-            failed = !(blk = val_csr_new(rows, h[H_N], nloc));
+            failed = !(blk = csr_new_field((int)h[H_FIELD], rows, h[H_N], nloc));
             if (D->rank == 0 && !(lens = malloc((size_t)(h[H_M] ? h[H_M] : 1) * sizeof *lens))) failed = 1;
             if (any_rank(D, failed)) {
                 free(nnzs);
@@ -625,12 +669,11 @@ int dist_share(silc_engine *E, silc_value *v, int64_t min_rows, silc_value **out
             scatterv(D, lens, counts, displs, blk->rowptr + 1, rows, 0);
             for (i = 0; i < rows; i++) blk->rowptr[i + 1] += blk->rowptr[i];
             scatterv(D, D->rank == 0 ? v->colind : NULL, nnzs, ndispls, blk->colind, nloc, 0);
-            scatterv(D, D->rank == 0 ? v->val : NULL, nnzs, ndispls, blk->val, nloc, 0);
+            scatterv(D, D->rank == 0 ? v->val : NULL, vcounts, vdispls, blk->val, nloc * wd, 0);
             val_csr_set_nnz(blk, nloc);
             count_moved(D, SILC_FMT_CSR, counts, 0, 0);
             count_moved(D, SILC_FMT_CSR, nnzs, 0, 0);
-            count_moved(D, SILC_FMT_CSR, nnzs, 0, 0);
-            (void)one;
+            count_moved(D, SILC_FMT_CSR, vcounts, 0, 0);
             free(nnzs);
             free(lens);
         }
@@ -656,42 +699,54 @@ oom:
 
 /* ---- properties, collectively ----------------------------------------------- */
 
+/* Entry k of an array of wd doubles per entry, as value.c's properties read
+ * it: its modulus, and whether it is nonzero, finite and positive (real and
+ * > 0, what Cholesky needs of a diagonal). */
+static double entry_mod(const double *val, int64_t k, int64_t wd, int *nonzero, int *finite, int *positive)
+{
+    double re = val[k * wd], im = wd == 2 ? val[k * wd + 1] : 0;
+    *nonzero = re != 0 || im != 0;
+    *finite = isfinite(re) && isfinite(im);
+    *positive = re > 0 && im == 0;
+    return wd == 2 ? hypot(re, im) : fabs(re);
+}
+
 /* The shape part of a distributed CSR or dense value from each rank's rows
  * (global row = first + local row), combined. */
 static void shape_props(silc_value *v)
 {
     dist_ctx *D = v->dist->ctx;
     const silc_value *b = v->dist->block;
-    int64_t first = part_first(v->dist->part, D->rank), i, j;
+    int64_t first = part_first(v->dist->part, D->rank), i, j, wd = val_width(b);
     /* flags: not pos_diag, not diagonal, not lower, not upper, nonfinite (max); kl, ku (max); nnz (sum) */
     double f[7] = {0, 0, 0, 0, 0, 0, 0}, nnz = 0;
     int64_t kl = 0, ku = 0;
     for (i = 0; i < b->m; i++) {
         int64_t g = first + i;
-        double diag = 0;
+        int diag_positive = 0, nonzero, finite, positive;
         if (b->format == SILC_FMT_CSR) {
             for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) {
-                double x = b->val[j];
                 int64_t c = b->colind[j];
-                if (!isfinite(x)) f[4] = 1;
-                if (c == g) diag = x;
-                if (x == 0) continue;
+                entry_mod(b->val, j, wd, &nonzero, &finite, &positive);
+                if (!finite) f[4] = 1;
+                if (c == g) diag_positive = positive;
+                if (!nonzero) continue;
                 nnz++;
                 if (c < g && g - c > kl) kl = g - c;
                 if (c > g && c - g > ku) ku = c - g;
             }
         } else {
             for (j = 0; j < b->n; j++) {
-                double x = b->val[i + j * b->m];
-                if (!isfinite(x)) f[4] = 1;
-                if (j == g) diag = x;
-                if (x == 0) continue;
+                entry_mod(b->val, i + j * b->m, wd, &nonzero, &finite, &positive);
+                if (!finite) f[4] = 1;
+                if (j == g) diag_positive = positive;
+                if (!nonzero) continue;
                 nnz++;
                 if (j < g && g - j > kl) kl = g - j;
                 if (j > g && j - g > ku) ku = j - g;
             }
         }
-        if (g < v->n && !(diag > 0)) f[0] = 1;
+        if (g < v->n && !diag_positive) f[0] = 1;
     }
     f[1] = kl > 0 || ku > 0;
     f[2] = ku > 0;
@@ -718,14 +773,16 @@ static void norm_props(silc_value *v)
     const silc_props *bp = val_props_part(b, SILC_PROPS_NORMS);
     double mx[2] = {bp->norminf, bp->maxabs}, s, fro;
     double *colsum = calloc((size_t)(v->n ? v->n : 1), sizeof *colsum);
-    int64_t i, j;
+    int64_t i, j, wd = val_width(b);
+    int nz, fin, pos;
     if (!colsum) die(D, "out of memory computing norms");
     if (b->format == SILC_FMT_CSR) {
         for (i = 0; i < b->m; i++)
-            for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) colsum[b->colind[j]] += fabs(b->val[j]);
+            for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++)
+                colsum[b->colind[j]] += entry_mod(b->val, j, wd, &nz, &fin, &pos);
     } else {
         for (j = 0; j < b->n; j++)
-            for (i = 0; i < b->m; i++) colsum[j] += fabs(b->val[i + j * b->m]);
+            for (i = 0; i < b->m; i++) colsum[j] += entry_mod(b->val, i + j * b->m, wd, &nz, &fin, &pos);
     }
     reduce(D, colsum, v->n, 0);
     reduce(D, mx, 2, 1);
@@ -745,16 +802,18 @@ static void norm_props(silc_value *v)
 
 /* Symmetry of a distributed CSR value: every off-diagonal entry travels to
  * the owner of its mirror, which compares (one exchange of the entries,
- * once per value). */
-static int symmetric_csr(silc_value *v)
+ * once per value).  Returns A = A.' (-1 when out of memory); *hermitian:
+ * A = A' (for a real value the same), which a complex diagonal with an
+ * imaginary part already breaks. */
+static int symmetric_csr(silc_value *v, int *hermitian)
 {
     dist_ctx *D = v->dist->ctx;
     const dist_part *P = v->dist->part;
     const silc_value *b = v->dist->block;
     int64_t first = part_first(P, D->rank), i, j, n = 0;
     int64_t *sc = calloc((size_t)D->size * 4, sizeof *sc), *sd, *rc, *rd;
-    double *send = NULL, *recv = NULL, bad = 0;
-    int64_t *fill = NULL, total = 0;
+    double *send = NULL, *recv = NULL, bad[2] = {0, 0}; /* not A = A.', not A = A' */
+    int64_t *fill = NULL, total = 0, wd = val_width(b), rec = 2 + wd; /* row, column, the entry */
     int r;
     if (!sc) die(D, "out of memory checking symmetry");
     sd = sc + D->size;
@@ -773,9 +832,12 @@ static int symmetric_csr(silc_value *v)
     } while (0)
     for (i = 0; i < b->m; i++)
         for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) {
-            if (b->colind[j] == first + i) continue;
+            if (b->colind[j] == first + i) {
+                if (wd == 2 && b->val[2 * j + 1] != 0) bad[1] = 1;
+                continue;
+            }
             OWNER(b->colind[j], r);
-            sc[r] += 3;
+            sc[r] += rec;
             n++;
         }
     for (r = 1; r < D->size; r++) sd[r] = sd[r - 1] + sc[r - 1];
@@ -792,7 +854,7 @@ static int symmetric_csr(silc_value *v)
         }
         free(allc);
     }
-    send = malloc((size_t)(3 * n + 1) * sizeof *send);
+    send = malloc((size_t)(rec * n + 1) * sizeof *send);
     recv = malloc((size_t)(total + 1) * sizeof *recv);
     fill = calloc((size_t)D->size, sizeof *fill);
     if (any_rank(D, !send || !recv || !fill)) {
@@ -805,10 +867,10 @@ static int symmetric_csr(silc_value *v)
             if (c == first + i) continue;
             OWNER(c, r);
             at = sd[r] + fill[r];
-            fill[r] += 3;
+            fill[r] += rec;
             send[at] = (double)c;          /* the mirror's row, */
             send[at + 1] = (double)(first + i); /* its column */
-            send[at + 2] = b->val[j];      /* and the value it must hold */
+            memcpy(send + at + 2, b->val + j * wd, (size_t)wd * sizeof *send); /* and what it must hold */
         }
 #undef OWNER
     COMM(D, alltoallv(D->ops->impl, send, sc, sd, recv, rc, rd, MSG));
@@ -820,25 +882,27 @@ static int symmetric_csr(silc_value *v)
         reduce(D, &moved, 1, 0);
         D->moved_matrix += (uint64_t)moved;
     }
-    for (i = 0; i < total && !bad; i += 3) {
+    for (i = 0; i < total && !(bad[0] && bad[1]); i += rec) {
         int64_t row = (int64_t)recv[i] - first, col = (int64_t)recv[i + 1], lo, hi;
-        double x = 0;
+        double x[2] = {0, 0}; /* the entry here, against its mirror's recv[i + 2 ..] */
         lo = b->rowptr[row];
         hi = b->rowptr[row + 1] - 1;
         while (lo <= hi) {
             int64_t mid = lo + (hi - lo) / 2;
             if (b->colind[mid] == col) {
-                x = b->val[mid];
+                memcpy(x, b->val + mid * wd, (size_t)wd * sizeof *x);
                 break;
             }
             if (b->colind[mid] < col) lo = mid + 1;
             else hi = mid - 1;
         }
-        if (x != recv[i + 2]) bad = 1;
+        if (x[0] != recv[i + 2] || (wd == 2 && x[1] != recv[i + 3])) bad[0] = 1;
+        if (x[0] != recv[i + 2] || (wd == 2 && x[1] != -recv[i + 3])) bad[1] = 1;
     }
     free(send), free(recv), free(fill), free(sc);
-    reduce(D, &bad, 1, 1);
-    return bad == 0;
+    reduce(D, bad, 2, 1);
+    *hermitian = bad[1] == 0;
+    return bad[0] == 0;
 }
 
 static void dist_props_hook(silc_value *v, int parts)
@@ -852,9 +916,9 @@ static void dist_props_hook(silc_value *v, int parts)
         v->props_have |= SILC_PROPS_NORMS;
     }
     if (parts & SILC_PROPS_SYMMETRY) {
-        int sym = 0;
+        int sym = 0, herm = 0;
         if (v->m != v->n) sym = 0;
-        else if (v->format == SILC_FMT_CSR) sym = symmetric_csr(v);
+        else if (v->format == SILC_FMT_CSR) sym = symmetric_csr(v, &herm);
         else { /* dense: rare enough to ask the whole copy */
             silc_engine E0;
             const silc_value *w;
@@ -862,9 +926,11 @@ static void dist_props_hook(silc_value *v, int parts)
             E0.dist = v->dist->ctx;
             w = dist_whole(&E0, v, 1);
             sym = w ? val_props_part(w, SILC_PROPS_SYMMETRY)->symmetric : -1;
+            herm = w ? val_props_part(w, SILC_PROPS_SYMMETRY)->hermitian : 0;
         }
         if (sym >= 0) {
             v->props.symmetric = sym;
+            v->props.hermitian = herm;
             v->props_have |= SILC_PROPS_SYMMETRY;
         }
     }
@@ -1035,7 +1101,7 @@ static halo_plan *halo_build(dist_ctx *D, const silc_value *A)
         }
         for (r = 1; r < D->size; r++) h->rd[r] = h->rd[r - 1] + h->rc[r - 1];
         allc = calloc((size_t)D->size * (size_t)D->size, sizeof *allc);
-        h->loc = val_csr_new(b->m, nl + ng, nnz);
+        h->loc = csr_new_field(b->field, b->m, nl + ng, nnz);
         failed = !allc || !h->loc;
     }
     if (any_rank(D, failed)) goto fail;
@@ -1054,7 +1120,7 @@ static halo_plan *halo_build(dist_ctx *D, const silc_value *A)
      * the order of the new numbers). */
     {
         silc_value *L = h->loc;
-        int64_t at = 0, row, pass;
+        int64_t at = 0, row, pass, wd = val_width(b);
         L->rowptr[0] = 0;
         for (row = 0; row < b->m; row++) {
             for (pass = 0; pass < 3; pass++)
@@ -1063,7 +1129,7 @@ static halo_plan *halo_build(dist_ctx *D, const silc_value *A)
                     int grp = c < first ? 1 : c >= first + nl ? 2 : 0;
                     if (grp != pass) continue;
                     L->colind[at] = grp ? nl + find_i64(g, ng, c) : c - first;
-                    L->val[at++] = b->val[k];
+                    memcpy(L->val + at++ * wd, b->val + k * wd, (size_t)wd * sizeof(double));
                 }
             L->rowptr[row + 1] = at;
         }
@@ -1103,7 +1169,8 @@ static int halo_operands(dist_ctx *D, const silc_value *A, const silc_value *x, 
     const silc_value *xb;
     halo_plan *h;
     double *send;
-    int64_t j, i, nsend;
+    int64_t j, i, nsend, wd = val_width(x), *wc = NULL; /* a complex x moves 2 words an entry */
+    int r;
     *xbuf = NULL;
     if (!halo_applies(A, x)) return 1;
     if (!(h = val_attach_get(A->dist->block, HALO_KEY))) {
@@ -1115,22 +1182,31 @@ static int halo_operands(dist_ctx *D, const silc_value *A, const silc_value *x, 
     }
     xb = x->dist->block;
     nsend = h->sd[D->size - 1] + h->sc[D->size - 1];
-    *xbuf = val_new_unset(SILC_FMT_DENSE, h->nl + h->ng, x->n, 0, 0, 0);
-    send = malloc((size_t)(nsend ? nsend : 1) * sizeof *send);
-    if (any_rank(D, !*xbuf || !send)) {
+    *xbuf = val_new_unset_field(SILC_FMT_DENSE, x->field, h->nl + h->ng, x->n, 0, 0, 0);
+    send = malloc((size_t)(nsend ? nsend * wd : 1) * sizeof *send);
+    if (wd > 1 && (wc = malloc((size_t)D->size * 4 * sizeof *wc)))
+        for (r = 0; r < 4 * D->size; r++) wc[r] = h->sc[r] * wd; /* sc, sd, rc, rd in words */
+    if (any_rank(D, !*xbuf || !send || (wd > 1 && !wc))) {
         val_release(*xbuf);
         *xbuf = NULL;
         free(send);
+        free(wc);
         return -1;
     }
     for (j = 0; j < x->n; j++) {
-        double *col = (*xbuf)->val + j * (h->nl + h->ng);
-        memcpy(col, xb->val + j * h->nl, (size_t)h->nl * sizeof *col);
-        for (i = 0; i < nsend; i++) send[i] = xb->val[h->sidx[i] + j * h->nl];
-        COMM(D, alltoallv(D->ops->impl, send, h->sc, h->sd, col + h->nl, h->rc, h->rd, MSG));
+        double *col = (*xbuf)->val + j * (h->nl + h->ng) * wd;
+        memcpy(col, xb->val + j * h->nl * wd, (size_t)(h->nl * wd) * sizeof *col);
+        for (i = 0; i < nsend; i++)
+            memcpy(send + i * wd, xb->val + (h->sidx[i] + j * h->nl) * wd, (size_t)wd * sizeof *send);
+        if (wc)
+            COMM(D, alltoallv(D->ops->impl, send, wc, wc + D->size, col + h->nl * wd, wc + 2 * D->size,
+                              wc + 3 * D->size, MSG));
+        else
+            COMM(D, alltoallv(D->ops->impl, send, h->sc, h->sd, col + h->nl, h->rc, h->rd, MSG));
     }
     free(send);
-    D->moved_vector += (uint64_t)h->total_ghosts * 8u * (uint64_t)x->n;
+    free(wc);
+    D->moved_vector += (uint64_t)h->total_ghosts * 8u * (uint64_t)x->n * (uint64_t)wd;
     *plan = h;
     return 0;
 }
@@ -1185,6 +1261,10 @@ static int reduction(silc_engine *E, silc_call *call, int *rc)
     int64_t k;
     if (!dist_is(x) || (call->nin > 1 && dist_is(call->in[1]) && !part_same(call->in[1]->dist->part, x->dist->part)))
         return 1;
+    /* The largest or smallest complex entry is chosen by modulus, then
+     * angle (Octave's rule): the ranks' picks are not combined entrywise,
+     * so those run on the gathered value. */
+    if (x->field == SILC_FIELD_COMPLEX && (sub == SILC_RED_MAX || sub == SILC_RED_MIN)) return 1;
     if (!vec && sub != SILC_RED_SUM && sub != SILC_RED_MAX && sub != SILC_RED_MIN && sub != SILC_RED_NORMINF &&
         sub != SILC_RED_NORMFRO && sub != SILC_RED_NORM1)
         return 1;
@@ -1228,8 +1308,8 @@ static int reduction(silc_engine *E, silc_call *call, int *rc)
     r = out->val;
     k = out->m * out->n;
     switch (sub) {
-    case SILC_RED_SUM: case SILC_RED_DOT:
-        reduce(D, r, k, 0);
+    case SILC_RED_SUM: case SILC_RED_DOT: /* a complex sum: both parts of each entry */
+        reduce(D, r, k * val_width(out), 0);
         break;
     case SILC_RED_NORM1:
         if (vec) reduce(D, r, k, 0);
@@ -1339,13 +1419,19 @@ void dist_walk_end(silc_call *call, dist_swap *s)
     s->mode = DIST_LOCAL;
 }
 
+/* Entry k of an array of wd doubles per entry as a complex number. */
+static double complex entry_c(const double *val, int64_t k, int64_t wd)
+{
+    return wd == 2 ? util_cmplx(val[2 * k], val[2 * k + 1]) : val[k];
+}
+
 double dist_backward_error(const silc_value *A, const silc_value *B, const silc_value *X)
 {
     dist_ctx *D = A->dist->ctx;
     silc_engine E0;
     const silc_value *xw, *a = A->dist->block, *b = B->dist->block;
     double nR = 0, nA, nX, nB, be;
-    int64_t i, j, k = X->n;
+    int64_t i, j, k = X->n, wa = val_width(A), wb = val_width(B), wx = val_width(X);
     memset(&E0, 0, sizeof E0);
     E0.dist = D;
     const halo_plan *h = NULL;
@@ -1363,10 +1449,18 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
     }
     for (j = 0; j < k; j++)
         for (i = 0; i < a->m; i++) {
-            double r = b->val[i + j * b->m];
+            double r;
             int64_t p;
-            for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) r -= a->val[p] * xw->val[a->colind[p] + j * xw->m];
-            r = fabs(r);
+            if (wa == 1 && wb == 1 && wx == 1) { /* real: no complex arithmetic in the inner loop */
+                double s = b->val[i + j * b->m];
+                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) s -= a->val[p] * xw->val[a->colind[p] + j * xw->m];
+                r = fabs(s);
+            } else { /* complex: |r| is the modulus, as backward_error_complex's infinity norm */
+                double complex s = entry_c(b->val, i + j * b->m, wb);
+                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++)
+                    s -= entry_c(a->val, p, wa) * entry_c(xw->val, a->colind[p] + j * xw->m, wx);
+                r = cabs(s);
+            }
             if (!(r <= nR)) nR = r; /* NaN sticks */
         }
     val_release(xbuf);

@@ -9,7 +9,8 @@
  * table: libsilc never links MPI).
  *
  * A value is whole (an ordinary value, the same on every rank) or
- * distributed by contiguous row blocks (store.h: val_dist, PETSc's layout).
+ * distributed by contiguous row blocks (store.h: val_dist, PETSc's layout),
+ * real or complex alike (a complex entry moves, and is counted, as 2 doubles).
  * Data moves only where the layout must change, and each move is counted:
  *   - an operation whose operands are all whole runs on every rank, moving
  *     nothing (scalars, small values: the same bits everywhere);
@@ -76,6 +77,11 @@ const silc_value *dist_whole(silc_engine *E, const silc_value *v, int all);
 int dist_make_whole(silc_engine *E, silc_value **v);
 /* Whether v is distributed (whatever rank we are). */
 #define dist_is(v) ((v) && (v)->dist != NULL)
+
+/* A complex copy of the distributed real value v, each rank promoting its
+ * own block (nothing moves).  Collective; NULL on every rank when one ran
+ * out of memory. */
+silc_value *dist_promote(silc_engine *E, const silc_value *v);
 
 /* SPMD: binds name to the value whose rows [first_row, first_row +
  * block->m) this rank holds (block taken over).  Collective. */

@@ -240,12 +240,15 @@ SILC_API void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
  *
  * silc_put_rows: this rank's rows [first_row, first_row + block->m) of the
  * value `name`; the blocks of the ranks, in rank order, must tile the rows
- * with no gap or overlap and have the same columns and format (CSR or dense;
- * CSR column indices are global).  On one process (any other context) the
- * block must be the whole value, first_row 0.
+ * with no gap or overlap and have the same columns, format (CSR or dense;
+ * CSR column indices are global) and field (real, or complex on every rank).
+ * On one process (any other context) the block must be the whole value,
+ * first_row 0.
  * silc_get_rows: this rank's rows of `name` and, in *first_row (may be NULL),
  * the first of them: a value computed from distributed operands keeps their
- * rows; a whole value is split evenly, as PETSc's PETSC_DECIDE splits it. */
+ * rows; a whole value is split evenly, as PETSc's PETSC_DECIDE splits it.
+ * Real values only, as silc_get: a complex one is fetched whole, on every
+ * rank, by silc_get_complex. */
 SILC_API int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row,
                            const silc_envelope_t *block);
 SILC_API int silc_get_rows(silc_context *ctx, silc_envelope_t *block, int64_t *first_row,

@@ -1366,8 +1366,8 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     p = &v->props;
     if (v->dist) {
         if ((parts & ~v->props_have) && dist_hooks.props) dist_hooks.props(v, parts & ~v->props_have);
-        /* distributed values are real (complex ones are not distributed) */
-        p->hermitian = p->symmetric;
+        /* the hook finds both for a complex value; a real one is Hermitian when symmetric */
+        if (v->field != SILC_FIELD_COMPLEX) p->hermitian = p->symmetric;
         return p;
     }
     if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR &&
