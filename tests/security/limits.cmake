@@ -40,7 +40,7 @@ if(TARGET silc_plugin_petsc)
 endif()
 if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
   set(_limits_mpi_cases request_time_mpi disconnect_mpi sigterm_mpi idle_cpu_mpi max_cpu_mpi stuck_mpi
-                        admission_mpi announce_mpi unread_get_mpi idle_timeout_mpi peer_share_mpi
+                        admission_mpi announce_mpi hostile_put_mpi unread_get_mpi idle_timeout_mpi peer_share_mpi
                         peak_mpi statement_cap_mpi data_cap_mpi)
   if(TARGET silc_plugin_petsc)
     list(APPEND _limits_mpi_cases library_output_mpi)

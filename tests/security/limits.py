@@ -910,6 +910,44 @@ def case_admission_mpi():
     srv.stop_cleanly()
 
 
+def case_hostile_put_mpi():
+    """Issue 27's hostile-PUT case under silcd --mpi: 3 sessions each announce
+    a 2 GiB value (within the limits given), send 1 MiB and then nothing.
+    One process (rank 0) reads every connection, so it must not take the
+    announcement at its word: its peak memory grows with the bytes that
+    arrived (3 MiB and the buffers' slack), not by 6 GiB, and a fourth
+    session is served meanwhile."""
+    srv = Server("--max-session-bytes", "3G", "--max-value-bytes", "3G", "--io-timeout", "20", mpi=True)
+    r0 = rank_pids(srv)[0]
+    idle = srv.session()
+    idle.exec("a = 1")
+    base = proc_status(r0, "VmHWM")
+    m = n = 16384                          # 16384^2 doubles = 2 GiB
+    hostile = []
+    for _ in range(3):
+        s = srv.session()
+        desc = _DESC.pack(DENSE, 1, m, n, m * n, 0, 0)
+        s.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + m * n * 8) + desc + b"h")
+        s.sock.sendall(b"\0" * MiB)
+        hostile.append(s)
+    idle.exec("b = a + 1")                 # served while the three wait for their bytes
+    if idle.get("b")[0, 0] != 2:
+        fail("the idle session was disturbed")
+    time.sleep(0.5)
+    grown = proc_status(r0, "VmHWM") - base
+    print("rank 0's VmHWM grew by %.1f MiB after 3 PUTs announcing 2 GiB each (1 MiB sent each)"
+          % (grown / MiB))
+    if grown > 3 * 64 * MiB + 16 * MiB:
+        fail("3 PUTs announcing 2 GiB each raised rank 0's peak memory by %.0f MiB" % (grown / MiB))
+    for s in hostile:
+        s.sock.close()
+    idle.exec("c = b + 1")
+    if idle.get("c")[0, 0] != 3:
+        fail("the idle session lost its values after the hostile PUTs closed")
+    idle.close()
+    srv.stop_cleanly()
+
+
 def case_announce_mpi():
     """A PUT header announcing 256 MiB (81 bytes sent) does not raise rank
     0's peak memory by more than a few MiB: its buffer grows with the bytes
