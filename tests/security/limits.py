@@ -240,6 +240,20 @@ def session_pids(srv, n):
 
 # ---- the cases -----------------------------------------------------------------
 
+def hostile_puts(srv, count):
+    """count sessions, each sending a PUT header that announces a 2 GiB dense
+    value (16384^2 doubles), 1 MiB of it, and then nothing."""
+    m = n = 16384
+    hostile = []
+    for _ in range(count):
+        s = srv.session()
+        desc = _DESC.pack(DENSE, 1, m, n, m * n, 0, 0)
+        s.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + m * n * 8) + desc + b"h")
+        s.sock.sendall(b"\0" * MiB)
+        hostile.append(s)
+    return hostile
+
+
 def case_hostile_put():
     """3 PUTs announcing 2 GiB each, sending 1 MiB and then nothing: each
     session reserves the array (VmData grows by 2 GiB: the header was
@@ -250,14 +264,7 @@ def case_hostile_put():
     base_pid = session_pids(srv, 1)[0]
     base_rss = proc_status(base_pid, "VmRSS")
     base_data = proc_status(base_pid, "VmData")
-    m = n = 16384                          # 16384^2 doubles = 2 GiB
-    hostile = []
-    for _ in range(3):
-        s = srv.session()
-        desc = _DESC.pack(DENSE, 1, m, n, m * n, 0, 0)
-        s.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + m * n * 8) + desc + b"h")
-        s.sock.sendall(b"\0" * MiB)
-        hostile.append(s)
+    hostile = hostile_puts(srv, 3)
     pids = [p for p in session_pids(srv, 4) if p != base_pid]
     for pid in pids:
         if not wait_until(lambda: (proc_status(pid, "VmData") or 0) > base_data + (2 << 30) - 64 * MiB, 20):
@@ -922,14 +929,7 @@ def case_hostile_put_mpi():
     idle = srv.session()
     idle.exec("a = 1")
     base = proc_status(r0, "VmHWM")
-    m = n = 16384                          # 16384^2 doubles = 2 GiB
-    hostile = []
-    for _ in range(3):
-        s = srv.session()
-        desc = _DESC.pack(DENSE, 1, m, n, m * n, 0, 0)
-        s.sock.sendall(_HEADER.pack(PUT, 0, len(desc) + 1 + m * n * 8) + desc + b"h")
-        s.sock.sendall(b"\0" * MiB)
-        hostile.append(s)
+    hostile = hostile_puts(srv, 3)
     idle.exec("b = a + 1")                 # served while the three wait for their bytes
     if idle.get("b")[0, 0] != 2:
         fail("the idle session was disturbed")
