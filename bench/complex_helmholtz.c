@@ -11,7 +11,11 @@
  * centre; A is complex symmetric (A = A.'), not Hermitian.  The bench links
  * the example's assembly (silc_helmholtz), so both solve the same matrix.
  *
- * Rows (each the median of R runs, a fresh A each time so nothing is reused):
+ * Rows (each the median of R runs, a fresh A each time so nothing is reused;
+ * the library and the three SILC rows run in alternating rounds, and a SILC
+ * row's ratio is the median of its round-by-round ratios to the library,
+ * since the machine drifts more over the minutes of a run (15-20 %, measured)
+ * than the differences this bench is for):
  *   UMFPACK direct    umfpack_zl_symbolic + numeric + solve, default
  *                     control (two refinement steps, as SILC's backend
  *                     asks too): what the library needs and nothing more,
@@ -260,8 +264,10 @@ static double run_tool(const char *cmd, double *resid)
     return s;
 }
 
-/* One row; report < 0: the solver has no report to read. */
-static void row(const char *name, const char *how, double s, double report, double resid, double base)
+/* One row; report < 0: the solver has no report to read; ratio < 0: s /
+ * base, else the ratio measured round by round. */
+static void row_ratio(const char *name, const char *how, double s, double report, double resid, double base,
+                      double ratio)
 {
     char rep[32] = "--";
     if (s < 0) {
@@ -269,22 +275,64 @@ static void row(const char *name, const char *how, double s, double report, doub
         return;
     }
     if (report >= 0) snprintf(rep, sizeof rep, "%.3f", report);
-    printf("| %-18s | %-58s | %9.3f | %9.3f | %11s | %9.1e |\n", name, how, s, base > 0 ? s / base : 0, rep,
-           resid);
+    if (ratio < 0) ratio = base > 0 ? s / base : 0;
+    printf("| %-18s | %-58s | %9.3f | %9.3f | %11s | %9.1e |\n", name, how, s, ratio, rep, resid);
+}
+
+static void row(const char *name, const char *how, double s, double report, double resid, double base)
+{
+    row_ratio(name, how, s, report, resid, base, -1);
+}
+
+/* The library and SILC under the three accuracy.condest modes, one run each
+ * per round, rounds alternating: t[0] the library's median, t[1..3] SILC's
+ * (auto, now, off), q[1..3] their medians of round-by-round ratios, and
+ * each SILC row's median first-info time, residual and backend. */
+static const char *const condest_modes[3] = {"auto", "now", "off"};
+
+static int run_rounds(const csr *A, const double complex *b, int reps, double t[4], double q[4], double info[4],
+                      double resid[4], char backend[3][300])
+{
+    double *rt[4], *rq[4], *ri[4];
+    int ok = 1;
+    for (int j = 0; j < 4; j++) {
+        rt[j] = calloc((size_t)reps, sizeof(double));
+        rq[j] = calloc((size_t)reps, sizeof(double));
+        ri[j] = calloc((size_t)reps, sizeof(double));
+        ok = ok && rt[j] && rq[j] && ri[j];
+    }
+    for (int r = 0; ok && r < reps; r++) {
+        rt[0][r] = run_umfpack(A, b, 1, &resid[0]);
+        ok = rt[0][r] > 0;
+        for (int j = 1; ok && j < 4; j++) {
+            rt[j][r] = run_silc(A, b, 1, condest_modes[j - 1], &resid[j], backend[j - 1], 300, &ri[j][r]);
+            ok = rt[j][r] > 0;
+            rq[j][r] = rt[j][r] / rt[0][r];
+        }
+    }
+    for (int j = 0; j < 4; j++) {
+        if (ok) {
+            t[j] = bench_median(rt[j], reps);
+            q[j] = j ? bench_median(rq[j], reps) : 1;
+            info[j] = j ? bench_median(ri[j], reps) : -1;
+        }
+        free(rt[j]);
+        free(rq[j]);
+        free(ri[j]);
+    }
+    return ok ? 0 : -1;
 }
 
 int main(int argc, char **argv)
 {
     int64_t N = 500;
-    double k = 50, r_silc = 0, r_umf = 0, r_sp = 0, r_oct = 0;
+    double k = 50, r_sp = 0, r_oct = 0;
     int reps = 3, scipy = 1, octave = 1;
-    char backend[300], dir[] = "/tmp/silc-helmholtz-XXXXXX", path[600], script[600], cmd[1600];
+    char backend[3][300], dir[] = "/tmp/silc-helmholtz-XXXXXX", path[600], script[600], cmd[1600];
     csr A;
     silc_envelope_t E;
     double complex *b;
-    double t_silc, t_silc_now, t_silc_nc, t_umf, t_sp = -1, t_oct = -1, r_silc_now = 0, r_silc_nc = 0;
-    double i_silc, i_silc_now, i_silc_nc;
-    char backend_now[300], backend_nc[300];
+    double t[4] = {-1, -1, -1, -1}, q[4], info[4], resid[4], t_sp = -1, t_oct = -1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--n") && i + 1 < argc) N = atoll(argv[++i]);
         else if (!strcmp(argv[i], "--k") && i + 1 < argc) k = atof(argv[++i]);
@@ -304,10 +352,7 @@ int main(int argc, char **argv)
     printf("2-D Helmholtz, %lld x %lld grid (%lld unknowns, %lld entries), k = %g, absorbing boundary; "
            "median of %d\n\n",
            (long long)N, (long long)N, (long long)A.n, (long long)A.nnz, k, reps);
-    t_umf = run_umfpack(&A, b, reps, &r_umf);
-    t_silc = run_silc(&A, b, reps, "auto", &r_silc, backend, sizeof backend, &i_silc);
-    t_silc_now = run_silc(&A, b, reps, "now", &r_silc_now, backend_now, sizeof backend_now, &i_silc_now);
-    t_silc_nc = run_silc(&A, b, reps, "off", &r_silc_nc, backend_nc, sizeof backend_nc, &i_silc_nc);
+    if (run_rounds(&A, b, reps, t, q, info, resid, backend)) fprintf(stderr, "complex_helmholtz: a run failed\n");
     if ((scipy || octave) && mkdtemp(dir)) {
         snprintf(path, sizeof path, "%s/A.bin", dir);
         if (write_matrix(path, &A, b) == 0) {
@@ -344,14 +389,14 @@ int main(int argc, char **argv)
     printf("| %-18s | %-58s | %9s | %9s | %11s | %9s |\n", "solver", "how", "CPU s", "/ UMFPACK",
            "info x [s]", "residual");
     printf("| %-18s | %-58s | %9s | %9s | %11s | %9s |\n", "---", "---", "---:", "---:", "---:", "---:");
-    row("UMFPACK direct", "umfpack_zl symbolic+numeric+solve", t_umf, -1, r_umf, t_umf);
-    row("SILC x = A \\ b", backend, t_silc, i_silc, r_silc, t_umf);
-    row("SILC x = A \\ b", backend_now, t_silc_now, i_silc_now, r_silc_now, t_umf);
-    row("SILC x = A \\ b", backend_nc, t_silc_nc, i_silc_nc, r_silc_nc, t_umf);
-    if (scipy) row("SciPy spsolve", "scipy.sparse.linalg (SuperLU)", t_sp, -1, r_sp, t_umf);
+    row("UMFPACK direct", "umfpack_zl symbolic+numeric+solve", t[0], -1, resid[0], t[0]);
+    for (int j = 1; j < 4; j++) row_ratio("SILC x = A \\ b", backend[j - 1], t[j], info[j], resid[j], t[0], q[j]);
+    if (scipy) row("SciPy spsolve", "scipy.sparse.linalg (SuperLU)", t_sp, -1, r_sp, t[0]);
     if (octave) row("Octave A\\b", access("/usr/bin/octave-cli", X_OK) ? "octave-cli not installed" : "octave-cli",
-                    t_oct, -1, r_oct, t_umf);
+                    t_oct, -1, r_oct, t[0]);
+    printf("\nSILC's ratios are medians of round-by-round ratios (the rounds alternate the library and SILC);\n"
+           "SciPy's and Octave's are their medians over the library's.\n");
     silc_envelope_free(&E);
     free(b);
-    return t_umf < 0 || t_silc < 0;
+    return t[0] < 0 || t[1] < 0;
 }
