@@ -88,7 +88,12 @@ static int exec_cancelled(silc_context *ctx, const char *text)
     atomic_init(&c.exec_done, 0);
     c.returned_in_time = 0;
     c.cpu_at_cancel = 0;
-    if (pthread_getcpuclockid(pthread_self(), &c.exec_cpu)) c.exec_cpu = CLOCK_THREAD_CPUTIME_ID;
+    /* the canceller reads this thread's clock: a fallback to its own would
+     * measure the wrong thread and pass whatever the EXEC did */
+    if (pthread_getcpuclockid(pthread_self(), &c.exec_cpu)) {
+        CHECK(0, "pthread_getcpuclockid: no CPU clock for the EXEC's thread");
+        return -1;
+    }
     pthread_create(&t, NULL, cancel_later, &c);
     rc = silc_exec(ctx, text);
     cpu_after = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);

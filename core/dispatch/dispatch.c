@@ -720,7 +720,8 @@ int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
  * safe side.  silcd counts these charges against a session's limit, on
  * whatever value the session holds, and releases the least recently used
  * first when it is reached (lang/memo.c: memo_held, memo_release).
- * Elsewhere (no mallinfo2) nothing is charged. */
+ * Elsewhere (no mallinfo2, or no budget to count against) nothing is
+ * charged. */
 static int64_t heap_in_use(void)
 {
 #if defined(SILC_HEAP_FROM_SANITIZER)
@@ -743,7 +744,9 @@ static void watch_begin(attach_watch *w, const silc_call *call)
 {
     int i;
     w->on = 0;
-    if (call->op != SILC_OP_SOLVE || (w->heap = heap_in_use()) < 0) return;
+    /* Only a session with a memory budget (silcd) reads the charges: with
+     * none (embedded) the two heap readings a solve would cost are skipped. */
+    if (call->op != SILC_OP_SOLVE || val_budget_room() == INT64_MAX || (w->heap = heap_in_use()) < 0) return;
     for (i = 0; i < 3; i++) w->before[i] = i < call->nin && call->in[i] ? call->in[i]->attach : NULL;
     w->live = val_live_bytes();
     w->on = 1;

@@ -614,30 +614,31 @@ int ld_load_path(silc_engine *E, const char *dirs)
     return rc;
 }
 
-int ld_backend_collective(const ld_backend *b, int op)
+/* b's entry in one of its plugin's per-backend op masks (the field at
+ * field_offset: collective_ops, complex_ops), read only from a table of
+ * ABI minor since_minor or later that is long enough to hold the field: an
+ * older plugin's struct ends before it (and such a plugin is never handed
+ * distributed or complex data).  0 also when the plugin leaves it NULL. */
+static uint32_t backend_op_mask(const ld_backend *b, int since_minor, size_t field_offset)
 {
     const silc_plugin *pl = b->plugin->table;
+    const uint32_t *mask;
     int i;
-    if (pl->abi_minor < 5 || pl->struct_size < offsetof(silc_plugin, collective_ops) + sizeof(void *) ||
-        !pl->collective_ops)
-        return 0;
-    for (i = 0; i < pl->n_backends; i++)
-        if (&pl->backends[i] == b->backend) return (pl->collective_ops[i] & SILC_COLLECTIVE(op)) != 0;
+    if (pl->abi_minor < since_minor || pl->struct_size < field_offset + sizeof mask) return 0;
+    memcpy(&mask, (const char *)pl + field_offset, sizeof mask);
+    for (i = 0; mask && i < pl->n_backends; i++)
+        if (&pl->backends[i] == b->backend) return mask[i];
     return 0;
+}
+
+int ld_backend_collective(const ld_backend *b, int op)
+{
+    return (backend_op_mask(b, 5, offsetof(silc_plugin, collective_ops)) & SILC_COLLECTIVE(op)) != 0;
 }
 
 int ld_backend_takes_complex(const ld_backend *b, int op)
 {
-    const silc_plugin *pl = b->plugin->table;
-    int i;
-    /* Read only from a 1.8 table long enough to hold the field: an older
-     * plugin's struct ends before it, and is never handed complex data. */
-    if (pl->abi_minor < 8 || pl->struct_size < offsetof(silc_plugin, complex_ops) + sizeof(void *) ||
-        !pl->complex_ops)
-        return 0;
-    for (i = 0; i < pl->n_backends; i++)
-        if (&pl->backends[i] == b->backend) return (pl->complex_ops[i] & SILC_COMPLEX_OPS(op)) != 0;
-    return 0;
+    return (backend_op_mask(b, 8, offsetof(silc_plugin, complex_ops)) & SILC_COMPLEX_OPS(op)) != 0;
 }
 
 static const ld_backend *find_loaded(const silc_engine *E, const char *full_name)
