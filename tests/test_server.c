@@ -189,7 +189,12 @@ static void *run_long(void *p)
     return NULL;
 }
 
-static char long_text[96];   /* calibrate_long_text */
+/* A statement that never ends by itself: the tests that need a request in
+ * flight stop it with silcd's own limit (--max-request-seconds) or by
+ * killing or stopping the server.  (An iteration count calibrated against
+ * the server was tried: under CI's load a cold first session measured 15x
+ * slow and the "long" loop ended before the tests looked at it.) */
+static const char long_text[] = "i = 0; while (1) { i = i + 1 }";
 
 /* Runs long_text in a new session of url on a thread of its own. */
 static void start_long(long_exec *L, pthread_t *th, const char *url)
@@ -200,33 +205,10 @@ static void start_long(long_exec *L, pthread_t *th, const char *url)
     pthread_create(th, NULL, run_long, L);
 }
 
-/* A loop that takes one to two seconds on this build (a sanitizer build
- * evaluates it 20 to 100 times slower): calibrated against the server. */
-static void calibrate_long_text(void)
-{
-    test_server srv;
-    const char *opts[] = {"--log-level", "error", NULL};
-    silc_context *c;
-    double t = 0, n = 20000;
-    snprintf(long_text, sizeof long_text, "i = 0; while (i < 1000000) { i = i + 1 }");
-    if (server_start(&srv, NULL, opts)) return;
-    if ((c = open_client(srv.url))) {
-        double t0 = util_now();
-        if (silc_exec(c, "i = 0; while (i < 20000) { i = i + 1 }") == 0) t = util_now() - t0;
-        silc_close(&c);
-    }
-    server_stop(&srv);
-    if (t > 0) n = n * 1.5 / t;
-    if (n < 20000) n = 20000;
-    if (n > 1e7) n = 1e7;
-    snprintf(long_text, sizeof long_text, "i = 0; while (i < %.0f) { i = i + 1 }", n);
-    printf("long EXEC: %s\n", long_text);
-}
-
 static void test_no_queue(void)
 {
     test_server srv;
-    const char *opts[] = {"--log-level", "error", NULL};
+    const char *opts[] = {"--log-level", "error", "--max-request-seconds", "4", NULL};
     long_exec L;
     pthread_t th;
     silc_context *c;
@@ -244,7 +226,8 @@ static void test_no_queue(void)
     CHECK(answered >= 5, "only %d tiny EXECs answered while another session computed (they queue)",
           answered);
     pthread_join(th, NULL);
-    CHECK(L.rc == 0, "the long EXEC: %s", L.err);
+    CHECK(L.rc != 0 && contains(L.err, "request took longer than 4 s: stopped"),
+          "the endless EXEC under --max-request-seconds 4: '%s'", L.err);
     silc_close(&c);
     CHECK(server_stop(&srv) == 0, "silcd did not shut down cleanly");
 }
@@ -422,7 +405,7 @@ static void test_killed_server(void)
     }
 }
 
-/* SIGTERM during a long EXEC: it is answered (done, or stopped after the
+/* SIGTERM during an endless EXEC: it is answered (stopped after the
  * shutdown grace), new connections are refused, and silcd exits 0. */
 static void test_sigterm_drains(void)
 {
@@ -447,9 +430,8 @@ static void test_sigterm_drains(void)
     for (i = 0; i < 3000 && waitpid(srv.pid, &status, WNOHANG) != srv.pid; i++) sleep_ms(20);
     CHECK(i < 3000, "silcd still running 60 s after SIGTERM");
     pthread_join(th, NULL);
-    /* Answered: finished within the shutdown grace, or stopped by it
-     * (docs/security.md, "Limits"; the loop takes seconds on a loaded machine). */
-    CHECK(L.rc == 0 || contains(L.err, "server shutting down: request stopped after a grace"),
+    /* Answered: stopped by the shutdown grace (docs/security.md, "Limits"). */
+    CHECK(L.rc != 0 && contains(L.err, "server shutting down: request stopped after a grace"),
           "the EXEC in flight at SIGTERM was not answered: %s", L.err);
     CHECK(i < 3000 && WIFEXITED(status) && WEXITSTATUS(status) == 0, "silcd's exit after SIGTERM: %d",
           status);
@@ -466,7 +448,6 @@ int main(int argc, char **argv)
 {
     const char *plugin_dir = argc > 1 ? argv[1] : CRASH_PLUGIN_DIR;
     signal(SIGPIPE, SIG_IGN);
-    calibrate_long_text();
     test_crash(plugin_dir);
     test_no_queue();
     test_idle_connections();
