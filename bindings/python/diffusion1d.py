@@ -3,7 +3,7 @@ Python, embedded or against a silcd server: Crank-Nicolson for u_t = u_xx
 on [0, pi], u(x, 0) = sin x, u = 0 at both ends; exact solution
 e^{-t} sin x.
 
-    SILC_LIBRARY=build/core/libsilc.so.1 /usr/bin/python3 diffusion1d.py [N [steps [T]]]
+    SILC_LIBRARY=build/lib/libsilc.so.1 /usr/bin/python3 diffusion1d.py [N [steps [T]]]
     SILC_SERVER=tcp://127.0.0.1:7070 /usr/bin/python3 diffusion1d.py [N [steps [T]]]
 
 The tridiagonal A = I - dt/2 L and B = I + dt/2 L are built here as CSR and

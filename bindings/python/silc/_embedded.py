@@ -67,7 +67,7 @@ def _library():
             tried.append("%s (%s)" % (path, e))
     if lib is None:
         raise SilcError("libsilc not found: tried " + "; ".join(tried) + ". Set SILC_LIBRARY to its path "
-                        "(build/core/libsilc.so.1 in a build tree), install SILC (cmake --install), or "
+                        "(build/lib/libsilc.so.1 in a build tree), install SILC (cmake --install), or "
                         "pass a server address for a remote session")
     vp, cp, env = ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(_Envelope)
     for name, res, args in (("silc_open", ctypes.c_int, [ctypes.POINTER(vp), cp]),
