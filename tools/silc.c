@@ -34,6 +34,10 @@
 #include <unistd.h>
 
 #ifdef SILC_HAVE_READLINE
+#include <dlfcn.h>
+#include <stddef.h>
+/* for the types of what line_editor_open looks up: libreadline itself is
+ * opened at run time */
 #include <readline/history.h>
 #include <readline/readline.h>
 #endif
@@ -308,6 +312,93 @@ static void catch_sigint(silc_context *ctx)
 }
 
 #ifdef SILC_HAVE_READLINE
+/* ---- line editing: GNU readline, opened when a terminal session starts ----- */
+
+/* The command does not link readline (nor libtinfo behind it): `-e`, `run`,
+ * `--complete` and a piped session never call it, and loading two more
+ * libraries is a measurable part of starting the command (issue 30,
+ * start-up: docs/overhead.md has the table).  An interactive session
+ * opens it by its soname, which the dynamic loader looks for where it
+ * looks for a linked library: silc's RUNPATH (no relative entry) and the
+ * system's directories.  The soname's number is the major version of the
+ * headers compiled against (readline's own rule for naming its library), so
+ * the library opened has the interface used.  What it needs of it, by name: */
+#define SILC_STRINGIFY(x) #x
+#define SILC_STRING_OF(x) SILC_STRINGIFY(x)
+#define SILC_READLINE_SONAME "libreadline.so." SILC_STRING_OF(RL_VERSION_MAJOR)
+typedef struct {
+    char *(*readline)(const char *);
+    void (*add_history)(const char *);
+    void (*using_history)(void);
+    void (*stifle_history)(int);
+    int (*read_history)(const char *);
+    int (*write_history)(const char *);
+    int (*append_history)(int, const char *);
+    int (*history_truncate_file)(const char *, int);
+    void (*replace_line)(const char *, int);
+    char **(*completion_matches)(const char *, rl_compentry_func_t *);
+    rl_completion_func_t **attempted_completion_function; /* variables: their addresses */
+    int *attempted_completion_over;
+    int *catch_signals;
+    rl_getc_func_t **getc_function;
+} line_editor;
+
+static line_editor rl; /* all NULL until line_editor_open succeeds */
+
+/* One entry of line_editor: the symbol and where its address goes (a
+ * function's, or a variable's: the field is then a pointer to it).  The
+ * unevaluated assignment in sizeof makes the compiler check the field's
+ * type against readline's own declaration, without referring to it. */
+#define LINE_EDITOR_SYMBOL(field, symbol) \
+    {#symbol, offsetof(line_editor, field), sizeof(((line_editor *)0)->field = symbol)}
+#define LINE_EDITOR_VARIABLE(field, symbol) \
+    {#symbol, offsetof(line_editor, field), sizeof(((line_editor *)0)->field = &symbol)}
+static const struct {
+    const char *name;
+    size_t offset, size;
+} line_editor_symbols[] = {
+    LINE_EDITOR_SYMBOL(readline, readline),
+    LINE_EDITOR_SYMBOL(add_history, add_history),
+    LINE_EDITOR_SYMBOL(using_history, using_history),
+    LINE_EDITOR_SYMBOL(stifle_history, stifle_history),
+    LINE_EDITOR_SYMBOL(read_history, read_history),
+    LINE_EDITOR_SYMBOL(write_history, write_history),
+    LINE_EDITOR_SYMBOL(append_history, append_history),
+    LINE_EDITOR_SYMBOL(history_truncate_file, history_truncate_file),
+    LINE_EDITOR_SYMBOL(replace_line, rl_replace_line),
+    LINE_EDITOR_SYMBOL(completion_matches, rl_completion_matches),
+    LINE_EDITOR_VARIABLE(attempted_completion_function, rl_attempted_completion_function),
+    LINE_EDITOR_VARIABLE(attempted_completion_over, rl_attempted_completion_over),
+    LINE_EDITOR_VARIABLE(catch_signals, rl_catch_signals),
+    LINE_EDITOR_VARIABLE(getc_function, rl_getc_function),
+};
+
+/* Opens readline and fills rl; 0 on success.  On failure rl stays all NULL
+ * and the session reads plain lines, saying once why there is no line
+ * editing or history. */
+static int line_editor_open(void)
+{
+    line_editor found;
+    size_t k;
+    void *lib = dlopen(SILC_READLINE_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        fail("no line editing or history: %s", dlerror());
+        return -1;
+    }
+    for (k = 0; k < sizeof line_editor_symbols / sizeof line_editor_symbols[0]; k++) {
+        void *sym = dlsym(lib, line_editor_symbols[k].name);
+        if (!sym || line_editor_symbols[k].size != sizeof sym) {
+            fail("no line editing or history: %s has no '%s'", SILC_READLINE_SONAME, line_editor_symbols[k].name);
+            dlclose(lib);
+            return -1;
+        }
+        /* POSIX's round trip of a function's address through void * */
+        memcpy((char *)&found + line_editor_symbols[k].offset, &sym, sizeof sym);
+    }
+    rl = found;
+    return 0;
+}
+
 /* readline's reader (rl_getc_function): on Ctrl-C the line typed so far is
  * dropped and readline returns at once, so the REPL can also drop the lines
  * of an unfinished statement and show a fresh prompt.  readline's own
@@ -320,7 +411,7 @@ static int read_key(FILE *in)
         char drain[64];
         ssize_t n;
         if (line_interrupted) {
-            rl_replace_line("", 0);
+            rl.replace_line("", 0);
             return '\n';
         }
         p[0].fd = fileno(in);
@@ -494,8 +585,8 @@ static char *completion_next(const char *text, int state)
 static char **complete(const char *text, int start, int end)
 {
     (void)start, (void)end;
-    rl_attempted_completion_over = 1; /* no file names */
-    return rl_completion_matches(text, completion_next);
+    *rl.attempted_completion_over = 1; /* no file names */
+    return rl.completion_matches(text, completion_next);
 }
 #endif
 
@@ -588,7 +679,7 @@ static char *read_line(int interactive, const char *prompt)
 {
     line_interrupted = 0;
 #ifdef SILC_HAVE_READLINE
-    if (interactive) return readline(prompt);
+    if (interactive && rl.readline) return rl.readline(prompt);
 #endif
     if (interactive) {
         fputs(prompt, stdout);
@@ -632,18 +723,19 @@ static int repl(silc_context *ctx)
     long blocks = 0;   /* Octave-style blocks they leave open (open_blocks) */
     char *buf = NULL;
 #ifdef SILC_HAVE_READLINE
-    char *hist = interactive ? history_path() : NULL;
-    if (interactive) {
+    char *hist = NULL;
+    if (interactive && line_editor_open() == 0) {
+        hist = history_path();
         completion_ctx = ctx;
-        rl_attempted_completion_function = complete;
-        using_history();
-        stifle_history(1000);
+        *rl.attempted_completion_function = complete;
+        rl.using_history();
+        rl.stifle_history(1000);
         /* Each line is appended to the file as it is entered, so a session
          * that ends any way at all keeps its lines; a first session makes
          * the file (append_history does not). */
-        if (hist && read_history(hist) == ENOENT) write_history(hist);
-        rl_catch_signals = 0;
-        rl_getc_function = read_key;
+        if (hist && rl.read_history(hist) == ENOENT) rl.write_history(hist);
+        *rl.catch_signals = 0;
+        *rl.getc_function = read_key;
     }
 #endif
     if (interactive) catch_sigint(ctx);
@@ -667,9 +759,9 @@ static int repl(silc_context *ctx)
             break;
         }
 #ifdef SILC_HAVE_READLINE
-        if (interactive && line[strspn(line, " \t")]) {
-            add_history(line);
-            if (hist) append_history(1, hist);
+        if (rl.add_history && line[strspn(line, " \t")]) {
+            rl.add_history(line);
+            if (hist) rl.append_history(1, hist);
         }
 #endif
         size_t add = strlen(line);
@@ -705,7 +797,7 @@ static int repl(silc_context *ctx)
     if (len && buf[strspn(buf, " \t\r\n")] && run_text(ctx, buf)) failed = 1;
     free(buf);
 #ifdef SILC_HAVE_READLINE
-    if (hist) history_truncate_file(hist, 1000);
+    if (hist) rl.history_truncate_file(hist, 1000);
     free(hist);
 #endif
     return interactive ? 0 : failed;
