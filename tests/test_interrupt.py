@@ -9,7 +9,7 @@ prompt comes back with "interrupted", a value set before is intact and the
 loop's own assignments are undone (read back with --get after `exit`);
 Ctrl-C at a half-typed line or a continuation prompt drops the statement,
 twice at an empty prompt does not leave; ~/.silc_history has every entered
-line, also when the REPL is killed.  Python: Session.cancel() from a
+line, also when the REPL is killed; Tab completes a name.  Python: Session.cancel() from a
 thread, and SIGINT during exec (KeyboardInterrupt once the statement
 stopped), raised in the process and sent from outside to a Python child,
 embedded too when SILC_LIBRARY names libsilc.
@@ -177,9 +177,16 @@ def check_history(env, home):
             fail("history: %r missing from %s (%s)" % (want, hist, lines))
     if "zz = 3" in lines:
         fail("history: the dropped line 'zz = 3' was saved")
-    # A REPL that is killed keeps the lines entered so far.
+    # A REPL that is killed keeps the lines entered so far.  Tab completes
+    # a session's name first (readline is opened when the session starts,
+    # tools/silc.c): without it "tab_tar" is an undefined name.
     r = Repl(env)
     if r.expect(PROMPT, 30 * SLOW, "history: first prompt"):
+        r.send("tab_target_zz = 41;\n")
+        r.expect(PROMPT, BOUND, "Tab: assignment")
+        r.send("tab_tar\t\n")
+        r.expect(r"tab_target_zz = 41", BOUND, "Tab completing 'tab_tar'")
+        r.expect(PROMPT, BOUND, "Tab: prompt")
         r.send("e = 1\n")
         r.expect(PROMPT, BOUND, "history")
     os.kill(r.pid, signal.SIGKILL)
