@@ -3,6 +3,7 @@
  * libraries called directly, SciPy and GNU Octave.
  *
  *     backends [--scipy] [--octave] [--install] [--reps R] [--loop N] [--grid K] [--only NAME]
+ *              [--mumps-rows]
  *
  * --install installs what --scipy and --octave need (Debian's python3-scipy,
  * octave) with apt-get when it is missing; needs root.  Without it the bench
@@ -47,7 +48,10 @@
  * 1e-8 (a fresh session and wisdom file: the first run's whole cost), SciPy
  * with splu(A) once and N solves, Octave's loop of A \ (B*u).  Each row
  * prints sum(u) at the end (the tools agree to about 1e-10 relative) and
- * the last step's backward error.
+ * the last step's backward error.  --mumps-rows adds the loop with MUMPS
+ * forced: double, single alone and single refined to 1e-8, each with
+ * MUMPS's amalgamation and with mumps.amalgamation = 12 (the per-step floor
+ * of the mixed-precision route, docs/backends.md).
  *
  * Set OPENBLAS_NUM_THREADS=1 (done here if unset) for a single-thread
  * comparison: every tool then runs its BLAS on one thread.
@@ -79,7 +83,7 @@ typedef struct problem {
 } problem;
 
 typedef struct opts {
-    int scipy, octave, install, reps, loop;
+    int scipy, octave, install, reps, loop, mumps_rows;
     int64_t grid, grid_given;
     const char *only;
     char tmpdir[256];
@@ -654,10 +658,33 @@ static void diffusion_row(const char *who, const char *ran, const double r[3], d
 
 static void bench_diffusion(const opts *o)
 {
+    /* MUMPS forced, for the per-step floor of the mixed-precision route
+     * (docs/backends.md): the double solve phase, the single one alone
+     * (solve.refine = 0: its backward error is what one single solve
+     * gives), and single refined to tune.accuracy = 1e-8 (refine.c stops
+     * there), with MUMPS's amalgamation and with fronts of >= 12 pivots. */
+    static const struct {
+        const char *who, *setup;
+    } forced[] = {
+        {"SILC, mumps (double)", "set dispatch.solve.sparse.spd = mumps"},
+        {"SILC, mumps, amalgamation 12", "set dispatch.solve.sparse.spd = mumps; set mumps.amalgamation = 12"},
+        {"SILC, mumps single, no refinement",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set solve.refine = 0"},
+        {"SILC, mumps single, refined to 1e-8",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set tune.accuracy = 1e-8"},
+        {"SILC, mumps single, amalg. 12, no ref.",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set mumps.amalgamation = 12; "
+         "set solve.refine = 0"},
+        {"SILC, mumps single, amalg. 12, to 1e-8",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set mumps.amalgamation = 12; "
+         "set tune.accuracy = 1e-8"},
+    };
+    enum { NFORCED = sizeof forced / sizeof forced[0] };
     int64_t k = o->grid_given ? o->grid : 200;
-    int r, reps = o->reps > 0 ? o->reps : 3;
-    char setup[320], cmd[1024], script[512], wisdom[64], ran[2][64] = {"", ""};
-    double best[2][3] = {{-1, 0, 0}, {-1, 0, 0}}, res[3];
+    int r, f, reps = o->reps > 0 ? o->reps : 3;
+    char setup[320], cmd[1024], script[512], wisdom[64], ran[2 + NFORCED][64] = {""};
+    double best[2 + NFORCED][3], res[3];
+    for (f = 0; f < 2 + NFORCED; f++) best[f][0] = -1, best[f][1] = best[f][2] = 0;
     printf("\ndiffusion loop: %lld x %lld grid (%lld unknowns), Crank-Nicolson, dt = %g, %d steps\n",
            (long long)k, (long long)k, (long long)(k * k), DIFF_DT, o->loop);
     printf("  %-40s %-22s %9s %9s %17s %8s\n", "", "last solve by", "seconds", "bwd err", "sum(u)",
@@ -674,10 +701,15 @@ static void bench_diffusion(const opts *o)
             memcpy(best[0], res, sizeof res), snprintf(ran[0], sizeof ran[0], "%s", rn);
         if (silc_diffusion(k, o->loop, setup, res, rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
             memcpy(best[1], res, sizeof res), snprintf(ran[1], sizeof ran[1], "%s", rn);
+        for (f = 0; o->mumps_rows && f < NFORCED; f++)
+            if (silc_diffusion(k, o->loop, forced[f].setup, res, rn) == 0 &&
+                (best[2 + f][0] < 0 || res[0] < best[2 + f][0]))
+                memcpy(best[2 + f], res, sizeof res), snprintf(ran[2 + f], sizeof ran[2 + f], "%s", rn);
     }
     remove(wisdom);
     diffusion_row("SILC, default config", ran[0], best[0], best[0][0]);
     diffusion_row("SILC, tune on, tune.accuracy = 1e-8", ran[1], best[1], best[0][0]);
+    for (f = 0; o->mumps_rows && f < NFORCED; f++) diffusion_row(forced[f].who, ran[2 + f], best[2 + f], best[0][0]);
     if (o->scipy) {
         write_file(o->tmpdir, "diffusion.py", scipy_diffusion, script, sizeof script);
         snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %lld %d %g", script, (long long)k, o->loop, DIFF_DT);
@@ -696,7 +728,7 @@ static void bench_diffusion(const opts *o)
 static int usage(void)
 {
     fprintf(stderr, "usage: backends [--scipy] [--octave] [--install] [--reps R] [--loop N] [--grid K] "
-                    "[--only NAME]\n");
+                    "[--only NAME] [--mumps-rows]\n");
     return 2;
 }
 
@@ -734,6 +766,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--loop") && a + 1 < argc) o.loop = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--grid") && a + 1 < argc) o.grid = atoll(argv[++a]), o.grid_given = 1;
         else if (!strcmp(argv[a], "--only") && a + 1 < argc) o.only = argv[++a];
+        else if (!strcmp(argv[a], "--mumps-rows")) o.mumps_rows = 1;
         else return usage();
     }
     if (o.reps < 0 || o.loop < 1 || o.grid < 2) return usage();
