@@ -28,7 +28,7 @@
  * supernodal solve.  mumps.amalgamation = k (KEEP(1), set between JOB=-1
  * and the analysis) merges fronts below k pivots: k = 12 gives 5776 fronts
  * and halves the solve phase there (factorization 0.8x, 1.6x the entries),
- * but costs bcsstk16 and memplus 1.4-3x in the factorization, so MUMPS's
+ * but costs bcsstk16 and memplus 1.6-3x in the factorization, so MUMPS's
  * default stays (docs/backends.md has the table).
  *
  * A 1-norm condition estimate is made once per factorization for the
@@ -1289,8 +1289,8 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
      * Once est_y0 is kept, the block is not solved again: the start block is
      * always the same, so A^-1 X0 and its bound are too, and a loop of
      * solves with one factorization would pay EST_COLS more columns in
-     * every solve phase (1.3x the one-column solve on the 200^2 diffusion
-     * matrix, docs/backends.md). */
+     * every solve phase (about 1.3x the one-column solve phase on the 200^2
+     * diffusion matrix, in a noisy measurement). */
     fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate) && !F->est_y0;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * (size_t)w * sizeof *rhs))) {
