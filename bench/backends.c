@@ -3,6 +3,7 @@
  * libraries called directly, SciPy and GNU Octave.
  *
  *     backends [--scipy] [--octave] [--install] [--reps R] [--loop N] [--grid K] [--only NAME]
+ *              [--mumps-rows]
  *
  * --install installs what --scipy and --octave need (Debian's python3-scipy,
  * octave) with apt-get when it is missing; needs root.  Without it the bench
@@ -47,7 +48,10 @@
  * 1e-8 (a fresh session and wisdom file: the first run's whole cost), SciPy
  * with splu(A) once and N solves, Octave's loop of A \ (B*u).  Each row
  * prints sum(u) at the end (the tools agree to about 1e-10 relative) and
- * the last step's backward error.
+ * the last step's backward error.  --mumps-rows adds the loop with MUMPS
+ * forced: double, single alone and single refined to 1e-8, each with
+ * MUMPS's amalgamation and with mumps.amalgamation = 12 (the per-step floor
+ * of the mixed-precision route, docs/backends.md).
  *
  * Set OPENBLAS_NUM_THREADS=1 (done here if unset) for a single-thread
  * comparison: every tool then runs its BLAS on one thread.
@@ -79,7 +83,7 @@ typedef struct problem {
 } problem;
 
 typedef struct opts {
-    int scipy, octave, install, reps, loop;
+    int scipy, octave, install, reps, loop, mumps_rows;
     int64_t grid, grid_given;
     const char *only;
     char tmpdir[256];
@@ -567,12 +571,12 @@ static const char scipy_diffusion[] =
     "A = (E + s * L).tocsc(); B = (E - s * L).tocsr()\n"
     "g = (np.arange(1, k + 1) * h); blk = ((g > 0.4) & (g < 0.6)).astype(float)\n"
     "u = np.kron(blk, blk)\n"
-    "t = time.perf_counter(); f = sl.splu(A)\n"
+    "t = time.perf_counter(); c = time.process_time(); f = sl.splu(A)\n"
     "for i in range(nloop): v = B @ u; u = f.solve(v)\n"
-    "t = time.perf_counter() - t\n"
+    "t = time.perf_counter() - t; c = time.process_time() - c\n"
     "nA = abs(A).sum(axis=1).max()\n"
     "be = np.abs(v - A @ u).max() / (nA * np.abs(u).max() + np.abs(v).max())\n"
-    "print('diffusion %.6g %.3g %.12g' % (t, be, u.sum()))\n";
+    "print('diffusion %.6g %.3g %.12g %.6g' % (t, be, u.sum(), c))\n";
 
 static const char octave_diffusion[] =
     "args = argv(); k = str2num(args{1}); nloop = str2num(args{2}); dt = str2num(args{3});\n"
@@ -580,19 +584,25 @@ static const char octave_diffusion[] =
     "T = spdiags([-e, 2 * e, -e], -1:1, k, k); I = speye(k); L = kron(I, T) + kron(T, I);\n"
     "A = speye(k * k) + s * L; B = speye(k * k) - s * L;\n"
     "g = (1:k)' * h; blk = double(g > 0.4 & g < 0.6); u = kron(blk, blk);\n"
-    "tic; for i = 1:nloop, v = B * u; u = A \\ v; end; t = toc;\n"
+    "c = cputime; tic; for i = 1:nloop, v = B * u; u = A \\ v; end; t = toc; c = cputime - c;\n"
     "be = norm(v - A * u, inf) / (norm(A, inf) * norm(u, inf) + norm(v, inf));\n"
-    "printf('diffusion %.6g %.3g %.12g\\n', t, be, sum(u));\n";
+    "printf('diffusion %.6g %.3g %.12g %.6g\\n', t, be, sum(u), c);\n";
 
-/* Runs a tool's diffusion script: time, backward error, sum(u). */
-static int run_diffusion_tool(const char *cmd, double out[3])
+/* A diffusion row: wall seconds, backward error, sum(u), CPU seconds of the
+ * process (on this shared 2-core VM the wall clock also counts other jobs'
+ * time slices; every tool here computes on one thread). */
+enum { D_WALL, D_BE, D_SUM, D_CPU, D_N };
+
+/* Runs a tool's diffusion script: its row. */
+static int run_diffusion_tool(const char *cmd, double out[D_N])
 {
     char line[256];
     FILE *p = popen(cmd, "r");
     int got = 0;
     if (!p) return -1;
     while (fgets(line, sizeof line, p))
-        if (sscanf(line, "diffusion %lf %lf %lf", &out[0], &out[1], &out[2]) == 3) got = 1;
+        if (sscanf(line, "diffusion %lf %lf %lf %lf", &out[D_WALL], &out[D_BE], &out[D_SUM], &out[D_CPU]) == 4)
+            got = 1;
     return pclose(p) == 0 && got ? 0 : -1;
 }
 
@@ -600,9 +610,16 @@ static int run_diffusion_tool(const char *cmd, double out[3])
  * before it, e.g. the tuner's), with the example's matrices and initial
  * field (diffusion_common.h); time of the loop, last step's backward error
  * and sum(u) into out, what ran the last solve into ran[64]. */
-static int silc_diffusion(int64_t k, int steps, const char *setup, double out[3], char ran[64])
+static double cpu_now(void)
 {
-    double h = diff2d_h(k), t0, *u, *sum;
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int silc_diffusion(int64_t k, int steps, const char *setup, double out[D_N], char ran[64])
+{
+    double h = diff2d_h(k), t0, c0, *u, *sum;
     silc_envelope_t A = {0}, B = {0}, U = {0};
     silc_context *c = NULL;
     tl_capture cap = {0};
@@ -623,17 +640,19 @@ static int silc_diffusion(int64_t k, int steps, const char *setup, double out[3]
     if (silc_put(c, "A", &A) || silc_put(c, "B", &B) || silc_put(c, "u", &U) || (setup && silc_exec(c, setup)))
         goto done;
     t0 = tl_now();
+    c0 = cpu_now();
     for (step = 0; step < steps; step++)
         if (silc_exec(c, "u = A \\ (B * u)")) goto done;
-    out[0] = tl_now() - t0;
+    out[D_WALL] = tl_now() - t0;
+    out[D_CPU] = cpu_now() - c0;
     {
         const char *info = tl_info(c, &cap, "u");
         const char *p = strstr(info, "  backend: ");
-        out[1] = tl_field(info, "backward error");
+        out[D_BE] = tl_field(info, "backward error");
         if (p) sscanf(p + 11, "%63s", ran);
     }
     if (silc_exec(c, "s = sum(u)") || !(sum = tl_get_dense(c, "s", &m, &n))) goto done;
-    out[2] = sum[0];
+    out[D_SUM] = sum[0];
     free(sum);
     rc = 0;
 done:
@@ -646,22 +665,46 @@ done:
     return rc;
 }
 
-static void diffusion_row(const char *who, const char *ran, const double r[3], double silc_t)
+static void diffusion_row(const char *who, const char *ran, const double r[D_N], const double silc[D_N])
 {
-    printf("  %-40s %-22s %9.4f %9.1e %17.12g %8.2f\n", who, ran, r[0], r[1], r[2],
-           silc_t > 0 ? r[0] / silc_t : NAN);
+    printf("  %-40s %-22s %9.4f %9.4f %9.1e %17.12g %8.2f %8.2f\n", who, ran, r[D_WALL], r[D_CPU], r[D_BE],
+           r[D_SUM], silc[D_WALL] > 0 ? r[D_WALL] / silc[D_WALL] : NAN,
+           silc[D_CPU] > 0 ? r[D_CPU] / silc[D_CPU] : NAN);
 }
 
 static void bench_diffusion(const opts *o)
 {
+    /* MUMPS forced, for the per-step floor of the mixed-precision route
+     * (docs/backends.md): the double solve phase, the single one alone
+     * (solve.refine = 0: its backward error is what one single solve
+     * gives), and single refined to tune.accuracy = 1e-8 (refine.c stops
+     * there), with MUMPS's amalgamation and with fronts of >= 12 pivots. */
+    static const struct {
+        const char *who, *setup;
+    } forced[] = {
+        {"SILC, mumps (double)", "set dispatch.solve.sparse.spd = mumps"},
+        {"SILC, mumps, amalgamation 12", "set dispatch.solve.sparse.spd = mumps; set mumps.amalgamation = 12"},
+        {"SILC, mumps single, no refinement",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set solve.refine = 0"},
+        {"SILC, mumps single, refined to 1e-8",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set tune.accuracy = 1e-8"},
+        {"SILC, mumps single, amalg. 12, no ref.",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set mumps.amalgamation = 12; "
+         "set solve.refine = 0"},
+        {"SILC, mumps single, amalg. 12, to 1e-8",
+         "set dispatch.solve.sparse.spd = mumps; set mumps.precision = single; set mumps.amalgamation = 12; "
+         "set tune.accuracy = 1e-8"},
+    };
+    enum { NFORCED = sizeof forced / sizeof forced[0] };
     int64_t k = o->grid_given ? o->grid : 200;
-    int r, reps = o->reps > 0 ? o->reps : 3;
-    char setup[320], cmd[1024], script[512], wisdom[64], ran[2][64] = {"", ""};
-    double best[2][3] = {{-1, 0, 0}, {-1, 0, 0}}, res[3];
+    int r, f, reps = o->reps > 0 ? o->reps : 3;
+    char setup[320], cmd[1024], script[512], wisdom[64], ran[2 + NFORCED][64] = {""};
+    double best[2 + NFORCED][D_N], res[D_N];
+    for (f = 0; f < 2 + NFORCED; f++) best[f][D_WALL] = -1, best[f][D_BE] = best[f][D_SUM] = best[f][D_CPU] = 0;
     printf("\ndiffusion loop: %lld x %lld grid (%lld unknowns), Crank-Nicolson, dt = %g, %d steps\n",
            (long long)k, (long long)k, (long long)(k * k), DIFF_DT, o->loop);
-    printf("  %-40s %-22s %9s %9s %17s %8s\n", "", "last solve by", "seconds", "bwd err", "sum(u)",
-           "/ SILC");
+    printf("  %-40s %-22s %9s %9s %9s %17s %8s %8s\n", "", "last solve by", "wall s", "CPU s", "bwd err", "sum(u)",
+           "/ SILC", "CPU / S.");
     snprintf(wisdom, sizeof wisdom, "/tmp/silc-bench-diffusion-wisdom-%ld", (long)getpid());
     /* Best of reps; the tuned run starts from no wisdom every time. */
     for (r = 0; r < reps; r++) {
@@ -674,29 +717,34 @@ static void bench_diffusion(const opts *o)
             memcpy(best[0], res, sizeof res), snprintf(ran[0], sizeof ran[0], "%s", rn);
         if (silc_diffusion(k, o->loop, setup, res, rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
             memcpy(best[1], res, sizeof res), snprintf(ran[1], sizeof ran[1], "%s", rn);
+        for (f = 0; o->mumps_rows && f < NFORCED; f++)
+            if (silc_diffusion(k, o->loop, forced[f].setup, res, rn) == 0 &&
+                (best[2 + f][0] < 0 || res[0] < best[2 + f][0]))
+                memcpy(best[2 + f], res, sizeof res), snprintf(ran[2 + f], sizeof ran[2 + f], "%s", rn);
     }
     remove(wisdom);
-    diffusion_row("SILC, default config", ran[0], best[0], best[0][0]);
-    diffusion_row("SILC, tune on, tune.accuracy = 1e-8", ran[1], best[1], best[0][0]);
+    diffusion_row("SILC, default config", ran[0], best[0], best[0]);
+    diffusion_row("SILC, tune on, tune.accuracy = 1e-8", ran[1], best[1], best[0]);
+    for (f = 0; o->mumps_rows && f < NFORCED; f++) diffusion_row(forced[f].who, ran[2 + f], best[2 + f], best[0]);
     if (o->scipy) {
         write_file(o->tmpdir, "diffusion.py", scipy_diffusion, script, sizeof script);
         snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %lld %d %g", script, (long long)k, o->loop, DIFF_DT);
-        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("SciPy splu once + loop", "SuperLU (COLAMD)", res, best[0][0]);
+        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("SciPy splu once + loop", "SuperLU (COLAMD)", res, best[0]);
         else printf("  SciPy: failed\n");
     }
     if (o->octave) {
         write_file(o->tmpdir, "diffusion.m", octave_diffusion, script, sizeof script);
         snprintf(cmd, sizeof cmd, "octave-cli -q %s %lld %d %g 2>/dev/null", script, (long long)k, o->loop, DIFF_DT);
-        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("Octave loop of A \\ (B*u)", "Octave", res, best[0][0]);
+        if (run_diffusion_tool(cmd, res) == 0) diffusion_row("Octave loop of A \\ (B*u)", "Octave", res, best[0]);
         else printf("  Octave: failed\n");
     }
-    printf("  (last column: seconds / SILC default's; below 1 is faster than SILC)\n");
+    printf("  (last columns: wall and CPU seconds / SILC default's; below 1 is faster than SILC; best of the runs by wall)\n");
 }
 
 static int usage(void)
 {
     fprintf(stderr, "usage: backends [--scipy] [--octave] [--install] [--reps R] [--loop N] [--grid K] "
-                    "[--only NAME]\n");
+                    "[--only NAME] [--mumps-rows]\n");
     return 2;
 }
 
@@ -734,6 +782,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--loop") && a + 1 < argc) o.loop = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--grid") && a + 1 < argc) o.grid = atoll(argv[++a]), o.grid_given = 1;
         else if (!strcmp(argv[a], "--only") && a + 1 < argc) o.only = argv[++a];
+        else if (!strcmp(argv[a], "--mumps-rows")) o.mumps_rows = 1;
         else return usage();
     }
     if (o.reps < 0 || o.loop < 1 || o.grid < 2) return usage();

@@ -20,6 +20,17 @@
  * condition numbers), it runs once per factorization, on the first
  * one-column solve, and `info` shows it from then on.
  *
+ * A solve phase (JOB=3) costs MUMPS a fixed amount per front of the
+ * elimination tree, and MUMPS's amalgamation (KEEP(1) = 5 pivots) leaves
+ * many: 26 208 fronts for the 40 000 unknowns of the 200^2 diffusion matrix
+ * (AMF), where the pair of triangular solves proper is ~2 ms and JOB=3
+ * costs 15-17 ms called directly (bench/mumps_solve), 4x CHOLMOD's
+ * supernodal solve.  mumps.amalgamation = k (KEEP(1), set between JOB=-1
+ * and the analysis) merges fronts below k pivots: k = 12 gives 5776 fronts
+ * and halves the solve phase there (factorization 0.8x, 1.6x the entries),
+ * but costs bcsstk16 and memplus 1.6-3x in the factorization, so MUMPS's
+ * default stays (docs/backends.md has the table).
+ *
  * A 1-norm condition estimate is made once per factorization for the
  * engine's report and its "fewer than 4 correct digits" warning: the host's
  * block estimator with two columns and two steps (estimate_cond below), whose
@@ -124,7 +135,7 @@ static const silc_host_api *host;
 #define C(k, help) {"cntl_" #k, SILC_OPT_DOUBLE, "", "CNTL(" #k "): " help}
 /* The list order matters: icntl_k is entry k-1, cntl_k is entry N_ICNTL+k-1.
  * An empty default means "MUMPS's own default". */
-static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
+static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 3] = {
     IC(1, "-1", "output stream for error messages (<= 0: none)"),
     IC(2, "-1", "output stream for diagnostics (<= 0: none)"),
     IC(3, "-1", "output stream for global information (<= 0: none)"),
@@ -186,6 +197,9 @@ static const silc_option_spec mumps_options[N_ICNTL + N_CNTL + 2] = {
      "factorization, the first block rides with the first solve)"},
     {"precision", SILC_OPT_STRING, "double",
      "factorization precision: double, or single (smumps factor, refined in double by the core)"},
+    {"amalgamation", SILC_OPT_INT, "",
+     "fewest pivots a front of the elimination tree keeps before it is merged into its parent "
+     "(MUMPS's KEEP(1), NEMIN; empty: MUMPS's own 5)"},
 };
 #undef IC
 #undef C
@@ -216,6 +230,7 @@ typedef struct settings {
     int cntl_set[N_CNTL];
     int64_t condest;
     int single;                 /* mumps.precision = single */
+    int64_t amalgamation;       /* KEEP(1), or ICNTL_UNSET */
 } settings;
 
 static int read_settings(silc_call *call, settings *s)
@@ -234,6 +249,10 @@ static int read_settings(silc_call *call, settings *s)
         s->cntl[k - 1] = s->cntl_set[k - 1] ? v : 0.0;
     }
     if ((rc = host->option_int(call, "condest", 1, &s->condest))) return rc;
+    if ((rc = host->option_int(call, "amalgamation", ICNTL_UNSET, &s->amalgamation))) return rc;
+    if (s->amalgamation != ICNTL_UNSET && (s->amalgamation < 1 || s->amalgamation > 100000))
+        return host->error(call, SILC_EARG, "option 'mumps.amalgamation' expects 1 to 100000 pivots, got %lld",
+                           (long long)s->amalgamation);
     {
         const char *prec = host->option_string(call, "precision", "double");
         if (!prec) return SILC_EARG; /* the host has set the message */
@@ -265,7 +284,7 @@ static int same_settings(const settings *a, const settings *b)
         if (a->icntl[k] != b->icntl[k]) return 0;
     for (k = 0; k < N_CNTL; k++)
         if (a->cntl_set[k] != b->cntl_set[k] || a->cntl[k] != b->cntl[k]) return 0;
-    return a->condest == b->condest && a->single == b->single;
+    return a->condest == b->condest && a->single == b->single && a->amalgamation == b->amalgamation;
 }
 
 /* ---- error meanings -------------------------------------------------------------- */
@@ -474,6 +493,8 @@ typedef struct mumps_factor {
     MUMPS_INT *irn, *jcn;       /* 1-based triplets; MUMPS reads them again for */
     double *a;                  /* error analysis and iterative refinement */
     float *af;                  /* single: 2^scale_a * a in float, a is then freed */
+    float *yf;                  /* single: the right-hand sides in float, kept for the next solve */
+    int64_t yf_cap;             /* floats yf holds */
     int scale_a;
     const char *fallback;       /* why mumps.precision = single factored in double */
     settings opts;              /* the options it was computed with */
@@ -481,6 +502,7 @@ typedef struct mumps_factor {
     double *est_y0;             /* A^-1 X0, the estimator's start block solved with the first
                                    solve of an owed estimate (real, n x EST_COLS), which the
                                    estimate goes on from when made: NULL when none is kept */
+    double est_lower;           /* the lower bound of cond_1 est_y0 gave (start_bound) */
     int analysed;               /* the error analysis ran (on the first 1-column solve) */
     double rinfog[11];          /* its RINFOG(1..11) */
     double factor_seconds;
@@ -521,6 +543,8 @@ static void mumps_job(mumps_factor *F, int job)
                  : (void)((F)->id.d.member = (value)))
 #define ID_N(F) ((F)->single ? (F)->id.s.n : (F)->cplx ? (F)->id.z.n : (F)->id.d.n)
 #define ID_SYM(F) ((F)->single ? (F)->id.s.sym : (F)->cplx ? (F)->id.z.sym : (F)->id.d.sym)
+/* MUMPS's internal KEEP(i) of F's instance (read-only here but for KEEP(1)). */
+#define ID_KEEP(F, i) ((F)->single ? (F)->id.s.keep[(i)-1] : (F)->cplx ? (F)->id.z.keep[(i)-1] : (F)->id.d.keep[(i)-1])
 /* The library entry point of F's arithmetic, for messages. */
 #define ID_FN(F) ((F)->single ? "smumps_c" : (F)->cplx ? "zmumps_c" : "dmumps_c")
 /* Doubles per entry of F's values and right-hand sides. */
@@ -536,10 +560,13 @@ static void factor_end(mumps_factor *F)
     host->free(F->jcn);
     host->free(F->a);
     host->free(F->af);
+    host->free(F->yf);
     host->free(F->est_y0);
     F->irn = F->jcn = NULL;
     F->a = NULL;
     F->af = NULL;
+    F->yf = NULL;
+    F->yf_cap = 0;
     F->est_y0 = NULL;
     host->free(F->irhs_loc);
     host->free(F->isol_loc);
@@ -654,29 +681,48 @@ static int scale_exponent(const double *x, int64_t n)
     return -e;
 }
 
+/* 2^e when that is a normal double, else 0.  Scaling by a multiplication
+ * with it rounds exactly as ldexp (both are exact or correctly rounded to a
+ * subnormal) at a fraction of ldexp's cost per entry (2-3 % of a single-
+ * precision solve on the 200^2 diffusion matrix); the caller falls back to
+ * ldexp when it is 0. */
+static double pow2_or_zero(int e)
+{
+    return e >= DBL_MIN_EXP - 1 && e <= DBL_MAX_EXP - 1 ? ldexp(1.0, e) : 0.0;
+}
+
 /* Single precision: each column of rhs scaled by its own power of two, solved
- * by smumps_c, scaled back (x = 2^(scale_a - q) y for (2^scale_a A) y = 2^q b). */
+ * by smumps_c, scaled back (x = 2^(scale_a - q) y for (2^scale_a A) y = 2^q b).
+ * The float copy of the right-hand sides stays with F for the next solve. */
 static int solve_single(mumps_factor *F, double *rhs, int64_t nrhs)
 {
     int64_t n = F->id.s.n, i, c;
-    float *y = host->alloc((size_t)(n * nrhs) * sizeof *y);
     int *q = host->alloc((size_t)nrhs * sizeof *q);
-    if (!y || !q) {
-        host->free(y);
-        host->free(q);
-        return SILC_ENOMEM;
+    if (!q) return SILC_ENOMEM;
+    if (n * nrhs > F->yf_cap) {
+        host->free(F->yf);
+        F->yf_cap = 0;
+        if (!(F->yf = host->alloc((size_t)(n * nrhs) * sizeof *F->yf))) {
+            host->free(q);
+            return SILC_ENOMEM;
+        }
+        F->yf_cap = n * nrhs;
     }
     for (c = 0; c < nrhs; c++) {
-        q[c] = scale_exponent(rhs + c * n, n);
-        for (i = 0; i < n; i++) y[i + c * n] = (float)ldexp(rhs[i + c * n], q[c]);
+        const double *x = rhs + c * n;
+        float *y = F->yf + c * n;
+        double in = pow2_or_zero(q[c] = scale_exponent(x, n));
+        for (i = 0; i < n; i++) y[i] = (float)(in != 0 ? x[i] * in : ldexp(x[i], q[c]));
     }
-    F->id.s.rhs = y;
+    F->id.s.rhs = F->yf;
     mumps_job(F, MUMPS_JOB_SOLVE);
     if (INFOG(F, 1) >= 0)
-        for (c = 0; c < nrhs; c++)
-            for (i = 0; i < n; i++) rhs[i + c * n] = ldexp((double)y[i + c * n], F->scale_a - q[c]);
+        for (c = 0; c < nrhs; c++) {
+            double *x = rhs + c * n, out = pow2_or_zero(F->scale_a - q[c]);
+            const float *y = F->yf + c * n;
+            for (i = 0; i < n; i++) x[i] = out != 0 ? (double)y[i] * out : ldexp((double)y[i], F->scale_a - q[c]);
+        }
     F->id.s.rhs = NULL;
-    host->free(y);
     host->free(q);
     return SILC_OK;
 }
@@ -930,6 +976,8 @@ static int analyse_factor(mumps_factor *F, int n, int64_t nnz, int sym, const se
     F->live = 1;
     for (k = 1; k <= N_ICNTL; k++)
         if (s->icntl[k - 1] != ICNTL_UNSET) ICNTL(F, k) = (MUMPS_INT)s->icntl[k - 1];
+    if (s->amalgamation != ICNTL_UNSET) /* read by the analysis (JOB=4) */
+        ID_SET(F, keep[0], (MUMPS_INT)s->amalgamation);
     for (k = 1; k <= N_CNTL; k++)
         if (s->cntl_set[k - 1]) {
             if (F->single)
@@ -1135,6 +1183,8 @@ static void fill_report(silc_report *r, const mumps_factor *F, const solve_ctx *
         note_add(r, "cond1 %.2g, cond2 %.2g, forward error bound %.2g", F->rinfog[9], F->rinfog[10],
                  F->rinfog[8]);
     note_estimate(r, F);
+    if (F->opts.amalgamation != ICNTL_UNSET) /* KEEP(28): the fronts the solve phase visits */
+        note_add(r, "mumps.amalgamation = %d: %d fronts", (int)F->opts.amalgamation, (int)ID_KEEP(F, 28));
     if (F->retries)
         note_add(r, "workspace raised to ICNTL(14)=%d after %d retr%s", (int)ICNTL(F, 14),
                  F->retries, F->retries == 1 ? "y" : "ies");
@@ -1235,8 +1285,13 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
      * costs about the same for a few more columns, A^-1 X0 gives the host a
      * lower bound of cond_1 that tells whether the estimate is urgent, and a
      * real estimate made later goes on from it (est_y0).  The complex
-     * estimator takes no block: its start rides along only for the bound. */
-    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate);
+     * estimator takes no block: its start rides along only for the bound.
+     * Once est_y0 is kept, the block is not solved again: the start block is
+     * always the same, so A^-1 X0 and its bound are too, and a loop of
+     * solves with one factorization would pay EST_COLS more columns in
+     * every solve phase (about 1.3x the one-column solve phase on the 200^2
+     * diffusion matrix, in a noisy measurement). */
+    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate) && !F->est_y0;
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * (size_t)w * sizeof *rhs))) {
         host->release(X);
@@ -1261,6 +1316,9 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
         F->est_y0 = NULL;
         if (!F->cplx && (F->est_y0 = host->alloc((size_t)n * EST_COLS * sizeof *rhs)))
             memcpy(F->est_y0, rhs + n * b->n, (size_t)n * EST_COLS * sizeof *rhs); /* else solved again */
+        F->est_lower = lower;
+    } else if (!rc && !estimate && F->est_y0 && condest_wanted(call, s, F)) {
+        lower = F->est_lower;
     }
     if (rhs != o.val) host->free(rhs);
     if (rc) {
@@ -1273,7 +1331,7 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
          * start block saves one */
         r->condest_solves = EST_PHASES - (F->est_y0 ? 1 : 0);
     }
-    if (fold && !estimate) r->condest_lower = lower;
+    if (!estimate && condest_wanted(call, s, F) && (fold || F->est_y0)) r->condest_lower = lower;
     *out = X;
     return SILC_OK;
 }

@@ -166,6 +166,35 @@ static void test_shared(silc_context *cm, silc_context *cr, const char *file)
     silc_envelope_free(&A);
 }
 
+/* mumps.amalgamation (KEEP(1)): fewer, larger fronts than MUMPS's own 5,
+ * the same accuracy; out-of-range values are refused by name. */
+static void test_amalgamation(silc_context *cm)
+{
+    const char *t, *e;
+    double fronts5 = -1, fronts16 = -1;
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.amalgamation = 5\")") == 0, "amalgamation 5: %s",
+          silc_context_errmsg(cm));
+    t = tl_out_info(cm, "x");
+    if ((t = strstr(t, "mumps.amalgamation = 5: "))) fronts5 = strtod(t + 24, NULL);
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.amalgamation = 16\"); r = norm(A * x - b, inf) / (norm(A, inf) * "
+                        "norm(x, inf) + norm(b, inf))") == 0,
+          "amalgamation 16: %s", silc_context_errmsg(cm));
+    t = tl_out_info(cm, "x");
+    CHECK(strstr(t, "reused factorization: no") != NULL, "amalgamation 16 refactors:\n%s", t);
+    if ((t = strstr(t, "mumps.amalgamation = 16: "))) fronts16 = strtod(t + 25, NULL);
+    CHECK(fronts5 > 0 && fronts16 > 0 && fronts16 < fronts5, "fronts: %g with 5, %g with 16", fronts5, fronts16);
+    {
+        silc_envelope_t r;
+        double rv = 1;
+        if (silc_get(cm, &r, "r") == 0) silc_envelope_to_dense(&r, &rv);
+        silc_envelope_free(&r);
+        CHECK(rv < 1e-14, "amalgamation 16: backward error %g", rv);
+    }
+    CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.amalgamation = 0\")") != 0, "amalgamation 0 accepted");
+    e = silc_context_errmsg(cm);
+    CHECK(strstr(e, "mumps.amalgamation") && strstr(e, "got 0"), "amalgamation 0 message: %s", e);
+}
+
 static void test_options(silc_context *cm)
 {
     const char *e;
@@ -192,6 +221,7 @@ static void test_options(silc_context *cm)
           silc_context_errmsg(cm));
     CHECK(strstr(tl_out_info(cm, "x"), "condition estimate: not estimated") && !strstr(tl_out(), "Hager"),
           "condest = false: no estimate, and info says so:\n%s", tl_out());
+    test_amalgamation(cm);
 }
 
 /* The condition estimate (the host's block estimator, two columns, two
@@ -344,6 +374,33 @@ static int hilbert_csr(silc_envelope_t *H, int64_t n)
     return rc;
 }
 
+/* With tune.accuracy set, the default refinement of a single factor stops
+ * once the backward error reaches it (refine.c): fewer steps than the
+ * steps_eps it takes to working precision, the target met (checked here
+ * from x), no warning. */
+static void test_single_target(silc_context *cm, const silc_envelope_t *A, const double *b, double *x,
+                               int steps_eps)
+{
+    const char *t;
+    double steps, before, be;
+    CHECK(silc_exec(cm, "set tune.accuracy = 1e-9; x = solve(A, b, \"mumps.precision = single\")") == 0,
+          "target: %s", silc_context_errmsg(cm));
+    t = tl_out_info(cm, "x");
+    steps = tl_out_number(t, "refinement: ");
+    before = tl_out_number(t, "backward error before: ");
+    CHECK(before > 1e-9, "target: the single solve alone reached %g (the test needs a step)", before);
+    CHECK(steps >= 1 && steps < steps_eps, "target: %g steps, %d to working precision:\n%s", steps, steps_eps, t);
+    CHECK(strstr(t, "at tune.accuracy") != NULL, "target: stop reason:\n%s", t);
+    be = tl_get_vec(cm, "x", x, A->m) == 0 ? tl_backward_error(A, x, b) : 1;
+    CHECK(be <= 1e-9, "target: backward error %g above tune.accuracy 1e-9", be);
+    CHECK(strstr(silc_context_warnings(cm), "single-precision") == NULL, "target warns: %s",
+          silc_context_warnings(cm));
+    /* below eps: the refinement stops at working precision again, as unset */
+    CHECK(silc_exec(cm, "set tune.accuracy = 1e-17") == 0, "tune.accuracy back: %s", silc_context_errmsg(cm));
+    printf("laplacian single, tune.accuracy 1e-9: %g step(s), backward error %.2g (to eps: %d)\n", steps, be,
+           steps_eps);
+}
+
 static void test_single(silc_context *cm)
 {
     silc_envelope_t A;
@@ -352,12 +409,13 @@ static void test_single(silc_context *cm)
     double *xs = malloc((size_t)n * sizeof *xs), *b = malloc((size_t)n * sizeof *b),
            *x = malloc((size_t)n * sizeof *x);
     const char *t;
+    int steps_eps;
     if (!xs || !b || !x || tl_laplacian2d(&A, k)) {
         CHECK(0, "single: setup failed");
         goto out;
     }
     CHECK(put_system(cm, &A, xs, b) == 0, "put: %s", silc_context_errmsg(cm));
-    single_solve(cm, &A, b, x, "laplacian");
+    steps_eps = single_solve(cm, &A, b, x, "laplacian");
     CHECK(tl_rel_diff(x, xs, n) <= 1e-12, "laplacian single forward error %g", tl_rel_diff(x, xs, n));
     /* The single factor stays on A next to the double one and is reused. */
     CHECK(silc_exec(cm, "y = A \\ b; x = solve(A, b, \"mumps.precision = single\")") == 0, "again: %s",
@@ -365,6 +423,7 @@ static void test_single(silc_context *cm)
     t = tl_out_info(cm, "x");
     CHECK(strstr(t, "reused factorization: yes") && strstr(t, "single precision"),
           "single factor reused:\n%s", t);
+    test_single_target(cm, &A, b, x, steps_eps);
     CHECK(silc_exec(cm, "x = solve(A, b, \"mumps.precision = half\")") != 0, "precision = half accepted");
     CHECK(strstr(silc_context_errmsg(cm), "expects double or single") != NULL, "half: %s",
           silc_context_errmsg(cm));

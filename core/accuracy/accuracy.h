@@ -122,13 +122,16 @@ void acc_pending_resolve(silc_engine *E, eng_pending *p, silc_report *r);
  * that one more triangular solve), and x += d.  Keys: solve.refine (steps,
  * per call "refine = 2") and solve.refine_residual (double | extended).  A
  * backend whose factorization is single precision sets report->single_factor
- * and gets up to REFINE_SINGLE_DEFAULT steps unless refine is set.
+ * and gets up to REFINE_SINGLE_DEFAULT steps unless refine is set; they stop
+ * at working precision, or at tune.accuracy when that is set (the accuracy
+ * the tuner chose a mixed-precision backend for: one step instead of two
+ * on the diffusion loop, docs/accuracy.md).
  */
 
 #define REFINE_SINGLE_DEFAULT 10
-/* Backward error a refined single-precision solve must reach, else a warning
- * says refinement did not converge (a lone single solve gives ~1e-8, a
- * converged refinement ~1e-16). */
+/* Backward error a refined single-precision solve must reach (or the
+ * refinement's target, when larger), else a warning says refinement did not
+ * converge (a lone single solve gives ~1e-8, a converged refinement ~1e-16). */
 #define REFINE_SINGLE_CONVERGED 1e-12
 
 /* If v stores a NaN or Inf, sets E->err to "<name> has NaN at (i, j)" (1-based)
@@ -153,6 +156,8 @@ typedef struct refine_how {
     const char *steps;          /* solve.refine, NULL when not set */
     const char *residual;       /* solve.refine_residual, NULL when not set */
     const char *backend;        /* the backend's full name, for the warning */
+    double target;              /* tune.accuracy when set, else 0: the backward error at which
+                                   the default refinement of a single-precision factor stops */
     silc_value *(*correct)(const void *ctx, silc_engine *E, const silc_call *call, const silc_value *R,
                            char *err, size_t errlen);
     const void *ctx;            /* the dispatcher's, for correct */

@@ -11,7 +11,11 @@
  *             order that lost accuracy) down to a backward error of order
  *             eps, but cannot beat the forward error cond * eps.  The loop
  *             stops when the backward error reaches eps or stops halving, and
- *             a step that makes it worse is thrown away.
+ *             a step that makes it worse is thrown away.  The default steps
+ *             of a single-precision factorization (solve.refine not set)
+ *             stop earlier, at how->target (tune.accuracy), when one is set:
+ *             the tuner picked that backend for that accuracy, and each
+ *             step costs a residual and a solve.
  *   extended  r accumulated in double-double (each product split exactly
  *             with fma, each sum with TwoSum), rounded once.  Then the
  *             forward error itself converges to about eps while
@@ -143,12 +147,14 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
     double *B = NULL, *X = NULL, *R = NULL, *lo = NULL, nA, nB, be, be0, dprev = INFINITY;
     double t0 = util_now();
     int64_t want, step, kept = 0, n = A->n, k = Bv->n;
+    double enough = DBL_EPSILON; /* the backward error at which the double-residual loop stops */
     int extended, w = A->field == SILC_FIELD_COMPLEX ? 2 : 1;
     char note[200], why[REFINE_WHY_MAX];
     const char *stop = "step limit";
     r->backward_error_unrefined = -1;
     r->refine_steps = 0;
     want = steps_wanted(how, r, &extended);
+    if (!how->steps && r->single_factor && how->target > enough) enough = how->target;
     if (!how->steps && want < at_least) want = at_least;
     if (want <= 0 || !call->out) return;
     if (A->m != A->n || n == 0 || k == 0) {
@@ -184,8 +190,8 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
         silc_value *Rv, *D;
         double *Xn, ben, dn;
         int64_t i;
-        if (!extended && be <= DBL_EPSILON) {
-            stop = "backward error at working precision";
+        if (!extended && be <= enough) {
+            stop = enough > DBL_EPSILON ? "backward error at tune.accuracy" : "backward error at working precision";
             break;
         }
         if (!(be == be)) {
@@ -251,7 +257,7 @@ void refine_solve(silc_engine *E, silc_call *call, const refine_how *how, int64_
     /* A single-precision factor gains about -log10(cond * eps_single) digits
      * per step, none once the (scaled) matrix's condition reaches
      * 1 / eps_single: then x is about as bad as the single solve, and says so. */
-    if (r->single_factor && !((kept ? be : be0) <= REFINE_SINGLE_CONVERGED))
+    if (r->single_factor && !((kept ? be : be0) <= fmax(REFINE_SINGLE_CONVERGED, enough)))
         eng_warn(E,
                  "'\\': refinement of %s's single-precision factorization stopped at backward "
                  "error %.2g (%s): too ill-conditioned for a single-precision factor, use a "

@@ -529,8 +529,11 @@ static silc_value *correction(const void *be, silc_engine *E, const silc_call *c
 static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t at_least)
 {
     refine_how how;
+    const char *acc;
     how.steps = cfg_get(E, "solve.refine");
     how.residual = cfg_get(E, "solve.refine_residual");
+    acc = cfg_get(E, "tune.accuracy"); /* config.c checked it is a number in (0, 1) */
+    how.target = acc ? strtod(acc, NULL) : 0;
     how.backend = b->full_name;
     how.correct = correction;
     how.ctx = b;
