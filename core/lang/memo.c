@@ -54,6 +54,7 @@
 #define MEMO_BYTES ((uint64_t)128 << 20)
 
 typedef struct memo_key {
+    uint64_t tag;         /* a hash of the rest (key_tag), compared first */
     int op, sub, nin;
     uint64_t ids[3];
     double alpha, beta, alpha_imag, beta_imag;
@@ -87,6 +88,16 @@ static uint64_t table_bytes(const eng_memo *M)
     return total;
 }
 
+/* A hash of what tells keys apart most often (the operation and its
+ * operands' ids): find() scans every slot for each call, and a loop whose
+ * operand changes every step finds none, so most comparisons stop at it. */
+static uint64_t key_tag(const memo_key *k)
+{
+    uint64_t h = (uint64_t)k->op * 0x9E3779B97F4A7C15ull ^ (uint64_t)k->sub << 32 ^ (uint64_t)k->nin;
+    for (int i = 0; i < 3; i++) h = (h ^ k->ids[i]) * 0x100000001B3ull;
+    return h;
+}
+
 /* The call's key; -1 for a call never kept: a solve (its report and
  * warnings belong to each statement), one with per-call options, or one on
  * an SPMD engine (ranks number values differently, and every rank must
@@ -109,6 +120,7 @@ static int key_of(const silc_engine *E, const silc_call *call, memo_key *k)
     k->beta_imag = call->beta_imag;
     k->ival[0] = call->ival[0];
     k->ival[1] = call->ival[1];
+    k->tag = key_tag(k);
     return 0;
 }
 
@@ -117,7 +129,7 @@ static void room_for_call(silc_engine *E, double need, const silc_call *keep);
 static int same_key(const memo_key *a, const memo_key *b)
 {
     /* Coefficients compare by bits: -0.0 and 0.0 scale differently. */
-    return a->op == b->op && a->sub == b->sub && a->nin == b->nin && !memcmp(a->ids, b->ids, sizeof a->ids) &&
+    return a->tag == b->tag && a->op == b->op && a->sub == b->sub && a->nin == b->nin && !memcmp(a->ids, b->ids, sizeof a->ids) &&
            !memcmp(&a->alpha, &b->alpha, sizeof a->alpha) && !memcmp(&a->beta, &b->beta, sizeof a->beta) &&
            !memcmp(&a->alpha_imag, &b->alpha_imag, sizeof a->alpha_imag) &&
            !memcmp(&a->beta_imag, &b->beta_imag, sizeof a->beta_imag) && a->ival[0] == b->ival[0] && a->ival[1] == b->ival[1];
@@ -161,9 +173,12 @@ static memo_slot *make_room(eng_memo *M)
 static void rename_operand(eng_memo *M, uint64_t from, uint64_t to)
 {
     int i, j;
-    for (i = 0; i < M->n; i++)
-        for (j = 0; j < M->slot[i].key.nin; j++)
-            if (M->slot[i].key.ids[j] == from) M->slot[i].key.ids[j] = to;
+    for (i = 0; i < M->n; i++) {
+        memo_key *k = &M->slot[i].key;
+        for (j = 0; j < k->nin; j++)
+            if (k->ids[j] == from) k->ids[j] = to;
+        k->tag = key_tag(k);
+    }
 }
 
 silc_value *memo_lookup(silc_engine *E, const silc_call *call)
@@ -174,9 +189,11 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call)
     int i;
     /* Before a call under a session's limit: room for what is kept and,
      * as a guess at what the call makes, its largest operand. */
-    for (i = 0; i < call->nin && i < 3; i++)
-        if (call->in[i] && (double)val_bytes(call->in[i]) > need) need = (double)val_bytes(call->in[i]);
-    room_for_call(E, need, call);
+    if (val_budget_room() != INT64_MAX) {
+        for (i = 0; i < call->nin && i < 3; i++)
+            if (call->in[i] && (double)val_bytes(call->in[i]) > need) need = (double)val_bytes(call->in[i]);
+        room_for_call(E, need, call);
+    }
     if (!E->memo || key_of(E, call, &k)) return NULL;
     s = find(E->memo, &k);
     if (!s || !s->result) return NULL;
