@@ -70,6 +70,7 @@ typedef struct memo_slot {
 
 struct eng_memo {
     memo_slot slot[MEMO_SLOTS];
+    uint64_t tag[MEMO_SLOTS]; /* slot[i].key.tag, packed: find() reads 8 cache lines, not 64 */
     int n;
     uint64_t clock;
 };
@@ -139,13 +140,14 @@ static memo_slot *find(eng_memo *M, const memo_key *k)
 {
     int i;
     for (i = 0; i < M->n; i++)
-        if (same_key(&M->slot[i].key, k)) return &M->slot[i];
+        if (M->tag[i] == k->tag && same_key(&M->slot[i].key, k)) return &M->slot[i];
     return NULL;
 }
 
 static void drop(eng_memo *M, memo_slot *s)
 {
     val_release(s->result);
+    M->tag[s - M->slot] = M->tag[M->n - 1];
     *s = M->slot[--M->n];
 }
 
@@ -177,7 +179,7 @@ static void rename_operand(eng_memo *M, uint64_t from, uint64_t to)
         memo_key *k = &M->slot[i].key;
         for (j = 0; j < k->nin; j++)
             if (k->ids[j] == from) k->ids[j] = to;
-        k->tag = key_tag(k);
+        M->tag[i] = k->tag = key_tag(k);
     }
 }
 
@@ -219,6 +221,7 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
         s = make_room(M);
         memset(s, 0, sizeof *s);
         s->key = k;
+        M->tag[s - M->slot] = k.tag;
         s->first_id = result ? result->id : 0;
         s->used = ++M->clock;
         return;
