@@ -54,6 +54,8 @@ struct cfg_db {
     int file_line;
     int serving;         /* a silcd session's engine (cfg_serve) */
     int data_fd;         /* its folder under --data-dir, -1 = file statements refused */
+    uint64_t generation; /* counts changes of any setting (cfg_generation) */
+    void *derived;       /* the dispatcher's cache of what it derives from settings (cfg_derived) */
 };
 
 static const char *const scope_names[3] = {"file", "session", "call"};
@@ -866,6 +868,7 @@ static int store_value(silc_engine *E, int scope, const char *key, const char *v
         free(o);
         return eng_error(E, "out of memory setting '%s'", key);
     }
+    E->cfg->generation++;
     if (*pe) {
         free((*pe)->value);
         free((*pe)->origin);
@@ -899,6 +902,7 @@ void cfg_destroy(silc_engine *E)
     int s;
     if (!E || !E->cfg) return;
     for (s = 0; s < 3; s++) free_list(E->cfg->scope[s]);
+    free(E->cfg->derived);
     if (E->cfg->data_fd >= 0) close(E->cfg->data_fd);
     free(E->cfg);
     E->cfg = NULL;
@@ -973,9 +977,22 @@ int cfg_set_call_options(silc_engine *E, const char *text)
 
 void cfg_clear_call_options(silc_engine *E)
 {
-    if (!E || !E->cfg) return;
+    if (!E || !E->cfg || !E->cfg->scope[CFG_SCOPE_CALL]) return;
     free_list(E->cfg->scope[CFG_SCOPE_CALL]);
     E->cfg->scope[CFG_SCOPE_CALL] = NULL;
+    E->cfg->generation++;
+}
+
+uint64_t cfg_generation(const silc_engine *E)
+{
+    return E && E->cfg ? E->cfg->generation : 0;
+}
+
+void *cfg_derived(const silc_engine *E, size_t bytes)
+{
+    if (!E || !E->cfg) return NULL;
+    if (!E->cfg->derived) E->cfg->derived = calloc(1, bytes);
+    return E->cfg->derived;
 }
 
 const char *cfg_get(const silc_engine *E, const char *key)

@@ -31,6 +31,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -300,7 +301,9 @@ int disp_classes(silc_engine *E, const silc_call *call, const char *out[4])
 static void split_list(const silc_engine *E, blist *L, const char *text, int all_optional)
 {
     char *p;
-    snprintf(L->buf, sizeof L->buf, "%s", text);
+    size_t len = strnlen(text, sizeof L->buf - 1); /* cut as snprintf would, without printf's cost */
+    memcpy(L->buf, text, len);
+    L->buf[len] = '\0';
     L->n = 0;
     for (p = L->buf; p && L->n < DISP_MAX_LIST - 1;) {
         char *comma = strchr(p, ','), *end;
@@ -361,15 +364,18 @@ static void list_source(const blist *L, strbuf *b)
                    L->default_distributed ? ", distributed operands" : "");
 }
 
-static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
-                         blist *L)
+static void resolve_list_afresh(const silc_engine *E, int distributed, const char *const *chain, int nchain,
+                                blist *L)
 {
-    int distributed = E->dist && dist_call_has(call);
     const char *forced = cfg_get(E, "backend"), *text = NULL;
-    char key[160];
+    char key[sizeof L->key] = "dispatch.";
     size_t i;
     int c;
-    memset(L, 0, sizeof *L);
+    /* Every field but the arrays, which are written before they are read
+     * (a whole memset is 1.7 KB a call) */
+    L->n = L->nlisted = L->forced = L->default_distributed = 0;
+    L->key[0] = L->absent[0] = '\0';
+    L->forced_text = L->default_class = NULL;
     if (forced) {
         split_list(E, L, forced, 0);
         L->nlisted = L->n;
@@ -378,10 +384,13 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
         return;
     }
     for (c = 0; c < nchain && !text; c++) {
-        snprintf(key, sizeof key, "dispatch.%s", chain[c]);
+        /* "dispatch." + the class, as snprintf would cut it, by copies */
+        size_t at = sizeof "dispatch." - 1, len = strnlen(chain[c], sizeof key - 1 - at);
+        memcpy(key + at, chain[c], len);
+        key[at + len] = '\0';
         text = cfg_get(E, key);
     }
-    if (text) snprintf(L->key, sizeof L->key, "%s", key);
+    if (text) memcpy(L->key, key, sizeof L->key);
     if (!text) {
         text = "reference";
         for (i = 0; i < sizeof default_lists / sizeof default_lists[0]; i++)
@@ -396,6 +405,115 @@ static void resolve_list(const silc_engine *E, const silc_call *call, const char
     for (c = 0; c < L->n; c++)
         if (strcmp(L->names[c], "reference") == 0) return;
     L->names[L->n++] = "reference";
+}
+
+/* ---- the resolved lists of the last class chains -----------------------------
+ * Resolving a list reads two or three settings, copies and splits a text
+ * and looks each name up: a tenth of a small SpMV statement's fixed cost
+ * (docs/overhead.md, issue 30).  What comes out depends only on the class
+ * chain, on whether the operands are distributed, on the settings and on
+ * which backends are installed; so the last LIST_CACHE lists are kept, each
+ * with the settings' generation it was made under (cfg_generation), and one
+ * made under another generation is made again.  The installed backends
+ * change only when core.plugin_path is set (a setting: a new generation)
+ * or at engine start; a plugin opened at first use (loader.c) was already
+ * known by name, and one that failed to open stays closed.  The chain is
+ * compared by its pointers (classify's string constants): another pointer
+ * to the same text only misses.  A list is copied out, never lent: a call
+ * inside the walk (refinement, per-call options) may remake the entry. */
+#define LIST_CACHE 8
+
+typedef struct cached_list {
+    const char *chain[4];
+    int nchain, distributed;
+    uint64_t generation, used;
+    size_t buflen;         /* bytes of L.buf in use */
+    blist L;
+} cached_list;
+
+typedef struct list_cache {
+    cached_list e[LIST_CACHE];
+    int n;
+    uint64_t clock;
+} list_cache;
+
+/* Whether name points into L's buffer (else at a constant: "reference");
+ * compared as integers, since C orders only pointers into one object. */
+static int in_buf(const blist *L, const char *name)
+{
+    uintptr_t p = (uintptr_t)name, b = (uintptr_t)L->buf;
+    return p >= b && p < b + sizeof L->buf;
+}
+
+/* *to = *from, with the names that point into from's buffer pointing into
+ * to's, copying only the bytes in use. */
+static void blist_copy(blist *to, const blist *from, size_t buflen)
+{
+    int i;
+    memcpy(to->buf, from->buf, buflen);
+    for (i = 0; i < from->n; i++)
+        to->names[i] = in_buf(from, from->names[i]) ? to->buf + ((uintptr_t)from->names[i] - (uintptr_t)from->buf)
+                                                    : from->names[i];
+    to->n = from->n;
+    memcpy(to->key, from->key, strlen(from->key) + 1);
+    memcpy(to->absent, from->absent, strlen(from->absent) + 1);
+    to->forced = from->forced;
+    to->nlisted = from->nlisted;
+    to->forced_text = from->forced_text;
+    to->default_class = from->default_class;
+    to->default_distributed = from->default_distributed;
+}
+
+/* The bytes of L->buf that split_list wrote (the text with its commas cut). */
+static size_t buf_in_use(const blist *L)
+{
+    size_t end = 0;
+    for (int i = 0; i < L->n; i++)
+        if (in_buf(L, L->names[i])) {
+            size_t e = (size_t)((uintptr_t)L->names[i] - (uintptr_t)L->buf) + strlen(L->names[i]) + 1;
+            if (e > end) end = e;
+        }
+    return end;
+}
+
+static void resolve_list(const silc_engine *E, const silc_call *call, const char *const *chain, int nchain,
+                         blist *L)
+{
+    int distributed = E->dist && dist_call_has(call), i, c;
+    uint64_t generation = cfg_generation(E);
+    list_cache *C = nchain >= 1 && nchain <= 4 ? cfg_derived(E, sizeof *C) : NULL;
+    cached_list *e = NULL;
+    if (!C) { /* out of memory: every call resolves its list */
+        resolve_list_afresh(E, distributed, chain, nchain, L);
+        return;
+    }
+    for (i = 0; i < C->n && !e; i++) {
+        cached_list *x = &C->e[i];
+        if (x->nchain != nchain || x->distributed != distributed) continue;
+        for (c = 0; c < nchain && x->chain[c] == chain[c]; c++) continue;
+        if (c == nchain) e = x;
+    }
+    if (e && e->generation == generation) {
+        e->used = ++C->clock;
+        blist_copy(L, &e->L, e->buflen);
+        return;
+    }
+    resolve_list_afresh(E, distributed, chain, nchain, L);
+    if (!e) { /* a new chain: a free entry, or the least recently used one */
+        int old = 0;
+        if (C->n < LIST_CACHE) old = C->n++;
+        else
+            for (i = 1; i < C->n; i++)
+                if (C->e[i].used < C->e[old].used) old = i;
+        e = &C->e[old];
+        for (c = 0; c < nchain; c++) e->chain[c] = chain[c];
+        e->nchain = nchain;
+        e->distributed = distributed;
+    }
+    e->generation = generation;
+    e->used = ++C->clock;
+    e->buflen = buf_in_use(L);
+    blist_copy(&e->L, L, e->buflen);
 }
 
 static int provides(const ld_backend *b, int op)
@@ -795,7 +913,7 @@ static int run_one(silc_engine *E, silc_call *call, const ld_backend *b, int con
     call->out = NULL;
     if (call->op == SILC_OP_SOLVE) report_reset(E, call->report, condest_later);
     watch_begin(&watch, call);
-    t0 = util_now();
+    t0 = call->op == SILC_OP_SOLVE ? util_now() : 0; /* only a solve's report reads it */
     rc = b->backend->ops[call->op].run(call);
     watch_end(&watch, call);
     if (rc == SILC_OK) rc = host_check_result(call);
@@ -1006,7 +1124,9 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                 dist_walk_end(call, &swap);
                 continue;
             }
-            t0 = util_now();
+            /* Only an attempt that can hand over to another backend reports
+             * its time (hand_over); a clock read is 70-80 ns in a VM. */
+            t0 = fallback_left(L, i) ? util_now() : 0;
             {
                 /* An initial guess (in[2]) goes only to plugins that know of it (ABI 1.6). */
                 int hide_guess = call->nin == 3 && b->plugin && b->plugin->table &&

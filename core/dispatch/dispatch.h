@@ -37,6 +37,14 @@ int cfg_set_call_options(silc_engine *E, const char *text);
 void cfg_clear_call_options(silc_engine *E);
 /* Value of key, the narrowest scope first; NULL if unset anywhere. */
 const char *cfg_get(const silc_engine *E, const char *key);
+/* A number that changes with every change of any setting, in any scope (a
+ * `set`, a file, per-call options set or cleared): what a cache of things
+ * derived from settings compares to stay fresh. */
+uint64_t cfg_generation(const silc_engine *E);
+/* The dispatcher's cache (dispatch.c: resolved backend lists), kept with
+ * the options database and freed with it: bytes zeroed on the first call,
+ * the same block after; NULL when out of memory (then nothing is cached). */
+void *cfg_derived(const silc_engine *E, size_t bytes);
 /* Appends every key SILC knows here (the settings table, each dispatch
  * class, each loaded plugin's options) with the value in force and where it
  * came from -- default, FILE:LINE, session, call -- to b (`set`). */

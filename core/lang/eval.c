@@ -151,14 +151,33 @@ void ev_shape(const silc_value *v, char *out, size_t outlen)
     snprintf(out, outlen, "%lldx%lld", (long long)v->m, (long long)v->n);
 }
 
+/* Appends len bytes of s to out (of outlen bytes, *at used), cut as snprintf
+ * would cut, and keeps it terminated. */
+static void put_bytes(char *out, size_t outlen, size_t *at, const char *s, size_t len)
+{
+    if (*at + 1 >= outlen) return;
+    if (len > outlen - 1 - *at) len = outlen - 1 - *at;
+    memcpy(out + *at, s, len);
+    *at += len;
+    out[*at] = 0;
+}
+
+/* Copies and memcpy, not snprintf: every binary operation names its operands
+ * for messages it rarely prints, and printf's machinery was a tenth of a
+ * statement's fixed cost (docs/overhead.md, issue 30). */
 void ev_operand_name(const lang_ev *V, const ast_node *n, int side, char *out, size_t outlen)
 {
-    size_t len = n->end - n->start;
-    if (len < 24)
-        snprintf(out, outlen, "'%.*s'", (int)len, V->src + n->start);
-    else
-        snprintf(out, outlen, "%s", side == 0 ? "the left operand" : side == 1 ? "the right operand"
-                                                                                : "the argument");
+    size_t len = n->end - n->start, at = 0;
+    const char *word = side == 0 ? "the left operand" : side == 1 ? "the right operand" : "the argument";
+    if (!outlen) return;
+    out[0] = 0;
+    if (len < 24) {
+        put_bytes(out, outlen, &at, "'", 1);
+        put_bytes(out, outlen, &at, V->src + n->start, len);
+        put_bytes(out, outlen, &at, "'", 1);
+    } else {
+        put_bytes(out, outlen, &at, word, strlen(word));
+    }
 }
 
 static void add_backend(lang_ev *V, const char *name)
@@ -206,6 +225,8 @@ static void profile_call(lang_ev *V, const silc_call *call, const silc_report *r
     if (call->op == SILC_OP_SOLVE && rep->reused_factor) r->reused++;
 }
 
+static silc_value *initial_guess(lang_ev *V, const ast_node *s);
+
 int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
 {
     silc_engine *E = V->E;
@@ -221,7 +242,14 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         rep.rcond = -1;
         call->report = &rep;
         /* The statement's initial guess goes to the first solve whose
-         * solution has its shape (exec_assign, solve.initial_guess). */
+         * solution has its shape (exec_assign, solve.initial_guess); it is
+         * looked up at the statement's first solve, so that a statement
+         * without one pays no lookups for it. */
+        if (V->warm_for) {
+            V->warm_held = initial_guess(V, V->warm_for);
+            V->warm = V->warm_held;
+            V->warm_for = NULL;
+        }
         if (V->warm && call->nin == 2 && V->warm->m == call->in[0]->n && V->warm->n == call->in[1]->n) {
             call->in[2] = V->warm;
             call->nin = 3;
@@ -914,6 +942,9 @@ static char *stmt_text(const lang_ev *V, const ast_node *n)
     return s;
 }
 
+_Static_assert(sizeof ((eng_info *)0)->backends == sizeof ((lang_ev *)0)->backends,
+               "bind copies the statement's backends whole");
+
 /* Binds name to v (taking over the caller's reference) and records how it was computed. */
 static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *v, double t0)
 {
@@ -948,7 +979,7 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
     info.pending = V->pending; /* handed over */
     memset(&V->pending, 0, sizeof V->pending);
     info.seconds = util_now() - t0;
-    snprintf(info.backends, sizeof info.backends, "%s", V->backends);
+    memcpy(info.backends, V->backends, sizeof info.backends); /* the same size, terminated */
     if (V->E->dist) {
         info.ranks = V->E->dist->size;
         info.moved_matrix = V->E->dist->moved_matrix - V->moved0[0];
@@ -1128,11 +1159,12 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
     int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
     if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
     if (s->kind == ST_ASSIGN && !cur) {
-        silc_value *guess = initial_guess(V, s);
-        V->warm = guess;
+        V->warm_for = s; /* ev_run finds the initial guess at the first solve */
         rc = ev_expr_dist(V, s->kids[0], &v);
+        V->warm_for = NULL;
         V->warm = NULL;
-        val_release(guess);
+        val_release(V->warm_held);
+        V->warm_held = NULL;
         if (rc) return -1;
         return bind(V, s, s->name, v, t0);
     }
@@ -1590,8 +1622,11 @@ static int empty_loop_cancelled(lang_ev *V)
 
 static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
 {
-    double t0 = util_now();
+    /* The text's first statement starts at lang_exec's clock read: a clock
+     * read costs 70-80 ns in a VM (kvm-clock), a twentieth of a statement. */
+    double t0 = V->t_first > 0 ? V->t_first : util_now();
     int truth;
+    V->t_first = 0;
     *flow = FLOW_NEXT;
     V->has_solve = 0;
     V->backends[0] = 0;
@@ -1866,6 +1901,7 @@ int lang_exec(silc_engine *E, const char *text)
     memset(&V, 0, sizeof V);
     V.E = E;
     V.src = prog->text;
+    V.t_first = t0;
     {
         const char *p = cfg_get(E, "core.profile");
         V.profile = p && !strcmp(p, "on");
@@ -1889,6 +1925,6 @@ int lang_exec(silc_engine *E, const char *text)
     }
     eng_pending_release(&V.pending);
     free(V.bind_text);
-    tuner_observe(E, text, util_now() - t0);
+    tuner_observe_since(E, text, t0);
     return 0;
 }

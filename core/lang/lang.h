@@ -131,7 +131,10 @@ typedef struct lang_ev {
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
     int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
     const silc_value *warm; /* initial guess for the statement's solve (solve.initial_guess), or NULL */
+    const ast_node *warm_for; /* the assignment whose guess is looked up at its first solve, or NULL */
+    silc_value *warm_held; /* the reference to the guess that exec_assign releases */
     int profile;           /* core.profile = on when the exec began: time statements and calls */
+    double t_first;        /* the exec's start on the clock, for its first statement; then 0 */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

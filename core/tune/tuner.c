@@ -1184,7 +1184,9 @@ static void follow_config(silc_engine *E, tuner *T, const char *v)
     if (!T->enabled && end != v && !*end && n >= 1 && n != E->threads) ld_set_threads(E, (int)n);
 }
 
-void tuner_observe(silc_engine *E, const char *text, double seconds)
+/* tuner_observe, with the EXEC's seconds given, or (since_start) its start
+ * on util_now()'s clock: then the clock is read only by a tuner that is on. */
+static void observe(silc_engine *E, const char *text, double seconds, int since_start)
 {
     tuner *T = E->tuner;
     const char *cfg = cfg_get(E, "tune.threads");
@@ -1206,6 +1208,7 @@ void tuner_observe(silc_engine *E, const char *text, double seconds)
         classes_clear(T->pend, &T->npend);
         return;
     }
+    if (since_start) seconds = util_now() - seconds;
     h = tuner_hash(text);
     if (T->explicit_steps) {
         if (T->step_open) {
@@ -1253,6 +1256,16 @@ void tuner_observe(silc_engine *E, const char *text, double seconds)
             memcpy(T->seq, T->hist + T->nhist - k, (size_t)k * sizeof *T->seq);
         }
     }
+}
+
+void tuner_observe(silc_engine *E, const char *text, double seconds)
+{
+    observe(E, text, seconds, 0);
+}
+
+void tuner_observe_since(silc_engine *E, const char *text, double started)
+{
+    observe(E, text, started, 1);
 }
 
 /* A script's time loop (`while` in one EXEC, as `silc run` runs it): every
