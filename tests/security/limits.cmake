@@ -2,7 +2,8 @@
 # hostile PUTs, of a statement's temporaries and of the memo, the statement text cap,
 # --max-request-seconds (cooperative and forced), --max-cpu, a client gone
 # during a runaway, --max-clients against orphaned runaways, SIGTERM and
-# SIGKILL of silcd with runaways; the cases that apply again under
+# SIGKILL of silcd with runaways, factorizations against the session's limit;
+# the cases that apply again under
 # `mpirun -np 2 silcd --mpi`.  Each case (tests/security/limits.py) starts
 # its own server on a Unix socket in the build directory.
 if(NOT TARGET silcd OR NOT SILC_SYSTEM_PYTHON)
@@ -44,6 +45,10 @@ if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
                         peak_mpi statement_cap_mpi data_cap_mpi)
   if(TARGET silc_plugin_petsc)
     list(APPEND _limits_mpi_cases library_output_mpi)
+  endif()
+  # MUMPS's factorizations of distributed matrices (issue 27).
+  if(TARGET silc_plugin_mumps_mpi)
+    list(APPEND _limits_mpi_cases attached_mpi)
   endif()
   foreach(case ${_limits_mpi_cases})
     add_test(NAME security_limits_${case}
