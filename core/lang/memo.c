@@ -434,24 +434,23 @@ uint64_t memo_release_plan(const silc_engine *E, double room, strbuf *plan)
 
 int memo_release_named(silc_engine *E, const char *plan, char *err, size_t errlen)
 {
-    const char *line = plan;
-    while (line && *line) {
-        const char *end = strchr(line, '\n'), *name = line + 2;
+    char *copy = util_strdup(plan), *line, *end;
+    int rc = 0;
+    if (!copy) {
+        snprintf(err, errlen, "out of memory reading a release plan");
+        return -1;
+    }
+    for (line = copy; !rc && *line; line = end) {
         const silc_value *v = NULL;
-        char holder[256];
-        size_t len;
+        const char *holder = line + 2;
         int operand = line[0] - '0';
-        if (operand < 0 || operand > 3 || line[1] != ' ') {
+        if ((end = strchr(line, '\n')) != NULL) *end++ = '\0';
+        else end = line + strlen(line);
+        if (operand < 0 || operand > 3 || line[1] != ' ' || !*holder) {
             snprintf(err, errlen, "a malformed release plan line: '%.60s'", line);
-            return -1;
+            rc = -1;
+            break;
         }
-        len = end ? (size_t)(end - name) : strlen(name);
-        if (len == 0 || len >= sizeof holder) {
-            snprintf(err, errlen, "a malformed release plan line: '%.60s'", line);
-            return -1;
-        }
-        memcpy(holder, name, len);
-        holder[len] = '\0';
         if (operand == 0) {
             v = store_get(&E->store, holder);
         } else {
@@ -460,14 +459,15 @@ int memo_release_named(silc_engine *E, const char *plan, char *err, size_t errle
             if (r) v = operand == 1 ? r->info.pending.A : operand == 2 ? r->info.pending.B : r->info.pending.X;
         }
         if (!v) {
-            snprintf(err, errlen, "the release plan names %s '%s', which this rank does not hold",
+            snprintf(err, errlen, "the release plan names %s '%.200s', which this rank does not hold",
                      operand ? "an operand of the info record" : "the value", holder);
-            return -1;
+            rc = -1;
+        } else {
+            release_attached(v);
         }
-        release_attached(v);
-        line = end ? end + 1 : NULL;
     }
-    return 0;
+    free(copy);
+    return rc;
 }
 
 /* Inside a request the budget counts the values alive (bound, temporary,

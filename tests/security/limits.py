@@ -4,8 +4,9 @@ hostile PUTs that announce 2 GiB and send nothing, a runaway `while` loop
 against --max-request-seconds and --max-cpu, a client SIGKILLed during a
 runaway, two orphaned runaways against --max-clients 2, SIGTERM with
 runaways, a request's temporaries against --max-session-bytes, the memo's
-kept results and their factorizations against it, and a statement text
-over the cap.  Each case starts its own silcd (or `mpirun
+kept results and their factorizations against it, the factorizations of
+bound values (distributed ones under --mpi) against it, and a statement
+text over the cap.  Each case starts its own silcd (or `mpirun
 -np 2 silcd --mpi`) on a Unix socket in the build directory and stops it.
 
     python3 limits.py BINDINGS_DIR STATEDIR CASE SILCD [MPIRUN]
