@@ -59,4 +59,8 @@ if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
       ENVIRONMENT "${_limits_env};OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
       TIMEOUT 180 RUN_SERIAL TRUE)
   endforeach()
+  # Its MUMPS factorizations take seconds each under AddressSanitizer.
+  if(TARGET silc_plugin_mumps_mpi)
+    set_tests_properties(security_limits_attached_mpi PROPERTIES TIMEOUT 300)
+  endif()
 endif()
