@@ -164,7 +164,7 @@ int srv_watch_check(void *user, char *why, size_t whylen);
  * step (command), and the other ranks, in srv_follow, take the same step on
  * their engine of that session. */
 enum { SRV_CMD_OPEN = 1, SRV_CMD_CLOSE, SRV_CMD_PUT, SRV_CMD_GET, SRV_CMD_EXEC, SRV_CMD_DELETE,
-       SRV_CMD_STOP };
+       SRV_CMD_STOP, SRV_CMD_RELEASE /* text: rank 0's plan of what gives way (memo_release_plan) */ };
 struct silc_comm_ops;
 typedef struct srv_ranks {
     int rank, size;

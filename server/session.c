@@ -13,7 +13,9 @@
  * without a name, and the factorizations solves attached to what the
  * session holds: memo_held) is kept under max_session_bytes; the memo and
  * then the factorizations give way first (memo_release), so only the
- * values themselves can make a request fail.  A PUT is checked from its descriptor
+ * values themselves can make a request fail (under silcd --mpi, rank 0
+ * chooses what gives way and every rank lets it go together: memo_give_way).
+ * A PUT is checked from its descriptor
  * before its arrays are read; an EXEC runs against a snapshot of the
  * bindings (eng_snapshot: names to retained values, which is cheap because
  * values are immutable) and is rolled back whole if it leaves the session
@@ -117,13 +119,53 @@ static uint64_t session_bytes(const silc_engine *E)
     return memo_held(E, NULL);
 }
 
+/* A rank that cannot let go of what rank 0 planned would leave the ranks
+ * disagreeing on which factorizations live (a distributed one dies
+ * collectively): the job ends, as on other collective failures. */
+static void release_failed(unsigned long id, const char *why)
+{
+    srv_log(LOG_ERROR, "rank %d: session %lu: %s; ending the job (the ranks can no longer agree)",
+            srv_mpi->rank, id, why);
+    abort();
+}
+
 /* At the limit the memo and the factorizations go first: they are let go
  * until they fit what the bound values and more bytes about to be bound
- * leave. */
-static void memo_give_way(silc_engine *E, double more)
+ * leave.  Under silcd --mpi rank 0 makes the choice (memo_release_plan) and
+ * every rank lets go of the same holders, in the same order, here and in
+ * srv_follow: called only between commands, where every rank is. */
+static void memo_give_way(session *S, double more)
 {
+    double room = (double)srv_cfg.max_session_bytes - more;
+    strbuf plan;
+    char why[512];
     if (!srv_cfg.max_session_bytes) return;
-    memo_release(E, (double)srv_cfg.max_session_bytes - more);
+    if (!srv_mpi) {
+        memo_release(S->E, room);
+        return;
+    }
+    sb_init(&plan);
+    memo_release_plan(S->E, room, &plan);
+    if (plan.len) {
+        srv_mpi->command(srv_mpi, SRV_CMD_RELEASE, S->id, sb_str(&plan));
+        if (memo_release_named(S->E, sb_str(&plan), why, sizeof why)) release_failed(S->id, why);
+    }
+    sb_free(&plan);
+}
+
+/* What the session holds once the memo and the factorizations have given
+ * way (memo_give_way), measured before anything is let go: under silcd
+ * --mpi the verdict on a request comes first, and the ranks let go after
+ * it, together. */
+static uint64_t bytes_after_giving_way(const silc_engine *E)
+{
+    strbuf plan;
+    uint64_t held;
+    if (!srv_cfg.max_session_bytes) return session_bytes(E);
+    sb_init(&plan);
+    held = memo_release_plan(E, (double)srv_cfg.max_session_bytes, &plan);
+    sb_free(&plan);
+    return held;
 }
 
 static void part_done(reply_part *r)
@@ -315,8 +357,8 @@ static int do_exec(session *S, const char *text)
         srv_log(LOG_INFO, "session %lu: %s", S->id, S->err);
     }
     if (guarded) {
-        memo_give_way(E, 0);
-        used = session_bytes(E);
+        if (!srv_mpi) memo_give_way(S, 0);
+        used = srv_mpi ? bytes_after_giving_way(E) : session_bytes(E);
         /* A value refused at the peak fails the request like a limit
          * crossed at its end: rolled back whole. */
         over = stop || refused || (srv_cfg.max_session_bytes && used > srv_cfg.max_session_bytes);
@@ -347,6 +389,8 @@ static int do_exec(session *S, const char *text)
         } else {
             eng_snapshot_free(&snap);
         }
+        /* Every rank has the verdict and the same store: they let go now. */
+        if (srv_mpi) memo_give_way(S, 0);
     }
     /* A client that has gone is not answered: the session ends. */
     if (stop == SRV_STOP_GONE) return -1;
@@ -386,7 +430,7 @@ static int put_refusal(session *S, const proto_request *q)
     if (srv_cfg.max_session_bytes > 0) {
         old = store_get(&S->E->store, q->text);
         old_bytes = old ? val_bytes(old) : 0;
-        memo_give_way(S->E, cost - (double)old_bytes);
+        memo_give_way(S, cost - (double)old_bytes);
         used = session_bytes(S->E);
         if ((double)(used - old_bytes) + cost > (double)srv_cfg.max_session_bytes) {
             snprintf(S->err, sizeof S->err, "session memory limit exceeded: storing '%s' "
@@ -442,6 +486,8 @@ static int do_get(session *S, const char *name, int accept_complex)
     if (v && dist_is(v)) { /* its blocks, gathered to rank 0 (once: kept with the value) */
         srv_mpi->command(srv_mpi, SRV_CMD_GET, S->id, name);
         if (!(v = (silc_value *)dist_whole(S->E, v, 0))) return reply_error(S, S->E->err);
+        /* The copy kept counts with the value: factorizations make room. */
+        memo_give_way(S, 0);
     }
     if (v && !accept_complex && env_refuse_complex(name, v, S->err, sizeof S->err)) v = NULL;
     val_retain(v);
@@ -864,8 +910,8 @@ static void quiet(void *user, const char *text)
 
 /* The engine-side half of each of rank 0's steps above, in the same order,
  * so that both reach the same collectives: do_put's dist_share, do_get's
- * dist_whole, do_exec's statements and verdict, do_delete, the engine's
- * creation and end. */
+ * dist_whole, do_exec's statements and verdict, do_delete, memo_give_way's
+ * release, the engine's creation and end. */
 int srv_follow(void)
 {
     follower *list = NULL, **pp, *f;
@@ -920,6 +966,8 @@ int srv_follow(void)
         } else if (cmd == SRV_CMD_GET) {
             const silc_value *v = store_get(&E->store, text);
             if (v) dist_whole(E, v, 0);
+        } else if (cmd == SRV_CMD_RELEASE) {
+            if (memo_release_named(E, text ? text : "", err, sizeof err)) release_failed(id, err);
         } else if (cmd == SRV_CMD_DELETE) {
             store_remove(&E->store, text);
             eng_info_remove(E, text);

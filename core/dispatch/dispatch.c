@@ -836,7 +836,8 @@ int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
  * its allocator's count) grows across the call by what the call kept,
  * less the value arrays it made (its result, counted by the store); that
  * growth is charged to the attachments the call added (val_attach_charge),
- * shared if it added several.  What else the call kept for itself (a
+ * shared if it added several (a collective solve's: summed over the
+ * ranks).  What else the call kept for itself (a
  * plugin's pattern cache) is charged with them: an overestimate, on the
  * safe side.  silcd counts these charges against a session's limit, on
  * whatever value the session holds, and releases the least recently used
@@ -888,12 +889,18 @@ static int new_attachments(const silc_value *v, const val_attachment *before, in
     return count;
 }
 
-static void watch_end(attach_watch *w, const silc_call *call)
+/* ranks: the engine of a collective call, whose factorization lies in
+ * parts on every rank: each rank's charge is the sum of the parts (every
+ * rank reaches this reduction, whether or not its part attached), so that
+ * the one rank that measures a session (silcd --mpi's rank 0) counts all of
+ * it. */
+static void watch_end(attach_watch *w, const silc_call *call, silc_engine *ranks)
 {
     int64_t kept;
     int i, count = 0;
     if (!w->on) return;
     kept = heap_in_use() - w->heap - (val_live_bytes() - w->live);
+    if (ranks) kept = (int64_t)dist_sum(ranks, kept > 0 ? (double)kept : 0);
     for (i = 0; i < 3 && i < call->nin; i++)
         if (!(i > 0 && call->in[i] == call->in[0])) count += new_attachments(call->in[i], w->before[i], 0, 0);
     if (!count) return;
@@ -915,7 +922,7 @@ static int run_one(silc_engine *E, silc_call *call, const ld_backend *b, int con
     watch_begin(&watch, call);
     t0 = call->op == SILC_OP_SOLVE ? util_now() : 0; /* only a solve's report reads it */
     rc = b->backend->ops[call->op].run(call);
-    watch_end(&watch, call);
+    watch_end(&watch, call, ((const host_call_ctx *)call->host_private)->collective ? E : NULL);
     if (rc == SILC_OK) rc = host_check_result(call);
     if (rc == SILC_OK && call->op == SILC_OP_SOLVE) {
         call->report->seconds = util_now() - t0;

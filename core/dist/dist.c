@@ -104,6 +104,12 @@ int dist_size(const silc_engine *E)
     return E && E->dist ? E->dist->size : 1;
 }
 
+double dist_sum(silc_engine *E, double x)
+{
+    if (E && E->dist && E->dist->size > 1) reduce(E->dist, &x, 1, 0);
+    return x;
+}
+
 static uint64_t call_hash(const char *what, const char *text);
 
 /* A failure every rank met with the same message is the statement's, not a

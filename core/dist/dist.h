@@ -60,6 +60,8 @@ void dist_detach(silc_engine *E);
 int dist_rank(const silc_engine *E);
 int dist_size(const silc_engine *E);
 
+/* Collective: the sum of x over the ranks (x without a communicator). */
+double dist_sum(silc_engine *E, double x);
 /* Agreement after a step every rank ran: rc is this rank's status.  Returns
  * 0 when every rank succeeded; else the status of the lowest failing rank,
  * whose message every rank's E->err then holds, prefixed "rank r of N: ". */

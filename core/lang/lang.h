@@ -227,7 +227,7 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
  * bound values, per name; those of the memo's results no name holds; and
  * the plugin state (factorizations) that solves attached to any of these
  * or to the operands an `info` record keeps, each value's once, as the
- * dispatcher measured it (none on an SPMD engine). */
+ * dispatcher measured it (on an SPMD engine, this rank's part). */
 typedef struct memo_holdings {
     uint64_t bound, memo_arrays, attached;
 } memo_holdings;
@@ -236,8 +236,18 @@ uint64_t memo_held(const silc_engine *E, memo_holdings *h);
 /* Lets go until memo_held(E) <= room, or nothing is left to let go: the
  * memo's results first, then attached state (no name's before a bound
  * value's), least recently used first.  Bound values stay; when they alone
- * are over room nothing is let go (the caller refuses). */
+ * are over room nothing is let go (the caller refuses).  Not on an SPMD
+ * engine, whose ranks must let go together: */
 void memo_release(silc_engine *E, double room);
+/* There (silcd --mpi), rank 0 makes memo_release's choice without letting
+ * anything go: what would go is appended to plan, one holder a line ("0
+ * NAME": the value bound to NAME; "1 NAME" .. "3 NAME": operand A, B, X of
+ * NAME's info record), in order, and the bytes held after it are returned.
+ * Every rank then lets go of the plan's holders, in its order, with
+ * memo_release_named at a point all reach: 0, or -1 with err when this
+ * engine lacks a holder the plan names (the ranks disagree). */
+uint64_t memo_release_plan(const silc_engine *E, double room, strbuf *plan);
+int memo_release_named(silc_engine *E, const char *plan, char *err, size_t errlen);
 /* Under a value budget (val_budget_set: inside a silcd request), lets go as
  * memo_release does until the attached state and need more bytes fit what
  * the budget has left (it counts the values themselves).  Nothing without

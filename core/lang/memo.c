@@ -257,9 +257,19 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
  * measured across the plugin call that made it (val_attach_charge,
  * dispatch.c).  A value held twice (two names, a name and a record) has
  * its attachments counted once: the walk stamps each value it counted.
- * On an SPMD engine attached state is neither counted nor let go here: a
- * distributed factorization is released collectively, by every rank at
- * once, which this walk of one rank cannot arrange. */
+ * A distributed value's attachments are its own (a collective backend's
+ * factorization, this rank's part of it) and those of its gathered whole
+ * copy (a sequential backend's).
+ *
+ * On an SPMD engine (silcd --mpi) the same walk makes the same choice, but
+ * nothing may be let go where it is made: a distributed factorization dies
+ * collectively (MUMPS's JOB=-2, PETSc's destroy), on every rank at once,
+ * and each rank measures its own part.  So rank 0's walk only plans
+ * (memo_release_plan): each value it would let go is counted as gone and
+ * named by what holds it on every rank -- a name, or an `info` record's
+ * operand -- since value ids differ between ranks; silcd sends the plan to
+ * every rank, and each lets go of the same holders in the same order
+ * (memo_release_named).  The memo keeps nothing there (key_of). */
 
 typedef struct holder_walk {
     memo_holdings h;
@@ -268,6 +278,10 @@ typedef struct holder_walk {
     const silc_value *value;  /* else the value whose attachments go first, NULL: none */
     int value_bound;
     uint64_t value_used;
+    const char *holder;       /* what holds value on every rank: a name, or an info record's */
+    int operand;              /* 0: value is bound to holder; 1-3: the record's pending A, B, X */
+    const silc_value **gone;  /* planning (SPMD): the values in the plan, counted as let go */
+    size_t ngone, capgone;
 } holder_walk;
 
 static uint64_t holder_walks; /* stamps values counted by the current walk (silc_value.counted) */
@@ -280,22 +294,48 @@ static int operand_of(const silc_call *call, const silc_value *v)
     return 0;
 }
 
-/* Counts v's attachments once per walk; a candidate to let go unless the
- * coming call needs it.  own: it is a memo result (dropped as a whole). */
-static void count_attached(holder_walk *w, const silc_value *v, uint64_t stamp, int bound, int own)
+static int planned(const holder_walk *w, const silc_value *v)
 {
+    size_t i;
+    for (i = 0; i < w->ngone; i++)
+        if (w->gone[i] == v) return 1;
+    return 0;
+}
+
+/* v's gathered whole copy, if it is distributed and has one. */
+static const silc_value *whole_copy(const silc_value *v)
+{
+    return v && v->dist ? v->dist->whole : NULL;
+}
+
+/* Counts v's attachments (and its whole copy's) once per walk; a candidate
+ * to let go unless the coming call needs it.  own: it is a memo result
+ * (dropped as a whole).  holder, operand: what holds v (holder_walk). */
+static void count_attached(holder_walk *w, const silc_value *v, uint64_t stamp, int bound, int own,
+                           const char *holder, int operand)
+{
+    const silc_value *c = whole_copy(v);
     int64_t attached;
     uint64_t used;
     if (!v || v->counted == stamp) return;
     ((silc_value *)v)->counted = stamp; /* bookkeeping, not contents */
-    if ((attached = val_attach_bytes(v)) <= 0) return;
+    if (planned(w, v)) return;          /* the plan lets it go */
+    attached = val_attach_bytes(v);
+    used = val_attach_last_use(v);
+    if (c && c->counted != stamp) {
+        ((silc_value *)c)->counted = stamp;
+        attached += val_attach_bytes(c);
+        if (val_attach_last_use(c) > used) used = val_attach_last_use(c);
+    }
+    if (attached <= 0) return;
     w->h.attached += (uint64_t)attached;
     if (own || operand_of(w->keep, v)) return;
-    used = val_attach_last_use(v);
     if (!w->value || (w->value_bound && !bound) || (w->value_bound == bound && used < w->value_used)) {
         w->value = v;
         w->value_bound = bound;
         w->value_used = used;
+        w->holder = holder;
+        w->operand = operand;
     }
 }
 
@@ -305,7 +345,6 @@ static void walk(const silc_engine *E, holder_walk *w)
     const eng_info_entry *r;
     const store_entry *e;
     uint64_t stamp = ++holder_walks;
-    int attached = !E->dist;
     size_t b;
     int i;
     memset(&w->h, 0, sizeof w->h);
@@ -314,25 +353,32 @@ static void walk(const silc_engine *E, holder_walk *w)
     for (b = 0; b < E->store.nbuckets; b++)
         for (e = E->store.buckets[b]; e; e = e->next) {
             w->h.bound += val_bytes(e->value);
-            if (attached) count_attached(w, e->value, stamp, 1, 0);
+            count_attached(w, e->value, stamp, 1, 0, e->name, 0);
         }
     for (i = 0; M && i < M->n; i++) {
         const memo_slot *s = &M->slot[i];
         if (!s->result || s->result->bindings > 0) continue; /* a name holds it: counted above */
         w->h.memo_arrays += val_bytes(s->result);
-        if (attached) count_attached(w, s->result, stamp, 0, 1);
+        count_attached(w, s->result, stamp, 0, 1, NULL, 0);
         if (!operand_of(w->keep, s->result) && (w->slot < 0 || s->used < M->slot[w->slot].used)) w->slot = i;
     }
-    for (r = attached ? E->infos : NULL; r; r = r->next) {
-        count_attached(w, r->info.pending.A, stamp, 0, 0);
-        count_attached(w, r->info.pending.B, stamp, 0, 0);
-        count_attached(w, r->info.pending.X, stamp, 0, 0);
+    for (r = E->infos; r; r = r->next) {
+        count_attached(w, r->info.pending.A, stamp, 0, 0, r->name, 1);
+        count_attached(w, r->info.pending.B, stamp, 0, 0, r->name, 2);
+        count_attached(w, r->info.pending.X, stamp, 0, 0, r->name, 3);
     }
 }
 
 static uint64_t held_total(const memo_holdings *h)
 {
     return h->bound + h->memo_arrays + h->attached;
+}
+
+/* Lets go of v's charged attachments and of its whole copy's. */
+static void release_attached(const silc_value *v)
+{
+    val_attach_release(v);
+    val_attach_release(whole_copy(v));
 }
 
 /* Drops the walk's first candidate: 0 if there was none. */
@@ -343,10 +389,29 @@ static int let_go(silc_engine *E, const holder_walk *w)
         return 1;
     }
     if (w->value) {
-        val_attach_release(w->value);
+        release_attached(w->value);
         return 1;
     }
     return 0;
+}
+
+/* Planning: the walk's first candidate goes into plan (an "OPERAND HOLDER"
+ * line) and counts as gone from the next walk on; 0 if there was none.
+ * Only a value's attachments can be named on every rank (the memo, which
+ * could offer a slot, keeps nothing on an SPMD engine). */
+static int plan_next(holder_walk *w, strbuf *plan)
+{
+    if (!w->value || !w->holder) return 0;
+    if (w->ngone == w->capgone) {
+        size_t cap = w->capgone ? 2 * w->capgone : 8;
+        const silc_value **g = realloc(w->gone, cap * sizeof *g);
+        if (!g) return 0; /* out of memory: the plan stops short; the caller sees what is left */
+        w->gone = g;
+        w->capgone = cap;
+    }
+    w->gone[w->ngone++] = w->value;
+    sb_printf(plan, "%d %s\n", w->operand, w->holder);
+    return 1;
 }
 
 uint64_t memo_held(const silc_engine *E, memo_holdings *h)
@@ -358,15 +423,71 @@ uint64_t memo_held(const silc_engine *E, memo_holdings *h)
     return held_total(&w.h);
 }
 
-void memo_release(silc_engine *E, double room)
+/* The one choice of what gives way (the top of this part): the walk's first
+ * candidate goes until the session fits room -- let go at once, or, with a
+ * plan, written to it and counted as gone.  Returns what the session holds
+ * after that. */
+static uint64_t give_way(silc_engine *E, double room, strbuf *plan)
 {
     holder_walk w;
+    uint64_t held;
     memset(&w, 0, sizeof w);
     walk(E, &w);
     /* The values alone over: the caller refuses; letting go would lose
      * the factorizations for nothing. */
-    if ((double)w.h.bound > room) return;
-    while ((double)held_total(&w.h) > room && let_go(E, &w)) walk(E, &w);
+    if ((double)w.h.bound <= room)
+        while ((double)held_total(&w.h) > room && (plan ? plan_next(&w, plan) : let_go(E, &w))) walk(E, &w);
+    held = held_total(&w.h);
+    free(w.gone);
+    return held;
+}
+
+void memo_release(silc_engine *E, double room)
+{
+    give_way(E, room, NULL);
+}
+
+uint64_t memo_release_plan(const silc_engine *E, double room, strbuf *plan)
+{
+    return give_way((silc_engine *)E, room, plan); /* with a plan nothing is let go */
+}
+
+int memo_release_named(silc_engine *E, const char *plan, char *err, size_t errlen)
+{
+    char *copy = util_strdup(plan), *line, *end;
+    int rc = 0;
+    if (!copy) {
+        snprintf(err, errlen, "out of memory reading a release plan");
+        return -1;
+    }
+    for (line = copy; !rc && *line; line = end) {
+        const silc_value *v = NULL;
+        const char *holder = line + 2;
+        int operand = line[0] - '0';
+        if ((end = strchr(line, '\n')) != NULL) *end++ = '\0';
+        else end = line + strlen(line);
+        if (operand < 0 || operand > 3 || line[1] != ' ' || !*holder) {
+            snprintf(err, errlen, "a malformed release plan line: '%.60s'", line);
+            rc = -1;
+            break;
+        }
+        if (operand == 0) {
+            v = store_get(&E->store, holder);
+        } else {
+            const eng_info_entry *r;
+            for (r = E->infos; r && strcmp(r->name, holder) != 0; r = r->next) {}
+            if (r) v = operand == 1 ? r->info.pending.A : operand == 2 ? r->info.pending.B : r->info.pending.X;
+        }
+        if (!v) {
+            snprintf(err, errlen, "the release plan names %s '%.200s', which this rank does not hold",
+                     operand ? "an operand of the info record" : "the value", holder);
+            rc = -1;
+        } else {
+            release_attached(v);
+        }
+    }
+    free(copy);
+    return rc;
 }
 
 /* Inside a request the budget counts the values alive (bound, temporary,

@@ -2,7 +2,8 @@
 # hostile PUTs, of a statement's temporaries and of the memo, the statement text cap,
 # --max-request-seconds (cooperative and forced), --max-cpu, a client gone
 # during a runaway, --max-clients against orphaned runaways, SIGTERM and
-# SIGKILL of silcd with runaways; the cases that apply again under
+# SIGKILL of silcd with runaways, factorizations against the session's limit;
+# the cases that apply again under
 # `mpirun -np 2 silcd --mpi`.  Each case (tests/security/limits.py) starts
 # its own server on a Unix socket in the build directory.
 if(NOT TARGET silcd OR NOT SILC_SYSTEM_PYTHON)
@@ -45,6 +46,10 @@ if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
   if(TARGET silc_plugin_petsc)
     list(APPEND _limits_mpi_cases library_output_mpi)
   endif()
+  # MUMPS's factorizations of distributed matrices (issue 27).
+  if(TARGET silc_plugin_mumps_mpi)
+    list(APPEND _limits_mpi_cases attached_mpi)
+  endif()
   foreach(case ${_limits_mpi_cases})
     add_test(NAME security_limits_${case}
              COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
@@ -54,4 +59,8 @@ if(TARGET silc_mpi AND MPIEXEC_EXECUTABLE)
       ENVIRONMENT "${_limits_env};OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
       TIMEOUT 180 RUN_SERIAL TRUE)
   endforeach()
+  # Its MUMPS factorizations take seconds each under AddressSanitizer.
+  if(TARGET silc_plugin_mumps_mpi)
+    set_tests_properties(security_limits_attached_mpi PROPERTIES TIMEOUT 300)
+  endif()
 endif()
