@@ -1236,7 +1236,8 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
      * lower bound of cond_1 that tells whether the estimate is urgent, and a
      * real estimate made later goes on from it (est_y0).  The complex
      * estimator takes no block: its start rides along only for the bound. */
-    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate);
+    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate) &&
+           !(condest_later(call) && r->condest_later == 2); /* on_request wants no bound */
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * (size_t)w * sizeof *rhs))) {
         host->release(X);
