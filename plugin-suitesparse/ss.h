@@ -172,8 +172,9 @@ void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t
  * on olm1000, cond_1 3e6).  The estimator's start block solved (e/n and
  * the alternating vector) gives a rigorous bound instead, ||A||_1 max_j
  * ||A^-1 x_j||_1 / ||x_j||_1, which settles it by the host's rule for
- * bounds (the reference's and MUMPS's).  Both columns: e/n alone is 1e4
- * times weaker on Hilbert matrices (A^-1 e cancels), whose warnings were
+ * bounds (the reference's and MUMPS's).  Both columns: e/n alone is 4e5
+ * to 1e7 times weaker on the Hilbert matrices of order 9-11 (A^-1 e
+ * cancels; the block's bound is within 2.8 of cond_1), whose warnings were
  * then lost (test_extremes).  The solved block is kept in
  * fi->start_solved, the estimate's start when it is made (two solves
  * then).  ss_start_due: the bound is wanted after this call's solve;

@@ -509,7 +509,10 @@ static void report_reset(silc_engine *E, silc_report *r, int later)
     r->forward_bound = -1;
     r->condest_off = c && !strcmp(c, "off");
     /* 2: on_request, whose estimate is never made at once, wants no bound */
-    r->condest_later = !later ? 0 : !c || !strcmp(c, "auto") || !strcmp(c, "on") ? 1 : !strcmp(c, "on_request") ? 2 : 0;
+    r->condest_later = !later                                             ? 0
+                       : !c || !strcmp(c, "auto") || !strcmp(c, "on") ? 1
+                       : !strcmp(c, "on_request")                     ? 2
+                                                                      : 0;
 }
 
 /* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
@@ -594,6 +597,8 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * Laplacian, 2 against 1.5e11 on fs_183_6), but every shared matrix that
  * warns has one of 1.2e7 or more: 1e6 keeps a margin of 12 (a heuristic,
  * documented as such; `now` is the setting that never relies on it).
+ * Real UMFPACK and KLU answer a ratio above it with the start block's L
+ * (ss.h, SILC_CONDEST_PIVOT_HINT), which then decides by the rule for L.
  * CHOLMOD's, (max L_ii / min L_ii)^2 of A = L L', is a rigorous lower
  * bound of cond_2(A) <= cond_1(A) and comes as condest_lower (cholmod.c);
  * the estimate is at most 740 times it on the shared spd matrices. */
@@ -681,9 +686,9 @@ static int condest_urgent(const silc_call *call)
  * once, as an L below the threshold makes it: "singular" could fire. */
 static int condest_settled(const silc_report *r)
 {
-    double lower = r->condest_lower;
-    if (lower >= 1 / DBL_EPSILON) return 1;
-    return lower >= DISP_CONDEST_WARN_AT && lower * DISP_CONDEST_LOWER_SLACK < 1 / DBL_EPSILON;
+    double eps_lower = r->condest_lower * DBL_EPSILON; /* warn_condition_of's tests */
+    if (eps_lower >= 1) return 1;
+    return eps_lower > 1e-4 && eps_lower * DISP_CONDEST_LOWER_SLACK < 1;
 }
 
 /* A solve whose backend left its estimate out (condest_deferred = 1): made
