@@ -131,11 +131,6 @@ typedef struct ref_factor {
     int64_t m, n;
     void *data;
     int (*solve)(void *data, double *x, int trans, double *work);
-    /* x, y := M^-1 x, M^-1 y in one sweep over the factor, each exactly as
-     * solve() rounds it, or NULL: where a solve costs a good share of the
-     * factorization (the band LU's, half of it on olm1000) the pair shares
-     * the factor's loads and overlaps the two divisions per row. */
-    int (*solve_pair)(void *data, double *x, double *y, double *work);
     void (*destroy)(void *data);
     int64_t work_len;       /* doubles of scratch solve() needs */
     int w;                  /* doubles per entry: 1 real, 2 complex */

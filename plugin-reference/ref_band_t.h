@@ -59,40 +59,6 @@ static int FN(band_lu_solve)(void *p, double *xd, int trans, double *work)
     return 0;
 }
 
-/* band_lu_solve (trans = 0) on two vectors at once (ref_factor.solve_pair):
- * the same operations in the same order on each. */
-static int FN(band_lu_solve_pair)(void *p, double *xd, double *yd, double *work)
-{
-    const FN(band_lu) *f = p;
-    ENT *x = (ENT *)xd, *y = (ENT *)yd;
-    int64_t n = f->n, kl = f->kl, kv = f->kl + f->ku;
-    (void)work;
-    for (int64_t j = 0; j < n; j++) {
-        int64_t q = f->piv[j];
-        ENT s = x[q], t = y[q];
-        x[q] = x[j], y[q] = y[j];
-        x[j] = s, y[j] = t;
-        int64_t hi = j + kl < n - 1 ? j + kl : n - 1;
-        for (int64_t i = j + 1; i <= hi; i++) {
-            ENT l = AB(f, i, j);
-            x[i] -= l * s;
-            y[i] -= l * t;
-        }
-    }
-    for (int64_t j = n - 1; j >= 0; j--) {
-        ENT d = AB(f, j, j);
-        x[j] /= d;
-        y[j] /= d;
-        ENT s = x[j], t = y[j];
-        for (int64_t i = j - kv > 0 ? j - kv : 0; i < j; i++) {
-            ENT u = AB(f, i, j);
-            x[i] -= u * s;
-            y[i] -= u * t;
-        }
-    }
-    return 0;
-}
-
 int FN(ref_band_lu)(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, char *msg, size_t msglen)
 {
     int64_t n = A->n;
@@ -153,7 +119,6 @@ int FN(ref_band_lu)(const silc_view *A, int64_t kl, int64_t ku, ref_factor *F, c
     }
     F->data = f;
     F->solve = FN(band_lu_solve);
-    F->solve_pair = FN(band_lu_solve_pair);
     F->destroy = FN(band_lu_free);
     F->w = ENT_W;
     snprintf(F->method, sizeof F->method, FIELD_NAME "band LU, partial pivoting (kl=%lld, ku=%lld)", (long long)kl,

@@ -107,15 +107,15 @@ static int make_estimate(ref_factor *F, int64_t n, int w, double norm1)
 
 /* ||A||_1 max_j ||A^-1 x_j||_1 / ||x_j||_1 over the estimator's two start
  * vectors (e/n and the alternating one; complex: with imaginary parts 0,
- * norms by modulus): a lower bound of cond_1(A) for two column solves (one
- * sweep over a band LU: F->solve_pair), a fraction of the estimate's, that
- * tells the host whether an owed estimate must be made at once
- * (condest_lower); -1 when out of memory.  A real factor keeps the solved
- * vectors (F->est_start), which the estimate, when made, starts from
- * instead of solving them again.  work: F's solve workspace. */
+ * norms by modulus): a lower bound of cond_1(A) for two column solves, a
+ * fraction of the estimate's, that tells the host whether an owed estimate
+ * must be made at once (condest_lower); -1 when out of memory.  A real
+ * factor keeps the solved vectors (F->est_start), which the estimate, when
+ * made, starts from instead of solving them again.  work: F's solve
+ * workspace. */
 static double start_bound(ref_factor *F, int64_t n, int w, double norm1, double *work)
 {
-    double *X = ref_alloc((size_t)(2 * n * w), sizeof(double)), best = 0, sx[2] = {0, 0};
+    double *X = ref_alloc((size_t)(2 * n * w), sizeof(double)), best = 0;
     int solved = 0;
     if (!X || n == 0) {
         ref_free(X);
@@ -124,18 +124,13 @@ static double start_bound(ref_factor *F, int64_t n, int w, double norm1, double 
     ref_inv_norm1_start(n, 2, X);
     if (w == 2)
         for (int64_t i = 2 * n - 1; i >= 0; i--) X[2 * i] = X[i], X[2 * i + 1] = 0;
-    for (int j = 0; j < 2; j++)
-        for (int64_t i = 0; i < n; i++)
-            sx[j] += w == 2 ? hypot(X[(j * n + i) * 2], X[(j * n + i) * 2 + 1]) : fabs(X[j * n + i]);
-    if (n > 1 && F->solve_pair) /* both in one sweep over the factor (band LU) */
-        solved = F->solve_pair(F->data, X, X + n * w, work) ? 0 : 2;
-    else
-        for (int j = 0; j < 2 && n > 1 && !F->solve(F->data, X + j * n * w, 0, work); j++) solved++;
-    for (int j = 0; j < solved; j++) {
-        const double *x = X + j * n * w;
-        double sy = 0;
+    for (int j = 0; j < 2 && n > 1; j++) {
+        double *x = X + j * n * w, sx = 0, sy = 0;
+        for (int64_t i = 0; i < n; i++) sx += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
+        if (F->solve(F->data, x, 0, work)) break;
+        solved++;
         for (int64_t i = 0; i < n; i++) sy += w == 2 ? hypot(x[2 * i], x[2 * i + 1]) : fabs(x[i]);
-        if (sy / sx[j] > best) best = sy / sx[j];
+        if (sy / sx > best) best = sy / sx;
     }
     ref_free(F->est_start);
     F->est_start = NULL;
