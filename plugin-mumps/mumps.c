@@ -1291,7 +1291,8 @@ static int solve_whole(silc_call *call, mumps_factor *F, const settings *s, cons
      * solves with one factorization would pay EST_COLS more columns in
      * every solve phase (about 1.3x the one-column solve phase on the 200^2
      * diffusion matrix, in a noisy measurement). */
-    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate) && !F->est_y0;
+    fold = condest_wanted(call, s, F) && !analyse && (!F->cplx || !estimate) && !F->est_y0 &&
+           !(condest_later(call) && r->condest_later == 2); /* on_request wants no bound */
     rhs = o.val;
     if (fold && !(rhs = host->alloc((size_t)n * (size_t)(b->n + EST_COLS) * (size_t)w * sizeof *rhs))) {
         host->release(X);

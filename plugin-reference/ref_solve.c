@@ -277,7 +277,8 @@ int ref_op_solve(silc_call *call)
     if (F->cond == 0.0 && wanted && later && attached) {
         rep->condest_deferred = 1;
         rep->condest_solves = (double)REF_EST_SOLVES / (double)(nrhs > 0 ? nrhs : 1);
-        if ((rep->condest_lower = start_bound(F, n, w, P->norm1, work)) < 0) {
+        if (rep->condest_later != 2 && /* on_request wants no bound */
+            (rep->condest_lower = start_bound(F, n, w, P->norm1, work)) < 0) {
             st = ref_nomem(call); /* without the hint an ill-conditioned matrix could go unwarned */
             goto done;
         }

@@ -81,6 +81,7 @@ static void kl_factor_free(void *p)
     else kl_numeric_free(F->num);
     ss_sym_release(F->entry);
     if (F->local) kl_symbolic_free(F->local);
+    ss_host->free(F->info.start_solved);
     ss_host->free(F);
 }
 
@@ -202,7 +203,7 @@ int ss_klu_solve(silc_call *call)
     silc_value *out;
     double t0, *fold;
     int64_t n, k;
-    int rc, condest;
+    int rc, condest, start;
     if (ss_is_complex(call->in[0])) return ss_klu_solve_complex(call);
     if ((rc = ss_square_solve_begin(call, &a, &b, &condest))) return rc;
     n = a.n;
@@ -228,7 +229,9 @@ int ss_klu_solve(silc_call *call)
      * solved in the same call. */
     if (!(out = ss_host->dense_new_uninit(n, k))) return ss_nomem(call, "KLU result");
     ss_host->view(out, &o);
-    fold = F && ss_cond_due(call, condest, &F->info) ? ss_rhs_with_start(&b, n) : NULL;
+    /* so does the block for an owed estimate's bound (ss_start_due) */
+    start = F && ss_start_due(call, condest, &F->info);
+    fold = F && (start || ss_cond_due(call, condest, &F->info)) ? ss_rhs_with_start(&b, n) : NULL;
     if (!fold) ss_rhs_copy(&b, o.val);
     kl_common(&c);
     if (n > 0 && (k > 0 || fold) &&
@@ -241,7 +244,8 @@ int ss_klu_solve(silc_call *call)
         kl_apply u;
         memcpy(o.val, fold, (size_t)(n * k) * sizeof(double));
         u.F = F, u.n = n;
-        ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info, fold + n * k);
+        if (start) ss_keep_start(&F->info, n, fold + n * k);
+        else ss_square_cond(call, condest, n, kl_apply_inv, &u, &F->info, fold + n * k);
         ss_host->free(fold);
     }
     call->out = out;

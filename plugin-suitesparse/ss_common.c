@@ -201,13 +201,61 @@ int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi)
     return !fi->estimated && ss_condest_wanted(call, mode) && !ss_condest_later(call);
 }
 
+/* ||A||_1 max_j ||Y_j||_1 for the start block X (n x SS_EST_COLS, each
+ * column of 1-norm 1: e/n and the alternating vector) solved into Y: a
+ * lower bound of cond_1(A), and of the estimate, which starts from X and
+ * never decreases. */
+static double start_bound(silc_call *call, int64_t n, const double *Y)
+{
+    double best = 0;
+    for (int j = 0; j < SS_EST_COLS; j++) {
+        double sy = 0;
+        for (int64_t i = 0; i < n; i++) sy += fabs(Y[i + j * n]);
+        if (sy > best || isnan(sy)) best = sy;
+    }
+    return silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * best;
+}
+
 void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t k)
 {
+    silc_view a;
     if (fi->estimated || !ss_condest_wanted(call, mode) || !ss_condest_later(call)) return;
     call->report->condest_deferred = 1;
     /* per column: KLU's and CHOLMOD's solves cost their columns' passes
-     * over the factors, UMFPACK's solve one column a call */
-    call->report->condest_solves = (double)SS_EST_COLUMN_SOLVES / (double)(k > 0 ? k : 1);
+     * over the factors, UMFPACK's solve one column a call; a kept start
+     * saves its two */
+    call->report->condest_solves = (double)(SS_EST_COLUMN_SOLVES - (fi->start_solved ? SS_EST_COLS : 0)) /
+                                   (double)(k > 0 ? k : 1);
+    if (!fi->start_solved) return;
+    ss_host->view(call->in[0], &a);
+    call->report->condest_lower = start_bound(call, a.n, fi->start_solved);
+}
+
+int ss_start_due(const silc_call *call, int mode, const ss_factor_info *fi)
+{
+    /* condest_later 2: on_request wants no bound */
+    return !fi->estimated && !fi->start_solved && ss_condest_wanted(call, mode) && ss_condest_later(call) &&
+           call->report->condest_later != 2 && !ss_condest_only(call) && fi->pivot_ratio > SILC_CONDEST_PIVOT_HINT;
+}
+
+void ss_keep_start(ss_factor_info *fi, int64_t n, const double *Y)
+{
+    ss_host->free(fi->start_solved);
+    if ((fi->start_solved = ss_host->alloc((size_t)(n > 0 ? n : 1) * SS_EST_COLS * sizeof *Y)))
+        memcpy(fi->start_solved, Y, (size_t)n * SS_EST_COLS * sizeof *Y);
+}
+
+void ss_solve_start(ss_factor_info *fi, int64_t n, ss_block_fn apply, void *ctx)
+{
+    double *y = ss_host->alloc((size_t)(n > 0 ? n : 1) * SS_EST_COLS * sizeof *y);
+    if (!y) return;
+    ss_host->inv_norm1_start(n, SS_EST_COLS, y);
+    if (apply(ctx, y, SS_EST_COLS, 0)) { /* a solve failed: no bound, the ratio decides */
+        ss_host->free(y);
+        return;
+    }
+    ss_host->free(fi->start_solved);
+    fi->start_solved = y;
 }
 
 int ss_estimate_alone(silc_call *call, int mode, int64_t n, ss_block_fn apply, void *ctx, ss_factor_info *fi)
@@ -247,7 +295,10 @@ void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, voi
     double inv = -1, *start = NULL;
     size_t len;
     if (!ss_cond_due(call, mode, fi)) return;
-    if (!Y0) { /* not folded into the user's solve: the start is solved here */
+    if (!Y0 && fi->start_solved) { /* solved for the bound (ss_start_due) */
+        start = fi->start_solved;
+        fi->start_solved = NULL;
+    } else if (!Y0) { /* not folded into the user's solve: the start is solved here */
         if (!(start = ss_host->alloc((size_t)n * SS_EST_COLS * sizeof *start))) return;
         ss_host->inv_norm1_start(n, SS_EST_COLS, start);
         if (apply(ctx, start, SS_EST_COLS, 0)) {
@@ -255,6 +306,8 @@ void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, voi
             return; /* a solve failed: no estimate */
         }
     }
+    ss_host->free(fi->start_solved);
+    fi->start_solved = NULL;
     /* The better start goes on alone: one column per solve from here. */
     inv = ss_host->inv_norm1_est_block(n, 1, SS_EST_STEPS, apply, ctx, best_start(n, Y0 ? Y0 : start));
     ss_host->free(start);

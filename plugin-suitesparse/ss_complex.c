@@ -238,7 +238,7 @@ static int complex_solve(silc_call *call, const z_ops *ops)
             r->condest_solves = (double)SS_COMPLEX_EST_SOLVES / (double)(b.n > 0 ? b.n : 1);
             if (ops->owed == Z_DIAG_BOUND) {
                 r->condest_lower = fi->pivot_ratio; /* 0, none: the host's own bound */
-            } else if (a.n > 0) {
+            } else if (a.n > 0 && r->condest_later != 2) { /* 2: on_request wants no bound */
                 /* without the bound an ill-conditioned matrix could go unwarned */
                 if ((r->condest_lower = start_bound(call, a.n, ops->apply, &u, fi)) < 0) {
                     ss_host->release(call->out);

@@ -53,6 +53,7 @@ static void um_factor_free(void *p)
     um_factor *F = p;
     if (!F) return;
     if (F->numeric) umfpack_dl_free_numeric(&F->numeric);
+    ss_host->free(F->info.start_solved);
     ss_host->free(F);
 }
 
@@ -284,6 +285,13 @@ int ss_umfpack_solve(silc_call *call)
     call->out = out;
     out = NULL;
     r->solve_seconds = ss_host->now() - t0;
+    if (F && ss_start_due(call, condest, &F->info)) { /* an owed estimate's bound (ss.h) */
+        um_apply u = {0};
+        u.a = &a, u.numeric = F->numeric;
+        ss_solve_start(&F->info, n, um_apply_block, &u);
+        ss_host->free(u.y);
+        ss_host->free(u.wi);
+    }
     if (F) {
         ss_report_factor(r, &F->info);
         ss_report_owed(call, condest, &F->info, k);

@@ -219,7 +219,12 @@ typedef struct silc_report {
      * write these only when host->abi_minor >= 8. */
     int condest_later;      /* host, set before the call: make no estimate that costs solves of
                                its own in this call; say instead that it is owed
-                               (condest_deferred = 1) and what it costs (condest_solves) */
+                               (condest_deferred = 1) and what it costs (condest_solves).
+                               1: with condest_lower where the plugin has one (auto); 2: no
+                               lower bound is wanted either (accuracy.condest = on_request,
+                               whose estimate is never made at once: a bound would be solves
+                               spent for nothing).  A plugin that knows only "nonzero"
+                               treats 2 as 1, which costs only the bound. */
     int condest_only;       /* host, set before the call: make only the estimate, with the
                                factorization an earlier call attached to in[0] (same options and
                                class); solve nothing (out stays NULL), factor nothing: with no
@@ -233,6 +238,14 @@ typedef struct silc_report {
                                start block solved with the user's columns), which makes the host
                                estimate at once when it hints at ill-conditioning; 0 = none */
 } silc_report;
+
+/* The library pivot ratio (report->pivot_ratio) above which the host makes an
+ * owed estimate at once, for its warnings, unless condest_lower proves that
+ * they cannot fire (docs/accuracy.md).  A ratio is no bound, so a plugin
+ * whose ratio is above it spares the whole estimate by solving a start
+ * vector for a rigorous condest_lower instead (SuiteSparse: e/n).  A
+ * constant, not a field: the layout and the ABI version are unchanged. */
+#define SILC_CONDEST_PIVOT_HINT 1e6
 
 typedef struct silc_call {
     int op;                     /* enum silc_op */

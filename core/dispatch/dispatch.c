@@ -563,17 +563,30 @@ static const char *status_text(int status)
 
 /* ---- the accuracy report --------------------------------------------------- */
 
-/* The warnings a condition estimate deserves, when it is made (at solve time,
- * or when the report is read: disp_condest_resolve). */
+/* The warnings a condition number cond deserves: "singular to working
+ * precision" from 1/eps, "fewer than 4 correct digits" above 1e-4/eps.  cond
+ * is the estimate once it is made (at solve time, or when the report is
+ * read: disp_condest_resolve), or, with lower_bound, a rigorous lower bound
+ * of cond_1 that settles the warning before the estimate is made
+ * (condest_settle), and the text says so. */
+static void warn_condition_of(silc_engine *E, double cond, int lower_bound)
+{
+    char what[160];
+    double eps_cond = cond * DBL_EPSILON;
+    if (lower_bound)
+        snprintf(what, sizeof what, "cond_1 >= %.2g so far, a rigorous lower bound; the condition estimate is made "
+                 "when the report is read", cond);
+    else
+        snprintf(what, sizeof what, "condition estimate %.2g", cond);
+    if (cond > 0 && eps_cond >= 1)
+        eng_warn(E, "'\\': matrix is singular to working precision (%s)", what);
+    else if (cond > 0 && eps_cond > 1e-4)
+        eng_warn(E, "'\\': result may have fewer than 4 correct digits (%s)", what);
+}
+
 static void warn_condition(silc_engine *E, const silc_report *r)
 {
-    double eps_cond = r->cond_est * DBL_EPSILON;
-    if (r->cond_est > 0 && eps_cond >= 1)
-        eng_warn(E, "'\\': matrix is singular to working precision (condition estimate %.2g)",
-                 r->cond_est);
-    else if (r->cond_est > 0 && eps_cond > 1e-4)
-        eng_warn(E, "'\\': result may have fewer than 4 correct digits (condition estimate %.2g)",
-                 r->cond_est);
+    warn_condition_of(E, r->cond_est, 0);
 }
 
 /* Completes the report of a solve that succeeded and warns about a result that
@@ -613,7 +626,11 @@ static void report_reset(silc_engine *E, silc_report *r, int later)
     r->cond_est = r->rcond = -1;
     r->forward_bound = -1;
     r->condest_off = c && !strcmp(c, "off");
-    r->condest_later = later && (!c || !strcmp(c, "auto") || !strcmp(c, "on") || !strcmp(c, "on_request"));
+    /* 2: on_request, whose estimate is never made at once, wants no bound */
+    r->condest_later = !later                                             ? 0
+                       : !c || !strcmp(c, "auto") || !strcmp(c, "on") ? 1
+                       : !strcmp(c, "on_request")                     ? 2
+                                                                      : 0;
 }
 
 /* refine_how's correction solve: D = A \ R by backend be (an ld_backend)
@@ -701,12 +718,14 @@ static void refine(silc_engine *E, silc_call *call, const ld_backend *b, int64_t
  * Laplacian, 2 against 1.5e11 on fs_183_6), but every shared matrix that
  * warns has one of 1.2e7 or more: 1e6 keeps a margin of 12 (a heuristic,
  * documented as such; `now` is the setting that never relies on it).
+ * Real UMFPACK and KLU answer a ratio above it with the start block's L
+ * (ss.h, SILC_CONDEST_PIVOT_HINT), which then decides by the rule for L.
  * CHOLMOD's, (max L_ii / min L_ii)^2 of A = L L', is a rigorous lower
  * bound of cond_2(A) <= cond_1(A) and comes as condest_lower (cholmod.c);
  * the estimate is at most 740 times it on the shared spd matrices. */
 #define DISP_CONDEST_WARN_AT (1e-4 / DBL_EPSILON)
 #define DISP_CONDEST_LOWER_SLACK 8000.0
-#define DISP_CONDEST_PIVOT_HINT 1e6
+#define DISP_CONDEST_PIVOT_HINT SILC_CONDEST_PIVOT_HINT /* shared with the plugins that answer it */
 
 /* The estimate's cost as a share of the factorization the solve made
  * (INFINITY when it made none). */
@@ -774,6 +793,25 @@ static int condest_urgent(const silc_call *call)
     return !(lower * DISP_CONDEST_LOWER_SLACK < DISP_CONDEST_WARN_AT); /* NaN: urgent */
 }
 
+/* 1 when the backend's rigorous lower bound L (condest_lower) settles which
+ * condition warning the estimate would give, so that an urgent estimate may
+ * still be owed with its warning given at solve time (condest_settle).  The
+ * estimate starts from L's vectors and never decreases, so it is >= L (a
+ * CHOLMOD diagonal bound is of cond_1 only: hence the warning's text speaks
+ * of cond_1).  L >= 1/eps settles "singular to working precision"; L >=
+ * DISP_CONDEST_WARN_AT settles "fewer than 4 correct digits", and the
+ * singular warning is ruled out by the rule that makes the estimate urgent
+ * (it is at most DISP_CONDEST_LOWER_SLACK x L on every shared matrix) when
+ * L x the slack < 1/eps, i.e. L < 5.6e11: bayer10 (L 4.83e11, estimate
+ * 3.82e15).  Between the two (watt_2, L 8.5e11) the estimate is made at
+ * once, as an L below the threshold makes it: "singular" could fire. */
+static int condest_settled(const silc_report *r)
+{
+    double eps_lower = r->condest_lower * DBL_EPSILON; /* warn_condition_of's tests */
+    if (eps_lower >= 1) return 1;
+    return eps_lower > 1e-4 && eps_lower * DISP_CONDEST_LOWER_SLACK < 1;
+}
+
 /* A solve whose backend left its estimate out (condest_deferred = 1): made
  * now when it is cheap or the matrix may be ill-conditioned, else owed.
  * -1 when that estimate ran out of memory: the solve fails, as it did when
@@ -787,7 +825,13 @@ static int condest_settle(silc_engine *E, silc_call *call, const ld_backend *b)
         return 0;
     }
     if (mode && !strcmp(mode, "on_request")) return 0; /* owed, whatever it costs */
-    if (condest_share(r) > DISP_CONDEST_BUDGET && !condest_urgent(call)) return 0; /* owed */
+    if (condest_share(r) > DISP_CONDEST_BUDGET) {
+        if (!condest_urgent(call)) return 0; /* owed */
+        if (condest_settled(r)) { /* owed, its warning given now */
+            warn_condition_of(E, r->condest_lower, 1);
+            return 0;
+        }
+    }
     r->condest_deferred = 0;
     return estimate_only(E, b, call, r) == SILC_ENOMEM ? -1 : 0; /* else none: "the backend gives none" */
 }
