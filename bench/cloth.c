@@ -544,7 +544,10 @@ static void find_session(void)
 /* CPU seconds of this process and of the silcd session serving it
  * (/proc/PID/task/T/schedstat, nanoseconds, over its threads): on a
  * shared machine the wall clock measures the load as much as the work,
- * the CPU time only the work. */
+ * the CPU time only the work.  Read before and after a run's steps, not
+ * around each: the ~30 system calls of reading /proc would be SILC's
+ * alone (the C step's run has no session to read), and between two steps
+ * they would keep the session waiting for the next request. */
 static double cpu_seconds(void)
 {
     struct timespec t;
@@ -591,7 +594,7 @@ static int seed_run_one(const cloth_scene *s, int c_step, int steps, int count, 
     cloth_model m;
     cloth_c_step c;
     cloth_driver *d = NULL;
-    double w0, c0, w = 0, cpu = 0;
+    double w0 = 0, c0 = 0;
     int k, rc = 0;
     memset(&o->t, 0, sizeof o->t);
     o->iterations = 0;
@@ -603,10 +606,11 @@ static int seed_run_one(const cloth_scene *s, int c_step, int steps, int count, 
         rc = !(d = cloth_driver_open(&m, CLOTH_CMP, seed_solver, SEED_TOL, err, errlen));
         if (!rc) find_session();
     }
+    /* A counting run's times (its steps interleaved with `info dv`) are
+     * not reported. */
+    if (!rc) w0 = bench_now(), c0 = cpu_seconds();
     for (k = 0; k < steps && !rc; k++) {
-        w0 = bench_now(), c0 = cpu_seconds();
         rc = c_step ? cloth_c_step_run(&c, &o->t, err, errlen) : cloth_driver_step(d, &o->t, err, errlen);
-        cpu += cpu_seconds() - c0, w += bench_now() - w0;
         if (!rc && count && !c_step) {
             double berr, cond;
             long it = 0;
@@ -614,6 +618,7 @@ static int seed_run_one(const cloth_scene *s, int c_step, int steps, int count, 
             o->iterations += it;
         }
     }
+    o->cpu = (cpu_seconds() - c0) / steps, o->wall = (bench_now() - w0) / steps;
     if (c_step && !rc) o->iterations = c.iterations;
     if (!c_step && !rc) rc = cloth_driver_sync(d, err, errlen);
     if (!rc && o->x) memcpy(o->x, m.x, (size_t)3 * m.n * sizeof *o->x);
@@ -624,7 +629,6 @@ static int seed_run_one(const cloth_scene *s, int c_step, int steps, int count, 
         session_pid = 0;
     }
     cloth_model_free(&m);
-    o->wall = w / steps, o->cpu = cpu / steps;
     return rc ? -1 : 0;
 }
 

@@ -81,6 +81,8 @@ struct session {
     int queued;            /* silcd --mpi: replies go to q, written by srv_session_flush */
     reply_queue q;
     srv_watch watch;       /* of the running EXEC (limits.c) */
+    proto_spin_memo spin;  /* how long the client took to send the request after each kind */
+    uint64_t last_kind;    /* proto_spin_kind of the request served last */
     char err[4096];
 };
 
@@ -675,16 +677,21 @@ void srv_session_expire(session *S)
 
 /* Waits for the next request; 0 when one is arriving, -1 on shutdown or
  * after --idle-timeout, which the client is told with an ERROR that its
- * next read finds. */
+ * next read finds.  Spins first only when the client followed the last
+ * request of this kind quickly (client.h, proto_spin_memo). */
 static int await_request(session *S)
 {
     struct pollfd p[2];
     double deadline = util_now() + srv_cfg.idle_timeout_ms / 1000.0;
+    int64_t started = proto_now_ns();
     p[0].fd = S->fd;
     p[0].events = POLLIN;
     p[1].fd = srv_shutdown_fd;
     p[1].events = POLLIN;
-    if (proto_spin(p, 2)) return p[1].revents ? -1 : 0;
+    if (proto_spin(p, 2, proto_spin_budget(&S->spin, S->last_kind))) {
+        proto_spin_learn(&S->spin, S->last_kind, proto_now_ns() - started);
+        return p[1].revents ? -1 : 0;
+    }
     for (;;) {
         int wait = -1, rc;
         if (srv_cfg.idle_timeout_ms > 0) {
@@ -695,14 +702,16 @@ static int await_request(session *S)
         rc = poll(p, 2, wait);
         if (rc < 0) continue;
         if (p[1].revents) return -1;
-        if (p[0].revents) return 0;
+        if (p[0].revents) {
+            proto_spin_learn(&S->spin, S->last_kind, proto_now_ns() - started);
+            return 0;
+        }
         if (rc == 0 && srv_cfg.idle_timeout_ms > 0 && util_now() >= deadline) {
             srv_session_expire(S);
             return -1;
         }
     }
 }
-
 
 static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
 {
@@ -719,6 +728,7 @@ static int serve_one(session *S, proto_stream *st, const proto_limits *lim)
         rc = reply_error(S, S->err);
     } else {
         srv_log(LOG_DEBUG, "session %lu: %s", S->id, proto_op_name(q.op));
+        S->last_kind = proto_spin_kind(q.op, q.text);
         switch (q.op) {
         case PROTO_PUT: rc = do_put(S, st, &q); break;
         case PROTO_GET: rc = do_get(S, q.text, 0); break;

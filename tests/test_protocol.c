@@ -5,6 +5,7 @@
  * (PROTO_REFUSED: consumed, session goes on; PROTO_FATAL: close) and a
  * message naming the problem.
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -289,10 +290,49 @@ static void test_hello_and_url(void)
     CHECK(proto_parse_url("tcp://host:99999", &a, err, sizeof err) != 0, "bad port");
 }
 
+/* The learned spin budgets (client.h, proto_spin_memo), fed waits as
+ * numbers: the policy, not the clock. */
+static void test_spin_memo(void)
+{
+    proto_spin_memo m;
+    uint64_t solve = proto_spin_kind(PROTO_EXEC, "dv = A \\ b"),
+             update = proto_spin_kind(PROTO_EXEC, "x += dt * v"), get = proto_spin_kind(PROTO_GET, "x"),
+             other, collide = 0;
+    int k, spins = 0;
+    memset(&m, 0, sizeof m);
+    CHECK(solve && update && get && solve != update && solve != proto_spin_kind(PROTO_GET, "dv = A \\ b") &&
+              get != proto_spin_kind(PROTO_GET, "y") && get == proto_spin_kind(PROTO_GET, "x"),
+          "kinds tell op and text apart, and repeat");
+    CHECK(proto_spin_budget(&m, solve) == PROTO_SPIN_NS, "a new kind spins");
+    proto_spin_learn(&m, solve, 3000000);          /* a 3 ms EXEC */
+    proto_spin_learn(&m, get, 20000);              /* a 20 us GET */
+    CHECK(proto_spin_budget(&m, get) == PROTO_SPIN_NS, "a quick kind spins");
+    CHECK(proto_spin_budget(&m, update) == PROTO_SPIN_NS, "another kind is not judged by a slow one");
+    /* A slow kind sleeps at once, but probes once every PROTO_SPIN_PROBE waits. */
+    for (k = 0; k < 4 * PROTO_SPIN_PROBE; k++) spins += proto_spin_budget(&m, solve) != 0;
+    CHECK(spins == 4, "a slow kind spins %d times in %d waits, want 4", spins, 4 * PROTO_SPIN_PROBE);
+    proto_spin_learn(&m, solve, PROTO_SPIN_NS - 1); /* it became quick */
+    CHECK(proto_spin_budget(&m, solve) == PROTO_SPIN_NS, "a kind that became quick spins again");
+    proto_spin_learn(&m, solve, PROTO_SPIN_NS);
+    CHECK(proto_spin_budget(&m, solve) == 0, "a wait as long as the spin itself was not caught by it");
+    /* A kind in the same slot takes it over and starts afresh. */
+    for (k = 0; k < 100000 && !collide; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "v%d", k);
+        other = proto_spin_kind(PROTO_GET, name);
+        if (other != solve && other % PROTO_SPIN_KINDS == solve % PROTO_SPIN_KINDS) collide = other;
+    }
+    CHECK(collide != 0, "a colliding kind was found");
+    CHECK(proto_spin_budget(&m, collide) == PROTO_SPIN_NS, "a colliding kind is new, so spins");
+    proto_spin_learn(&m, collide, 10);
+    CHECK(proto_spin_budget(&m, solve) == PROTO_SPIN_NS, "the slot's old kind is forgotten, so spins");
+}
+
 int main(void)
 {
     test_roundtrip();
     test_malformed();
     test_hello_and_url();
+    test_spin_memo();
     return check_done();
 }

@@ -444,6 +444,116 @@ static void test_sigterm_drains(void)
     }
 }
 
+/* ---- 5. sessions' heap on transparent huge pages ---------------------- */
+
+/* Whether the kernel gives huge pages on request (the only mode in which
+ * silcd asks glibc for them: silcd.c, exec_with_huge_page_heap). */
+static int thp_on_request(void)
+{
+    char mode[128] = "";
+    size_t got = 0;
+    FILE *f = fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (f) {
+        got = fread(mode, 1, sizeof mode - 1, f);
+        fclose(f);
+    }
+    mode[got] = '\0';
+    return strstr(mode, "[madvise]") != NULL;
+}
+
+/* The value of GLIBC_TUNABLES in pid's environment ("" if unset). */
+static void tunables_of(pid_t pid, char *out, size_t len)
+{
+    char path[64], env[1 << 16];
+    size_t got = 0, at;
+    FILE *f;
+    snprintf(path, sizeof path, "/proc/%ld/environ", (long)pid);
+    out[0] = '\0';
+    if (!(f = fopen(path, "r"))) return;
+    got = fread(env, 1, sizeof env - 1, f);
+    fclose(f);
+    env[got] = '\0';
+    for (at = 0; at < got; at += strlen(env + at) + 1)
+        if (!strncmp(env + at, "GLIBC_TUNABLES=", 15)) snprintf(out, len, "%s", env + at + 15);
+}
+
+/* Whether a [heap] mapping of pid is marked for huge pages (VmFlags "hg"). */
+static int heap_marked_huge(pid_t pid)
+{
+    char path[64], line[512];
+    int in_heap = 0, marked = 0;
+    FILE *f;
+    snprintf(path, sizeof path, "/proc/%ld/smaps", (long)pid);
+    if (!(f = fopen(path, "r"))) return -1;
+    while (fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        char perms[8];
+        if (sscanf(line, "%lx-%lx %7s", &lo, &hi, perms) == 3) /* a mapping's first line */
+            in_heap = strstr(line, "[heap]") != NULL;
+        else if (in_heap && !strncmp(line, "VmFlags:", 8) && strstr(line, " hg"))
+            marked = 1;
+    }
+    fclose(f);
+    return marked;
+}
+
+/* silcd asks for huge pages by re-executing itself with the tunable
+ * added (a session's heap is then marked for them), keeps what else
+ * GLIBC_TUNABLES held, and leaves an operator's own setting alone.  (What
+ * /proc shows of the variable is its first tunable only: glibc 2.36 cuts
+ * the original string at each ':' as it parses it.) */
+static void test_huge_page_heap(void)
+{
+    static const struct {
+        const char *given, *shown;
+        int huge;
+    } cases[] = {{NULL, "glibc.malloc.hugetlb=1", 1},
+                 {"glibc.malloc.arena_max=2", "glibc.malloc.arena_max=2", 1},
+                 {"glibc.malloc.hugetlb=0", "glibc.malloc.hugetlb=0", 0}};
+    const char *saved = getenv("GLIBC_TUNABLES");
+    char *keep = saved ? strdup(saved) : NULL;
+    size_t k;
+    if (!thp_on_request()) {
+        printf("test_huge_page_heap: skipped: this kernel's transparent huge pages are not "
+               "'madvise', so silcd does not ask for them\n");
+        free(keep);
+        return;
+    }
+    for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        test_server srv;
+        silc_context *c;
+        char got[4096];
+        pid_t session;
+        if (cases[k].given) setenv("GLIBC_TUNABLES", cases[k].given, 1);
+        else unsetenv("GLIBC_TUNABLES");
+        if (server_start(&srv, NULL, NULL) != 0) {
+            CHECK(0, "silcd did not start with GLIBC_TUNABLES=%s", cases[k].given);
+            continue;
+        }
+        tunables_of(srv.pid, got, sizeof got);
+        CHECK(!strncmp(got, cases[k].shown, strlen(cases[k].shown)),
+              "GLIBC_TUNABLES=%s: silcd runs with '%s', want '%s'",
+              cases[k].given ? cases[k].given : "(unset)", got, cases[k].shown);
+        /* The heap a session computes in (not checked under ASan, whose
+         * allocator is not glibc's). */
+        if ((c = open_client(srv.url)) != NULL) {
+            put_marker(c, "h", 1 << 18);
+            session = only_child_of(srv.pid);
+            if (!getenv("ASAN_OPTIONS") && session > 0)
+                CHECK(heap_marked_huge(session) == cases[k].huge,
+                      "GLIBC_TUNABLES=%s: the session's heap %s marked for huge pages",
+                      cases[k].given ? cases[k].given : "(unset)",
+                      heap_marked_huge(session) ? "is" : "is not");
+            CHECK(session > 0, "one session process");
+            silc_close(&c);
+        }
+        CHECK(server_stop(&srv) == 0, "silcd stops cleanly");
+    }
+    if (keep) setenv("GLIBC_TUNABLES", keep, 1);
+    else unsetenv("GLIBC_TUNABLES");
+    free(keep);
+}
+
 int main(int argc, char **argv)
 {
     const char *plugin_dir = argc > 1 ? argv[1] : CRASH_PLUGIN_DIR;
@@ -454,5 +564,6 @@ int main(int argc, char **argv)
     test_killed_client();
     test_killed_server();
     test_sigterm_drains();
+    test_huge_page_heap();
     return check_done();
 }

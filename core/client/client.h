@@ -184,15 +184,47 @@ int proto_send(int fd, struct iovec *iov, int iovcnt, int timeout_ms, char *err,
 /* How long a reader or writer busy-waits before it sleeps in poll.  Waking a
  * sleeping thread costs ~10 us on the 2-core VM (more than the whole server
  * side of a small EXEC, and more than copying the 64 KiB a bulk transfer
- * waits for), so every wait spins this long first, and so does silcd waiting
- * for the next request of a session: a ping-pong of small requests and a
- * bulk transfer never sleep; a client that is computing costs the server one
- * core for 50 us per request. */
+ * waits for), so a wait inside a frame spins this long first: a bulk
+ * transfer never sleeps.  The waits between frames -- a client for the
+ * first reply to its request, silcd for a session's next request -- spin
+ * only when the last wait of the same kind ended within this time
+ * (proto_spin_memo below): a ping-pong of small requests never sleeps,
+ * and a side whose peer is computing (an EXEC of milliseconds, a client
+ * between steps) sleeps at once instead of burning 50 us of a core per
+ * request, which the CPU clock of a shared machine counts. */
 #define PROTO_SPIN_NS 50000
 /* Polls the n descriptors (for their events) without blocking until one is
- * ready (1) or PROTO_SPIN_NS have passed (0); revents are set as by poll. */
+ * ready (1) or budget_ns have passed (0; 0 ns polls once); revents are set
+ * as by poll. */
 struct pollfd;
-int proto_spin(struct pollfd *p, int n);
+int proto_spin(struct pollfd *p, int n, int64_t budget_ns);
+
+/* What the last waits of each kind took, so that the next wait of that
+ * kind spins only if spinning would have paid: a kind is a request's
+ * opcode and text (an EXEC's statements, a GET's name), hashed, which a
+ * program's loop repeats.  A kind not seen yet spins; one whose last wait
+ * outlasted PROTO_SPIN_NS does not, except every PROTO_SPIN_PROBE-th wait,
+ * which spins again to notice a kind that became quick.  A direct-mapped
+ * table of PROTO_SPIN_KINDS entries: a colliding kind takes the entry
+ * over. */
+#define PROTO_SPIN_KINDS 64
+#define PROTO_SPIN_PROBE 16
+typedef struct proto_spin_memo {
+    struct {
+        uint64_t key;        /* 0: empty */
+        int64_t waited_ns;   /* the last wait of that kind */
+        unsigned sleeps;     /* waits without spinning since the last spin */
+    } kind[PROTO_SPIN_KINDS];
+} proto_spin_memo;
+/* The kind of a wait for the reply to (or the request after) op with text
+ * (NULL: none): never 0. */
+uint64_t proto_spin_kind(uint32_t op, const char *text);
+/* The spin budget of the next wait of kind key: PROTO_SPIN_NS or 0. */
+int64_t proto_spin_budget(proto_spin_memo *m, uint64_t key);
+/* Records that a wait of kind key took waited_ns. */
+void proto_spin_learn(proto_spin_memo *m, uint64_t key, int64_t waited_ns);
+/* Nanoseconds of the monotonic clock, for timing waits. */
+int64_t proto_now_ns(void);
 /* Sends one frame whose body is the concatenation of body[0..n). */
 int proto_send_frame(int fd, uint32_t op, const struct iovec *body, int n, int timeout_ms,
                      char *err, size_t errlen);

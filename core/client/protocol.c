@@ -293,19 +293,59 @@ static struct iovec *iov_advance(struct iovec *iov, int *iovcnt, size_t n)
     return iov;
 }
 
-int proto_spin(struct pollfd *p, int n)
+int64_t proto_now_ns(void)
 {
-    struct timespec t0, t;
-    int64_t waited;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
+}
+
+int proto_spin(struct pollfd *p, int n, int64_t budget_ns)
+{
+    int64_t t0 = proto_now_ns();
     do {
         int i;
         for (i = 0; i < n; i++) p[i].revents = 0;
         if (poll(p, (nfds_t)n, 0) > 0) return 1;
-        clock_gettime(CLOCK_MONOTONIC, &t);
-        waited = (int64_t)(t.tv_sec - t0.tv_sec) * 1000000000 + (t.tv_nsec - t0.tv_nsec);
-    } while (waited < PROTO_SPIN_NS);
+    } while (proto_now_ns() - t0 < budget_ns);
     return 0;
+}
+
+/* Texts longer than this are hashed by their length and first bytes: a
+ * kind needs no more, and a 64 MiB statement is not read twice. */
+#define SPIN_KIND_TEXT_BYTES 4096
+
+uint64_t proto_spin_kind(uint32_t op, const char *text)
+{
+    uint64_t h = 1469598103934665603u; /* FNV-1a */
+    size_t n = text ? strlen(text) : 0, i;
+    int k;
+    for (k = 0; k < 4; k++) h = (h ^ ((op >> (8 * k)) & 0xffu)) * 1099511628211u;
+    for (k = 0; k < 8; k++) h = (h ^ (((uint64_t)n >> (8 * k)) & 0xffu)) * 1099511628211u;
+    for (i = 0; i < n && i < SPIN_KIND_TEXT_BYTES; i++)
+        h = (h ^ (uint8_t)text[i]) * 1099511628211u;
+    return h ? h : 1;
+}
+
+int64_t proto_spin_budget(proto_spin_memo *m, uint64_t key)
+{
+    unsigned slot = (unsigned)(key % PROTO_SPIN_KINDS);
+    if (m->kind[slot].key != key || m->kind[slot].waited_ns < PROTO_SPIN_NS) return PROTO_SPIN_NS;
+    if (++m->kind[slot].sleeps >= PROTO_SPIN_PROBE) {
+        m->kind[slot].sleeps = 0;
+        return PROTO_SPIN_NS;
+    }
+    return 0;
+}
+
+void proto_spin_learn(proto_spin_memo *m, uint64_t key, int64_t waited_ns)
+{
+    unsigned slot = (unsigned)(key % PROTO_SPIN_KINDS);
+    if (m->kind[slot].key != key) {
+        m->kind[slot].key = key;
+        m->kind[slot].sleeps = 0;
+    }
+    m->kind[slot].waited_ns = waited_ns;
 }
 
 /* Waits until fd is ready (spinning first, see PROTO_SPIN_NS; timeout_ms < 0
@@ -316,7 +356,7 @@ static int wait_fd(int fd, short events, int timeout_ms, char *err, size_t errle
     int rc;
     p.fd = fd;
     p.events = events;
-    if (proto_spin(&p, 1)) return 0;
+    if (proto_spin(&p, 1, PROTO_SPIN_NS)) return 0;
     do rc = poll(&p, 1, timeout_ms < 0 ? -1 : timeout_ms);
     while (rc < 0 && errno == EINTR);
     if (rc == 0)

@@ -68,6 +68,7 @@ struct rem_conn {
     int exec_timeout_ms;       /* SILC_EXEC_TIMEOUT: the longest wait for an EXEC's reply; -1 none */
     proto_limits limits;       /* SILC_MAX_REPLY_BYTES per value; text as silcd's statements */
     atomic_int exec_state;   /* EXEC_*; lock-free, so rem_cancel is async-signal-safe */
+    proto_spin_memo spin;      /* how long the first reply to each kind of request took */
     char url[512];
 };
 
@@ -189,17 +190,17 @@ static int bad_reply(rem_conn *c, int rc, const char *why, char *err, size_t err
 /* Waits up to timeout_ms (-1: for ever) for the first byte of a reply; -1
  * with why ("sent nothing for 300 s (SILC_IO_TIMEOUT)") when none came.
  * Always here, never in proto_recv, whose waits are the I/O timeout: an
- * EXEC's reply may rightly take longer.  Spins first (PROTO_SPIN_NS), as
- * every wait of the protocol does, so a small request's round trip does
- * not pay for waking a sleeping thread. */
-static int await_first_byte(rem_conn *c, int timeout_ms, const char *var, char *why,
-                            size_t whylen)
+ * EXEC's reply may rightly take longer.  Spins spin_ns first, so that a
+ * small request's round trip does not pay for waking a sleeping thread
+ * (client.h, PROTO_SPIN_NS: how long is learned per kind of request). */
+static int await_first_byte(rem_conn *c, int timeout_ms, const char *var, int64_t spin_ns,
+                            char *why, size_t whylen)
 {
     struct pollfd p;
     int rc;
     p.fd = c->fd;
     p.events = POLLIN;
-    if (proto_spin(&p, 1)) return 0;
+    if (proto_spin(&p, 1, spin_ns)) return 0;
     do rc = poll(&p, 1, timeout_ms);
     while (rc < 0 && errno == EINTR);
     if (rc > 0) return 0;
@@ -211,20 +212,30 @@ static int await_first_byte(rem_conn *c, int timeout_ms, const char *var, char *
 /* The reply that ends a request: OK, ERROR (its text into err), or VALUE into
  * *env when env is not NULL.  TEXT and WARN before it go to fn and warnings.
  * Each reply frame is awaited for the I/O timeout, or for an EXEC (exec set)
- * the EXEC timeout; inside a frame every wait is the I/O timeout. */
+ * the EXEC timeout; inside a frame every wait is the I/O timeout.  kind
+ * (proto_spin_kind of the request; 0 for none) sets and learns how long the
+ * wait for the first frame spins; later frames follow it at once. */
 static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, void *user,
-                       strbuf *warnings, int exec, char *err, size_t errlen)
+                       strbuf *warnings, int exec, uint64_t kind, char *err, size_t errlen)
 {
     proto_stream s = {c->fd, c->io_timeout_ms, NULL, 0, 0};
+    int64_t spin_ns = kind ? proto_spin_budget(&c->spin, kind) : PROTO_SPIN_NS,
+            started = proto_now_ns();
     for (;;) {
         proto_reply r;
         char why[512];
         int rc;
         if (await_first_byte(c, exec ? c->exec_timeout_ms : c->io_timeout_ms,
-                             exec ? "SILC_EXEC_TIMEOUT" : "SILC_IO_TIMEOUT", why, sizeof why)) {
+                             exec ? "SILC_EXEC_TIMEOUT" : "SILC_IO_TIMEOUT", spin_ns, why,
+                             sizeof why)) {
             c->broken = 1;
             snprintf(err, errlen, "silc server %s %s; connection closed", c->url, why);
             return -1;
+        }
+        if (kind) {
+            proto_spin_learn(&c->spin, kind, proto_now_ns() - started);
+            kind = 0;
+            spin_ns = PROTO_SPIN_NS;
         }
         if ((rc = proto_read_reply(&s, &c->limits, &r, why, sizeof why)))
             return bad_reply(c, rc, why, err, errlen);
@@ -307,7 +318,7 @@ int rem_open(rem_conn **out, const char *url, const char *token, char *err, size
     iov[1].iov_len = toklen;
     s = (proto_stream){c->fd, c->io_timeout_ms, NULL, 0, 0};
     if (proto_send(c->fd, iov, 2, c->io_timeout_ms, why, sizeof why) ||
-        await_first_byte(c, c->io_timeout_ms, "SILC_IO_TIMEOUT", why, sizeof why) ||
+        await_first_byte(c, c->io_timeout_ms, "SILC_IO_TIMEOUT", PROTO_SPIN_NS, why, sizeof why) ||
         proto_read_hello(&s, &version, &tok, why, sizeof why)) {
         snprintf(err, errlen, "handshake with silc server %s failed: %s", url, why);
         free(tok);
@@ -316,7 +327,7 @@ int rem_open(rem_conn **out, const char *url, const char *token, char *err, size
         return -1;
     }
     free(tok);
-    if (await_reply(c, NULL, NULL, NULL, NULL, 0, why, sizeof why)) {
+    if (await_reply(c, NULL, NULL, NULL, NULL, 0, 0, why, sizeof why)) {
         if (c->broken) snprintf(err, errlen, "%s", why);
         else snprintf(err, errlen, "silc server %s refused the connection: %s", url, why);
         close(c->fd);
@@ -336,7 +347,7 @@ void rem_close(rem_conn **pc)
     /* Closing waits 5 s at most for the server's goodbye. */
     if (c->io_timeout_ms < 0 || c->io_timeout_ms > 5000) c->io_timeout_ms = 5000;
     if (!c->broken && proto_send_text(c->fd, PROTO_BYE, NULL, 5000, why, sizeof why) == 0)
-        await_reply(c, NULL, NULL, NULL, NULL, 0, why, sizeof why);
+        await_reply(c, NULL, NULL, NULL, NULL, 0, 0, why, sizeof why);
     close(c->fd);
     free(c);
     *pc = NULL;
@@ -383,7 +394,7 @@ int rem_put(rem_conn *c, const char *name, const silc_envelope_t *e, char *err, 
     body[4].iov_len = (size_t)L.values_bytes;
     if (proto_send_frame(c->fd, PROTO_PUT, body, 5, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
-    return await_reply(c, NULL, NULL, NULL, NULL, 0, err, errlen);
+    return await_reply(c, NULL, NULL, NULL, NULL, 0, proto_spin_kind(PROTO_PUT, name), err, errlen);
 }
 
 int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, int accept_complex, char *err,
@@ -394,7 +405,8 @@ int rem_get(rem_conn *c, silc_envelope_t *e, const char *name, int accept_comple
     if (proto_send_text(c->fd, accept_complex ? PROTO_GET_COMPLEX : PROTO_GET, name, c->io_timeout_ms,
                         why, sizeof why))
         return lost(c, why, err, errlen);
-    if (await_reply(c, e, NULL, NULL, NULL, 0, err, errlen)) return -1;
+    if (await_reply(c, e, NULL, NULL, NULL, 0, proto_spin_kind(PROTO_GET, name), err, errlen))
+        return -1;
     /* A plain GET's caller reads real values only (silc.h): a server that
      * answers it with a complex one breaks the protocol, and the caller
      * must not read half of each entry. */
@@ -415,7 +427,8 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
     if (proto_send_text(c->fd, PROTO_EXEC, statements, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
     atomic_store(&c->exec_state, EXEC_AWAITING);
-    rc = await_reply(c, NULL, fn, user, warnings, 1, err, errlen);
+    rc = await_reply(c, NULL, fn, user, warnings, 1, proto_spin_kind(PROTO_EXEC, statements), err,
+                     errlen);
     /* A CANCEL being written (another thread) finishes before the next
      * request may be sent; a signal handler's has finished by now. */
     for (;;) {
