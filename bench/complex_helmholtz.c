@@ -11,15 +11,19 @@
  * centre; A is complex symmetric (A = A.'), not Hermitian.  The bench links
  * the example's assembly (silc_helmholtz), so both solve the same matrix.
  *
- * Rows (each the median of R runs, a fresh A each time so nothing is reused;
- * the library and the three SILC rows run in alternating rounds, and a SILC
- * row's ratio is the median of its round-by-round ratios to the library,
- * since the machine drifts more over the minutes of a run (15-20 %, measured)
- * than the differences this bench is for):
- *   UMFPACK direct    umfpack_zl_symbolic + numeric + solve, default
- *                     control (two refinement steps, as SILC's backend
- *                     asks too): what the library needs and nothing more,
- *                     the baseline of the ratios;
+ * Rows (each the median of R runs, a fresh A each time so nothing is
+ * reused; every row runs once per round and the rounds alternate them all,
+ * since the machine drifts more over the minutes of a run (15-20 %,
+ * measured) than the differences this bench is for; a row's ratio is the
+ * median of its round-by-round ratios to the first row):
+ *   UMFPACK direct    umfpack_zl_symbolic + numeric + solve (UMFPACK_A),
+ *                     default control (strategy auto, row scaling by sums,
+ *                     up to two refinement steps, as SILC's backend asks
+ *                     too): what the library needs and nothing more, the
+ *                     baseline of the ratios;
+ *   UMFPACK direct    the same with Octave's control: its sparse `\`
+ *                     (liboctave CSparse.cc, fsolve) keeps the defaults and
+ *                     sets UMFPACK_IRSTEP = 1;
  *   SILC  x = A \ b   default dispatch (whatever backend the dispatcher
  *                     picks, named in the row), each run in a new context
  *                     (nothing reused: checked with info), PUT not timed;
@@ -30,10 +34,16 @@
  *                     solve time) and off (no estimate at all);
  *   SciPy spsolve     /usr/bin/python3, scipy.sparse.linalg.spsolve (SuperLU);
  *   Octave A\b        octave-cli, skipped when absent.
+ * SciPy and Octave run in a process of their own each round (started and
+ * fed untimed, then one untimed solve of a 2 x 2 system so that nothing
+ * is loaded on first use inside the timing).
  * Times are CPU seconds of the process that solves (every solver runs
  * single-threaded here: OPENBLAS_NUM_THREADS=1), so the other jobs of a
- * shared machine do not count; each row also shows the relative residual
- * ||b - A x||_1 / ||b||_1.
+ * shared machine do not count; each row also shows the page faults of the
+ * timed part (minor faults: the kernel hands the solver a fresh zeroed page
+ * on first touch; UMFPACK's ~500 MB of work space here is mostly fresh
+ * pages, and their faults are a fifth of the time on this machine) and the
+ * relative residual ||b - A x||_1 / ||b||_1.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <complex.h>
@@ -42,6 +52,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -114,132 +125,133 @@ static double cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Each run in a context of its own, so no factorization or analysis of an
+/* Minor page faults of this process so far. */
+static double minor_faults(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_minflt;
+}
+
+/* One timed run of one row: CPU seconds, the first `info x` (SILC; -1 for
+ * a solver with no report), page faults, residual. */
+typedef struct run_result {
+    double s, report, faults, resid;
+} run_result;
+
+/* One run in a context of its own, so no factorization or analysis of an
  * earlier run is reused (the store would hand an identical PUT the value
  * it already has); the PUTs are not timed.  condest: accuracy.condest's
- * value; *report: the median time of the first `info x` (the work the
- * statement left for the report). */
-static double run_silc(const csr *A, const double complex *b, int reps, const char *condest, double *resid,
-                       char *backend, size_t blen, double *report)
+ * value; how: the backend as info names it, and the mode. */
+static int run_silc(const csr *A, const double complex *b, const char *condest, run_result *out, char *how,
+                    size_t hlen)
 {
     silc_envelope_t EA, Eb, Ex;
     silc_context *c = NULL;
-    double *t = calloc((size_t)reps, sizeof *t), *ti = calloc((size_t)reps, sizeof *ti), med;
-    char set[64];
+    char set[64], info[2048] = "", name[64], reused[16];
     double complex *x = malloc((size_t)A->n * sizeof *x);
-    char info[2048] = "", name[64], reused[16];
-    if (!t || !ti || !x) return -1;
+    double t0, f0;
+    int ok = 0;
     snprintf(set, sizeof set, "set accuracy.condest = %s", condest);
-    if (silc_envelope_csr_complex(&EA, A->n, A->n, A->rowptr, A->colind, (const double *)A->val) ||
+    if (!x || silc_envelope_csr_complex(&EA, A->n, A->n, A->rowptr, A->colind, (const double *)A->val) ||
         silc_envelope_dense_complex(&Eb, A->n, 1, (const double *)b))
-        goto fail;
-    for (int r = 0; r < reps; r++) {
-        double t0;
-        if (silc_open(&c, NULL) || silc_put(c, "A", &EA) || silc_put(c, "b", &Eb) || silc_exec(c, set))
-            goto fail;
-        t0 = cpu_now();
-        if (silc_exec(c, "x = A \\ b;")) goto fail;
-        t[r] = cpu_now() - t0;
-        info[0] = 0;
-        silc_set_output(c, collect, info);
-        t0 = cpu_now();
-        if (silc_exec(c, "info x")) goto fail;
-        ti[r] = cpu_now() - t0;
-        info_field(info, "reused factorization: ", reused, sizeof reused);
-        if (strcmp(reused, "no") != 0) {
-            fprintf(stderr, "complex_helmholtz: run %d reused a factorization (info: '%s')\n", r, reused);
-            goto fail;
-        }
-        if (r == reps - 1 && (silc_get_complex(c, &Ex, "x") || silc_envelope_to_dense(&Ex, (double *)x))) goto fail;
-        if (r < reps - 1) silc_close(&c);
+        goto done;
+    if (silc_open(&c, NULL) || silc_put(c, "A", &EA) || silc_put(c, "b", &Eb) || silc_exec(c, set)) goto done;
+    f0 = minor_faults();
+    t0 = cpu_now();
+    if (silc_exec(c, "x = A \\ b;")) goto done;
+    out->s = cpu_now() - t0;
+    out->faults = minor_faults() - f0;
+    silc_set_output(c, collect, info);
+    t0 = cpu_now();
+    if (silc_exec(c, "info x")) goto done;
+    out->report = cpu_now() - t0;
+    info_field(info, "reused factorization: ", reused, sizeof reused);
+    if (strcmp(reused, "no") != 0) {
+        fprintf(stderr, "complex_helmholtz: a run reused a factorization (info: '%s')\n", reused);
+        goto done;
     }
-    *resid = residual(A, x, b);
-    info_field(info, "backend: ", name, sizeof name);
-    snprintf(backend, blen, "%s, accuracy.condest = %s%s", name, condest,
-             strstr(info, "computed when the report was first read") ? " (estimate deferred)" : "");
+    if (silc_get_complex(c, &Ex, "x") || silc_envelope_to_dense(&Ex, (double *)x)) goto done;
     silc_envelope_free(&Ex);
-    silc_close(&c);
+    out->resid = residual(A, x, b);
+    info_field(info, "backend: ", name, sizeof name);
+    snprintf(how, hlen, "%s, accuracy.condest = %s%s", name, condest,
+             strstr(info, "computed when the report was first read") ? " (estimate deferred)" : "");
+    ok = 1;
+done:
+    if (!ok) {
+        fprintf(stderr, "complex_helmholtz: SILC failed: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
+        snprintf(how, hlen, "failed (message on stderr)");
+    }
+    if (c) silc_close(&c);
     silc_envelope_free(&EA);
     silc_envelope_free(&Eb);
-    med = bench_median(t, reps);
-    *report = bench_median(ti, reps);
-    free(t);
-    free(ti);
     free(x);
-    return med;
-fail:
-    fprintf(stderr, "complex_helmholtz: SILC failed: %s\n", c ? silc_context_errmsg(c) : silc_errmsg());
-    snprintf(backend, blen, "failed (message on stderr)");
-    if (c) silc_close(&c);
-    free(t);
-    free(ti);
-    free(x);
-    return -1;
+    return ok ? 0 : -1;
 }
 
 /* ---- UMFPACK directly -------------------------------------------------------------- */
 
-static double run_umfpack(const csr *A, const double complex *b, int reps, double *resid)
+/* UMFPACK's default control but for irstep (its refinement steps). */
+static int run_umfpack(const csr *A, const double complex *b, double irstep, run_result *out)
 {
-    double *t = calloc((size_t)reps, sizeof *t), control[UMFPACK_CONTROL], info[UMFPACK_INFO], med;
+    double control[UMFPACK_CONTROL], info[UMFPACK_INFO], t0, f0;
     double complex *x = malloc((size_t)A->n * sizeof *x);
-    int st = 0;
-    if (!t || !x) return -1;
+    void *sym = NULL, *num = NULL;
+    int st;
+    if (!x) return -1;
     umfpack_zl_defaults(control);
-    for (int r = 0; r < reps && st == 0; r++) {
-        void *sym = NULL, *num = NULL;
-        double t0 = cpu_now();
-        /* A = A.': its CSR arrays are its own compressed columns */
-        st = (int)umfpack_zl_symbolic(A->n, A->n, A->rowptr, A->colind, (const double *)A->val, NULL, &sym,
-                                      control, info);
-        if (!st)
-            st = (int)umfpack_zl_numeric(A->rowptr, A->colind, (const double *)A->val, NULL, sym, &num, control,
-                                         info);
-        if (!st)
-            st = (int)umfpack_zl_solve(UMFPACK_A, A->rowptr, A->colind, (const double *)A->val, NULL,
-                                       (double *)x, NULL, (const double *)b, NULL, num, control, info);
-        t[r] = cpu_now() - t0;
-        umfpack_zl_free_symbolic(&sym);
-        umfpack_zl_free_numeric(&num);
-    }
-    if (st) {
-        fprintf(stderr, "complex_helmholtz: UMFPACK failed (status %d)\n", st);
-        free(t);
-        free(x);
-        return -1;
-    }
-    *resid = residual(A, x, b);
-    med = bench_median(t, reps);
-    free(t);
+    control[UMFPACK_IRSTEP] = irstep;
+    f0 = minor_faults();
+    t0 = cpu_now();
+    /* A = A.': its CSR arrays are its own compressed columns */
+    st = (int)umfpack_zl_symbolic(A->n, A->n, A->rowptr, A->colind, (const double *)A->val, NULL, &sym, control,
+                                  info);
+    if (!st)
+        st = (int)umfpack_zl_numeric(A->rowptr, A->colind, (const double *)A->val, NULL, sym, &num, control, info);
+    if (!st)
+        st = (int)umfpack_zl_solve(UMFPACK_A, A->rowptr, A->colind, (const double *)A->val, NULL, (double *)x,
+                                   NULL, (const double *)b, NULL, num, control, info);
+    out->s = cpu_now() - t0;
+    out->faults = minor_faults() - f0;
+    umfpack_zl_free_symbolic(&sym);
+    umfpack_zl_free_numeric(&num);
+    if (st) fprintf(stderr, "complex_helmholtz: UMFPACK failed (status %d)\n", st);
+    else out->resid = residual(A, x, b);
     free(x);
-    return med;
+    return st ? -1 : 0;
 }
 
 /* ---- SciPy and Octave, from a file ------------------------------------------------ */
 
+/* Each prints "seconds residual faults" for one solve, after one untimed
+ * solve of a 2 x 2 complex system (whatever the library loads or sets up on
+ * first use is not timed; the direct and SILC rows are warm after the first
+ * round too). */
 static const char scipy_script[] =
-    "import sys, time, numpy as np, scipy.sparse as sp, scipy.sparse.linalg as sla\n"
-    "f, n, nnz, reps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])\n"
+    "import sys, time, resource, numpy as np, scipy.sparse as sp, scipy.sparse.linalg as sla\n"
+    "f, n, nnz = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])\n"
+    "sla.spsolve(sp.csc_matrix(np.array([[2, 1j], [1j, 3]])), np.array([1, 1j]))\n"
     "raw = open(f, 'rb').read()\n"
     "rp = np.frombuffer(raw, np.int64, n + 1, 0)\n"
     "ci = np.frombuffer(raw, np.int64, nnz, 8 * (n + 1))\n"
     "v = np.frombuffer(raw, np.complex128, nnz, 8 * (n + 1 + nnz))\n"
     "b = np.frombuffer(raw, np.complex128, n, 8 * (n + 1 + nnz) + 16 * nnz)\n"
     "A = sp.csr_matrix((v, ci, rp), shape=(n, n)).tocsc()\n"
-    "ts = []\n"
-    "for r in range(reps):\n"
-    "    t0 = time.process_time(); x = sla.spsolve(A, b); ts.append(time.process_time() - t0)\n"
-    "print(sorted(ts)[len(ts) // 2], np.abs(b - A @ x).sum() / np.abs(b).sum())\n";
+    "f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt\n"
+    "t0 = time.process_time(); x = sla.spsolve(A, b); t = time.process_time() - t0\n"
+    "f1 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt\n"
+    "print(t, np.abs(b - A @ x).sum() / np.abs(b).sum(), f1 - f0)\n";
 
 static const char octave_script[] =
-    "a = argv(); f = a{1}; n = str2num(a{2}); nnz = str2num(a{3}); reps = str2num(a{4});\n"
-    "fid = fopen(f, 'r'); rp = fread(fid, n + 1, 'int64'); ci = fread(fid, nnz, 'int64');\n"
-    "v = fread(fid, 2 * nnz, 'double'); bb = fread(fid, 2 * n, 'double'); fclose(fid);\n"
+    "a = argv(); f = a{1}; n = str2num(a{2}); nz = str2num(a{3});\n"
+    "w = sparse([2 1i; 1i 3]) \\ [1; 1i];\n"
+    "fid = fopen(f, 'r'); rp = fread(fid, n + 1, 'int64'); ci = fread(fid, nz, 'int64');\n"
+    "v = fread(fid, 2 * nz, 'double'); bb = fread(fid, 2 * n, 'double'); fclose(fid);\n"
     "v = v(1:2:end) + 1i * v(2:2:end); b = bb(1:2:end) + 1i * bb(2:2:end);\n"
     "r = repelem((1:n)', diff(rp)); A = sparse(r, ci + 1, v, n, n);\n"
-    "ts = zeros(reps, 1);\n"
-    "for k = 1:reps, t0 = cputime; x = A \\ b; ts(k) = cputime - t0; end\n"
-    "printf('%.17g %.17g\\n', median(ts), sum(abs(b - A * x)) / sum(abs(b)));\n";
+    "u0 = getrusage(); t0 = cputime; x = A \\ b; t = cputime - t0; u1 = getrusage();\n"
+    "printf('%.17g %.17g %d\\n', t, sum(abs(b - A * x)) / sum(abs(b)), u1.minflt - u0.minflt);\n";
 
 static int write_matrix(const char *path, const csr *A, const double complex *b)
 {
@@ -253,86 +265,107 @@ static int write_matrix(const char *path, const csr *A, const double complex *b)
     return fclose(f) == 0 && ok ? 0 : -1;
 }
 
-/* Runs cmd, which prints "seconds residual"; -1 if it fails. */
-static double run_tool(const char *cmd, double *resid)
+static int write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    int ok;
+    if (!f) return -1;
+    ok = fputs(text, f) >= 0;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
+/* Runs cmd, which prints "seconds residual faults". */
+static int run_tool(const char *cmd, run_result *out)
 {
     FILE *p = popen(cmd, "r");
-    double s = -1;
+    int ok;
     if (!p) return -1;
-    if (fscanf(p, "%lf %lf", &s, resid) != 2) s = -1;
-    if (pclose(p) != 0) s = -1;
-    return s;
+    ok = fscanf(p, "%lf %lf %lf", &out->s, &out->resid, &out->faults) == 3;
+    if (pclose(p) != 0) ok = 0;
+    return ok ? 0 : -1;
 }
 
-/* One row; report < 0: the solver has no report to read; ratio < 0: s /
- * base, else the ratio measured round by round. */
-static void row_ratio(const char *name, const char *how, double s, double report, double resid, double base,
-                      double ratio)
+/* ---- the rounds ----------------------------------------------------------------- */
+
+/* The 1-minute load average (/proc/loadavg), -1 where there is none: the
+ * rounds print it, since a shared machine's load says how far to trust
+ * a few per cent. */
+static double load_average(void)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    double l = -1;
+    if (f) {
+        if (fscanf(f, "%lf", &l) != 1) l = -1;
+        fclose(f);
+    }
+    return l;
+}
+
+enum { ROW_DIRECT, ROW_DIRECT_OCTAVE, ROW_SILC_AUTO, ROW_SILC_NOW, ROW_SILC_OFF, ROW_SCIPY, ROW_OCTAVE, ROWS };
+
+typedef struct bench_row {
+    const char *name;
+    char how[300];
+    int on;                            /* runs at all */
+    double *s, *ratio, *report, *faults; /* one per round */
+    double resid;
+    int failed;
+} bench_row;
+
+/* Row j's run of one round. */
+static int run_row(int j, const csr *A, const double complex *b, const char *cmd_scipy, const char *cmd_octave,
+                   run_result *out, char *how, size_t hlen)
+{
+    out->report = -1;
+    switch (j) {
+    case ROW_DIRECT: return run_umfpack(A, b, 2, out);
+    case ROW_DIRECT_OCTAVE: return run_umfpack(A, b, 1, out);
+    case ROW_SILC_AUTO: return run_silc(A, b, "auto", out, how, hlen);
+    case ROW_SILC_NOW: return run_silc(A, b, "now", out, how, hlen);
+    case ROW_SILC_OFF: return run_silc(A, b, "off", out, how, hlen);
+    case ROW_SCIPY: return run_tool(cmd_scipy, out);
+    default: return run_tool(cmd_octave, out);
+    }
+}
+
+static void print_row(const bench_row *r, int reps)
 {
     char rep[32] = "--";
-    if (s < 0) {
-        printf("| %-18s | %-58s | %9s | %9s | %11s | %9s |\n", name, how, "n/a", "", "", "");
+    double report;
+    if (!r->on) return;
+    if (r->failed) {
+        printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", r->name, r->how, "n/a", "", "", "", "");
         return;
     }
+    report = bench_median(r->report, reps);
     if (report >= 0) snprintf(rep, sizeof rep, "%.3f", report);
-    if (ratio < 0) ratio = base > 0 ? s / base : 0;
-    printf("| %-18s | %-58s | %9.3f | %9.3f | %11s | %9.1e |\n", name, how, s, ratio, rep, resid);
-}
-
-static void row(const char *name, const char *how, double s, double report, double resid, double base)
-{
-    row_ratio(name, how, s, report, resid, base, -1);
-}
-
-/* The library and SILC under the three accuracy.condest modes, one run each
- * per round, rounds alternating: t[0] the library's median, t[1..3] SILC's
- * (auto, now, off), q[1..3] their medians of round-by-round ratios, and
- * each SILC row's median first-info time, residual and backend. */
-static const char *const condest_modes[3] = {"auto", "now", "off"};
-
-static int run_rounds(const csr *A, const double complex *b, int reps, double t[4], double q[4], double info[4],
-                      double resid[4], char backend[3][300])
-{
-    double *rt[4], *rq[4], *ri[4];
-    int ok = 1;
-    for (int j = 0; j < 4; j++) {
-        rt[j] = calloc((size_t)reps, sizeof(double));
-        rq[j] = calloc((size_t)reps, sizeof(double));
-        ri[j] = calloc((size_t)reps, sizeof(double));
-        ok = ok && rt[j] && rq[j] && ri[j];
-    }
-    for (int r = 0; ok && r < reps; r++) {
-        rt[0][r] = run_umfpack(A, b, 1, &resid[0]);
-        ok = rt[0][r] > 0;
-        for (int j = 1; ok && j < 4; j++) {
-            rt[j][r] = run_silc(A, b, 1, condest_modes[j - 1], &resid[j], backend[j - 1], 300, &ri[j][r]);
-            ok = rt[j][r] > 0;
-            rq[j][r] = rt[j][r] / rt[0][r];
-        }
-    }
-    for (int j = 0; j < 4; j++) {
-        if (ok) {
-            t[j] = bench_median(rt[j], reps);
-            q[j] = j ? bench_median(rq[j], reps) : 1;
-            info[j] = j ? bench_median(ri[j], reps) : -1;
-        }
-        free(rt[j]);
-        free(rq[j]);
-        free(ri[j]);
-    }
-    return ok ? 0 : -1;
+    printf("| %-18s | %-76s | %9.3f | %9.3f | %11s | %9.0f | %9.1e |\n", r->name, r->how, bench_median(r->s, reps),
+           bench_median(r->ratio, reps), rep, bench_median(r->faults, reps), r->resid);
 }
 
 int main(int argc, char **argv)
 {
     int64_t N = 500;
-    double k = 50, r_sp = 0, r_oct = 0;
-    int reps = 3, scipy = 1, octave = 1;
-    char backend[3][300], dir[] = "/tmp/silc-helmholtz-XXXXXX", path[600], script[600], cmd[1600];
+    double k = 50;
+    int reps = 3, scipy = 1, octave = 1, rc = 0;
+    char dir[] = "/tmp/silc-helmholtz-XXXXXX", path[600], py[600], m[600], cmd_scipy[2000] = "",
+         cmd_octave[2000] = "";
     csr A;
     silc_envelope_t E;
     double complex *b;
-    double t[4] = {-1, -1, -1, -1}, q[4], info[4], resid[4], t_sp = -1, t_oct = -1;
+    bench_row rows[ROWS] = {
+        {.name = "UMFPACK direct",
+         .how = "umfpack_zl, default control (IRSTEP 2, SCALE SUM, STRATEGY AUTO), UMFPACK_A",
+         .on = 1},
+        {.name = "UMFPACK direct",
+         .how = "umfpack_zl, Octave's control (the defaults but IRSTEP 1), UMFPACK_A",
+         .on = 1},
+        {.name = "SILC x = A \\ b", .how = "", .on = 1},
+        {.name = "SILC x = A \\ b", .how = "", .on = 1},
+        {.name = "SILC x = A \\ b", .how = "", .on = 1},
+        {.name = "SciPy spsolve", .how = "scipy.sparse.linalg (SuperLU)", .on = 1},
+        {.name = "Octave A\\b", .how = "octave-cli (UMFPACK)", .on = 1},
+    };
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--n") && i + 1 < argc) N = atoll(argv[++i]);
         else if (!strcmp(argv[i], "--k") && i + 1 < argc) k = atof(argv[++i]);
@@ -349,54 +382,85 @@ int main(int argc, char **argv)
         return 2;
     }
     if (helmholtz(N, k, &E, &A, &b)) return 1;
-    printf("2-D Helmholtz, %lld x %lld grid (%lld unknowns, %lld entries), k = %g, absorbing boundary; "
-           "median of %d\n\n",
-           (long long)N, (long long)N, (long long)A.n, (long long)A.nnz, k, reps);
-    if (run_rounds(&A, b, reps, t, q, info, resid, backend)) fprintf(stderr, "complex_helmholtz: a run failed\n");
-    if ((scipy || octave) && mkdtemp(dir)) {
+    if (octave && access("/usr/bin/octave-cli", X_OK) != 0) {
+        snprintf(rows[ROW_OCTAVE].how, sizeof rows[ROW_OCTAVE].how, "octave-cli not installed");
+        rows[ROW_OCTAVE].failed = 1;
+        octave = 0;
+    }
+    if (!(scipy || octave) || !mkdtemp(dir)) {
+        dir[0] = 0;
+        scipy = octave = 0;
+    }
+    if (dir[0]) {
         snprintf(path, sizeof path, "%s/A.bin", dir);
-        if (write_matrix(path, &A, b) == 0) {
-            if (scipy) {
-                FILE *f;
-                snprintf(script, sizeof script, "%s/bench.py", dir);
-                if ((f = fopen(script, "w"))) {
-                    fputs(scipy_script, f);
-                    fclose(f);
-                    snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %s %lld %lld %d", script, path, (long long)A.n,
-                             (long long)A.nnz, reps);
-                    t_sp = run_tool(cmd, &r_sp);
-                }
-            }
-            if (octave && access("/usr/bin/octave-cli", X_OK) == 0) {
-                FILE *f;
-                snprintf(script, sizeof script, "%s/bench.m", dir);
-                if ((f = fopen(script, "w"))) {
-                    fputs(octave_script, f);
-                    fclose(f);
-                    snprintf(cmd, sizeof cmd, "octave-cli -q %s %s %lld %lld %d 2>/dev/null", script, path,
-                             (long long)A.n, (long long)A.nnz, reps);
-                    t_oct = run_tool(cmd, &r_oct);
-                }
-            }
-            unlink(path);
+        snprintf(py, sizeof py, "%s/bench.py", dir);
+        snprintf(m, sizeof m, "%s/bench.m", dir);
+        if (write_matrix(path, &A, b) || write_text(py, scipy_script) || write_text(m, octave_script)) {
+            fprintf(stderr, "complex_helmholtz: cannot write the matrix for SciPy and Octave in %s\n", dir);
+            scipy = octave = 0;
         }
-        snprintf(script, sizeof script, "%s/bench.py", dir);
-        unlink(script);
-        snprintf(script, sizeof script, "%s/bench.m", dir);
-        unlink(script);
+        snprintf(cmd_scipy, sizeof cmd_scipy, "/usr/bin/python3 %s %s %lld %lld", py, path, (long long)A.n,
+                 (long long)A.nnz);
+        snprintf(cmd_octave, sizeof cmd_octave, "octave-cli -q %s %s %lld %lld 2>/dev/null", m, path,
+                 (long long)A.n, (long long)A.nnz);
+    }
+    rows[ROW_SCIPY].on = scipy;
+    rows[ROW_OCTAVE].on = octave || rows[ROW_OCTAVE].failed;
+    for (int j = 0; j < ROWS; j++) {
+        bench_row *r = &rows[j];
+        r->s = calloc((size_t)reps, sizeof(double));
+        r->ratio = calloc((size_t)reps, sizeof(double));
+        r->report = calloc((size_t)reps, sizeof(double));
+        r->faults = calloc((size_t)reps, sizeof(double));
+        if (!r->s || !r->ratio || !r->report || !r->faults) {
+            fprintf(stderr, "complex_helmholtz: out of memory\n");
+            return 1;
+        }
+    }
+    printf("2-D Helmholtz, %lld x %lld grid (%lld unknowns, %lld entries), k = %g, absorbing boundary; "
+           "median of %d rounds\n\n",
+           (long long)N, (long long)N, (long long)A.n, (long long)A.nnz, k, reps);
+    for (int round = 0; round < reps; round++) {
+        fprintf(stderr, "round %d of %d (load average %.2f):", round + 1, reps, load_average());
+        for (int j = 0; j < ROWS; j++) {
+            bench_row *r = &rows[j];
+            run_result out = {-1, -1, 0, 0};
+            if (!r->on || r->failed) continue;
+            if (run_row(j, &A, b, cmd_scipy, cmd_octave, &out, r->how, sizeof r->how)) {
+                r->failed = 1;
+                if (j == ROW_DIRECT) rc = 1;
+                if (j == ROW_SCIPY || j == ROW_OCTAVE) fprintf(stderr, " (%s failed)", r->name);
+                continue;
+            }
+            r->s[round] = out.s;
+            r->report[round] = out.report;
+            r->faults[round] = out.faults;
+            r->resid = out.resid;
+            r->ratio[round] = rows[ROW_DIRECT].failed ? 0 : out.s / rows[ROW_DIRECT].s[round];
+            fprintf(stderr, " %.2f", out.s);
+        }
+        fprintf(stderr, "\n");
+    }
+    if (dir[0]) {
+        unlink(path);
+        unlink(py);
+        unlink(m);
         rmdir(dir);
     }
-    printf("| %-18s | %-58s | %9s | %9s | %11s | %9s |\n", "solver", "how", "CPU s", "/ UMFPACK",
-           "info x [s]", "residual");
-    printf("| %-18s | %-58s | %9s | %9s | %11s | %9s |\n", "---", "---", "---:", "---:", "---:", "---:");
-    row("UMFPACK direct", "umfpack_zl symbolic+numeric+solve", t[0], -1, resid[0], t[0]);
-    for (int j = 1; j < 4; j++) row_ratio("SILC x = A \\ b", backend[j - 1], t[j], info[j], resid[j], t[0], q[j]);
-    if (scipy) row("SciPy spsolve", "scipy.sparse.linalg (SuperLU)", t_sp, -1, r_sp, t[0]);
-    if (octave) row("Octave A\\b", access("/usr/bin/octave-cli", X_OK) ? "octave-cli not installed" : "octave-cli",
-                    t_oct, -1, r_oct, t[0]);
-    printf("\nSILC's ratios are medians of round-by-round ratios (the rounds alternate the library and SILC);\n"
-           "SciPy's and Octave's are their medians over the library's.\n");
+    printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", "solver", "how", "CPU s", "/ UMFPACK",
+           "info x [s]", "faults", "residual");
+    printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", "---", "---", "---:", "---:", "---:", "---:",
+           "---:");
+    for (int j = 0; j < ROWS; j++) print_row(&rows[j], reps);
+    printf("\nRatios are medians of round-by-round ratios to the first row (each round runs every row once);\n"
+           "faults: minor page faults of the timed part (median).\n");
+    for (int j = 0; j < ROWS; j++) {
+        free(rows[j].s);
+        free(rows[j].ratio);
+        free(rows[j].report);
+        free(rows[j].faults);
+    }
     silc_envelope_free(&E);
     free(b);
-    return t[0] < 0 || t[1] < 0;
+    return rc || rows[ROW_SILC_AUTO].failed;
 }
