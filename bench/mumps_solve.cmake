@@ -1,39 +1,17 @@
 # bench/mumps_solve (included from bench/CMakeLists.txt): MUMPS's solve phase
 # called directly (sequential dmumps_c and smumps_c, the static archives the
 # plugin links), the baseline for SILC's mumps backend in a loop that reuses
-# one factorization (docs/backends.md, the diffusion loop).  Skipped when
-# sequential MUMPS is missing.
-find_path(BENCH_MS_INCLUDE dmumps_c.h PATH_SUFFIXES mumps_seq)
-set(_ms_libs "")
-set(_ms_missing "")
-foreach(lib dmumps_seq smumps_seq mumps_common_seq pord_seq mpiseq_seq)
-  find_library(BENCH_MS_${lib} NAMES lib${lib}.a)
-  if(BENCH_MS_${lib})
-    list(APPEND _ms_libs ${BENCH_MS_${lib}})
-  else()
-    list(APPEND _ms_missing lib${lib}.a)
-  endif()
-endforeach()
-foreach(lib esmumps scotch scotcherr lapack blas)
-  find_library(BENCH_MS_DEP_${lib} NAMES ${lib})
-  if(BENCH_MS_DEP_${lib})
-    list(APPEND _ms_libs ${BENCH_MS_DEP_${lib}})
-  else()
-    list(APPEND _ms_missing lib${lib})
-  endif()
-endforeach()
-find_library(BENCH_MS_gfortran NAMES gfortran libgfortran.so.5)
-if(NOT BENCH_MS_gfortran)
-  list(APPEND _ms_missing libgfortran)
-endif()
-if(NOT BENCH_MS_INCLUDE)
-  list(APPEND _ms_missing dmumps_c.h)
-endif()
-if(_ms_missing)
-  string(REPLACE ";" ", " _ms_missing "${_ms_missing}")
-  message(STATUS "SILC: bench/mumps_solve skipped: ${_ms_missing} not found (apt-get install libmumps-seq-dev)")
-else()
+# one factorization (docs/backends.md, the diffusion loop).  Built when the
+# sequential mumps plugin is: it links what plugin-mumps/CMakeLists.txt found
+# (cached there), so the search for MUMPS is written once.
+if(TARGET silc_plugin_mumps)
   add_executable(mumps_solve mumps_solve.c)
-  target_include_directories(mumps_solve PRIVATE ${BENCH_MS_INCLUDE})
-  target_link_libraries(mumps_solve PRIVATE ${_ms_libs} ${BENCH_MS_gfortran} ${MATH_LIB})
+  target_include_directories(mumps_solve PRIVATE ${MUMPS_INCLUDE_DIR})
+  target_link_libraries(mumps_solve PRIVATE
+    ${MUMPS_dmumps_seq_STATIC} ${MUMPS_smumps_seq_STATIC} ${MUMPS_mumps_common_seq_STATIC}
+    ${MUMPS_pord_seq_STATIC} ${MUMPS_mpiseq_seq_STATIC}
+    ${MUMPS_DEP_esmumps} ${MUMPS_DEP_scotch} ${MUMPS_DEP_scotcherr} ${MUMPS_DEP_lapack}
+    ${MUMPS_DEP_blas} ${MUMPS_DEP_gfortran} ${MATH_LIB})
+else()
+  message(STATUS "SILC: bench/mumps_solve skipped: the sequential mumps plugin is not built")
 endif()
