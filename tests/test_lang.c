@@ -1119,6 +1119,16 @@ static void test_diagvec_of_product(void)
     silc_close(&c);
 }
 
+/* What the last captured `info` says of "reused factorization:": 1 yes,
+ * 0 no, -1 not said. */
+static int captured_reuse(void)
+{
+    const char *t = strstr(captured, "reused factorization: ");
+    if (!t) return -1;
+    t += strlen("reused factorization: ");
+    return !strncmp(t, "yes", 3) ? 1 : !strncmp(t, "no", 2) ? 0 : -1;
+}
+
 /* A chain of operations on constants settles in its second pass as one
  * operation does (memo.c renames the keys that named the first pass's
  * results): here A of three operations keeps its identity, and its
@@ -1131,7 +1141,6 @@ static void test_memo_chain(void)
     int pass, want;
     int64_t m, n;
     double *x;
-    const char *t;
     if (!c) return;
     silc_set_output(c, capture, NULL);
     CHECK(silc_exec(c, "M = sparse([1; 2; 3], [1; 2; 3], [4; 5; 6], 3, 3); r = ones(3, 1)") == 0, "chain set-up");
@@ -1142,8 +1151,7 @@ static void test_memo_chain(void)
               silc_context_errmsg(c));
         /* silcd --mpi keeps no such results (test_memo) */
         want = (pass == 3 || pass == 4 || pass == 7) && !strstr(captured, "\n  ranks: ");
-        t = strstr(captured, "reused factorization: ");
-        CHECK(t && !strncmp(t + 22, want ? "yes" : "no", want ? 3 : 2),
+        CHECK(captured_reuse() == want,
               "chain pass %d: the solve %s have reused A's factorization:\n%s", pass, want ? "should" : "should not",
               captured);
         if (fetch(c, "y", &m, &n, &x) == 3) {
@@ -1167,7 +1175,6 @@ static void test_memo(void)
     int pass, want;
     int64_t m, n;
     double *x;
-    const char *t;
     if (!c) return;
     silc_set_output(c, capture, NULL);
     CHECK(silc_exec(c, "M = sparse([1; 2; 3], [1; 2; 3], [4; 5; 6], 3, 3); r = ones(3, 1)") == 0, "memo set-up");
@@ -1177,8 +1184,7 @@ static void test_memo(void)
         /* An engine on several ranks (silcd --mpi: `info` names the ranks)
          * keeps no such results: there the matrix is new every pass. */
         want = pass >= 3 && !strstr(captured, "\n  ranks: ");
-        t = strstr(captured, "reused factorization: ");
-        CHECK(t && !strncmp(t + 22, want ? "yes" : "no", want ? 3 : 2),
+        CHECK(captured_reuse() == want,
               "pass %d: the solve %s have reused A's factorization:\n%s", pass, want ? "should" : "should not",
               captured);
         if (fetch(c, "y", &m, &n, &x) == 3) {
@@ -1191,8 +1197,7 @@ static void test_memo(void)
     captured[0] = 0;
     CHECK(silc_exec(c, "M = 2 * M; A = M + M; y = A \\ r; info y") == 0, "memo after a change: %s",
           silc_context_errmsg(c));
-    t = strstr(captured, "reused factorization: ");
-    CHECK(t && !strncmp(t + 22, "no", 2), "a changed M reused a factorization:\n%s", captured);
+    CHECK(captured_reuse() == 0, "a changed M reused a factorization:\n%s", captured);
     if (fetch(c, "y", &m, &n, &x) == 3) {
         CHECK(x[0] == 1.0 / 16 && x[2] == 1.0 / 24, "after the change y = %g .. %g", x[0], x[2]);
         free(x);
@@ -1211,8 +1216,7 @@ static void test_memo(void)
             captured[0] = 0;
             CHECK(silc_exec(c, "z = P \\ r; info z") == 0, "solve with P: %s", silc_context_errmsg(c));
             want = pass == 2;
-            t = strstr(captured, "reused factorization: ");
-            CHECK(t && !strncmp(t + 22, want ? "yes" : "no", want ? 3 : 2), "PUT pass %d:\n%s", pass, captured);
+            CHECK(captured_reuse() == want, "PUT pass %d:\n%s", pass, captured);
             if (fetch(c, "z", &m, &n, &x) == 3) {
                 CHECK(x[1] == 1 / val[1], "PUT pass %d: z(2) = %g, want %g", pass, x[1], 1 / val[1]);
                 free(x);

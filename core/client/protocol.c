@@ -317,13 +317,14 @@ int proto_spin(struct pollfd *p, int n, int64_t budget_ns)
 
 uint64_t proto_spin_kind(uint32_t op, const char *text)
 {
-    uint64_t h = 1469598103934665603u; /* FNV-1a */
-    size_t n = text ? strlen(text) : 0, i;
+    size_t n = text ? strlen(text) : 0;
+    unsigned char head[12]; /* op and the text's length, least significant byte first */
+    uint64_t h;
     int k;
-    for (k = 0; k < 4; k++) h = (h ^ ((op >> (8 * k)) & 0xffu)) * 1099511628211u;
-    for (k = 0; k < 8; k++) h = (h ^ (((uint64_t)n >> (8 * k)) & 0xffu)) * 1099511628211u;
-    for (i = 0; i < n && i < SPIN_KIND_TEXT_BYTES; i++)
-        h = (h ^ (uint8_t)text[i]) * 1099511628211u;
+    for (k = 0; k < 4; k++) head[k] = (unsigned char)(op >> (8 * k));
+    for (k = 0; k < 8; k++) head[4 + k] = (unsigned char)((uint64_t)n >> (8 * k));
+    h = util_fnv1a(UTIL_FNV1A_START, head, sizeof head);
+    if (n) h = util_fnv1a(h, text, n < SPIN_KIND_TEXT_BYTES ? n : SPIN_KIND_TEXT_BYTES);
     return h ? h : 1;
 }
 

@@ -151,12 +151,10 @@ int dist_agree(silc_engine *E, int rc)
 /* FNV-1a over the call kind and its text. */
 static uint64_t call_hash(const char *what, const char *text)
 {
-    uint64_t h = 1469598103934665603ULL;
-    const char *p;
-    for (p = what; *p; p++) h = (h ^ (unsigned char)*p) * 1099511628211ULL;
-    h = (h ^ 0xff) * 1099511628211ULL;
-    for (p = text ? text : ""; *p; p++) h = (h ^ (unsigned char)*p) * 1099511628211ULL;
-    return h;
+    static const unsigned char separator = 0xff;
+    uint64_t h = util_fnv1a(UTIL_FNV1A_START, what, strlen(what));
+    h = util_fnv1a(h, &separator, 1);
+    return text ? util_fnv1a(h, text, strlen(text)) : h;
 }
 
 int dist_check_call(silc_engine *E, const char *what, const char *text)

@@ -241,9 +241,7 @@ int tuner_loo_stable(const double *p, const double *t, int n, int pmin, int pmax
 
 uint64_t tuner_hash(const char *text)
 {
-    uint64_t h = 1469598103934665603ull;
-    while (*text) h = (h ^ (unsigned char)*text++) * 1099511628211ull;
-    return h;
+    return util_fnv1a(UTIL_FNV1A_START, text, strlen(text));
 }
 
 int tuner_detect_period(const uint64_t *h, int n, int maxk)

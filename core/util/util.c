@@ -153,6 +153,14 @@ const char *util_closest(const char *name, const char *const *cands, size_t ncan
     return best;
 }
 
+uint64_t util_fnv1a(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    size_t i;
+    for (i = 0; i < n; i++) h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
 double util_now(void)
 {
     struct timespec ts;

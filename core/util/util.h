@@ -59,6 +59,11 @@ int util_is_name(const char *s);
 #endif
 
 double util_now(void);                 /* monotonic seconds */
+/* FNV-1a: h carried through the n bytes at p.  Start from UTIL_FNV1A_START;
+ * the tuner's step keys, the SPMD call check and the protocol's wait kinds
+ * all hash with it. */
+#define UTIL_FNV1A_START 1469598103934665603ull
+uint64_t util_fnv1a(uint64_t h, const void *p, size_t n);
 char *util_strdup(const char *s);
 /* Formats a double the way the language prints values: %.17g, but shortest
  * round-trip form (tries %.15g, %.16g first). */
