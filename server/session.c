@@ -491,7 +491,7 @@ static int do_get(session *S, const char *name, int accept_complex)
         /* The copy kept counts with the value: factorizations make room. */
         memo_give_way(S, 0);
     }
-    if (v && !accept_complex && env_refuse_complex(name, v, S->err, sizeof S->err)) v = NULL;
+    if (v && !accept_complex && env_refuse_complex(name, v, "silc_get_complex", S->err, sizeof S->err)) v = NULL;
     val_retain(v);
     if (!v) return reply_error(S, S->err);
     k = proto_value_iov(v, &d, body + 1);

@@ -2,7 +2,8 @@
  * test_mpi.c -- distributed SILC checked against the sequential engine.
  *
  *     mpirun -np P test_mpi spmd      an MPI program: silc_open_mpi, each rank
- *                                     its own rows (silc_put_rows/get_rows)
+ *                                     its own rows (silc_put_rows/get_rows,
+ *                                     silc_get_rows_complex)
  *     test_mpi server                 a plain client of SILC_SERVER, which is
  *                                     `mpirun -np P silcd --mpi` (tests/mpi.cmake)
  *
@@ -19,8 +20,12 @@
  *     agree with the embedded engine's to rounding; `x = A \ b` runs on
  *     MPI MUMPS (zmumps) with the right-hand side and solution distributed
  *     (ICNTL(20)=10, ICNTL(21)=1), equals the embedded complex solve to
- *     rounding and x_true to cond x eps; PETSc (a real build) declines it
- *     and the chain moves on;
+ *     rounding and x_true to cond x eps; each rank's rows of x come back
+ *     complex (silc_get_rows_complex: its own block in SPMD mode, the whole
+ *     value from a server), equal to those rows of the embedded solve and of
+ *     x_true within n eps cond2, while silc_get_rows refuses them, naming
+ *     the complex call; PETSc (a real build) declines it and the chain moves
+ *     on;
  *   - the bytes a solve moves: nothing gathered, only the solution's
  *     entries MUMPS leaves off their row block (the count its report gives),
  *     16 bytes each for a complex column, 8 for a real one;
@@ -30,6 +35,7 @@
  * The reference solves run in an ordinary embedded context of this process.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -321,6 +327,54 @@ out:
     free(u0), free(ud), free(ur);
 }
 
+/* This rank's rows of the complex solution x (n entries) through
+ * silc_get_rows_complex: in SPMD mode the block of A's rows (x = A \ b
+ * keeps b's rows, b = A * xt A's, and A was put split evenly), from a
+ * server the whole value.  The rows must be those of the embedded solve
+ * x_emb (to rounding, as the gathered x) and of x_true within n eps cond2
+ * (young1c's cond2 4.2e2, from the matrices' README).  The real-only
+ * silc_get_rows refuses the complex value, naming it. */
+static void check_complex_rows(silc_context *c, const double *x_emb, const double *x_true, int64_t n)
+{
+    const double cond2 = 4.2e2, bound = (double)n * DBL_EPSILON * cond2;
+    silc_envelope_t blk;
+    int64_t first = -1, want_first = 0, want_rows = n, i;
+    double d_emb = 0, d_true = 0, s = 0;
+    int ok, rc;
+    memset(&blk, 0, sizeof blk);
+    if (spmd) my_rows(n, &want_first, &want_rows);
+    ok = silc_get_rows_complex(c, &blk, &first, "x") == 0;
+    CHECK(all_ok(ok), "silc_get_rows_complex x: %s", silc_context_errmsg(c));
+    ok = ok && first == want_first && blk.m == want_rows && blk.n == 1 && blk.format == (SILC_DENSE | SILC_COMPLEX);
+    CHECK(all_ok(ok), "rank %d's complex rows of x: first %lld, %lldx%lld, format %d; want first %lld, %lld rows, "
+          "complex dense", rank, (long long)first, (long long)blk.m, (long long)blk.n, (int)blk.format,
+          (long long)want_first, (long long)want_rows);
+    if (all_ok(ok)) {
+        for (i = 0; i < n; i++) s = fmax(s, hypot(x_true[2 * i], x_true[2 * i + 1]));
+        for (i = 0; i < blk.m; i++) {
+            const double *got = blk.values + 2 * i, *e = x_emb + 2 * (first + i), *t = x_true + 2 * (first + i);
+            d_emb = fmax(d_emb, hypot(got[0] - e[0], got[1] - e[1]));
+            d_true = fmax(d_true, hypot(got[0] - t[0], got[1] - t[1]));
+        }
+        d_emb = max_all(d_emb / s);
+        d_true = max_all(d_true / s);
+        CHECK(d_emb <= 1e-12, "complex rows of x on %d ranks: %.3g from the embedded solve > 1e-12", engine_ranks,
+              d_emb);
+        CHECK(d_true <= bound, "complex rows of x on %d ranks: error to x_true %.3g > n eps cond2 = %.3g",
+              engine_ranks, d_true, bound);
+        if (rank == 0)
+            printf("  young1c complex rows: rank 0 got rows %lld..%lld, %.2g from the embedded solve, error "
+                   "%.2g (bound n eps cond2 %.2g)\n", (long long)first, (long long)(first + blk.m - 1), d_emb,
+                   d_true, bound);
+    }
+    silc_envelope_free(&blk);
+    rc = silc_get_rows(c, &blk, &first, "x");
+    CHECK(all_ok(rc != 0 && blk.values == NULL && strstr(silc_context_errmsg(c), "'x' is complex") &&
+                 strstr(silc_context_errmsg(c), spmd ? "silc_get_rows_complex" : "silc_get_complex")),
+          "silc_get_rows of a complex value: rc %d, '%s'", rc, silc_context_errmsg(c));
+    silc_envelope_free(&blk);
+}
+
 /* Complex values distributed by rows (young1c, 841 x 841 complex general):
  * put, products, reductions and a solve against the embedded engine, and
  * x_true.  The server splits what it is PUT (test_mpi_server.sh's
@@ -408,6 +462,7 @@ static void check_complex(silc_context *c, silc_context *ref, tl_capture *cap)
         CHECK(all_ok(d <= 1e-12), "complex solve on %d ranks: relative difference %.3g to the embedded > 1e-12",
               engine_ranks, d);
         CHECK(all_ok(get_scalar(c, "e", &e) == 0 && e <= 1e-10), "complex solve: error to x_true %.3g > 1e-10", e);
+        if (all_ok(ok)) check_complex_rows(c, zr, x_true, n);
         /* Again with the same A: no matrix byte moves, and the vectors are
          * exactly the solution entries MUMPS left off their row block. */
         ok = silc_exec(c, "x = A \\ b") == 0;

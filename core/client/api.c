@@ -342,37 +342,6 @@ int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const 
     return 0;
 }
 
-int silc_get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, const char *name)
-{
-    const silc_value *v = NULL;
-    silc_value *blk = NULL;
-    int64_t first = 0;
-    int rc = 0;
-    if (e) memset(e, 0, sizeof *e);
-    if (first_row) *first_row = 0;
-    if (!ctx) return env_error("silc_get_rows: NULL context");
-    if (!e) rc = ctx_error(ctx, "silc_get_rows: NULL envelope");
-    else if (!name) rc = ctx_error(ctx, "silc_get_rows: NULL name");
-    if (ctx->R) return rc ? ctx_result(ctx, rc) : silc_get(ctx, e, name);
-    if (!rc && !(v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err))) rc = -1;
-    if (!rc && env_refuse_complex(name, v, ctx->err, sizeof ctx->err)) rc = -1;
-    if (spmd_enter(ctx, "GET_ROWS", name ? name : "", rc)) return ctx_result(ctx, -1);
-    if (dist_rows_of(ctx->E, v, &blk, &first)) {
-        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
-        return ctx_result(ctx, -1);
-    }
-    rc = env_from_value(blk, e);
-    val_release(blk);
-    if (ctx->E->dist && dist_agree(ctx->E, rc ? (snprintf(ctx->E->err, sizeof ctx->E->err, "out of memory copying '%s'", name), -1) : 0)) {
-        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
-        silc_envelope_free(e);
-        return ctx_result(ctx, -1);
-    }
-    if (rc) return ctx_error(ctx, "out of memory copying '%s'", name);
-    if (first_row) *first_row = first;
-    return 0;
-}
-
 /* silc_get and silc_get_complex: a caller that did not ask for complex
  * values gets none (silc.h). */
 static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, int accept_complex)
@@ -386,7 +355,7 @@ static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, in
     if (ctx->R)
         return ctx_result(ctx, rem_get(ctx->R, e, name, accept_complex, ctx->err, sizeof ctx->err));
     v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err);
-    if (v && !accept_complex && env_refuse_complex(name, v, ctx->err, sizeof ctx->err)) v = NULL;
+    if (v && !accept_complex && env_refuse_complex(name, v, "silc_get_complex", ctx->err, sizeof ctx->err)) v = NULL;
     if (spmd_enter(ctx, "GET", name, v ? 0 : -1)) return ctx_result(ctx, -1);
     if (dist_is(v) && !(v = dist_whole(ctx->E, v, 1))) { /* every rank gets the whole value */
         snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
@@ -406,6 +375,53 @@ int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
 int silc_get_complex(silc_context *ctx, silc_envelope_t *e, const char *name)
 {
     return get_value(ctx, e, name, 1);
+}
+
+/* silc_get_rows and silc_get_rows_complex: as get_value, a caller that did
+ * not ask for complex values gets none; on a remote context (one process)
+ * the block is the whole value. */
+static int get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, const char *name,
+                    int accept_complex)
+{
+    const silc_value *v = NULL;
+    silc_value *blk = NULL;
+    const char *fn = accept_complex ? "silc_get_rows_complex" : "silc_get_rows";
+    int64_t first = 0;
+    int rc = 0;
+    if (e) memset(e, 0, sizeof *e);
+    if (first_row) *first_row = 0;
+    if (!ctx) return env_error("%s: NULL context", fn);
+    if (!e) rc = ctx_error(ctx, "%s: NULL envelope", fn);
+    else if (!name) rc = ctx_error(ctx, "%s: NULL name", fn);
+    if (ctx->R) return rc ? ctx_result(ctx, rc) : get_value(ctx, e, name, accept_complex);
+    if (!rc && !(v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err))) rc = -1;
+    if (!rc && !accept_complex && env_refuse_complex(name, v, "silc_get_rows_complex", ctx->err, sizeof ctx->err))
+        rc = -1;
+    if (spmd_enter(ctx, "GET_ROWS", name ? name : "", rc)) return ctx_result(ctx, -1);
+    if (dist_rows_of(ctx->E, v, &blk, &first)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        return ctx_result(ctx, -1);
+    }
+    rc = env_from_value(blk, e);
+    val_release(blk);
+    if (ctx->E->dist && dist_agree(ctx->E, rc ? (snprintf(ctx->E->err, sizeof ctx->E->err, "out of memory copying '%s'", name), -1) : 0)) {
+        snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
+        silc_envelope_free(e);
+        return ctx_result(ctx, -1);
+    }
+    if (rc) return ctx_error(ctx, "out of memory copying '%s'", name);
+    if (first_row) *first_row = first;
+    return 0;
+}
+
+int silc_get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, const char *name)
+{
+    return get_rows(ctx, e, first_row, name, 0);
+}
+
+int silc_get_rows_complex(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, const char *name)
+{
+    return get_rows(ctx, e, first_row, name, 1);
 }
 
 int silc_exec(silc_context *ctx, const char *statements)

@@ -247,12 +247,17 @@ SILC_API void silc_set_output(silc_context *ctx, silc_output_fn fn, void *user);
  * silc_get_rows: this rank's rows of `name` and, in *first_row (may be NULL),
  * the first of them: a value computed from distributed operands keeps their
  * rows; a whole value is split evenly, as PETSc's PETSC_DECIDE splits it.
- * Real values only, as silc_get: a complex one is fetched whole, on every
- * rank, by silc_get_complex. */
+ * Real values only, as silc_get: a complex one is refused ("'x' is complex
+ * ... fetch it with silc_get_rows_complex").
+ * silc_get_rows_complex: the same for either field, as silc_get_complex: a
+ * complex value's rows come as a complex block (2 doubles an entry,
+ * interleaved; silc_envelope_is_complex(block) tells which came). */
 SILC_API int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row,
                            const silc_envelope_t *block);
 SILC_API int silc_get_rows(silc_context *ctx, silc_envelope_t *block, int64_t *first_row,
                            const char *name);
+SILC_API int silc_get_rows_complex(silc_context *ctx, silc_envelope_t *block, int64_t *first_row,
+                                   const char *name);
 /* This process's rank and the number of ranks of ctx (0 and 1 unless the
  * context is an SPMD one). */
 SILC_API int silc_context_rank(const silc_context *ctx, int *rank, int *size);

@@ -8,6 +8,7 @@
  *     silc_put_rows(ctx, "b", first_row, &my_b);
  *     silc_exec(ctx, "x = A \\ b");                  collective
  *     silc_get_rows(ctx, &my_x, &first, "x");         each rank its rows back
+ *                          (silc_get_rows_complex for a complex x: interleaved)
  *     silc_close(&ctx);
  *     MPI_Finalize();
  *

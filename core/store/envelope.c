@@ -125,11 +125,11 @@ int env_format_code(int format, int field)
     return format | (field == SILC_FIELD_COMPLEX ? SILC_COMPLEX : 0);
 }
 
-int env_refuse_complex(const char *name, const silc_value *v, char *err, size_t errlen)
+int env_refuse_complex(const char *name, const silc_value *v, const char *getter, char *err, size_t errlen)
 {
     if (!v || v->field != SILC_FIELD_COMPLEX) return 0;
     return check_fail(err, errlen, "'%s' is complex: this client did not ask for complex values "
-                      "(fetch it with silc_get_complex, or take real(%s) or abs(%s))", name, name, name);
+                      "(fetch it with %s, or take real(%s) or abs(%s))", name, getter, name, name);
 }
 
 /* Doubles per entry of an envelope's values. */

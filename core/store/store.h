@@ -356,8 +356,9 @@ int env_format_field(int envelope_format);
 int env_format_code(int format, int field);
 /* -1 with "'z' is complex: ..." in err when v is complex: what a GET from a
  * caller that did not ask for complex values answers (silc_get, silcd's
- * GET); 0 for a real v. */
-int env_refuse_complex(const char *name, const silc_value *v, char *err, size_t errlen);
+ * GET, silc_get_rows); getter names the call that would fetch it
+ * (silc_get_complex, silc_get_rows_complex).  0 for a real v. */
+int env_refuse_complex(const char *name, const silc_value *v, const char *getter, char *err, size_t errlen);
 
 /* Records a context-free failure message; returns -1. */
 int env_error(const char *fmt, ...)
