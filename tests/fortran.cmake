@@ -3,7 +3,8 @@
 # the scheme's bound.  Both run embedded; the module's test runs against the
 # fixture's silcd too (test_fortran_remote).  With MPI for Fortran, the SPMD example
 # (diffusion1d_mpi.f90) runs under mpirun -np 2 and must print the serial
-# example's summary and end with its field to 1e-12 relative.
+# example's summary and end with its field to 1e-12 relative, and
+# test_fortran_mpi checks complex row blocks in and out under mpirun -np 2.
 if(TARGET silc_fortran)
   add_executable(test_fortran ${CMAKE_CURRENT_LIST_DIR}/test_fortran.f90)
   target_link_libraries(test_fortran PRIVATE silc_fortran)
@@ -55,6 +56,21 @@ awk 'NR == FNR { a[FNR] = $1 + 0; n = FNR; next }
                      $<TARGET_FILE:diffusion1d_mpi_fortran> ${CMAKE_CURRENT_BINARY_DIR}/diffusion1d-fortran-mpi)
     set_tests_properties(example_diffusion1d_fortran_mpi PROPERTIES
       ENVIRONMENT "${SILC_TEST_ENV};OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
+      TIMEOUT 120 RUN_SERIAL TRUE)
+
+    # The row-block calls with complex values under mpirun -np 2: each rank
+    # puts its rows of a complex tridiagonal, MUMPS solves on the blocks, and
+    # each rank's rows of x must match the exact solution (test_fortran_mpi.f90).
+    # MPI::MPI_Fortran is found here again: imported targets are per directory.
+    find_package(MPI COMPONENTS Fortran QUIET)
+    add_executable(test_fortran_mpi ${CMAKE_CURRENT_LIST_DIR}/test_fortran_mpi.f90)
+    target_link_libraries(test_fortran_mpi PRIVATE silc_fortran silc_mpi MPI::MPI_Fortran)
+    if(CMAKE_Fortran_COMPILER_ID STREQUAL "GNU")
+      target_compile_options(test_fortran_mpi PRIVATE -Wno-compare-reals) # imaginary parts exactly 0
+    endif()
+    add_test(NAME test_fortran_mpi COMMAND ${MPIEXEC_EXECUTABLE} -np 2 $<TARGET_FILE:test_fortran_mpi>)
+    set_tests_properties(test_fortran_mpi PROPERTIES
+      ENVIRONMENT "${SILC_TEST_ENV};SILC_MODE=spmd;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
       TIMEOUT 120 RUN_SERIAL TRUE)
   else()
     message(STATUS "SILC: Fortran MPI test skipped (diffusion1d_mpi_fortran or mpirun not built/found)")

@@ -5,7 +5,9 @@
 ! silc_get_rows: the block is the whole value, first row 1), and complex(8)
 ! values through the same generics (a complex tridiagonal solve against its
 ! exact solution, bit-exact round trips, a real array refusing a complex
-! value).
+! value), the row-block calls included (complex blocks in, complex rows out,
+! a real array refusing a complex value's rows; under mpirun -np 2:
+! test_fortran_mpi.f90).
 ! Prints "N passed, N failed" as its last line, like the C tests (tests/check.h),
 ! and ends with error stop when anything failed.  Runs embedded, or remote when
 ! SILC_SERVER is set.
@@ -25,6 +27,7 @@ program test_fortran
   call test_errors()
   call test_rows()
   call test_complex()
+  call test_rows_complex()
   call check_ok(silc_finalize(), 'silc_finalize')
   call check_fails(silc_exec('x = 1'), '', 'exec after silc_finalize')
   call test_rows_closed()
@@ -340,6 +343,63 @@ contains
     call check_fails(silc_exec('z = Zr'), 'Zr', 'no failed put_rows left Zr behind')
     call check_fails(silc_get_rows('nosuchname', first, got), 'nosuchname', 'get_rows of an undefined name')
   end subroutine test_rows
+
+  ! Complex row blocks on one process: the block is the whole value, as for
+  ! real ones; values come back bit for bit (products by 1 + 1i of small
+  ! integers are exact).
+  subroutine test_rows_complex()
+    complex(c_double_complex), parameter :: i1 = (0.0_c_double, 1.0_c_double)
+    complex(c_double_complex) :: v(3), x(2, 3)
+    complex(c_double_complex), allocatable :: got(:), got2(:, :)
+    real(c_double), allocatable :: rgot(:)
+    integer :: first, i
+    integer(c_int64_t) :: first64
+    v = [(cmplx(i, -i, c_double_complex), i = 1, 3)]
+    call check_ok(silc_put_rows('zrv', 1, v), 'put_rows of a complex vector')
+    call check_ok(silc_exec('zrw = (1 + 1i) * zrv'), 'exec on a complex block')
+    first = -1
+    call check_ok(silc_get_rows('zrw', first, got), 'get_rows of a complex vector')
+    call check(first == 1 .and. allocated(got), 'complex get_rows allocates, first row 1')
+    if (allocated(got)) call check(size(got) == 3 .and. all(got == (1 + i1) * v), 'complex get_rows values')
+    first64 = -1
+    call check_ok(silc_get_rows('zrv', first64, got), 'complex get_rows with an int64 first_row')
+    call check(first64 == 1 .and. all(got == v), 'complex get_rows int64: first row 1, values')
+    call check_fails(silc_get_rows('zrw', first, rgot), '''zrw'' is complex', &
+                     'get_rows of a complex value into a real array')
+    call check(.not. allocated(rgot), 'a refused get_rows allocates nothing')
+
+    x = reshape([(cmplx(i, 2 * i, c_double_complex), i = 1, 6)], [2, 3])
+    call check_ok(silc_put_rows('ZRX', 1_c_int64_t, x), 'put_rows of a complex 2x3 block')
+    call check_ok(silc_get_rows('ZRX', first, got2), 'complex get_rows into a 2-D array')
+    call check(all(shape(got2) == [2, 3]), 'shape of the complex 2-D block')
+    if (all(shape(got2) == [2, 3])) call check(all(got2 == x), 'complex dense block round trip')
+    call check_fails(silc_get_rows('ZRX', first, got), '3 columns', 'complex get_rows of a matrix into 1-D')
+
+    ! A complex 2x3 CSR block: row 1 has columns 1 and 3, row 2 column 2.
+    call check_ok(silc_put_rows('ZRA', 1, 2, 3, [1, 3, 4], [1, 3, 2], [v(1), v(2), i1]), &
+                  'put_rows of a complex CSR block')
+    call check_ok(silc_get_rows('ZRA', first, got2), 'complex CSR into a 2-D block')
+    if (all(shape(got2) == [2, 3])) then
+      call check(all(got2(1, :) == [v(1), (0.0_c_double, 0.0_c_double), v(2)]) .and. &
+                 all(got2(2, :) == [(0.0_c_double, 0.0_c_double), i1, (0.0_c_double, 0.0_c_double)]), &
+                 'complex CSR block values')
+    else
+      call check(.false., 'shape of the complex CSR block')
+    end if
+    call check_ok(silc_put_rows('ZRA64', 1_c_int64_t, 1_c_int64_t, 2_c_int64_t, [1_c_int64_t, 2_c_int64_t], &
+                                [2_c_int64_t], [i1]), 'put_rows of an int64 complex CSR block')
+    call check_ok(silc_get_rows('ZRA64', first64, got2), 'int64 complex CSR block back')
+    if (all(shape(got2) == [1, 2])) call check(all(got2(1, :) == [(0.0_c_double, 0.0_c_double), i1]), &
+                                               'int64 complex CSR block values')
+    call check_fails(silc_put_rows('ZRA', 1, 2, 3, [1, 3, 4], [1, 4, 2], [v(1), v(2), i1]), 'outside 1..3', &
+                     'a complex CSR block with a bad column')
+
+    ! A complex array takes a real value's rows, imaginary parts 0.
+    call check_ok(silc_put_rows('rrv', 1, [1.5_c_double, -2.0_c_double]), 'put_rows of a real vector')
+    call check_ok(silc_get_rows('rrv', first, got), 'a real value''s rows into a complex array')
+    call check(size(got) == 2 .and. all(got == [(1.5_c_double, 0.0_c_double), (-2.0_c_double, 0.0_c_double)]), &
+               'real rows, imaginary parts 0')
+  end subroutine test_rows_complex
 
   ! After silc_finalize the row calls fail with a message, not a crash.
   subroutine test_rows_closed()

@@ -39,9 +39,11 @@
 ! the C API's are 0-based and converted).  The blocks of the ranks, in rank
 ! order, must tile the rows with no gap or overlap; a CSR block has the
 ! value's global column count n, local rowptr (rowptr(1) = 1) and global
-! 1-based column indices.  On one process (embedded, remote, or SPMD under
-! mpirun -np 1) the block is the whole value, first = 1, so the same program
-! runs without MPI too.  A failure found here before the collective call
+! 1-based column indices.  values, b and x may be complex(c_double_complex)
+! as for silc_put / silc_get: a complex x takes a complex value's rows
+! (silc_get_rows_complex in C), a real x refuses them.  On one process
+! (embedded, remote, or SPMD under mpirun -np 1) the block is the whole
+! value, first = 1, so the same program runs without MPI too.  A failure found here before the collective call
 ! (e.g. first < 1) still makes that call, so the other ranks fail with it
 ! instead of waiting.
 !
@@ -106,16 +108,24 @@ module silc
   ! silc_put_rows(name, first_row, x) for a dense block (1-D or 2-D), and
   ! silc_put_rows(name, first_row, m, n, rowptr, colind, values) for a CSR
   ! block; first_row is 1-based, default integer or integer(c_int64_t) (for
-  ! CSR of the kind of the other integers).
+  ! CSR of the kind of the other integers).  x and values are real(c_double)
+  ! or complex(c_double_complex), as for silc_put.
   interface silc_put_rows
     module procedure put_rows_vector, put_rows_vector_int64, put_rows_matrix, put_rows_matrix_int64
     module procedure put_rows_csr_int, put_rows_csr_int64
+    module procedure put_rows_vector_complex, put_rows_vector_int64_complex
+    module procedure put_rows_matrix_complex, put_rows_matrix_int64_complex
+    module procedure put_rows_csr_int_complex, put_rows_csr_int64_complex
   end interface silc_put_rows
 
   ! silc_get_rows(name, first_row, x): this rank's rows into an allocatable
-  ! 1-D or 2-D array, first_row (1-based, intent(out)) the first of them.
+  ! 1-D or 2-D array, first_row (1-based, intent(out)) the first of them.  A
+  ! complex array takes a complex value's rows (or a real one's, imaginary
+  ! parts 0); a real array refuses a complex value, as silc_get does.
   interface silc_get_rows
     module procedure get_rows_vector, get_rows_vector_int64, get_rows_matrix, get_rows_matrix_int64
+    module procedure get_rows_vector_complex, get_rows_vector_int64_complex
+    module procedure get_rows_matrix_complex, get_rows_matrix_int64_complex
   end interface silc_get_rows
 
   ! The C API (core/include/silc.h) and strlen.
@@ -171,6 +181,14 @@ module silc
       integer(c_int64_t), intent(out) :: first_row
       character(kind=c_char), intent(in) :: name(*)
     end function c_silc_get_rows
+
+    integer(c_int) function c_silc_get_rows_complex(ctx, e, first_row, name) bind(c, name='silc_get_rows_complex')
+      import :: c_int, c_int64_t, c_char, c_ptr, silc_envelope_t
+      type(c_ptr), value :: ctx
+      type(silc_envelope_t), intent(inout) :: e
+      integer(c_int64_t), intent(out) :: first_row
+      character(kind=c_char), intent(in) :: name(*)
+    end function c_silc_get_rows_complex
 
     integer(c_int) function c_silc_context_rank(ctx, rank, size) bind(c, name='silc_context_rank')
       import :: c_int, c_ptr
@@ -655,6 +673,65 @@ contains
     status = put_csr_0based(name, m, n, rp, ci, first_row, values=values)
   end function put_rows_csr_int64
 
+  !> The complex blocks: as the real ones above, complex(c_double_complex) values.
+  integer function put_rows_vector_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row
+    complex(c_double_complex), intent(in) :: x(:)
+    own_failure = .false.
+    status = put_rows_dense(name, int(first_row, c_int64_t), int(size(x), c_int64_t), 1_c_int64_t, z=x)
+  end function put_rows_vector_complex
+
+  integer function put_rows_vector_int64_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row
+    complex(c_double_complex), intent(in) :: x(:)
+    own_failure = .false.
+    status = put_rows_dense(name, first_row, int(size(x), c_int64_t), 1_c_int64_t, z=x)
+  end function put_rows_vector_int64_complex
+
+  integer function put_rows_matrix_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row
+    complex(c_double_complex), intent(in) :: x(:, :)
+    own_failure = .false.
+    status = put_rows_dense(name, int(first_row, c_int64_t), int(size(x, 1), c_int64_t), &
+                            int(size(x, 2), c_int64_t), z=x)
+  end function put_rows_matrix_complex
+
+  integer function put_rows_matrix_int64_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row
+    complex(c_double_complex), intent(in) :: x(:, :)
+    own_failure = .false.
+    status = put_rows_dense(name, first_row, int(size(x, 1), c_int64_t), int(size(x, 2), c_int64_t), z=x)
+  end function put_rows_matrix_int64_complex
+
+  integer function put_rows_csr_int_complex(name, first_row, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: first_row, m, n, rowptr(:), colind(:)
+    complex(c_double_complex), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = int(rowptr, c_int64_t)
+    ci(:) = int(colind, c_int64_t)
+    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, &
+                            int(first_row, c_int64_t), zvalues=values)
+  end function put_rows_csr_int_complex
+
+  integer function put_rows_csr_int64_complex(name, first_row, m, n, rowptr, colind, values) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row, m, n, rowptr(:), colind(:)
+    complex(c_double_complex), intent(in) :: values(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = rowptr
+    ci(:) = colind
+    status = put_csr_0based(name, m, n, rp, ci, first_row, zvalues=values)
+  end function put_rows_csr_int64_complex
+
   !> Fetches this rank's rows of the vector name into x, allocated (or
   !> reallocated) here, and the first of them (1-based) into first_row: a
   !> value computed from distributed operands keeps their rows, a whole value
@@ -665,7 +742,7 @@ contains
     real(c_double), allocatable, intent(inout) :: x(:)
     integer(c_int64_t) :: first
     first_row = 0
-    status = get_rows_vector_int64(name, first, x)
+    status = get_rows_into(name, first, x=x)
     if (status == 0) status = narrow_first_row(name, first, size(x, kind=c_int64_t), first_row)
   end function get_rows_vector
 
@@ -673,15 +750,7 @@ contains
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(out) :: first_row
     real(c_double), allocatable, intent(inout) :: x(:)
-    type(silc_envelope_t) :: e
-    own_failure = .false.
-    first_row = 0
-    status = get_rows_envelope(name, .true., e, first_row)
-    if (status /= 0) return
-    if (allocated(x)) deallocate(x)
-    allocate(x(e%m))
-    status = int(c_envelope_to_dense(e, x))
-    call c_envelope_free(e)
+    status = get_rows_into(name, first_row, x=x)
   end function get_rows_vector_int64
 
   !> This rank's rows of a matrix (dense, or sparse made dense) into x(:, :),
@@ -692,9 +761,52 @@ contains
     real(c_double), allocatable, intent(inout) :: x(:, :)
     integer(c_int64_t) :: first
     first_row = 0
-    status = get_rows_matrix_int64(name, first, x)
+    status = get_rows_into(name, first, x2=x)
     if (status == 0) status = narrow_first_row(name, first, size(x, 1, kind=c_int64_t), first_row)
   end function get_rows_matrix
+
+  integer function get_rows_matrix_int64(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: first_row
+    real(c_double), allocatable, intent(inout) :: x(:, :)
+    status = get_rows_into(name, first_row, x2=x)
+  end function get_rows_matrix_int64
+
+  !> The same into complex(c_double_complex) arrays: a complex value's rows,
+  !> or a real value's with imaginary parts 0.
+  integer function get_rows_vector_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: first_row
+    complex(c_double_complex), allocatable, intent(inout) :: x(:)
+    integer(c_int64_t) :: first
+    first_row = 0
+    status = get_rows_into(name, first, z=x)
+    if (status == 0) status = narrow_first_row(name, first, size(x, kind=c_int64_t), first_row)
+  end function get_rows_vector_complex
+
+  integer function get_rows_vector_int64_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: first_row
+    complex(c_double_complex), allocatable, intent(inout) :: x(:)
+    status = get_rows_into(name, first_row, z=x)
+  end function get_rows_vector_int64_complex
+
+  integer function get_rows_matrix_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: first_row
+    complex(c_double_complex), allocatable, intent(inout) :: x(:, :)
+    integer(c_int64_t) :: first
+    first_row = 0
+    status = get_rows_into(name, first, z2=x)
+    if (status == 0) status = narrow_first_row(name, first, size(x, 1, kind=c_int64_t), first_row)
+  end function get_rows_matrix_complex
+
+  integer function get_rows_matrix_int64_complex(name, first_row, x) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(out) :: first_row
+    complex(c_double_complex), allocatable, intent(inout) :: x(:, :)
+    status = get_rows_into(name, first_row, z2=x)
+  end function get_rows_matrix_int64_complex
 
   ! first_row for a default-integer caller: an error when the block's rows
   ! (first .. first + rows - 1) do not all fit a default integer.
@@ -712,20 +824,40 @@ contains
     end if
   end function narrow_first_row
 
-  integer function get_rows_matrix_int64(name, first_row, x) result(status)
+  ! Every silc_get_rows: this rank's rows of name into the one array given
+  ! (x, x2 real 1-D or 2-D; z, z2 complex), allocated (or reallocated) here
+  ! with the block's shape, and the first row (1-based).  A complex array
+  ! asks for either field (silc_get_rows_complex), a real one for a real
+  ! value only (silc_get_rows refuses a complex one, naming it).
+  integer function get_rows_into(name, first_row, x, x2, z, z2) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(out) :: first_row
-    real(c_double), allocatable, intent(inout) :: x(:, :)
+    real(c_double), allocatable, intent(inout), optional :: x(:), x2(:, :)
+    complex(c_double_complex), allocatable, intent(inout), optional :: z(:), z2(:, :)
     type(silc_envelope_t) :: e
     own_failure = .false.
     first_row = 0
-    status = get_rows_envelope(name, .false., e, first_row)
+    status = get_rows_envelope(name, present(x) .or. present(z), present(z) .or. present(z2), e, first_row)
     if (status /= 0) return
-    if (allocated(x)) deallocate(x)
-    allocate(x(e%m, e%n))
-    status = int(c_envelope_to_dense(e, x))
+    if (present(x)) then
+      if (allocated(x)) deallocate(x)
+      allocate(x(e%m))
+      status = int(c_envelope_to_dense(e, x))
+    else if (present(x2)) then
+      if (allocated(x2)) deallocate(x2)
+      allocate(x2(e%m, e%n))
+      status = int(c_envelope_to_dense(e, x2))
+    else if (present(z)) then
+      if (allocated(z)) deallocate(z)
+      allocate(z(e%m))
+      status = envelope_to_complex(e, e%m, z)
+    else if (present(z2)) then
+      if (allocated(z2)) deallocate(z2)
+      allocate(z2(e%m, e%n))
+      status = envelope_to_complex(e, e%m * e%n, z2)
+    end if
     call c_envelope_free(e)
-  end function get_rows_matrix_int64
+  end function get_rows_into
 
   ! ---- helpers ---------------------------------------------------------------
 
@@ -869,13 +1001,19 @@ contains
     if (.not. c_associated(ctx)) status = fail(who // 'silc_init has not been called')
   end function default_context
 
-  integer function put_rows_dense(name, first, m, n, x) result(status)
+  ! A dense block of m x n values, real (x) or complex (z): one of them given.
+  integer function put_rows_dense(name, first, m, n, x, z) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(in) :: first, m, n
-    real(c_double), intent(in) :: x(*)
+    real(c_double), intent(in), optional :: x(*)
+    complex(c_double_complex), intent(in), optional :: z(*)
     type(silc_envelope_t) :: e
     e = empty_envelope()
-    status = int(c_envelope_dense(e, m, n, x))
+    if (present(z)) then
+      status = int(c_envelope_dense_complex(e, m, n, z))
+    else
+      status = int(c_envelope_dense(e, m, n, x))
+    end if
     status = put_rows_envelope(name, first, e, status)
   end function put_rows_dense
 
@@ -921,10 +1059,11 @@ contains
   end subroutine spoil_put_rows
 
   ! Fetches this rank's rows of name (e to be freed by the caller on success)
-  ! and the first of them, 1-based; a vector must have one column.
-  integer function get_rows_envelope(name, vector, e, first) result(status)
+  ! and the first of them, 1-based; a vector must have one column.  A real
+  ! value only, or either field when accept_complex.
+  integer function get_rows_envelope(name, vector, accept_complex, e, first) result(status)
     character(len=*), intent(in) :: name
-    logical, intent(in) :: vector
+    logical, intent(in) :: vector, accept_complex
     type(silc_envelope_t), intent(out) :: e
     integer(c_int64_t), intent(out) :: first
     type(c_ptr) :: ctx
@@ -933,7 +1072,11 @@ contains
     first = 0
     status = default_context('silc_get_rows: ', ctx)
     if (status /= 0) return
-    status = int(c_silc_get_rows(ctx, e, first0, c_string(name)))
+    if (accept_complex) then
+      status = int(c_silc_get_rows_complex(ctx, e, first0, c_string(name)))
+    else
+      status = int(c_silc_get_rows(ctx, e, first0, c_string(name)))
+    end if
     if (status /= 0) return
     if (vector .and. e%n /= 1) then
       status = fail('silc_get_rows: ''' // trim(name) // ''' has ' // int_text(e%n) // &
@@ -985,31 +1128,39 @@ contains
   end function get_dense
 
   ! get_dense for a complex array: a complex value, or a real one with
-  ! imaginary parts 0.  The envelope is made dense through a buffer of
-  ! doubles (silc_envelope_to_dense takes doubles: 2 an entry when complex).
+  ! imaginary parts 0.
   integer function get_dense_complex(name, m, n, either_way, what, x) result(status)
     character(len=*), intent(in) :: name, what
     integer(c_int64_t), intent(in) :: m, n
     logical, intent(in) :: either_way
     complex(c_double_complex), intent(inout) :: x(*)
     type(silc_envelope_t) :: e
-    real(c_double), allocatable :: buf(:)
     status = get_envelope(name, e, accept_complex=.true.)
     if (status /= 0) return
     status = shape_fits(name, e, m, n, either_way, what)
-    if (status == 0) then
-      if (is_complex(e)) then
-        allocate(buf(2 * m * n))
-        status = int(c_envelope_to_dense(e, buf))
-        if (status == 0) x(1:m * n) = cmplx(buf(1::2), buf(2::2), c_double_complex)
-      else
-        allocate(buf(m * n))
-        status = int(c_envelope_to_dense(e, buf))
-        if (status == 0) x(1:m * n) = cmplx(buf, 0.0_c_double, c_double_complex)
-      end if
-    end if
+    if (status == 0) status = envelope_to_complex(e, m * n, x)
     call c_envelope_free(e)
   end function get_dense_complex
+
+  ! The count entries of e (dense, or made dense) into x: a complex
+  ! envelope's as they are, a real one's with imaginary parts 0.  Through a
+  ! buffer of doubles (silc_envelope_to_dense takes doubles: 2 an entry when
+  ! complex).
+  integer function envelope_to_complex(e, count, x) result(status)
+    type(silc_envelope_t), intent(in) :: e
+    integer(c_int64_t), intent(in) :: count
+    complex(c_double_complex), intent(inout) :: x(*)
+    real(c_double), allocatable :: buf(:)
+    if (is_complex(e)) then
+      allocate(buf(2 * count))
+      status = int(c_envelope_to_dense(e, buf))
+      if (status == 0) x(1:count) = cmplx(buf(1::2), buf(2::2), c_double_complex)
+    else
+      allocate(buf(count))
+      status = int(c_envelope_to_dense(e, buf))
+      if (status == 0) x(1:count) = cmplx(buf, 0.0_c_double, c_double_complex)
+    end if
+  end function envelope_to_complex
 
   ! 0 if e (the value of name) is m x n (or n x m for a vector, when
   ! either_way); otherwise a failure naming both shapes.
