@@ -122,9 +122,9 @@ typedef struct ss_factor_info {
     int estimated;              /* cond holds a Hager/Higham estimate */
     double pivot_ratio;         /* the library's max/min factor diagonal (1/rcond), 0 = none */
     double *start_solved;       /* the estimator's start solved for an owed estimate's lower
-                                   bound, its first step: real A^-1 [e/n, alternating] (n x
-                                   SS_EST_COLS: ss_start_due), complex A^-1 e/n (2n doubles,
-                                   ss_complex.c); NULL when none */
+                                   bound, its first step: A^-1 [e/n, alternating] (n x
+                                   SS_EST_COLS, real: ss_start_due; complex, 2 doubles an
+                                   entry: ss_complex.c); NULL when none */
     char method[64];
     char note[160];
 } ss_factor_info;
@@ -183,6 +183,13 @@ void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t
  * ss_solve_start solves it alone (UMFPACK).  Out of memory they keep
  * nothing: the host then goes by the ratio and makes the estimate at once. */
 int ss_start_due(const silc_call *call, int mode, const ss_factor_info *fi);
+/* The start block of both fields: X gets the n x SS_EST_COLS block (e/n,
+ * the alternating vector) of width doubles an entry (1 real; 2 complex,
+ * imaginary parts 0, which is the complex estimator's e/n and alternating
+ * vector too).  ss_start_bound: its bound ||A||_1 max_j ||A^-1 x_j||_1 from
+ * the solved block Y (the columns have 1-norm 1; complex by modulus). */
+void ss_start_block(int64_t n, int width, double *X);
+double ss_start_bound(silc_call *call, int64_t n, int width, const double *Y);
 void ss_keep_start(ss_factor_info *fi, int64_t n, const double *y);
 void ss_solve_start(ss_factor_info *fi, int64_t n, ss_block_fn apply, void *ctx);
 int ss_no_factor(silc_call *call, const char *library);

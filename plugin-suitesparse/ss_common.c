@@ -201,16 +201,22 @@ int ss_cond_due(const silc_call *call, int mode, const ss_factor_info *fi)
     return !fi->estimated && ss_condest_wanted(call, mode) && !ss_condest_later(call);
 }
 
-/* ||A||_1 max_j ||Y_j||_1 for the start block X (n x SS_EST_COLS, each
- * column of 1-norm 1: e/n and the alternating vector) solved into Y: a
- * lower bound of cond_1(A), and of the estimate, which starts from X and
- * never decreases. */
-static double start_bound(silc_call *call, int64_t n, const double *Y)
+void ss_start_block(int64_t n, int width, double *X)
+{
+    ss_host->inv_norm1_start(n, SS_EST_COLS, X);
+    /* complex: spread the real values to the real parts from the last entry
+     * down, so that no entry is read after its slot is overwritten */
+    if (width == 2)
+        for (int64_t i = n * SS_EST_COLS - 1; i >= 0; i--) X[2 * i] = X[i], X[2 * i + 1] = 0;
+}
+
+double ss_start_bound(silc_call *call, int64_t n, int width, const double *Y)
 {
     double best = 0;
     for (int j = 0; j < SS_EST_COLS; j++) {
+        const double *y = Y + (int64_t)width * n * j;
         double sy = 0;
-        for (int64_t i = 0; i < n; i++) sy += fabs(Y[i + j * n]);
+        for (int64_t i = 0; i < n; i++) sy += width == 2 ? hypot(y[2 * i], y[2 * i + 1]) : fabs(y[i]);
         if (sy > best || isnan(sy)) best = sy;
     }
     return silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * best;
@@ -228,7 +234,7 @@ void ss_report_owed(silc_call *call, int mode, const ss_factor_info *fi, int64_t
                                    (double)(k > 0 ? k : 1);
     if (!fi->start_solved) return;
     ss_host->view(call->in[0], &a);
-    call->report->condest_lower = start_bound(call, a.n, fi->start_solved);
+    call->report->condest_lower = ss_start_bound(call, a.n, 1, fi->start_solved);
 }
 
 int ss_start_due(const silc_call *call, int mode, const ss_factor_info *fi)
@@ -249,7 +255,7 @@ void ss_solve_start(ss_factor_info *fi, int64_t n, ss_block_fn apply, void *ctx)
 {
     double *y = ss_host->alloc((size_t)(n > 0 ? n : 1) * SS_EST_COLS * sizeof *y);
     if (!y) return;
-    ss_host->inv_norm1_start(n, SS_EST_COLS, y);
+    ss_start_block(n, 1, y);
     if (apply(ctx, y, SS_EST_COLS, 0)) { /* a solve failed: no bound, the ratio decides */
         ss_host->free(y);
         return;
@@ -300,7 +306,7 @@ void ss_square_cond(silc_call *call, int mode, int64_t n, ss_block_fn apply, voi
         fi->start_solved = NULL;
     } else if (!Y0) { /* not folded into the user's solve: the start is solved here */
         if (!(start = ss_host->alloc((size_t)n * SS_EST_COLS * sizeof *start))) return;
-        ss_host->inv_norm1_start(n, SS_EST_COLS, start);
+        ss_start_block(n, 1, start);
         if (apply(ctx, start, SS_EST_COLS, 0)) {
             ss_host->free(start);
             return; /* a solve failed: no estimate */
@@ -325,7 +331,7 @@ double *ss_rhs_with_start(const silc_view *b, int64_t n)
     double *x = ss_host->alloc((size_t)(n * (b->n + SS_EST_COLS) + 1) * sizeof *x);
     if (!x) return NULL;
     ss_rhs_copy(b, x);
-    ss_host->inv_norm1_start(n, SS_EST_COLS, x + n * b->n);
+    ss_start_block(n, 1, x + n * b->n);
     return x;
 }
 

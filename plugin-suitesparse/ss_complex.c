@@ -86,52 +86,54 @@ static silc_value *complex_value(silc_call *call, int64_t m, int64_t k, const do
  * the host finds it urgent or cheap, or when the report is read. */
 #define SS_COMPLEX_EST_SOLVES 5 /* zlacn2: the start, two steps (A^-H, A^-1), the alternating vector */
 
-/* The estimator's solves, its first (A^-1 e/n, e/n with imaginary parts 0)
- * taken from fi->start_solved when the owed estimate's solve kept it. */
+/* The estimator's solves, those of its start vectors (e/n first, the
+ * alternating vector last, both with imaginary parts 0: the columns of
+ * ss_start_block's complex block X) taken from fi->start_solved when the
+ * owed estimate's bound solved them. */
 typedef struct z_cached {
     int (*apply)(void *ctx, double *x, int trans, double *work);
     void *ctx;
     ss_factor_info *fi;
     int64_t n;
+    const double *X; /* the unsolved start block, 2n doubles a column; NULL: nothing kept */
 } z_cached;
-
-static int is_start(int64_t n, const double *x)
-{
-    for (int64_t i = 0; i < n; i++)
-        if (x[2 * i] != 1.0 / (double)n || x[2 * i + 1] != 0) return 0;
-    return 1;
-}
 
 static int apply_cached(void *ctx, double *x, int trans, double *work)
 {
     z_cached *c = ctx;
-    if (c->fi->start_solved && !trans && is_start(c->n, x)) {
-        memcpy(x, c->fi->start_solved, (size_t)c->n * 2 * sizeof *x);
-        return 0;
-    }
+    size_t col = (size_t)c->n * 2;
+    for (int j = 0; c->X && !trans && j < SS_EST_COLS; j++)
+        if (!memcmp(x, c->X + col * (size_t)j, col * sizeof *x)) {
+            memcpy(x, c->fi->start_solved + col * (size_t)j, col * sizeof *x);
+            return 0;
+        }
     return c->apply(c->ctx, x, trans, work);
 }
 
-/* ||A||_1 ||A^-1 e/n||_1 (||e/n||_1 = 1), a rigorous lower bound of cond_1(A)
- * and of the estimate, which starts from e/n: one solve, kept in
- * fi->start_solved for the estimate's first step.  On the shared matrices
- * it is the start block's bound (e/n gives the larger of the two on all
- * but impcol_a), 1.2e10 on mhd1280b.  -1 when out of memory or a solve
- * fails. */
+/* The estimator's start block, e/n and the alternating vector, solved (two
+ * solves) and kept in fi->start_solved: the owed estimate's rigorous lower
+ * bound ||A||_1 max_j ||A^-1 x_j||_1 (ss_start_bound, as the real path's),
+ * whose solves the estimate, when made, takes instead of repeating them.
+ * Both columns, as for real matrices: e/n alone is 4e5 to 1e7 times weaker
+ * where A^-1 e cancels (the Hilbert matrices of order 9-11, real or times
+ * 1 + 1i; test_condest_auto), and their warnings came only with `info`.  A
+ * solve that reuses the factorization takes the kept block's bound: no
+ * solve.  -1 when out of memory or a solve fails. */
 static double start_bound(silc_call *call, int64_t n, int (*apply)(void *ctx, double *x, int trans, double *work),
                           void *ctx, ss_factor_info *fi)
 {
-    double *y = ss_host->alloc((size_t)n * 2 * sizeof *y), sy = 0;
-    if (!y) return -1;
-    for (int64_t i = 0; i < n; i++) y[2 * i] = 1.0 / (double)n, y[2 * i + 1] = 0;
-    if (apply(ctx, y, 0, NULL)) {
-        ss_host->free(y);
-        return -1;
-    }
-    for (int64_t i = 0; i < n; i++) sy += hypot(y[2 * i], y[2 * i + 1]);
-    ss_host->free(fi->start_solved);
-    fi->start_solved = y;
-    return silc_props_of(ss_host, call->in[0], SILC_PROPS_NORMS)->norm1 * sy;
+    size_t col = (size_t)n * 2;
+    double *Y;
+    if (fi->start_solved) return ss_start_bound(call, n, 2, fi->start_solved);
+    if (!(Y = ss_host->alloc(col * SS_EST_COLS * sizeof *Y))) return -1;
+    ss_start_block(n, 2, Y);
+    for (int j = 0; j < SS_EST_COLS; j++)
+        if (apply(ctx, Y + col * (size_t)j, 0, NULL)) {
+            ss_host->free(Y);
+            return -1;
+        }
+    fi->start_solved = Y;
+    return ss_start_bound(call, n, 2, Y);
 }
 
 static void complex_cond(silc_call *call, int mode, int64_t n,
@@ -145,8 +147,11 @@ static void complex_cond(silc_call *call, int mode, int64_t n,
     if (ss_host->struct_size < SILC_HOST_NEEDS(inv_norm1_est_complex) || !ss_host->inv_norm1_est_complex)
         return; /* an older host: "not estimated" */
     {
-        z_cached c = {apply, ctx, fi, n};
+        double *X = fi->start_solved ? ss_host->alloc((size_t)n * 2 * SS_EST_COLS * sizeof *X) : NULL;
+        z_cached c = {apply, ctx, fi, n, X};
+        if (X) ss_start_block(n, 2, X); /* out of memory: the kept solves are repeated */
         inv = ss_host->inv_norm1_est_complex(n, apply_cached, &c, NULL);
+        ss_host->free(X);
     }
     ss_host->free(fi->start_solved);
     fi->start_solved = NULL;
@@ -175,8 +180,8 @@ typedef struct z_ops {
      * A = L L^H (condest_lower); UMFPACK's and KLU's pivot ratios, the
      * heuristic of the real path, were below 1e6 on mhd1280b (cond_1
      * 6e12), which lost its warning (tests/test_condest_auto.c), so they
-     * solve e/n for a rigorous bound (start_bound), one solve that the
-     * estimate then skips. */
+     * solve the estimator's start block for a rigorous bound (start_bound),
+     * two solves that the estimate then skips. */
     enum { Z_START_BOUND, Z_DIAG_BOUND } owed;
 } z_ops;
 
@@ -246,7 +251,7 @@ static int complex_solve(silc_call *call, const z_ops *ops)
                     call->out = NULL;
                     return ss_nomem(call, "the condition estimate's start");
                 }
-                r->condest_solves = (double)(SS_COMPLEX_EST_SOLVES - 1) / (double)(b.n > 0 ? b.n : 1);
+                r->condest_solves = (double)(SS_COMPLEX_EST_SOLVES - SS_EST_COLS) / (double)(b.n > 0 ? b.n : 1);
             }
         }
     }
