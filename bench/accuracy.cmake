@@ -12,3 +12,10 @@ add_executable(accuracy_condest ${CMAKE_CURRENT_LIST_DIR}/accuracy_condest.c)
 target_include_directories(accuracy_condest PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/core/include)
 target_compile_definitions(accuracy_condest PRIVATE SILC_SHARED_MATRICES="${PROJECT_SOURCE_DIR}/../shared/matrices")
 target_link_libraries(accuracy_condest PRIVATE silc ${MATH_LIB})
+
+# bench/complex_condest: what the complex estimate's start block costs
+# under accuracy.condest = auto (UMFPACK, KLU), on examples/helmholtz's matrix.
+if(TARGET silc_helmholtz)
+  add_executable(complex_condest ${CMAKE_CURRENT_LIST_DIR}/complex_condest.c)
+  target_link_libraries(complex_condest PRIVATE silc_helmholtz silc ${MATH_LIB})
+endif()
