@@ -978,17 +978,20 @@ static char *stmt_text(const lang_ev *V, const ast_node *n)
 }
 
 /* The text of stmt for name's new `info` record.  A loop rebinds a name by
- * the same statement each time: the text its record holds already is taken
- * over (eng_info_take then finds the record, so cannot fail), not copied
- * again and the old copy freed. */
+ * a statement of the same length or shorter (often the same one) each
+ * time: the buffer the record holds is taken over and written again (the
+ * record is then found by eng_info_take, which cannot fail), not a new copy
+ * made and the old one freed -- a malloc and a free a statement. */
 static char *bind_text_for(const lang_ev *V, const ast_node *stmt, const char *name)
 {
     size_t len = stmt->end - stmt->start;
     eng_info *old = eng_info_get(V->E, name);
-    if (old && old->statement && !strncmp(old->statement, V->src + stmt->start, len) && !old->statement[len]) {
-        char *same = old->statement;
+    if (old && old->statement && strlen(old->statement) >= len) {
+        char *s = old->statement;
         old->statement = NULL;
-        return same;
+        memcpy(s, V->src + stmt->start, len);
+        s[len] = 0;
+        return s;
     }
     return stmt_text(V, stmt);
 }
