@@ -34,6 +34,12 @@
  * with and without it.  A is random with a dominant diagonal (not
  * symmetric), b = A * ones.
  *
+ * Instructions per statement, which no load changes (this VM has no
+ * hardware counters): `valgrind --tool=callgrind --dump-before=spmv_row
+ * limit --cpu spmv 1e4` writes one profile per SpMV row; silc_exec's
+ * inclusive count over its calls is a statement, spmv_c's lines over
+ * theirs the C loop (docs/overhead.md).
+ *
  * Set OPENBLAS_NUM_THREADS (1 for the figures in docs/overhead.md).  Not
  * run by the test suite: timings never are.
  */

@@ -1226,8 +1226,10 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                      * that check up (solve.backward_error = on_request);
                      * distributed solves keep the old rule (their ranks
                      * must agree). */
-                    const char *when = cfg_get(E, "solve.backward_error");
                     int local = call->op == SILC_OP_SOLVE && !ctx.collective && !E->dist;
+                    /* read only where it counts: a setting lookup is ~50
+                     * instructions, 1 % of a small product's fixed cost */
+                    const char *when = local ? cfg_get(E, "solve.backward_error") : NULL;
                     int defer = may_defer &&
                                 (!local || (when && !strcmp(when, "on_request")) ||
                                  vouched(call->in[0], b,

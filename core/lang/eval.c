@@ -58,6 +58,11 @@ typedef struct lang_cache {
     cache_entry *b[CACHE_BUCKETS];
     size_t count;
     prof_table statements, calls;
+    /* core.profile and core.display as of settings generation `generation`
+     * (cfg_generation): read once per change of any setting, not by two
+     * lookups a statement */
+    uint64_t generation;
+    int have_flags, profile, display;
 } lang_cache;
 
 /* The row named name (made when new; the last row takes the overflow). */
@@ -142,6 +147,19 @@ static int program_for(silc_engine *E, const char *text, lang_program **out)
     c->b[h] = e;
     c->count++;
     return 0;
+}
+
+/* Whether key is "on" now, from the copy made under the settings' current
+ * generation. */
+static void read_flags(silc_engine *E, lang_cache *c)
+{
+    uint64_t g = cfg_generation(E);
+    if (c->have_flags && c->generation == g) return;
+    const char *p = cfg_get(E, "core.profile"), *d = cfg_get(E, "core.display");
+    c->profile = p && !strcmp(p, "on");
+    c->display = d && !strcmp(d, "on");
+    c->generation = g;
+    c->have_flags = 1;
 }
 
 /* ---- helpers shared with builtins.c and index.c ---------------------------- */
@@ -436,19 +454,36 @@ static int ewise_sub(int op)
     }
 }
 
+/* The operands' names are for messages only: a node's is quoted from the
+ * source when a message needs it (operand_name), not for every operation
+ * (two copies a statement, 2 % of a small product's fixed cost). */
 typedef struct operands {
-    const char *lname, *rname;   /* as quoted in messages */
+    const char *lname, *rname;   /* as quoted in messages, or NULL: from lnode, rnode */
+    const ast_node *lnode, *rnode;
+    char ltext[64], rtext[64];
     const char *what;            /* the operation's source text, for explain */
 } operands;
 
-static int shape_error(lang_ev *V, const char *fmt_head, int op, const operands *o,
+/* The left (side 0) or right operand's name as messages quote it. */
+static const char *operand_name(const lang_ev *V, operands *o, int side)
+{
+    const char **name = side ? &o->rname : &o->lname;
+    char *text = side ? o->rtext : o->ltext;
+    if (!*name) {
+        ev_operand_name(V, side ? o->rnode : o->lnode, side, text, sizeof o->ltext);
+        *name = text;
+    }
+    return *name;
+}
+
+static int shape_error(lang_ev *V, const char *fmt_head, int op, operands *o,
                        const silc_value *a, const silc_value *b)
 {
     char sa[48], sb[48];
     ev_shape(a, sa, sizeof sa);
     ev_shape(b, sb, sizeof sb);
-    return eng_error(V->E, "'%s' %s: %s is %s, %s is %s", op_text(op), fmt_head, o->lname, sa,
-                     o->rname, sb);
+    return eng_error(V->E, "'%s' %s: %s is %s, %s is %s", op_text(op), fmt_head, operand_name(V, o, 0), sa,
+                     operand_name(V, o, 1), sb);
 }
 
 static int same_or_scalar(const silc_value *a, const silc_value *b)
@@ -535,7 +570,7 @@ static double complex reciprocal(const silc_value *v)
 }
 
 /* a op b for every binary operator. */
-static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value *a,
+static int apply_binary(lang_ev *V, int op, operands *o, const silc_value *a,
                         const silc_value *b, silc_value **out)
 {
     silc_engine *E = V->E;
@@ -577,7 +612,8 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
         /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
          * repeats the check with role names for every other route). */
-        if (refine_check_finite(V->E, a, 1, o->lname) || refine_check_finite(V->E, b, 0, o->rname))
+        if (refine_check_finite(V->E, a, 1, operand_name(V, o, 0)) ||
+            refine_check_finite(V->E, b, 0, operand_name(V, o, 1)))
             return -1;
         return ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
     case TK_CARET:
@@ -585,12 +621,12 @@ static int apply_binary(lang_ev *V, int op, const operands *o, const silc_value 
             return ev_run_op(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);
         if (a->m != a->n) {
             ev_shape(a, sa, sizeof sa);
-            return eng_error(E, "%s is %s but '^' needs a square matrix", o->lname, sa);
+            return eng_error(E, "%s is %s but '^' needs a square matrix", operand_name(V, o, 0), sa);
         }
         if (!val_is_scalar(b)) {
             ev_shape(b, sa, sizeof sa);
             return eng_error(E, "'^' needs a scalar exponent: %s is %s (use '^@' for element-wise powers)",
-                             o->rname, sa);
+                             operand_name(V, o, 1), sa);
         }
         {
             double k = val_scalar(b);
@@ -621,14 +657,13 @@ static void node_text(const lang_ev *V, const ast_node *n, char *out, size_t out
  * released here). */
 UTIL_NOINLINE static int binary_of(lang_ev *V, const ast_node *n, silc_value *a, silc_value *b, silc_value **out)
 {
-    char ln[64], rn[64], what[256];
+    char what[256];
     operands o;
     int rc;
-    ev_operand_name(V, n->kids[0], 0, ln, sizeof ln);
-    ev_operand_name(V, n->kids[1], 1, rn, sizeof rn);
     node_text(V, n, what, sizeof what);
-    o.lname = ln;
-    o.rname = rn;
+    o.lname = o.rname = NULL;
+    o.lnode = n->kids[0];
+    o.rnode = n->kids[1];
     o.what = what;
     rc = apply_binary(V, n->op, &o, a, b, out);
     val_release(a);
@@ -942,6 +977,25 @@ static char *stmt_text(const lang_ev *V, const ast_node *n)
     return s;
 }
 
+/* The text of stmt for name's new `info` record.  A loop rebinds a name by
+ * a statement of the same length or shorter (often the same one) each
+ * time: the buffer the record holds is taken over and written again (the
+ * record is then found by eng_info_take, which cannot fail), not a new copy
+ * made and the old one freed -- a malloc and a free a statement. */
+static char *bind_text_for(const lang_ev *V, const ast_node *stmt, const char *name)
+{
+    size_t len = stmt->end - stmt->start;
+    eng_info *old = eng_info_get(V->E, name);
+    if (old && old->statement && strlen(old->statement) >= len) {
+        char *s = old->statement;
+        old->statement = NULL;
+        memcpy(s, V->src + stmt->start, len);
+        s[len] = 0;
+        return s;
+    }
+    return stmt_text(V, stmt);
+}
+
 _Static_assert(sizeof ((eng_info *)0)->backends == sizeof ((lang_ev *)0)->backends,
                "bind copies the statement's backends whole");
 
@@ -968,7 +1022,7 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
         return eng_error(V->E, "out of memory recording a warning of '%s'", name);
     }
     memset(&info, 0, sizeof info);
-    info.statement = V->bind_text ? V->bind_text : stmt_text(V, stmt);
+    info.statement = V->bind_text ? V->bind_text : bind_text_for(V, stmt, name);
     V->bind_text = NULL;
     if (!info.statement) {
         val_release(v);
@@ -1154,7 +1208,7 @@ static silc_value *initial_guess(lang_ev *V, const ast_node *s)
 static int exec_assign(lang_ev *V, const ast_node *s, double t0)
 {
     silc_value *v = NULL, *cur = NULL, *r;
-    char ln[64], rn[64], what[256];
+    char ln[64], what[256];
     operands o;
     int op = s->kind == ST_OPASSIGN ? s->op : self_update_op(s), rc;
     if (s->kind != ST_ASSIGN || op) cur = store_get(&V->E->store, s->name);
@@ -1197,10 +1251,11 @@ static int exec_assign(lang_ev *V, const ast_node *s, double t0)
         return -1;
     }
     snprintf(ln, sizeof ln, "'%s'", s->name);
-    ev_operand_name(V, s->kids[0], 1, rn, sizeof rn);
     node_text(V, s, what, sizeof what);
     o.lname = ln;
-    o.rname = rn;
+    o.rname = NULL;
+    o.lnode = NULL;
+    o.rnode = s->kids[0];
     o.what = what;
     if (s->kind == ST_OPASSIGN)
         rc = apply_binary(V, opassign_token(s->op), &o, cur, r, &v);
@@ -1443,10 +1498,10 @@ static int exec_stmt(lang_ev *V, const ast_node *s, int *flow);
  * values), and never under explain. */
 static int displaying(const lang_ev *V, const ast_node *s)
 {
-    const char *d;
+    lang_cache *c = V->E->lang_cache; /* made by program_for before any statement */
     if (s->quiet || V->explain) return 0;
-    d = cfg_get(V->E, "core.display");
-    return d && !strcmp(d, "on");
+    read_flags(V->E, c);
+    return c->display;
 }
 
 static int show(lang_ev *V, const char *name, const silc_value *v)
@@ -1902,10 +1957,8 @@ int lang_exec(silc_engine *E, const char *text)
     V.E = E;
     V.src = prog->text;
     V.t_first = t0;
-    {
-        const char *p = cfg_get(E, "core.profile");
-        V.profile = p && !strcmp(p, "on");
-    }
+    read_flags(E, E->lang_cache);
+    V.profile = ((lang_cache *)E->lang_cache)->profile;
     for (i = 0; i < prog->nstmts; i++) {
         int rc;
         double ts = V.profile ? util_now() : 0;

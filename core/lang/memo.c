@@ -68,9 +68,22 @@ typedef struct memo_slot {
     uint64_t used;        /* for least-recently-used eviction */
 } memo_slot;
 
+/* Every call looks its key up and, in a loop whose operand changes every
+ * step, adds it and evicts the least recently used key: with a scan of the
+ * 64 slots for each, that was a quarter of a small product's fixed cost
+ * (docs/overhead.md, issue 30).  So the slots are also chained by key tag
+ * in MEMO_BUCKETS buckets (find), and kept in a list by use, least recently
+ * used first (the order of `used`, which the holder walk below still
+ * reads).  Slots are numbered by signed char: -1 is none. */
+#define MEMO_BUCKETS 128
+_Static_assert(MEMO_SLOTS < 127 && (MEMO_BUCKETS & (MEMO_BUCKETS - 1)) == 0, "slot numbers fit a signed char");
+
 struct eng_memo {
     memo_slot slot[MEMO_SLOTS];
-    uint64_t tag[MEMO_SLOTS]; /* slot[i].key.tag, packed: find() reads 8 cache lines, not 64 */
+    signed char bucket[MEMO_BUCKETS]; /* the first slot of each tag bucket */
+    signed char chain[MEMO_SLOTS];    /* the next slot in the same bucket */
+    signed char older[MEMO_SLOTS], newer[MEMO_SLOTS]; /* the use list */
+    signed char oldest, newest;
     int n;
     uint64_t clock;
 };
@@ -90,8 +103,8 @@ static uint64_t table_bytes(const eng_memo *M)
 }
 
 /* A hash of what tells keys apart most often (the operation and its
- * operands' ids): find() scans every slot for each call, and a loop whose
- * operand changes every step finds none, so most comparisons stop at it. */
+ * operands' ids): it picks the key's bucket, and a comparison of two keys
+ * in one bucket stops at it unless they are the same. */
 static uint64_t key_tag(const memo_key *k)
 {
     uint64_t h = (uint64_t)k->op * 0x9E3779B97F4A7C15ull ^ (uint64_t)k->sub << 32 ^ (uint64_t)k->nin;
@@ -136,50 +149,133 @@ static int same_key(const memo_key *a, const memo_key *b)
            !memcmp(&a->beta_imag, &b->beta_imag, sizeof a->beta_imag) && a->ival[0] == b->ival[0] && a->ival[1] == b->ival[1];
 }
 
+static int bucket_of(uint64_t tag)
+{
+    return (int)((tag ^ tag >> 32) & (MEMO_BUCKETS - 1));
+}
+
+static void index_add(eng_memo *M, int i)
+{
+    int b = bucket_of(M->slot[i].key.tag);
+    M->chain[i] = M->bucket[b];
+    M->bucket[b] = (signed char)i;
+}
+
+static void index_remove(eng_memo *M, int i)
+{
+    signed char *at = &M->bucket[bucket_of(M->slot[i].key.tag)];
+    while (*at != i) at = &M->chain[*at];
+    *at = M->chain[i];
+}
+
+/* Slot i's neighbours in the use list point at it as slot `as`. */
+static void order_link(eng_memo *M, int i, int as)
+{
+    if (M->older[i] >= 0) M->newer[M->older[i]] = (signed char)as;
+    else M->oldest = (signed char)as;
+    if (M->newer[i] >= 0) M->older[M->newer[i]] = (signed char)as;
+    else M->newest = (signed char)as;
+}
+
+static void order_remove(eng_memo *M, int i)
+{
+    if (M->older[i] >= 0) M->newer[M->older[i]] = M->newer[i];
+    else M->oldest = M->newer[i];
+    if (M->newer[i] >= 0) M->older[M->newer[i]] = M->older[i];
+    else M->newest = M->older[i];
+}
+
+static void order_append(eng_memo *M, int i)
+{
+    M->older[i] = M->newest;
+    M->newer[i] = -1;
+    if (M->newest >= 0) M->newer[M->newest] = (signed char)i;
+    else M->oldest = (signed char)i;
+    M->newest = (signed char)i;
+}
+
+/* The slot was used now: the newest in the list. */
+static void touch(eng_memo *M, memo_slot *s)
+{
+    int i = (int)(s - M->slot);
+    s->used = ++M->clock;
+    order_remove(M, i);
+    order_append(M, i);
+}
+
+static eng_memo *memo_new(void)
+{
+    eng_memo *M = calloc(1, sizeof *M);
+    if (M) {
+        memset(M->bucket, -1, sizeof M->bucket);
+        M->oldest = M->newest = -1;
+    }
+    return M;
+}
+
 static memo_slot *find(eng_memo *M, const memo_key *k)
 {
     int i;
-    for (i = 0; i < M->n; i++)
-        if (M->tag[i] == k->tag && same_key(&M->slot[i].key, k)) return &M->slot[i];
+    for (i = M->bucket[bucket_of(k->tag)]; i >= 0; i = M->chain[i])
+        if (same_key(&M->slot[i].key, k)) return &M->slot[i];
     return NULL;
 }
 
+/* Empties slot s: the last slot moves into it. */
 static void drop(eng_memo *M, memo_slot *s)
 {
+    int i = (int)(s - M->slot), last = M->n - 1;
     val_release(s->result);
-    M->tag[s - M->slot] = M->tag[M->n - 1];
-    *s = M->slot[--M->n];
+    index_remove(M, i);
+    order_remove(M, i);
+    if (i != last) {
+        index_remove(M, last);
+        M->older[i] = M->older[last];
+        M->newer[i] = M->newer[last];
+        order_link(M, i, i);
+        M->slot[i] = M->slot[last];
+        index_add(M, i);
+    }
+    M->n--;
 }
 
 /* The least recently used slot holding a result, but not keep; -1 if none. */
 static int oldest_result(const eng_memo *M, const memo_slot *keep)
 {
-    int i, old = -1;
-    for (i = 0; i < M->n; i++)
-        if (M->slot[i].result && &M->slot[i] != keep && (old < 0 || M->slot[i].used < M->slot[old].used)) old = i;
-    return old;
+    int i;
+    for (i = M->oldest; i >= 0; i = M->newer[i])
+        if (M->slot[i].result && &M->slot[i] != keep) return i;
+    return -1;
 }
 
-/* A free slot, evicting the least recently used when the table is full. */
-static memo_slot *make_room(eng_memo *M)
+/* A slot for key k, used now, evicting the least recently used when the
+ * table is full. */
+static memo_slot *make_room(eng_memo *M, const memo_key *k)
 {
-    int i, old = 0;
-    if (M->n < MEMO_SLOTS) return &M->slot[M->n++];
-    for (i = 1; i < M->n; i++)
-        if (M->slot[i].used < M->slot[old].used) old = i;
-    drop(M, &M->slot[old]);
-    return &M->slot[M->n++];
+    memo_slot *s;
+    if (M->n == MEMO_SLOTS) drop(M, &M->slot[M->oldest]);
+    s = &M->slot[M->n];
+    memset(s, 0, sizeof *s);
+    s->key = *k;
+    s->used = ++M->clock;
+    index_add(M, M->n);
+    order_append(M, M->n);
+    M->n++;
+    return s;
 }
 
-/* Keys naming the value `from` name `to` instead (see the top of the file). */
+/* Keys naming the value `from` name `to` instead (see the top of the file);
+ * their tags change, so the buckets are made again. */
 static void rename_operand(eng_memo *M, uint64_t from, uint64_t to)
 {
     int i, j;
+    memset(M->bucket, -1, sizeof M->bucket);
     for (i = 0; i < M->n; i++) {
         memo_key *k = &M->slot[i].key;
         for (j = 0; j < k->nin; j++)
             if (k->ids[j] == from) k->ids[j] = to;
-        M->tag[i] = k->tag = key_tag(k);
+        k->tag = key_tag(k);
+        index_add(M, i);
     }
 }
 
@@ -199,7 +295,7 @@ silc_value *memo_lookup(silc_engine *E, const silc_call *call)
     if (!E->memo || key_of(E, call, &k)) return NULL;
     s = find(E->memo, &k);
     if (!s || !s->result) return NULL;
-    s->used = ++E->memo->clock;
+    touch(E->memo, s);
     return val_retain(s->result);
 }
 
@@ -210,7 +306,7 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
     memo_slot *s;
     uint64_t bytes;
     if (key_of(E, call, &k)) return;
-    if (!E->memo && !(E->memo = calloc(1, sizeof *E->memo))) return; /* no table: nothing kept, nothing lost */
+    if (!E->memo && !(E->memo = memo_new())) return; /* no table: nothing kept, nothing lost */
     M = E->memo;
     s = find(M, &k);
     if (warned) { /* its warnings belong to each run: never hand it out */
@@ -218,15 +314,11 @@ void memo_note(silc_engine *E, const silc_call *call, silc_value *result, int wa
         return;
     }
     if (!s) { /* the first sighting: remember the key only */
-        s = make_room(M);
-        memset(s, 0, sizeof *s);
-        s->key = k;
-        M->tag[s - M->slot] = k.tag;
+        s = make_room(M, &k);
         s->first_id = result ? result->id : 0;
-        s->used = ++M->clock;
         return;
     }
-    s->used = ++M->clock;
+    touch(M, s);
     if (s->result) return;
     bytes = result_bytes(result);
     while (table_bytes(M) + bytes > MEMO_BYTES) {
