@@ -18,7 +18,9 @@
 #      (bench/crank_nicolson.m timed inside octave-cli with tic/toc and
 #      cputime, Octave's own start and its assembly excluded); both print
 #      sum(u).  silc's time is split into parts by running the script also
-#      stopped after 0, 1 and 2 steps.  Skipped, saying so, without octave-cli.
+#      stopped after 0, 1 and 2 steps, and the optional older silc's whole
+#      process is measured in the same rounds.  Skipped, saying so, without
+#      octave-cli.
 #
 #     sh bench/startup.sh BUILD_DIR [ROUNDS [LOOP_ROUNDS [OLD_SILC OLD_LIBSILC_DIR]]]
 #
@@ -113,15 +115,23 @@ with open(script) as f:
 for steps in (0, 1, 2):
     path = os.path.join(tmp, "cn_%d.silc" % steps)
     with open(path, "w") as f:
-        f.write(text.replace("for step = 1:100", "for step = 1:%d" % steps))
+        # stopped by a break, not a shorter loop: the solves take the path
+        # of the whole run's (a loop with passes left factors at its first
+        # solve; a last pass is a one-shot solve, docs/backends.md)
+        f.write(text.replace("for step = 1:100", "for step = 1:100\n  if step > %d\n    break\n  end" % steps))
     partial.append(([silc, "run", path], ([], [])))
 before = load()
-silc_t, oct_t = ([], []), ([], [])
-silc_sum = oct_sum = None
+silc_t, oct_t, old_t = ([], []), ([], []), ([], [])
+silc_sum = oct_sum = old_sum = None
+old_env = dict(os.environ, LD_LIBRARY_PATH=old_lib) if old and old_lib else None
 for _ in range(loop_rounds):
     wall, cpu, out = run([silc, "run", script])
     silc_t[0].append(wall), silc_t[1].append(cpu)
     silc_sum = out.split("=")[-1].strip()
+    if old:  # the older silc's whole process, in the same rounds
+        wall, cpu, out = run([old, "run", script], old_env)
+        old_t[0].append(wall), old_t[1].append(cpu)
+        old_sum = out.split("=")[-1].strip()
     for argv, (walls, cpus) in partial:
         wall, cpu, _ = run(argv)
         walls.append(wall), cpus.append(cpu)
@@ -137,6 +147,11 @@ print("%-44s %9s %9s %22s" % ("", "wall s", "CPU s", "sum(u)"))
 print("%-44s %9.3f %9.3f %22s" % ("silc run crank_nicolson.silc (whole process)", sw, sc, silc_sum))
 print("%-44s %9.3f %9.3f %22s" % ("Octave's loop alone (inside octave-cli)", ow, oc, oct_sum))
 print("%-44s %8.1fx %8.1fx" % ("Octave's loop / silc's whole process", ow / sw, oc / sc))
+if old:
+    aw, ac = statistics.median(old_t[0]), statistics.median(old_t[1])
+    print("%-44s %9.3f %9.3f %22s" % ("  the same, old build", aw, ac, old_sum))
+    print("%-44s %8.1fx %8.1fx" % ("  Octave's loop / the old build's", ow / aw, oc / ac))
+    print("%-44s %8.2fx %8.2fx" % ("  old build / silc", aw / sw, ac / sc))
 print("silc's whole process by part (differences of medians: the script stopped after 0, 1, 2 steps)")
 start = res[-1]  # silc -e 'x = 1;' of table 1
 prev = (start[1], start[2])

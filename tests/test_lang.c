@@ -389,6 +389,10 @@ static const lang_case cases[] = {
     ERR("x = [ones(2, 1), ones(3, 1)]",
         "'[...]' row 1: blocks side by side need equal row counts: 'ones(2, 1)' is 2x1, 'ones(3, 1)' is 3x1"),
     ERR("x = [1, 2", "1:10: expected ']' (to close '[' at 1:5) near end of input"),
+    /* a loop that fails inside a loop: the outer one keeps none of the
+     * names the inner one noted (parser.c: note_statement; ASan reads) */
+    ERR("for i = 1:2\n x = 1\n while (i < 3) { y = 2; z ==:2 }\nend", "3:29: unexpected ':'"),
+    ERR("while (1) { for k = 1:2 { y = 2 } k = ( }", "1:41: unexpected '}'"),
     ERR("x = (1 + 2;", "1:11: expected ')' (to close '(' at 1:5) near ';'"),
     ERR("x = foo(1, 2;", "1:13: expected ')' (to close '(' at 1:8) near ';'"),
     ERR("x = 1 * * 2", "1:9: unexpected '*'"),

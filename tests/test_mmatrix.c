@@ -56,15 +56,17 @@ static int put_laplacian(silc_context *c, int64_t k)
     return rc ? -1 : 0;
 }
 
-/* x = A \ b; 1 when `backend` solved it, with `be_max` met by the report
- * and by the backward error recomputed here, and x within cond * be of xt. */
-static int solved_by(silc_context *c, const char *what, const char *backend, const char *method,
-                     double be_max)
+/* x bound by the text solve (`x = A \ b`, or a loop); 1 when `backend`
+ * made it, with `be_max` met by the report and by the backward error
+ * recomputed here, and x within cond * be of xt. */
+static int solved_by_text(silc_context *c, const char *solve, const char *what, const char *backend,
+                          const char *method, double be_max)
 {
     const char *in;
     double be, e;
-    char stmt[] = "x = A \\ b; e = norm(A * x - b, inf) / (norm(A, inf) * norm(x, inf) + norm(b, inf)); "
-                  "f = norm(x - xt, inf) / norm(xt, inf)";
+    char stmt[512];
+    snprintf(stmt, sizeof stmt, "%s\ne = norm(A * x - b, inf) / (norm(A, inf) * norm(x, inf) + norm(b, inf)); "
+                                "f = norm(x - xt, inf) / norm(xt, inf)", solve);
     if (silc_exec(c, stmt)) {
         CHECK(0, "%s: %s", what, silc_context_errmsg(c));
         return 0;
@@ -81,6 +83,13 @@ static int solved_by(silc_context *c, const char *what, const char *backend, con
     CHECK(e >= 0 && e <= 1e4 * be_max * 10, "%s: ||x - xt|| / ||xt|| = %g", what, e);
     printf("  %s: %s, backward error %.2g\n", what, backend, be);
     return strstr(in, backend) != NULL;
+}
+
+/* solved_by_text of `x = A \ b`. */
+static int solved_by(silc_context *c, const char *what, const char *backend, const char *method,
+                     double be_max)
+{
+    return solved_by_text(c, "x = A \\ b", what, backend, method, be_max);
 }
 
 static void test_first_solve(silc_context *c)
@@ -103,6 +112,100 @@ static void test_first_solve(silc_context *c)
     /* A new matrix (another value under the same name) starts afresh. */
     if (put_laplacian(c, 121)) return;
     solved_by(c, "new A", "lis-style", "CG + SA-AMG", 1e-12);
+}
+
+/* A loop that solves with an A it does not change starts with the
+ * factorization (E->solve_again): its first solve is CHOLMOD's, not an AMG
+ * solve the second would throw away.  Each case with an A never solved
+ * before: a grid of its own size (the Laplacian of a size put again is the
+ * value solved before). */
+static void test_loops(silc_context *c)
+{
+    const char *ex, *in;
+    if (put_laplacian(c, 101)) return;
+    ex = tl_out_exec(c, "for k = 1:2\n explain x = A \\ b\n break\n end");
+    CHECK(strstr(ex, "inside a loop that does not change it") &&
+              strstr(ex, "-> solve.sparse.spd, then solve.sparse") && !strstr(ex, "mmatrix"),
+          "explain in a loop of 2 says why the M-matrix class is skipped:\n%s", ex);
+    /* the loop's first solve (and only one: break) */
+    solved_by_text(c, "for k = 1:2\n x = A \\ b;\n break\n end", "loop of 2, first solve", "suitesparse.cholmod",
+                   NULL, 1e-14);
+    CHECK(tl_contains(tl_out_info(c, "x"), "reused factorization: no"), "it factors:\n%s", tl_out());
+    /* two solves: the second reuses the first's factorization, no AMG ran */
+    if (put_laplacian(c, 102)) return;
+    solved_by_text(c, "for k = 1:2\n x = A \\ b;\n end", "loop of 2, second solve", "suitesparse.cholmod", NULL,
+                   1e-14);
+    in = tl_out_info(c, "x");
+    CHECK(tl_contains(in, "reused factorization: yes") && !tl_contains(in, "earlier attempts"),
+          "the second solve reuses the first's factorization:\n%s", in);
+    /* solve(A, b), a while loop (its length unknown), an outer loop that
+     * comes round again around an inner one that does not */
+    if (put_laplacian(c, 103)) return;
+    solved_by_text(c, "for k = 1:2\n x = solve(A, b);\n break\n end", "solve() in a loop", "suitesparse.cholmod",
+                   NULL, 1e-14);
+    if (put_laplacian(c, 104)) return;
+    solved_by_text(c, "k = 0;\n while k < 1\n k = k + 1;\n x = A \\ b;\n end", "while loop",
+                   "suitesparse.cholmod", NULL, 1e-14);
+    if (put_laplacian(c, 105)) return;
+    solved_by_text(c, "for i = 1:2\n for j = 1:1\n x = A \\ b;\n end\n break\n end", "nested loops",
+                   "suitesparse.cholmod", NULL, 1e-14);
+    /* The one-shot rule stays: a loop that assigns A (here in an `if`, or
+     * a `clear` of every name), a loop's last pass, a solve after a loop. */
+    if (put_laplacian(c, 106)) return;
+    solved_by_text(c, "for k = 1:2\n A = A';\n x = A \\ b;\n end", "A assigned in the loop", "lis-style",
+                   "CG + SA-AMG", 1e-12);
+    if (put_laplacian(c, 107)) return;
+    solved_by_text(c, "for k = 1:2\n if k > 2\n A = A';\n end\n x = A \\ b;\n break\n end",
+                   "A assigned in an if of the loop", "lis-style", "CG + SA-AMG", 1e-12);
+    if (put_laplacian(c, 108)) return;
+    solved_by_text(c, "for k = 1:2\n x = A \\ b;\n break\n clear\n end", "clear in the loop", "lis-style",
+                   "CG + SA-AMG", 1e-12);
+    if (put_laplacian(c, 109)) return;
+    solved_by_text(c, "for k = 1:1\n x = A \\ b;\n end", "loop of 1", "lis-style", "CG + SA-AMG", 1e-12);
+    if (put_laplacian(c, 110)) return;
+    solved_by_text(c, "for k = 1:2\n y = k;\n end\n x = A \\ b", "after a loop", "lis-style", "CG + SA-AMG",
+                   1e-12);
+}
+
+/* `tune on N` (N > 1) says the run repeats its steps: in its first step a
+ * first solve starts with the factorization; `tune on` alone does not. */
+static void test_tune_steps(silc_context *c)
+{
+    if (put_laplacian(c, 120)) return;
+    CHECK(silc_exec(c, "tune on") == 0, "tune on: %s", silc_context_errmsg(c));
+    solved_by(c, "tune on", "lis-style", "CG + SA-AMG", 1e-12);
+    CHECK(silc_exec(c, "tune off") == 0, "tune off: %s", silc_context_errmsg(c));
+    if (put_laplacian(c, 122)) return;
+    CHECK(silc_exec(c, "tune on 5") == 0, "tune on 5: %s", silc_context_errmsg(c));
+    solved_by(c, "tune on 5", "suitesparse.cholmod", NULL, 1e-14);
+    CHECK(silc_exec(c, "tune off") == 0, "tune off: %s", silc_context_errmsg(c));
+}
+
+/* The seeds' Crank-Nicolson loop (bench/crank_nicolson.silc): every step
+ * by CHOLMOD, one factorization, and sum(u) that of Octave's loop
+ * (374.5394257281691, bench/startup.sh's run of bench/crank_nicolson.m). */
+static void test_crank_nicolson(silc_context *c)
+{
+    char text[4096];
+    size_t len;
+    double heat;
+    const char *in;
+    FILE *f = fopen(SILC_SOURCE_DIR "/bench/crank_nicolson.silc", "r");
+    CHECK(f != NULL, "open bench/crank_nicolson.silc");
+    if (!f) return;
+    len = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    CHECK(len > 0 && len < sizeof text - 1, "read bench/crank_nicolson.silc (%zu bytes)", len);
+    text[len] = '\0';
+    CHECK(silc_exec(c, text) == 0, "crank_nicolson.silc: %s", silc_context_errmsg(c));
+    in = tl_out_info(c, "u");
+    CHECK(tl_contains(in, "suitesparse.cholmod") && tl_contains(in, "reused factorization: yes") &&
+              !tl_contains(in, "earlier attempts"),
+          "the loop's steps reuse one CHOLMOD factorization:\n%s", in);
+    heat = scalar(c, "heat");
+    CHECK(fabs(heat - 374.5394257281691) <= 1e-12 * 374.5394257281691, "sum(u) = %.16g, Octave's 374.5394257281691",
+          heat);
+    printf("  Crank-Nicolson 100 x 100, 100 steps: sum(u) = %.16g\n", heat);
 }
 
 static void test_not_this_class(silc_context *c)
@@ -187,6 +290,8 @@ int main(void)
         return 0;
     }
     test_first_solve(c);
+    test_loops(c);
+    test_crank_nicolson(c);
     test_not_this_class(c);
     test_backward_criterion(c);
     silc_close(&c);
@@ -194,6 +299,8 @@ int main(void)
     if ((c = tl_open_printing())) test_configured(c);
     silc_close(&c);
     if ((c = tl_open_printing())) test_fallback(c);
+    silc_close(&c);
+    if ((c = tl_open_printing())) test_tune_steps(c);
     silc_close(&c);
     return check_done();
 }

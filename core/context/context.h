@@ -66,6 +66,11 @@ struct silc_engine {
     int threads;                        /* thread budget granted to plugins */
     int accuracy_defer;                 /* solves may defer their backward error
                                            (accuracy.h); set by the evaluator */
+    const char *solve_again;            /* set by the evaluator around one solve whose A it
+                                           expects to be solved with again (a loop that does
+                                           not assign A, `tune on N`): why, for explain; NULL
+                                           = a one-shot solve as far as it knows (dispatch.c:
+                                           a factorization then pays from the first solve) */
     uint64_t rand_state;                /* rand() seed state */
     uint64_t loop_budget;               /* most `while` iterations one exec may run, 0 =
                                            unlimited (the default): an internal guard that

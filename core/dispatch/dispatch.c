@@ -134,7 +134,10 @@ typedef struct blist {
  * 10 000 unknowns up (docs/backends.md), and algebraic multigrid is built
  * for exactly these matrices.  A second solve with the same A is
  * solve.sparse.spd, where a factorization reused for every later solve is
- * what pays: a time loop pays for one AMG solve more than it would have. */
+ * what pays.  So is a first solve the evaluator expects to be repeated
+ * (E->solve_again: inside a loop that does not assign A, or the first step
+ * of a run `tune on N` announced): started with the factorization, a time
+ * loop pays for no AMG solve it would throw away. */
 #define MMATRIX_MIN_N 10000
 #define SOLVED_KEY "dispatch.solved" /* attached to A by its first sparse solve */
 
@@ -195,7 +198,7 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
     const silc_value *A, *B;
     const silc_props *p;
     const char *reason;
-    char band_reason[160], spd_reason[192];
+    char band_reason[160], spd_reason[320];
     int sparse, banded = 0, n = 0;
     if (why && whylen) why[0] = '\0';
     if (!call || call->op < 0 || call->op >= SILC_OP_COUNT || call->nin < 1 || !call->in[0])
@@ -229,21 +232,26 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
              * diagonal: Cholesky's class.  A complex symmetric A (A = A.')
              * is not, and goes to the general class below (LU).  (Not on an
              * MPI engine: its lists start with the distributed solvers.)  A
-             * repeat is scanned only to explain itself. */
+             * repeat, or a first solve expected to be repeated, is scanned
+             * only to explain itself. */
             int repeat = sparse && val_attach_get(A, SOLVED_KEY) != NULL;
-            int mm = sparse && E && !E->dist && (!repeat || why) && mmatrix_class_applies(E) &&
+            const char *again = sparse && E && !repeat ? E->solve_again : NULL;
+            int mm = sparse && E && !E->dist && (!(repeat || again) || why) && mmatrix_class_applies(E) &&
                      A->field == SILC_FIELD_REAL && large_mmatrix(A);
-            if (mm && !repeat) out[n++] = "solve.sparse.mmatrix.spd";
+            if (mm && !repeat && !again) out[n++] = "solve.sparse.mmatrix.spd";
             out[n++] = sparse ? "solve.sparse.spd" : "solve.dense.spd";
             out[n++] = sparse ? "solve.sparse" : "solve.dense";
-            snprintf(spd_reason, sizeof spd_reason, "%s%s",
+            snprintf(spd_reason, sizeof spd_reason, "%s%s%s%s",
                      banded ? "banded, but a sparse class is configured and solve.band is not; " : "",
                      !mm ? (A->field == SILC_FIELD_COMPLEX ? "Hermitian with real positive diagonal"
                                                           : "symmetric with positive diagonal")
                      : repeat ? "symmetric M-matrix solved before (a factorization kept for the later solves "
                                 "pays from here)"
+                     : again  ? "symmetric M-matrix, first solve with it, "
                               : "symmetric M-matrix (positive diagonal, off-diagonal entries <= 0), first "
-                                "solve with it");
+                                "solve with it",
+                     mm && again ? again : "",
+                     mm && again ? " (a factorization kept for the later solves pays from the first)" : "");
             reason = spd_reason;
         } else if (banded) {
             out[n++] = "solve.sparse";

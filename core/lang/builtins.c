@@ -567,7 +567,9 @@ static int bi_solve(lang_ev *V, const ast_node *call, silc_value **a, int n, sil
     c.in[1] = a[1];
     c.options = opts;
     call_text(V, call, what, sizeof what);
+    V->solve_matrix = call->kids[0];
     rc = ev_run(V, &c, what, out);
+    V->solve_matrix = NULL;
     if (opts) cfg_clear_call_options(V->E);
     return rc;
 }

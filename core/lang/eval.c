@@ -245,6 +245,31 @@ static void profile_call(lang_ev *V, const silc_call *call, const silc_report *r
 
 static silc_value *initial_guess(lang_ev *V, const ast_node *s);
 
+/* A loop running: V->loop is the innermost, each frame on the C stack of
+ * its own statement (exec_for, the while), so it is bounded as the
+ * parser bounds nesting. */
+typedef struct ev_loop {
+    const ast_node *stmt;       /* the ST_FOR or ST_WHILE */
+    int64_t left;               /* iterations after the running one; -1: unknown (a while) */
+    const struct ev_loop *up;
+} ev_loop;
+
+/* Why the solve call is expected to be followed by more with the same A
+ * (E->solve_again: dispatch.c then starts with a factorization), or NULL:
+ * its A is written as a name that a loop around it, which runs again, does
+ * not bind (ps_loop_binds: a loop that assigns A gets a new matrix each
+ * time, and the one-shot rule stays); or `tune on N` said the run repeats. */
+static const char *solve_again(const lang_ev *V, const silc_call *call)
+{
+    const ev_loop *l;
+    const ast_node *a = V->solve_matrix;
+    if (call->op != SILC_OP_SOLVE) return NULL;
+    if (a && a->kind == AST_NAME)
+        for (l = V->loop; l && !ps_loop_binds(l->stmt, a->name); l = l->up)
+            if (l->left) return "inside a loop that does not change it";
+    return tuner_solve_again(V->E);
+}
+
 int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
 {
     silc_engine *E = V->E;
@@ -286,7 +311,9 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
         sb_puts(V->explain_out, "\n");
         sb_init(&d);
         dist_explain(E, call, &d);
+        E->solve_again = solve_again(V, call);
         rc = disp_explain(E, call, &d);
+        E->solve_again = NULL;
         if (rc && strstr(E->err, "out of memory")) { /* not a reason to show, a failure */
             sb_free(&d);
             return -1;
@@ -313,9 +340,11 @@ int ev_run(lang_ev *V, silc_call *call, const char *what, silc_value **out)
     warned = E->warnings.len;
     /* The evaluator records what a deferred backward error needs (bind). */
     E->accuracy_defer = 1;
+    E->solve_again = solve_again(V, call);
     t0 = V->profile ? util_now() : 0;
     rc = E->dist ? dist_run(E, call) : disp_run(E, call);
     E->accuracy_defer = 0;
+    E->solve_again = NULL;
     /* ... and right after one: a call that cannot be stopped from inside (a
      * MUMPS or UMFPACK factorization) is followed by nothing more */
     if (!rc && !E->dist && eng_cancel_check(E)) rc = -1;
@@ -665,7 +694,9 @@ UTIL_NOINLINE static int binary_of(lang_ev *V, const ast_node *n, silc_value *a,
     o.lnode = n->kids[0];
     o.rnode = n->kids[1];
     o.what = what;
+    V->solve_matrix = n->op == TK_BACKSLASH ? n->kids[0] : NULL;
     rc = apply_binary(V, n->op, &o, a, b, out);
+    V->solve_matrix = NULL;
     val_release(a);
     val_release(b);
     return rc;
@@ -1758,6 +1789,8 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
          * (a script's loop is the program's time loop; tuner_loop_step). */
         int rc = 0, outer = V->loop_depth++ == 0 && !V->explain;
         uint64_t key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
+        ev_loop loop = {s, -1, V->loop};
+        V->loop = &loop;
         for (;;) {
             double ti = util_now();
             if ((rc = condition(V, s->cond, &truth)) || !truth) break;
@@ -1772,6 +1805,7 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
             if (*flow == FLOW_BREAK) break;
         }
         V->loop_depth--;
+        V->loop = loop.up;
         if (!rc) *flow = FLOW_NEXT;
         return rc;
     }
@@ -1860,6 +1894,7 @@ static int exec_for(lang_ev *V, const ast_node *s, int *flow)
     int64_t k, count;
     int rc = 0, outer;
     uint64_t key;
+    ev_loop loop = {s, 0, V->loop};
     if (s->cond->kind == AST_RANGE) {
         if (range_of(V, s->cond, &r)) return -1;
         count = (int64_t)r.count;
@@ -1869,9 +1904,11 @@ static int exec_for(lang_ev *V, const ast_node *s, int *flow)
     }
     outer = V->loop_depth++ == 0 && !V->explain;
     key = outer ? tuner_hash(V->src) ^ ((uint64_t)s->line << 32 | (uint32_t)s->col) : 0;
+    V->loop = &loop;
     for (k = 0; k < count; k++) {
         double ti = util_now();
         silc_value *v;
+        loop.left = count - k - 1;
         if (V->E->loop_budget && ++V->loops > V->E->loop_budget) {
             rc = eng_error(V->E, "loop stopped after %llu iterations (the engine's loop budget)",
                            (unsigned long long)V->E->loop_budget);
@@ -1890,6 +1927,7 @@ static int exec_for(lang_ev *V, const ast_node *s, int *flow)
         if (V->explain) break;   /* explain describes one pass */
     }
     V->loop_depth--;
+    V->loop = loop.up;
     val_release(all);
     if (!rc) *flow = FLOW_NEXT;
     return rc;

@@ -81,6 +81,19 @@ enum ast_kind {
     ST_SAVE, ST_LOAD       /* save/load "file" [names]: name is the file, kids AST_NAME */
 };
 
+/* The names a loop's body may bind (ST_FOR, ST_WHILE; parser.c): its
+ * assignments, its loop variable, clear and load, nested loops' included;
+ * what tells the evaluator that a matrix stays the same from one iteration
+ * to the next (eval.c: solve_again).  any: the body may bind any name (a
+ * clear or load without names), or it binds more than AST_LOOP_BINDS_MAX
+ * (then the list is not kept). */
+#define AST_LOOP_BINDS_MAX 32
+typedef struct ast_binds {
+    int any;
+    size_t n;
+    const char *names[AST_LOOP_BINDS_MAX];  /* the binding statements' names (not owned) */
+} ast_binds;
+
 typedef struct ast_node ast_node;
 struct ast_node {
     int kind;              /* enum ast_kind */
@@ -100,6 +113,7 @@ struct ast_node {
     size_t nkids;
     ast_node *cond;        /* IF, WHILE */
     ast_node *els;         /* IF: else branch (a block or another IF), may be NULL */
+    ast_binds *binds;      /* FOR, WHILE: what the body binds (owned); else NULL */
 };
 
 /* A parsed text: the owned copy of the source and its top-level statements. */
@@ -112,6 +126,8 @@ typedef struct lang_program {
 /* Parses text into *out.  Returns 0, or -1 with "L:C: message" in err. */
 int ps_parse(const char *text, lang_program **out, char *err, size_t errlen);
 void ps_free(lang_program *p);
+/* 1 when the body of loop (ST_FOR, ST_WHILE) may bind name. */
+int ps_loop_binds(const ast_node *loop, const char *name);
 
 /* ---- evaluation state --------------------------------------------------------- */
 typedef struct lang_ev {
@@ -130,6 +146,9 @@ typedef struct lang_ev {
     char *bind_text;       /* the statement's text, made before an update in place */
     uint64_t loops;        /* `while` iterations of this exec (E->loop_budget) */
     int loop_depth;        /* `while` loops open (the outermost one's iterations are the tuner's steps) */
+    const struct ev_loop *loop; /* the innermost loop running (eval.c), NULL outside loops */
+    const ast_node *solve_matrix; /* the operand text of the matrix of the solve about to run
+                                     (A of `A \ b`, `solve(A, b)`), or NULL */
     const silc_value *warm; /* initial guess for the statement's solve (solve.initial_guess), or NULL */
     const ast_node *warm_for; /* the assignment whose guess is looked up at its first solve, or NULL */
     silc_value *warm_held; /* the reference to the guess that exec_assign releases */

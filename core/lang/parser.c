@@ -33,6 +33,8 @@ typedef struct ps_state {
     lx_token *t;
     size_t pos, n;
     int loop_depth;
+    ast_node *loop;        /* the innermost loop whose body is being parsed: it collects
+                              the names its statements bind (note_binding) */
     int depth;             /* nested expressions: enter() bounds it */
     int block_depth;       /* nested statements (blocks, else if, explain): the same */
     int bracket_depth;     /* inside [ ]: `end` and `:` are subscripts */
@@ -148,6 +150,7 @@ static void node_free(ast_node *n)
     for (i = 0; i < n->nkids; i++) node_free(n->kids[i]);
     free(n->kids);
     free(n->name);
+    free(n->binds);
     node_free(n->cond);
     node_free(n->els);
     free(n);
@@ -830,6 +833,69 @@ static ast_node *parse_if(ps_state *P, const lx_token *kw)
     return n;
 }
 
+/* name (NULL: any name) is bound by a statement of the body b collects. */
+static void note_binding(ast_binds *b, const char *name)
+{
+    size_t i;
+    if (!b || b->any) return;
+    if (!name || b->n == AST_LOOP_BINDS_MAX) {
+        b->any = 1;
+        return;
+    }
+    for (i = 0; i < b->n; i++)
+        if (!strcmp(b->names[i], name)) return;
+    b->names[b->n++] = name;
+}
+
+/* What statement s, parsed whole, binds, noted by the loop whose body is
+ * being parsed: a nested loop's names (its variable included) are bound
+ * in the loop around it too.  Only once s is whole, since the names are
+ * its nodes' (a failed statement's are freed). */
+static void note_statement(ps_state *P, const ast_node *s)
+{
+    ast_binds *b = P->loop ? P->loop->binds : NULL;
+    size_t i;
+    switch (s->kind) {
+    case ST_ASSIGN: case ST_OPASSIGN: case ST_INDEX_ASSIGN:
+        note_binding(b, s->name);
+        break;
+    case ST_CLEAR: case ST_LOAD: /* without names: every name */
+        if (!s->nkids) note_binding(b, NULL);
+        for (i = 0; i < s->nkids; i++) note_binding(b, s->kids[i]->name);
+        break;
+    case ST_FOR: case ST_WHILE:
+        if (s->binds->any) note_binding(b, NULL);
+        for (i = 0; i < s->binds->n; i++) note_binding(b, s->binds->names[i]);
+        break;
+    default:
+        break;
+    }
+}
+
+/* The body of loop n (kw its keyword), parsed with n collecting the names
+ * it binds. */
+static ast_node *parse_loop_body(ps_state *P, ast_node *n, const lx_token *kw, int *braced)
+{
+    ast_node *outer = P->loop, *b;
+    if (!(n->binds = calloc(1, sizeof *n->binds))) return fail(P, kw, "out of memory while parsing");
+    if (n->kind == ST_FOR) note_binding(n->binds, n->name);
+    P->loop = n;
+    P->loop_depth++;
+    b = parse_body(P, n, kw, braced);
+    P->loop_depth--;
+    P->loop = outer;
+    return b;
+}
+
+int ps_loop_binds(const ast_node *loop, const char *name)
+{
+    size_t i;
+    if (!loop->binds || loop->binds->any) return 1;
+    for (i = 0; i < loop->binds->n; i++)
+        if (!strcmp(loop->binds->names[i], name)) return 1;
+    return 0;
+}
+
 static ast_node *parse_while(ps_state *P, const lx_token *kw)
 {
     ast_node *n = node_new(P, ST_WHILE, kw), *b;
@@ -839,9 +905,7 @@ static ast_node *parse_while(ps_state *P, const lx_token *kw)
         node_free(n);
         return NULL;
     }
-    P->loop_depth++;
-    b = parse_body(P, n, kw, &braced);
-    P->loop_depth--;
+    b = parse_loop_body(P, n, kw, &braced);
     if (!b || add_kid(P, n, b) || (!braced && close_word_block(P, n, kw))) {
         node_free(n);
         return NULL;
@@ -875,9 +939,7 @@ static ast_node *parse_for(ps_state *P, const lx_token *kw)
         node_free(n);
         return NULL;
     }
-    P->loop_depth++;
-    b = parse_body(P, n, kw, &braced);
-    P->loop_depth--;
+    b = parse_loop_body(P, n, kw, &braced);
     if (!b || add_kid(P, n, b) || (!braced && close_word_block(P, n, kw))) {
         node_free(n);
         return NULL;
@@ -1138,6 +1200,7 @@ static ast_node *parse_statement(ps_state *P)
     if (enter_block(P)) return NULL;
     s = parse_statement_body(P);
     leave_block(P);
+    if (s) note_statement(P, s);
     return s;
 }
 

@@ -85,6 +85,11 @@ void tuner_note_solve(silc_engine *E, const silc_call *call);
 int tuner_command(silc_engine *E, const char *word, const double *xs, int nx, const char *arg);
 /* Appends the tuner's view of a solve class to `explain` output. */
 void tuner_explain(silc_engine *E, const silc_call *call, strbuf *b);
+/* Why a solve is expected to be repeated, as far as the tuner knows: tuning
+ * is on, `tune on N` announced N > 1 steps, and no whole step has been seen
+ * yet (a matrix first seen in a later step is one that changed between
+ * steps, which the one-shot rule fits); else NULL.  For E->solve_again. */
+const char *tuner_solve_again(const silc_engine *E);
 void tuner_free(silc_engine *E);
 
 /* ---- internals exposed for tests and the bench ---------------------------- */

@@ -416,6 +416,14 @@ void tuner_expect_steps(silc_engine *E, int steps)
     if (T) T->expect_steps = steps > 0 ? steps : 0;
 }
 
+const char *tuner_solve_again(const silc_engine *E)
+{
+    const tuner *T = E->tuner;
+    return T && T->enabled && T->expect_steps > 1 && T->steps == 0 ? "in the first step of a run `tune on N` "
+                                                                      "said repeats"
+                                                                    : NULL;
+}
+
 void tuner_set_rule(silc_engine *E, double loo_tol, double rep_tol, int max_repeats)
 {
     tuner *T = tuner_get(E);
