@@ -207,7 +207,7 @@ static int dense_row(int64_t n, int reps)
     double *a = malloc(nn * sizeof *a), *w = malloc(nn * sizeof *w);
     double *b = malloc((size_t)n * sizeof *b), *xb = malloc((size_t)n * sizeof *xb);
     lapack_int *ipiv = malloc((size_t)n * sizeof *ipiv), info = 0;
-    double tl[16], tcl[16], ts[MODES][16], faults[16];
+    double tl[16], tcl[16], ts[MODES][16], faults[MODES][16];
     silc_envelope_t A = {0}, be = {0};
     int rc = !a || !w || !b || !xb || !ipiv;
     if (rc) fprintf(stderr, "limit: out of memory\n");
@@ -249,13 +249,16 @@ static int dense_row(int64_t n, int reps)
             memcpy(A.values, a, nn * sizeof *a);
             rc = check(silc_exec(ctx, mode_settings[m]), mode_settings[m]) || silc_solve_time(&A, &t, &f);
             if (r >= 0) ts[m][r] = t;
-            if (r >= 0 && m == BARE) faults[r] = f;
+            if (r >= 0) faults[m][r] = f;
         }
     }
     if (!rc) {
         double l = bench_median(tl, reps), cl = bench_median(tcl, reps), s = bench_median(ts[BARE], reps);
-        printf("%6lld %9.4f %11.4f %9.4f %7.0f %8.4f %8.4f %8.3f %10.3f %8.3f\n", (long long)n, l, cl, s,
-               bench_median(faults, reps), median_difference(ts[BERR], ts[BARE], reps),
+        char fl[48];
+        snprintf(fl, sizeof fl, "%.0f/%.0f/%.0f", bench_median(faults[BARE], reps),
+                 bench_median(faults[BERR], reps), bench_median(faults[FULL], reps));
+        printf("%6lld %9.4f %11.4f %9.4f %17s %8.4f %8.4f %8.3f %10.3f %8.3f\n", (long long)n, l, cl, s, fl,
+               median_difference(ts[BERR], ts[BARE], reps),
                median_difference(ts[FULL], ts[BERR], reps), s / l, s / cl, bench_median(ts[FULL], reps) / l);
     }
     silc_envelope_free(&A);
@@ -268,12 +271,12 @@ static int dense(int64_t max_n)
 {
     printf("\nDense solve x = A \\ b, A random n x n with a dominant diagonal (not symmetric); seconds (%s),\n"
            "median of the rounds; SILC factors afresh each time (a new PUT of A)\n", clock_name);
-    printf("%6s %9s %11s %9s %7s %8s %8s %8s %10s %8s\n", "n", "dgesv s", "copy+dgesv", "SILC s", "faults",
+    printf("%6s %9s %11s %9s %17s %8s %8s %8s %10s %8s\n", "n", "dgesv s", "copy+dgesv", "SILC s", "faults",
            "berr s", "condest", "ratio", "ratio(cp)", "ratio+r");
     for (int64_t n = 1000; n <= max_n; n += 1000)
         if (dense_row(n, n <= 2000 ? 5 : 3)) return 1;
-    printf("SILC = bare (accuracy.condest = off, solve.backward_error = on_request), faults = its minor\n"
-           "page faults an EXEC (median); berr = the backward error's cost, condest = the condition\n"
+    printf("SILC = bare (accuracy.condest = off, solve.backward_error = on_request); faults = minor page\n"
+           "faults an EXEC (medians: bare/with berr/with both); berr = the backward error's cost, condest = the condition\n"
            "estimate's (the accuracy report's extra work, each the median difference of two SILC runs);\n"
            "ratio = SILC / dgesv, ratio(cp) = SILC / copy+dgesv, ratio+r = SILC with the whole report\n"
            "(the defaults) / dgesv\n");
