@@ -274,9 +274,9 @@ static int factor(silc_call *call, int route, const silc_view *A, const silc_pro
                   lp_factor **F)
 {
     switch (route) {
-    case R_LU: return lp_dense_lu(call, A, P->norm1, F);
-    case R_CHOL: return lp_dense_chol(call, A, P->norm1, F);
-    case R_LDLT: return lp_dense_ldlt(call, A, P->norm1, F);
+    case R_LU: return lp_dense_lu(call, A, F);
+    case R_CHOL: return lp_dense_chol(call, A, F);
+    case R_LDLT: return lp_dense_ldlt(call, A, F);
     case R_TRI: return lp_dense_tri(call, A, P->lower ? 'L' : 'U', F);
     case R_BAND: return lp_band(call, A, P->kl, P->ku, P->symmetric && P->pos_diag, P->norm1, F);
     default: return lp_dense_qr(call, A, rank_tol, F);
@@ -385,11 +385,12 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
      * sgecon / spocon estimate from them: as good as single precision, which
      * is all a condition estimate needs, since a matrix too ill-conditioned
      * for single precision makes LAPACK fall back to double anyway. */
-    if (iter < 0) {
+    int estimate = !(lp_host->abi_minor >= 7 && r->condest_off); /* accuracy.condest = off: none */
+    if (estimate && iter < 0) {
         if (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
                  : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork))
             rcond = -1;
-    } else {
+    } else if (estimate) {
         float srcond = -1, *fwork = lp_alloc((size_t)4 * (size_t)n, sizeof(float));
         if (fwork && !(chol ? LAPACKE_spocon_work(LAPACK_COL_MAJOR, 'L', n, swork, n, (float)P->norm1,
                                                    &srcond, fwork, iwork)
@@ -430,7 +431,7 @@ static int op_solve(silc_call *call)
     const silc_props *P;
     lp_factor *F, *owned = NULL;
     silc_value *out;
-    double rank_tol = 0, t0, t1, *work;
+    double rank_tol = 0, t0, t1, te = 0, *work;
     int64_t ldw;
     int route, rc, fresh = 0, cx = lp_is_complex(call->in[0]), mixed_asked = 0;
     size_t w = cx ? 2 : 1; /* doubles per entry */
@@ -483,6 +484,17 @@ static int op_solve(silc_call *call)
         }
         fresh = 1;
     }
+    /* The condition estimate, unless accuracy.condest = off: made with a
+     * fresh factorization (and timed with it), or by the first solve that
+     * wants it from a factor made without. */
+    if (F->rcond_owed && !(lp_host->abi_minor >= 7 && call->report->condest_off)) {
+        te = lp_host->now();
+        if ((rc = lp_dense_estimate(call, F, &A, P->norm1))) {
+            lp_factor_free(owned);
+            return rc;
+        }
+        te = lp_host->now() - te;
+    }
     t1 = lp_host->now();
 
     out = dense_out(cx, A.n, B.n);
@@ -520,7 +532,7 @@ static int op_solve(silc_call *call)
                  "lapack.precision = mixed is real only: factored in double");
     call->report->reused_factor = !fresh && F->kind != LP_TRI && F->kind != LP_LSY;
     call->report->factor_seconds = fresh ? t1 - t0 : 0.0;
-    call->report->solve_seconds = lp_host->now() - t1;
+    call->report->solve_seconds = lp_host->now() - t1 + (fresh ? 0.0 : te);
     lp_factor_free(owned);
     call->out = out;
     return SILC_OK;

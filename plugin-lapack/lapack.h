@@ -59,6 +59,7 @@ typedef struct lp_factor {
     double *tau;             /* LP_QR, LP_LQ */
     lapack_int *ipiv;
     double rcond;            /* LAPACK's reciprocal 1-norm condition estimate, -1 = unknown */
+    int rcond_owed;          /* LU, CHOL, LDLT, TRI: rcond not made yet (lp_dense_estimate) */
     lapack_int bad;          /* LP_CHOL: leading minor that was not positive (kept to skip a retry) */
     lapack_int rank;         /* LP_LSY: numerical rank found by the last dgelsy */
     double rank_tol;         /* LP_QR, LP_LQ, LP_LSY: the rank threshold it was made with */
@@ -96,11 +97,16 @@ int lp_is_complex(const silc_value *v);
 /* Factorizations.  On success *F is a new factor; on failure the status is
  * returned after host->error (LP_CHOL: a factor with bad > 0 is still returned
  * in *F with SILC_ENOTSPD, so the driver can remember the failure).  norm1 is
- * ||A||_1 from host->props. */
-int lp_dense_lu(silc_call *call, const silc_view *A, double norm1, lp_factor **F);
-int lp_dense_chol(silc_call *call, const silc_view *A, double norm1, lp_factor **F);
-int lp_dense_ldlt(silc_call *call, const silc_view *A, double norm1, lp_factor **F);
+ * ||A||_1 from host->props.  The dense LU, Cholesky, LDL' and triangular
+ * factors come without their condition estimate (rcond_owed): the driver
+ * asks lp_dense_estimate for it when the session wants one. */
+int lp_dense_lu(silc_call *call, const silc_view *A, lp_factor **F);
+int lp_dense_chol(silc_call *call, const silc_view *A, lp_factor **F);
+int lp_dense_ldlt(silc_call *call, const silc_view *A, lp_factor **F);
 int lp_dense_tri(silc_call *call, const silc_view *A, char uplo, lp_factor **F);
+/* F->rcond of such a factor (A: the matrix it was made from); 0, or the
+ * status after host->error when out of memory. */
+int lp_dense_estimate(silc_call *call, lp_factor *F, const silc_view *A, double norm1);
 int lp_dense_qr(silc_call *call, const silc_view *A, double rank_tol, lp_factor **F);
 /* Band or tridiagonal LU, or their Cholesky variants when spd_first is set
  * (falling back to LU, with a note, if A is not positive definite). */

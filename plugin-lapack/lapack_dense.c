@@ -54,11 +54,10 @@ static lapack_int lwork_of(double w)
     return w < 1.0 ? 1 : (lapack_int)w;
 }
 
-int lp_dense_lu(silc_call *call, const silc_view *A, double norm1, lp_factor **out)
+int lp_dense_lu(silc_call *call, const silc_view *A, lp_factor **out)
 {
     lp_factor *F = factor_with_copy(call, LP_LU, A, 1);
-    double *work;
-    lapack_int *iwork, n = (lapack_int)A->n, info;
+    lapack_int n = (lapack_int)A->n, info;
     char p;
     if (!F) return lp_nomem(call);
     p = LP_P(F);
@@ -72,26 +71,16 @@ int lp_dense_lu(silc_call *call, const silc_view *A, double norm1, lp_factor **o
                                   (int)info, (int)info, (int)info);
         return lp_illegal_p(call, p, "getrf", info);
     }
-    if (lp_con_scratch(n, F->cplx ? LP_ZCON_DOUBLES(n) : 4 * n, &work, &iwork)) {
-        lp_factor_free(F);
-        return lp_nomem(call);
-    }
-    if (F->cplx ? LAPACKE_zgecon_work(LAPACK_COL_MAJOR, '1', n, LZ(F->a), F->ld, norm1, &F->rcond,
-                                      LZ(work), work + 4 * n)
-                : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, F->a, F->ld, norm1, &F->rcond, work, iwork))
-        F->rcond = -1;
-    lp_free(work);
-    lp_free(iwork);
+    F->rcond_owed = 1;
     snprintf(F->method, sizeof F->method, "LU, partial pivoting (%cgetrf)", p);
     *out = F;
     return SILC_OK;
 }
 
-int lp_dense_chol(silc_call *call, const silc_view *A, double norm1, lp_factor **out)
+int lp_dense_chol(silc_call *call, const silc_view *A, lp_factor **out)
 {
     lp_factor *F = factor_with_copy(call, LP_CHOL, A, 0);
-    double *work;
-    lapack_int *iwork, n = (lapack_int)A->n, info;
+    lapack_int n = (lapack_int)A->n, info;
     char p;
     if (!F) return lp_nomem(call);
     p = LP_P(F);
@@ -112,26 +101,17 @@ int lp_dense_chol(silc_call *call, const silc_view *A, double norm1, lp_factor *
         lp_factor_free(F);
         return lp_illegal_p(call, p, "potrf", info);
     }
-    if (lp_con_scratch(n, F->cplx ? LP_ZCON_DOUBLES(n) : 3 * n, &work, &iwork)) {
-        lp_factor_free(F);
-        return lp_nomem(call);
-    }
-    if (F->cplx ? LAPACKE_zpocon_work(LAPACK_COL_MAJOR, 'L', n, LZ(F->a), F->ld, norm1, &F->rcond,
-                                      LZ(work), work + 4 * n)
-                : LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, F->a, F->ld, norm1, &F->rcond, work, iwork))
-        F->rcond = -1;
-    lp_free(work);
-    lp_free(iwork);
+    F->rcond_owed = 1;
     snprintf(F->method, sizeof F->method, "%s (%cpotrf)", F->cplx ? "Hermitian Cholesky" : "Cholesky", p);
     *out = F;
     return SILC_OK;
 }
 
-int lp_dense_ldlt(silc_call *call, const silc_view *A, double norm1, lp_factor **out)
+int lp_dense_ldlt(silc_call *call, const silc_view *A, lp_factor **out)
 {
     lp_factor *F = factor_with_copy(call, LP_LDLT, A, 1);
     double q[2] = {0, 0}, *work;
-    lapack_int *iwork, n = (lapack_int)A->n, info, lwork;
+    lapack_int n = (lapack_int)A->n, info, lwork;
     char p;
     if (!F) return lp_nomem(call);
     p = LP_P(F);
@@ -139,21 +119,17 @@ int lp_dense_ldlt(silc_call *call, const silc_view *A, double norm1, lp_factor *
     info = F->cplx ? LAPACKE_zsytrf_work(LAPACK_COL_MAJOR, 'L', n, LZ(F->a), F->ld, F->ipiv, LZ(q), -1)
                    : LAPACKE_dsytrf_work(LAPACK_COL_MAJOR, 'L', n, F->a, F->ld, F->ipiv, q, -1);
     lwork = lwork_of(q[0]);
-    if (lwork < 2 * n) lwork = LP_LD(2 * n); /* the same array serves ?sycon below */
     work = lp_alloc((size_t)lwork * (size_t)LP_W(F), sizeof(double));
-    iwork = lp_alloc((size_t)LP_LD(n), sizeof(lapack_int));
-    if (info != 0 || !work || !iwork) {
+    if (info != 0 || !work) {
         lp_free(work);
-        lp_free(iwork);
         lp_factor_free(F);
         if (info) return lp_illegal_p(call, p, "sytrf", info);
         return lp_nomem(call);
     }
     info = F->cplx ? LAPACKE_zsytrf_work(LAPACK_COL_MAJOR, 'L', n, LZ(F->a), F->ld, F->ipiv, LZ(work), lwork)
                    : LAPACKE_dsytrf_work(LAPACK_COL_MAJOR, 'L', n, F->a, F->ld, F->ipiv, work, lwork);
+    lp_free(work);
     if (info != 0) {
-        lp_free(work);
-        lp_free(iwork);
         lp_factor_free(F);
         if (info > 0)
             return lp_host->error(call, SILC_ESINGULAR,
@@ -161,13 +137,7 @@ int lp_dense_ldlt(silc_call *call, const silc_view *A, double norm1, lp_factor *
                                   (int)info, (int)info, (int)info);
         return lp_illegal_p(call, p, "sytrf", info);
     }
-    if (F->cplx ? LAPACKE_zsycon_work(LAPACK_COL_MAJOR, 'L', n, LZ(F->a), F->ld, F->ipiv, norm1, &F->rcond,
-                                      LZ(work))
-                : LAPACKE_dsycon_work(LAPACK_COL_MAJOR, 'L', n, F->a, F->ld, F->ipiv, norm1, &F->rcond, work,
-                                      iwork))
-        F->rcond = -1;
-    lp_free(work);
-    lp_free(iwork);
+    F->rcond_owed = 1;
     snprintf(F->method, sizeof F->method, "%s LDL', Bunch-Kaufman (%csytrf)",
              F->cplx ? "complex symmetric (A = A.')" : "symmetric indefinite", p);
     *out = F;
@@ -179,26 +149,58 @@ int lp_dense_tri(silc_call *call, const silc_view *A, char uplo, lp_factor **out
 {
     lapack_int n = (lapack_int)A->n;
     lp_factor *F = lp_factor_new(LP_TRI, n, n);
-    double *work;
-    lapack_int *iwork;
     if (!F) return lp_nomem(call);
     F->cplx = lp_is_complex(call->in[0]);
-    if (lp_con_scratch(n, F->cplx ? LP_ZCON_DOUBLES(n) : 3 * n, &work, &iwork)) {
-        lp_factor_free(F);
-        return lp_nomem(call);
-    }
     F->uplo = uplo;
     F->ld = LP_LD(n);
-    if (F->cplx ? LAPACKE_ztrcon_work(LAPACK_COL_MAJOR, '1', uplo, 'N', n, LZ(A->val), F->ld, &F->rcond,
-                                      LZ(work), work + 4 * n)
-                : LAPACKE_dtrcon_work(LAPACK_COL_MAJOR, '1', uplo, 'N', n, A->val, F->ld, &F->rcond, work,
-                                      iwork))
-        F->rcond = -1;
-    lp_free(work);
-    lp_free(iwork);
+    F->rcond_owed = 1;
     snprintf(F->method, sizeof F->method, "%s triangular (%ctrtrs)", uplo == 'L' ? "lower" : "upper",
              LP_P(F));
     *out = F;
+    return SILC_OK;
+}
+
+/* The condition estimate of an LU, Cholesky, LDL' or triangular factor,
+ * made apart from the factorization so that accuracy.condest = off skips it:
+ * it reads the factors some ten times (Hager-Higham through ?latrs), 8-13 %
+ * of a dgetrf at n = 1000-3000 (bench/limit), which the solve need not pay
+ * when nobody wants the number.  A factor made without it keeps it owed
+ * (rcond_owed) and a later solve that wants it makes it then, from the same
+ * factors, so it is the number the factorization would have given. */
+int lp_dense_estimate(silc_call *call, lp_factor *F, const silc_view *A, double norm1)
+{
+    lapack_int n = F->n, *iwork, *ipiv = F->ipiv, info = 0;
+    double *work, *rcond = &F->rcond;
+    const double *a = F->kind == LP_TRI ? A->val : F->a; /* a triangular A is its own factor */
+    int cx = F->cplx;
+    /* ?gecon wants 4n doubles of work (the z routines 2n complex and 2n
+     * doubles of rwork after them: LP_ZCON_DOUBLES), the others fewer */
+    if (lp_con_scratch(n, cx ? LP_ZCON_DOUBLES(n) : 4 * n, &work, &iwork)) return lp_nomem(call);
+    switch (F->kind) {
+    case LP_LU:
+        info = cx ? LAPACKE_zgecon_work(LAPACK_COL_MAJOR, '1', n, LZ(a), F->ld, norm1, rcond, LZ(work), work + 4 * n)
+                  : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, F->ld, norm1, rcond, work, iwork);
+        break;
+    case LP_CHOL:
+        info = cx ? LAPACKE_zpocon_work(LAPACK_COL_MAJOR, 'L', n, LZ(a), F->ld, norm1, rcond, LZ(work), work + 4 * n)
+                  : LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, F->ld, norm1, rcond, work, iwork);
+        break;
+    case LP_LDLT:
+        info = cx ? LAPACKE_zsycon_work(LAPACK_COL_MAJOR, 'L', n, LZ(a), F->ld, ipiv, norm1, rcond, LZ(work))
+                  : LAPACKE_dsycon_work(LAPACK_COL_MAJOR, 'L', n, a, F->ld, ipiv, norm1, rcond, work, iwork);
+        break;
+    case LP_TRI:
+        info = cx ? LAPACKE_ztrcon_work(LAPACK_COL_MAJOR, '1', F->uplo, 'N', n, LZ(a), F->ld, rcond, LZ(work),
+                                        work + 4 * n)
+                  : LAPACKE_dtrcon_work(LAPACK_COL_MAJOR, '1', F->uplo, 'N', n, a, F->ld, rcond, work, iwork);
+        break;
+    default: /* band and least-squares factors estimate as they factor */
+        break;
+    }
+    if (info) F->rcond = -1;
+    F->rcond_owed = 0;
+    lp_free(work);
+    lp_free(iwork);
     return SILC_OK;
 }
 

@@ -149,6 +149,24 @@ static void check_square(silc_context *L, silc_context *R, const char *label, in
     text = tl_out_info(L, "y");
     CHECK(tl_contains(text, "reused factorization: yes") || tl_contains(routine, "dtrtrs"),
           "%s: second solve did not reuse the factorization:\n%s", label, text);
+    /* The same entries as a new value, factored under accuracy.condest =
+     * off (the plugin leaves its estimate out), then solved again with the
+     * estimate wanted: it is made then from the kept factors, the number
+     * the first solve gave. */
+    tl_put_dense_checked(L, "A2", n, n, A);
+    CHECK(silc_exec(L, "set accuracy.condest = off; x2 = A2 \\ b") == 0, "%s: solve, condest off: %s", label,
+          silc_context_errmsg(L));
+    text = tl_out_info(L, "x2");
+    CHECK(tl_contains(text, "not estimated (accuracy.condest = off)"), "%s: an estimate under off:\n%s", label,
+          text);
+    CHECK(silc_exec(L, "set accuracy.condest = auto; y2 = A2 \\ b") == 0, "%s: solve, condest back on: %s",
+          label, silc_context_errmsg(L));
+    text = tl_out_info(L, "y2");
+    CHECK(tl_contains(text, "reused factorization: yes") || tl_contains(routine, "dtrtrs"),
+          "%s: the solve after condest off did not reuse the factorization:\n%s", label, text);
+    CHECK(info_cond(text) == cond, "%s: estimate made after the factorization %g, with it %g:\n%s", label,
+          info_cond(text), cond, text);
+    CHECK(silc_exec(L, "clear A2 x2 y2") == 0, "%s: clear: %s", label, silc_context_errmsg(L));
     free(xt);
     free(b);
 }
