@@ -14,8 +14,10 @@
  * Rows (each the median of R runs, a fresh A each time so nothing is
  * reused; every row runs once per round and the rounds alternate them all,
  * since the machine drifts more over the minutes of a run (15-20 %,
- * measured) than the differences this bench is for; a row's ratio is the
- * median of its round-by-round ratios to the first row):
+ * measured) than the differences this bench is for, each round starting
+ * one row further on, so that with R a multiple of the rows every row
+ * follows every other once; a row's ratio is the median of its
+ * round-by-round ratios to the first row):
  *   UMFPACK direct    umfpack_zl_symbolic + numeric + solve (UMFPACK_A),
  *                     default control (strategy auto, row scaling by sums,
  *                     up to two refinement steps, as SILC's backend asks
@@ -24,6 +26,12 @@
  *   UMFPACK direct    the same with Octave's control: its sparse `\`
  *                     (liboctave CSparse.cc, fsolve) keeps the defaults and
  *                     sets UMFPACK_IRSTEP = 1;
+ *   UMFPACK direct    the first row's call with SuiteSparse_config's hooks
+ *                     set to the large allocator SILC's plugin gives
+ *                     UMFPACK (core/util/largealloc.c: blocks of 4 MiB and
+ *                     more on transparent huge pages) for the row, then put
+ *                     back: SILC's default against the library called the
+ *                     same way (the other direct rows keep libc's malloc);
  *   SILC  x = A \ b   default dispatch (whatever backend the dispatcher
  *                     picks, named in the row), each run in a new context
  *                     (nothing reused: checked with info), PUT not timed;
@@ -31,7 +39,8 @@
  *                     later (a deferred condition estimate) is what the
  *                     first `info x` costs, in a column of its own;
  *                     again with accuracy.condest = now (the estimate at
- *                     solve time) and off (no estimate at all);
+ *                     solve time) and off (no estimate at all), and with
+ *                     suitesparse.huge_pages = off (libc's malloc);
  *   SciPy spsolve     /usr/bin/python3, scipy.sparse.linalg.spsolve (SuperLU);
  *   Octave A\b        octave-cli, skipped when absent.
  * SciPy and Octave run in a process of their own each round (started and
@@ -43,7 +52,8 @@
  * timed part (minor faults: the kernel hands the solver a fresh zeroed page
  * on first touch; UMFPACK's ~500 MB of work space here is mostly fresh
  * pages, and their faults are a fifth of the time on this machine) and the
- * relative residual ||b - A x||_1 / ||b||_1.
+ * relative residual ||b - A x||_1 / ||b||_1.  Ratios are to the first row
+ * and, in a second column, to the huge-page direct row.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <complex.h>
@@ -61,6 +71,7 @@
 #include "helmholtz.h"
 #include "silc.h"
 #include "timing.h"
+#include "util.h" /* util_large_*: the allocator the plugin hands UMFPACK */
 
 typedef struct csr {
     int64_t n, nnz;
@@ -143,16 +154,16 @@ typedef struct run_result {
  * earlier run is reused (the store would hand an identical PUT the value
  * it already has); the PUTs are not timed.  condest: accuracy.condest's
  * value; how: the backend as info names it, and the mode. */
-static int run_silc(const csr *A, const double complex *b, const char *condest, run_result *out, char *how,
-                    size_t hlen)
+static int run_silc(const csr *A, const double complex *b, const char *condest, const char *huge,
+                    run_result *out, char *how, size_t hlen)
 {
     silc_envelope_t EA, Eb, Ex;
     silc_context *c = NULL;
-    char set[64], info[2048] = "", name[64], reused[16];
+    char set[128], info[2048] = "", name[64], reused[16];
     double complex *x = malloc((size_t)A->n * sizeof *x);
     double t0, f0;
     int ok = 0;
-    snprintf(set, sizeof set, "set accuracy.condest = %s", condest);
+    snprintf(set, sizeof set, "set accuracy.condest = %s; set suitesparse.huge_pages = %s", condest, huge);
     if (!x || silc_envelope_csr_complex(&EA, A->n, A->n, A->rowptr, A->colind, (const double *)A->val) ||
         silc_envelope_dense_complex(&Eb, A->n, 1, (const double *)b))
         goto done;
@@ -175,8 +186,9 @@ static int run_silc(const csr *A, const double complex *b, const char *condest, 
     silc_envelope_free(&Ex);
     out->resid = residual(A, x, b);
     info_field(info, "backend: ", name, sizeof name);
-    snprintf(how, hlen, "%s, accuracy.condest = %s%s", name, condest,
-             strstr(info, "computed when the report was first read") ? " (estimate deferred)" : "");
+    snprintf(how, hlen, "%s, accuracy.condest = %s%s%s", name, condest,
+             strstr(info, "computed when the report was first read") ? " (estimate deferred)" : "",
+             strcmp(huge, "auto") ? ", suitesparse.huge_pages = off" : "");
     ok = 1;
 done:
     if (!ok) {
@@ -192,9 +204,11 @@ done:
 
 /* ---- UMFPACK directly -------------------------------------------------------------- */
 
-/* UMFPACK's default control but for irstep (its refinement steps). */
-static int run_umfpack(const csr *A, const double complex *b, double irstep, run_result *out)
+/* UMFPACK's default control but for irstep (its refinement steps); huge:
+ * with SILC's large allocator in SuiteSparse_config for the call. */
+static int run_umfpack(const csr *A, const double complex *b, double irstep, int huge, run_result *out)
 {
+    struct SuiteSparse_config_struct saved = SuiteSparse_config;
     double control[UMFPACK_CONTROL], info[UMFPACK_INFO], t0, f0;
     double complex *x = malloc((size_t)A->n * sizeof *x);
     void *sym = NULL, *num = NULL;
@@ -202,6 +216,12 @@ static int run_umfpack(const csr *A, const double complex *b, double irstep, run
     if (!x) return -1;
     umfpack_zl_defaults(control);
     control[UMFPACK_IRSTEP] = irstep;
+    if (huge) {
+        SuiteSparse_config.malloc_func = util_large_malloc;
+        SuiteSparse_config.calloc_func = util_large_calloc;
+        SuiteSparse_config.realloc_func = util_large_realloc;
+        SuiteSparse_config.free_func = util_large_free;
+    }
     f0 = minor_faults();
     t0 = cpu_now();
     /* A = A.': its CSR arrays are its own compressed columns */
@@ -216,6 +236,7 @@ static int run_umfpack(const csr *A, const double complex *b, double irstep, run
     out->faults = minor_faults() - f0;
     umfpack_zl_free_symbolic(&sym);
     umfpack_zl_free_numeric(&num);
+    SuiteSparse_config = saved;
     if (st) fprintf(stderr, "complex_helmholtz: UMFPACK failed (status %d)\n", st);
     else out->resid = residual(A, x, b);
     free(x);
@@ -301,13 +322,24 @@ static double load_average(void)
     return l;
 }
 
-enum { ROW_DIRECT, ROW_DIRECT_OCTAVE, ROW_SILC_AUTO, ROW_SILC_NOW, ROW_SILC_OFF, ROW_SCIPY, ROW_OCTAVE, ROWS };
+enum {
+    ROW_DIRECT,
+    ROW_DIRECT_OCTAVE,
+    ROW_DIRECT_HUGE,
+    ROW_SILC_AUTO,
+    ROW_SILC_NOW,
+    ROW_SILC_OFF,
+    ROW_SILC_NOHUGE,
+    ROW_SCIPY,
+    ROW_OCTAVE,
+    ROWS
+};
 
 typedef struct bench_row {
     const char *name;
     char how[300];
     int on;                            /* runs at all */
-    double *s, *ratio, *report, *faults; /* one per round */
+    double *s, *ratio, *ratio_huge, *report, *faults; /* one per round */
     double resid;
     int failed;
 } bench_row;
@@ -318,11 +350,13 @@ static int run_row(int j, const csr *A, const double complex *b, const char *cmd
 {
     out->report = -1;
     switch (j) {
-    case ROW_DIRECT: return run_umfpack(A, b, 2, out);
-    case ROW_DIRECT_OCTAVE: return run_umfpack(A, b, 1, out);
-    case ROW_SILC_AUTO: return run_silc(A, b, "auto", out, how, hlen);
-    case ROW_SILC_NOW: return run_silc(A, b, "now", out, how, hlen);
-    case ROW_SILC_OFF: return run_silc(A, b, "off", out, how, hlen);
+    case ROW_DIRECT: return run_umfpack(A, b, 2, 0, out);
+    case ROW_DIRECT_OCTAVE: return run_umfpack(A, b, 1, 0, out);
+    case ROW_DIRECT_HUGE: return run_umfpack(A, b, 2, 1, out);
+    case ROW_SILC_AUTO: return run_silc(A, b, "auto", "auto", out, how, hlen);
+    case ROW_SILC_NOW: return run_silc(A, b, "now", "auto", out, how, hlen);
+    case ROW_SILC_OFF: return run_silc(A, b, "off", "auto", out, how, hlen);
+    case ROW_SILC_NOHUGE: return run_silc(A, b, "auto", "off", out, how, hlen);
     case ROW_SCIPY: return run_tool(cmd_scipy, out);
     default: return run_tool(cmd_octave, out);
     }
@@ -334,13 +368,15 @@ static void print_row(const bench_row *r, int reps)
     double report;
     if (!r->on) return;
     if (r->failed) {
-        printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", r->name, r->how, "n/a", "", "", "", "");
+        printf("| %-18s | %-76s | %9s | %9s | %9s | %11s | %9s | %9s |\n", r->name, r->how, "n/a", "", "", "", "",
+               "");
         return;
     }
     report = bench_median(r->report, reps);
     if (report >= 0) snprintf(rep, sizeof rep, "%.3f", report);
-    printf("| %-18s | %-76s | %9.3f | %9.3f | %11s | %9.0f | %9.1e |\n", r->name, r->how, bench_median(r->s, reps),
-           bench_median(r->ratio, reps), rep, bench_median(r->faults, reps), r->resid);
+    printf("| %-18s | %-76s | %9.3f | %9.3f | %9.3f | %11s | %9.0f | %9.1e |\n", r->name, r->how,
+           bench_median(r->s, reps), bench_median(r->ratio, reps), bench_median(r->ratio_huge, reps), rep,
+           bench_median(r->faults, reps), r->resid);
 }
 
 int main(int argc, char **argv)
@@ -360,6 +396,10 @@ int main(int argc, char **argv)
         {.name = "UMFPACK direct",
          .how = "umfpack_zl, Octave's control (the defaults but IRSTEP 1), UMFPACK_A",
          .on = 1},
+        {.name = "UMFPACK direct",
+         .how = "umfpack_zl, default control, SILC's large allocator (huge pages) in SuiteSparse_config",
+         .on = 1},
+        {.name = "SILC x = A \\ b", .how = "", .on = 1},
         {.name = "SILC x = A \\ b", .how = "", .on = 1},
         {.name = "SILC x = A \\ b", .how = "", .on = 1},
         {.name = "SILC x = A \\ b", .how = "", .on = 1},
@@ -410,9 +450,10 @@ int main(int argc, char **argv)
         bench_row *r = &rows[j];
         r->s = calloc((size_t)reps, sizeof(double));
         r->ratio = calloc((size_t)reps, sizeof(double));
+        r->ratio_huge = calloc((size_t)reps, sizeof(double));
         r->report = calloc((size_t)reps, sizeof(double));
         r->faults = calloc((size_t)reps, sizeof(double));
-        if (!r->s || !r->ratio || !r->report || !r->faults) {
+        if (!r->s || !r->ratio || !r->ratio_huge || !r->report || !r->faults) {
             fprintf(stderr, "complex_helmholtz: out of memory\n");
             return 1;
         }
@@ -421,8 +462,16 @@ int main(int argc, char **argv)
            "median of %d rounds\n\n",
            (long long)N, (long long)N, (long long)A.n, (long long)A.nnz, k, reps);
     for (int round = 0; round < reps; round++) {
-        fprintf(stderr, "round %d of %d (load average %.2f):", round + 1, reps, load_average());
-        for (int j = 0; j < ROWS; j++) {
+        fprintf(stderr, "round %d of %d (load average %.2f), from row %d:", round + 1, reps, load_average(),
+                round % ROWS + 1);
+        /* Round r starts at row r (mod ROWS): the memory a solve frees is
+         * cheaper for the next solve to touch again than memory it has not
+         * had for a while (this VM's balloon hands free pages back to the
+         * host after a few seconds, and a page the host took back faults
+         * there again), so a fixed order favoured the row after a large one;
+         * over ROWS rounds every row has every place once. */
+        for (int jj = 0; jj < ROWS; jj++) {
+            int j = (jj + round) % ROWS;
             bench_row *r = &rows[j];
             run_result out = {-1, -1, 0, 0};
             if (!r->on || r->failed) continue;
@@ -436,10 +485,15 @@ int main(int argc, char **argv)
             r->report[round] = out.report;
             r->faults[round] = out.faults;
             r->resid = out.resid;
-            r->ratio[round] = rows[ROW_DIRECT].failed ? 0 : out.s / rows[ROW_DIRECT].s[round];
-            fprintf(stderr, " %.2f", out.s);
         }
+        for (int j = 0; j < ROWS; j++) /* in the table's order */
+            if (rows[j].on && !rows[j].failed) fprintf(stderr, " %.2f", rows[j].s[round]);
         fprintf(stderr, "\n");
+        for (int j = 0; j < ROWS; j++) { /* once the round has every row */
+            bench_row *r = &rows[j];
+            r->ratio[round] = rows[ROW_DIRECT].failed ? 0 : r->s[round] / rows[ROW_DIRECT].s[round];
+            r->ratio_huge[round] = rows[ROW_DIRECT_HUGE].failed ? 0 : r->s[round] / rows[ROW_DIRECT_HUGE].s[round];
+        }
     }
     if (dir[0]) {
         unlink(path);
@@ -447,16 +501,18 @@ int main(int argc, char **argv)
         unlink(m);
         rmdir(dir);
     }
-    printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", "solver", "how", "CPU s", "/ UMFPACK",
-           "info x [s]", "faults", "residual");
-    printf("| %-18s | %-76s | %9s | %9s | %11s | %9s | %9s |\n", "---", "---", "---:", "---:", "---:", "---:",
-           "---:");
+    printf("| %-18s | %-76s | %9s | %9s | %9s | %11s | %9s | %9s |\n", "solver", "how", "CPU s", "/ UMFPACK",
+           "/ huge", "info x [s]", "faults", "residual");
+    printf("| %-18s | %-76s | %9s | %9s | %9s | %11s | %9s | %9s |\n", "---", "---", "---:", "---:", "---:", "---:",
+           "---:", "---:");
     for (int j = 0; j < ROWS; j++) print_row(&rows[j], reps);
-    printf("\nRatios are medians of round-by-round ratios to the first row (each round runs every row once);\n"
-           "faults: minor page faults of the timed part (median).\n");
+    printf("\nRatios are medians of round-by-round ratios to the first row (/ UMFPACK) and to the direct row\n"
+           "on huge pages (/ huge); each round runs every row once; faults: minor page faults of the timed\n"
+           "part (median).\n");
     for (int j = 0; j < ROWS; j++) {
         free(rows[j].s);
         free(rows[j].ratio);
+        free(rows[j].ratio_huge);
         free(rows[j].report);
         free(rows[j].faults);
     }

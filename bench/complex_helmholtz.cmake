@@ -15,5 +15,7 @@ if(_hz_missing)
 else()
   add_executable(complex_helmholtz complex_helmholtz.c)
   target_include_directories(complex_helmholtz PRIVATE ${BENCH_HZ_SS_INCLUDE})
-  target_link_libraries(complex_helmholtz PRIVATE silc_helmholtz silc ${_hz_libs} ${MATH_LIB})
+  # silc_internal (the engine's objects, as silcd links them): the bench also
+  # calls the large allocator (core/util) the suitesparse plugin hands UMFPACK.
+  target_link_libraries(complex_helmholtz PRIVATE silc_helmholtz silc_internal ${_hz_libs} ${MATH_LIB})
 endif()

@@ -12,6 +12,7 @@
  *   spqr.c         SuiteSparseQR: rectangular least squares
  *   ss_complex.c   complex values on UMFPACK, KLU and CHOLMOD (umfpack_zl,
  *                  klu_zl, CHOLMOD_COMPLEX); SPQR stays real
+ *   ss_alloc.c     the libraries' large blocks on huge pages (huge_pages)
  *
  * Zero-copy: a CSR value of A is, array for array, the compressed-column form
  * of A'.  UMFPACK and KLU factor that A' in place and solve with the
@@ -51,6 +52,15 @@ int ss_is_complex(const silc_value *v);   /* 0 on a host older than ABI 1.8 */
 int ss_umfpack_solve_complex(silc_call *call);
 int ss_klu_solve_complex(silc_call *call);
 int ss_cholmod_solve_complex(silc_call *call);
+
+/* ---- ss_alloc.c: SuiteSparse's work space on huge pages (ABI 1.9) ---------- */
+/* suitesparse.huge_pages: *on = 1 for auto, 0 for off; SILC_EARG otherwise. */
+int ss_huge_pages_mode(silc_call *call, int *on);
+/* run(call) with SuiteSparse's large blocks from the host's large allocator
+ * when huge_pages says so (setting SuiteSparse_config's hooks at the first
+ * call, unless the program set its own): every op of the plugin goes
+ * through it. */
+int ss_with_huge_pages(silc_call *call, int (*run)(silc_call *call));
 
 /* ---- ss_common.c ------------------------------------------------------------ */
 int ss_start(void);                 /* 0 on success; starts the cholmod_common */

@@ -35,14 +35,33 @@ static pthread_mutex_t users_mutex = PTHREAD_MUTEX_INITIALIZER;
     "1.0 SuiteSparse " SS_STR(SUITESPARSE_MAIN_VERSION) "." SS_STR(SUITESPARSE_SUB_VERSION) "." \
         SS_STR(SUITESPARSE_SUBSUB_VERSION)
 
+/* Every solve runs with the libraries' large blocks on huge pages when
+ * suitesparse.huge_pages says so (ss_alloc.c). */
+static int umfpack_run(silc_call *call)
+{
+    return ss_with_huge_pages(call, ss_umfpack_solve);
+}
+static int cholmod_run(silc_call *call)
+{
+    return ss_with_huge_pages(call, ss_cholmod_solve);
+}
+static int klu_run(silc_call *call)
+{
+    return ss_with_huge_pages(call, ss_klu_solve);
+}
+static int spqr_run(silc_call *call)
+{
+    return ss_with_huge_pages(call, ss_spqr_solve);
+}
+
 static const silc_op_entry umfpack_ops[SILC_OP_COUNT] = {
-    [SILC_OP_SOLVE] = {ss_umfpack_solve, ss_umfpack_accepts}};
+    [SILC_OP_SOLVE] = {umfpack_run, ss_umfpack_accepts}};
 static const silc_op_entry cholmod_ops[SILC_OP_COUNT] = {
-    [SILC_OP_SOLVE] = {ss_cholmod_solve, ss_cholmod_accepts}};
+    [SILC_OP_SOLVE] = {cholmod_run, ss_cholmod_accepts}};
 static const silc_op_entry klu_ops[SILC_OP_COUNT] = {
-    [SILC_OP_SOLVE] = {ss_klu_solve, ss_klu_accepts}};
+    [SILC_OP_SOLVE] = {klu_run, ss_klu_accepts}};
 static const silc_op_entry spqr_ops[SILC_OP_COUNT] = {
-    [SILC_OP_SOLVE] = {ss_spqr_solve, ss_spqr_accepts}};
+    [SILC_OP_SOLVE] = {spqr_run, ss_spqr_accepts}};
 
 static const silc_backend ss_backends[] = {
     {"umfpack", "UMFPACK multifrontal sparse LU (square sparse systems)", SILC_OP_COUNT,
@@ -60,6 +79,10 @@ static const silc_option_spec ss_options[] = {
      "true (auto means the same), false (none; the libraries' cheap pivot ratio is shown, "
      "labelled, never as the estimate)"},
     {"umfpack_irstep", SILC_OPT_INT, "2", "UMFPACK: maximum steps of iterative refinement"},
+    {"huge_pages", SILC_OPT_STRING, "auto",
+     "auto: the libraries' blocks of 4 MiB and more on transparent huge pages (fewer page faults "
+     "and TLB misses; only where the kernel has them, and only if the program has not set "
+     "SuiteSparse_config's allocator itself), off: libc's malloc"},
     {"spqr_tol", SILC_OPT_DOUBLE, "-2",
      "SPQR: columns of 2-norm <= tol count as zero (rank detection); -2 = SPQR's default "
      "20*(m+n)*eps*max column norm, -1 = none"},

@@ -347,6 +347,10 @@ static const silc_host_api host_table = {
     h_band_new_complex,
     ref_inv_norm1_est_complex,
     h_dist_moved,
+    util_large_malloc,
+    util_large_calloc,
+    util_large_realloc,
+    util_large_free,
 };
 
 int host_check_result(silc_call *call)

@@ -116,4 +116,29 @@ void util_fd_path(int fd, char *out, size_t len);
  * why on anything else. */
 int util_parse_size(const char *s, uint64_t max, uint64_t *out, char *why, size_t whylen);
 
+/* ---- large blocks (largealloc.c): a library's work space on transparent
+ * huge pages ---- */
+
+/* Requests from this size up are served by 2 MiB-aligned mappings advised
+ * MADV_HUGEPAGE (where the kernel has transparent huge pages), smaller ones
+ * by malloc.  UMFPACK's work space on a 250 000-unknown complex system comes
+ * in blocks of 6 to 450 MB. */
+#define UTIL_LARGE_MIN_BYTES ((size_t)4 << 20)
+/* Live mappings it keeps track of; past them, malloc serves. */
+#define UTIL_LARGE_MAX_BLOCKS 256
+/* malloc, calloc, realloc and free by those rules.  free and realloc take
+ * any pointer: one these functions did not hand out goes to libc's free or
+ * realloc, so they can replace a library's hooks while blocks it allocated
+ * before are still live.  Thread-safe; NULL and errno ENOMEM when out of
+ * memory (realloc then leaves the block as it was). */
+void *util_large_malloc(size_t bytes);
+void *util_large_calloc(size_t count, size_t size);
+void *util_large_realloc(void *p, size_t bytes);
+void util_large_free(void *p);
+/* 1 when p is a live block of the large allocator's own mappings. */
+int util_large_owns(const void *p);
+/* 1 when the kernel gives transparent huge pages to an madvise'd mapping
+ * (mode "always" or "madvise"); otherwise the functions above are libc's. */
+int util_huge_pages_available(void);
+
 #endif
