@@ -645,6 +645,22 @@ contains
     status = put_rows_dense(name, first_row, int(size(x, 1), c_int64_t), int(size(x, 2), c_int64_t), x)
   end function put_rows_matrix_int64
 
+  ! The CSR row wrappers' one worker: copies the block's 1-based index arrays
+  ! (put_csr_0based makes them 0-based in place, and a program's arrays are
+  ! intent(in)) and puts them with real or complex values.
+  integer function put_rows_csr_copy(name, first_row, m, n, rowptr, colind, values, zvalues) result(status)
+    character(len=*), intent(in) :: name
+    integer(c_int64_t), intent(in) :: first_row, m, n, rowptr(:), colind(:)
+    real(c_double), intent(in), optional :: values(:)
+    complex(c_double_complex), intent(in), optional :: zvalues(:)
+    integer(c_int64_t), allocatable :: rp(:), ci(:)
+    own_failure = .false.
+    allocate(rp(size(rowptr)), ci(size(colind)))
+    rp(:) = rowptr
+    ci(:) = colind
+    status = put_csr_0based(name, m, n, rp, ci, first_row, values=values, zvalues=zvalues)
+  end function put_rows_csr_copy
+
   !> A CSR block: this rank's m rows (first_row..first_row+m-1) of a matrix
   !> with n columns, as 1-based CSR of the block (rowptr(1) = 1, m+1 entries)
   !> with global column indices 1..n.
@@ -652,25 +668,15 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(in) :: first_row, m, n, rowptr(:), colind(:)
     real(c_double), intent(in) :: values(:)
-    integer(c_int64_t), allocatable :: rp(:), ci(:)
-    own_failure = .false.
-    allocate(rp(size(rowptr)), ci(size(colind)))
-    rp(:) = int(rowptr, c_int64_t)
-    ci(:) = int(colind, c_int64_t)
-    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, &
-                            int(first_row, c_int64_t), values=values)
+    status = put_rows_csr_copy(name, int(first_row, c_int64_t), int(m, c_int64_t), int(n, c_int64_t), &
+                               int(rowptr, c_int64_t), int(colind, c_int64_t), values=values)
   end function put_rows_csr_int
 
   integer function put_rows_csr_int64(name, first_row, m, n, rowptr, colind, values) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(in) :: first_row, m, n, rowptr(:), colind(:)
     real(c_double), intent(in) :: values(:)
-    integer(c_int64_t), allocatable :: rp(:), ci(:)
-    own_failure = .false.
-    allocate(rp(size(rowptr)), ci(size(colind)))
-    rp(:) = rowptr
-    ci(:) = colind
-    status = put_csr_0based(name, m, n, rp, ci, first_row, values=values)
+    status = put_rows_csr_copy(name, first_row, m, n, rowptr, colind, values=values)
   end function put_rows_csr_int64
 
   !> The complex blocks: as the real ones above, complex(c_double_complex) values.
@@ -711,25 +717,15 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(in) :: first_row, m, n, rowptr(:), colind(:)
     complex(c_double_complex), intent(in) :: values(:)
-    integer(c_int64_t), allocatable :: rp(:), ci(:)
-    own_failure = .false.
-    allocate(rp(size(rowptr)), ci(size(colind)))
-    rp(:) = int(rowptr, c_int64_t)
-    ci(:) = int(colind, c_int64_t)
-    status = put_csr_0based(name, int(m, c_int64_t), int(n, c_int64_t), rp, ci, &
-                            int(first_row, c_int64_t), zvalues=values)
+    status = put_rows_csr_copy(name, int(first_row, c_int64_t), int(m, c_int64_t), int(n, c_int64_t), &
+                               int(rowptr, c_int64_t), int(colind, c_int64_t), zvalues=values)
   end function put_rows_csr_int_complex
 
   integer function put_rows_csr_int64_complex(name, first_row, m, n, rowptr, colind, values) result(status)
     character(len=*), intent(in) :: name
     integer(c_int64_t), intent(in) :: first_row, m, n, rowptr(:), colind(:)
     complex(c_double_complex), intent(in) :: values(:)
-    integer(c_int64_t), allocatable :: rp(:), ci(:)
-    own_failure = .false.
-    allocate(rp(size(rowptr)), ci(size(colind)))
-    rp(:) = rowptr
-    ci(:) = colind
-    status = put_csr_0based(name, m, n, rp, ci, first_row, zvalues=values)
+    status = put_rows_csr_copy(name, first_row, m, n, rowptr, colind, zvalues=values)
   end function put_rows_csr_int64_complex
 
   !> Fetches this rank's rows of the vector name into x, allocated (or
