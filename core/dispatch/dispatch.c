@@ -885,7 +885,7 @@ int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
  * UMFPACK, MUMPS or PETSc allocate it with their own malloc.  So it is
  * measured: the heap in use (glibc's mallinfo2: the main arena, where the
  * engine's thread allocates, and every mmapped block; under AddressSanitizer
- * its allocator's count) grows across the call by what the call kept,
+ * its allocator's count; and the large allocator's huge-page blocks) grows across the call by what the call kept,
  * less the value arrays it made (its result, counted by the store); that
  * growth is charged to the attachments the call added (val_attach_charge),
  * shared if it added several (a collective solve's: summed over the
@@ -898,11 +898,13 @@ int disp_condest_resolve(silc_engine *E, eng_pending *p, silc_report *r)
  * charged. */
 static int64_t heap_in_use(void)
 {
+    /* plus the large allocator's mappings (a SuiteSparse factorization on
+     * huge pages, util/largealloc.c), which neither count sees */
 #if defined(SILC_HEAP_FROM_SANITIZER)
-    return (int64_t)__sanitizer_get_current_allocated_bytes();
+    return (int64_t)(__sanitizer_get_current_allocated_bytes() + util_large_in_use());
 #elif defined(SILC_HEAP_FROM_MALLINFO2)
     struct mallinfo2 mi = mallinfo2();
-    return (int64_t)(mi.uordblks + mi.hblkhd);
+    return (int64_t)(mi.uordblks + mi.hblkhd + util_large_in_use());
 #else
     return -1;
 #endif

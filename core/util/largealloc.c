@@ -51,6 +51,7 @@ typedef struct large_block {
 static pthread_mutex_t large_lock = PTHREAD_MUTEX_INITIALIZER;
 static large_block large_blocks[UTIL_LARGE_MAX_BLOCKS];
 static int large_count;
+static size_t large_mapped; /* the sum of the live blocks' len */
 
 /* ---- whether the kernel gives huge pages --------------------------------- */
 
@@ -97,7 +98,10 @@ static size_t large_lookup(const void *p, int take)
     pthread_mutex_lock(&large_lock);
     if ((i = large_find(p)) >= 0) {
         len = large_blocks[i].len;
-        if (take) large_blocks[i] = large_blocks[--large_count];
+        if (take) {
+            large_mapped -= len;
+            large_blocks[i] = large_blocks[--large_count];
+        }
     }
     pthread_mutex_unlock(&large_lock);
     return len;
@@ -108,13 +112,25 @@ int util_large_owns(const void *p)
     return large_lookup(p, 0) != 0;
 }
 
+size_t util_large_in_use(void)
+{
+    size_t bytes;
+    pthread_mutex_lock(&large_lock);
+    bytes = large_mapped;
+    pthread_mutex_unlock(&large_lock);
+    return bytes;
+}
+
 /* Records a block; 0, or -1 when the registry is full. */
 static int large_record(void *p, size_t len)
 {
     int ok;
     pthread_mutex_lock(&large_lock);
     ok = large_count < UTIL_LARGE_MAX_BLOCKS;
-    if (ok) large_blocks[large_count++] = (large_block){p, len};
+    if (ok) {
+        large_blocks[large_count++] = (large_block){p, len};
+        large_mapped += len;
+    }
     pthread_mutex_unlock(&large_lock);
     return ok ? 0 : -1;
 }
@@ -124,7 +140,10 @@ static void large_rerecord(const void *old, void *now, size_t len)
 {
     int i;
     pthread_mutex_lock(&large_lock);
-    if ((i = large_find(old)) >= 0) large_blocks[i] = (large_block){now, len};
+    if ((i = large_find(old)) >= 0) {
+        large_mapped += len - large_blocks[i].len; /* modulo 2^N: a shrink subtracts */
+        large_blocks[i] = (large_block){now, len};
+    }
     pthread_mutex_unlock(&large_lock);
 }
 

@@ -137,6 +137,9 @@ void *util_large_realloc(void *p, size_t bytes);
 void util_large_free(void *p);
 /* 1 when p is a live block of the large allocator's own mappings. */
 int util_large_owns(const void *p);
+/* The bytes the large allocator's own mappings hold now: memory that
+ * glibc's mallinfo2 does not see, for whoever measures what a call kept. */
+size_t util_large_in_use(void);
 /* 1 when the kernel gives transparent huge pages to an madvise'd mapping
  * (mode "always" or "madvise"); otherwise the functions above are libc's. */
 int util_huge_pages_available(void);

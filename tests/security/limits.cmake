@@ -23,9 +23,9 @@ foreach(case hostile_put request_time peak statement_cap max_cpu disconnect max_
   set_tests_properties(security_limits_${case} PROPERTIES ENVIRONMENT "${_limits_env}" TIMEOUT 120)
 endforeach()
 # The memo's kept results and their UMFPACK factorizations (issue 33); the
-# CHOLMOD factorizations of bound values (issue 27).
+# CHOLMOD factorizations of bound values (issue 27); UMFPACK's on huge pages.
 if(TARGET silc_plugin_suitesparse)
-  foreach(case memo attached)
+  foreach(case memo attached attached_huge)
     add_test(NAME security_limits_${case}
              COMMAND ${SILC_SYSTEM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/limits.py
                      ${PROJECT_SOURCE_DIR}/bindings/python ${_limits_dir} ${case} $<TARGET_FILE:silcd>)

@@ -600,6 +600,44 @@ def case_attached():
     srv.stop_cleanly()
 
 
+def case_attached_huge():
+    """A factorization on huge pages is charged as one on malloc's pages.
+    SuiteSparse's work space of 4 MiB and more comes from SILC's large
+    allocator (suitesparse.huge_pages = auto), whose mappings glibc's
+    mallinfo2 does not see: uncounted, a session could hold any number of
+    UMFPACK factorizations past --max-session-bytes.  The same matrix is
+    solved by UMFPACK in two sessions, huge pages on and off, and each
+    session's charge for what the solve attached must agree within 25 %
+    and exceed the matrix itself."""
+    k = 150
+    n = k * k
+    A, b = laplacian(k, 0)
+    csr = (n + 1) * 8 + A.nnz * 16
+    srv = Server("--max-session-bytes", str(256 * MiB))
+    charged = {}
+    for mode in ("auto", "off"):
+        s = srv.session()
+        s.exec("set accuracy.condest = on_request")
+        s.put("A", A)
+        s.put("b", b.reshape(-1, 1))
+        before = info_bytes(s)
+        s.exec('x = solve(A, b, "backend = suitesparse.umfpack; suitesparse.huge_pages = %s")' % mode)
+        x = s.get("x").ravel()
+        if not np.abs(A @ x - b).max() / np.abs(b).max() < 1e-12:
+            fail("huge_pages = %s: the solve is wrong" % mode)
+        charged[mode] = info_bytes(s) - before - n * 8
+        print("huge_pages = %s: the factorization is charged %.1f MiB (the matrix %.1f MiB)"
+              % (mode, charged[mode] / MiB, csr / MiB))
+        s.close()
+    if charged["off"] < 2 * csr:
+        fail("the case cannot fail: UMFPACK's factorization is charged %d bytes with malloc's pages"
+             % charged["off"])
+    if not 0.75 * charged["off"] <= charged["auto"] <= 1.25 * charged["off"]:
+        fail("the factorization is charged %d bytes on huge pages, %d on malloc's"
+             % (charged["auto"], charged["off"]))
+    srv.stop_cleanly()
+
+
 def case_attached_mpi():
     """Issue 27 under `mpirun -np 2 silcd --mpi`: distributed factorizations
     count too.  16 distinct 2-D Laplacians of 2500 rows, PUT (so split in
