@@ -55,12 +55,12 @@ if(SILC_CLANG AND NOT SILC_SANITIZE)
     set(_fz ${CMAKE_CURRENT_BINARY_DIR}/fuzz_frame_libfuzzer)
     set(_src ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c ${PROJECT_SOURCE_DIR}/core/client/protocol.c
              ${PROJECT_SOURCE_DIR}/core/store/envelope.c ${PROJECT_SOURCE_DIR}/core/store/value.c
-             ${PROJECT_SOURCE_DIR}/core/util/util.c ${PROJECT_SOURCE_DIR}/core/util/largealloc.c)
+             ${PROJECT_SOURCE_DIR}/core/util/util.c)
     list(TRANSFORM SILC_CORE_DIRS PREPEND -I OUTPUT_VARIABLE _core_inc)
     add_custom_command(OUTPUT ${_fz}
       COMMAND ${SILC_CLANG} -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined
               -I${PROJECT_SOURCE_DIR}/core/include ${_core_inc}
-              -I${PROJECT_SOURCE_DIR}/plugins ${_src} -lm -pthread -o ${_fz}
+              -I${PROJECT_SOURCE_DIR}/plugins ${_src} -lm -o ${_fz}
       DEPENDS ${_src} VERBATIM)
     add_custom_target(fuzz_frame_libfuzzer ALL DEPENDS ${_fz})
     # libFuzzer adds what it finds to its first directory: a scratch one.

@@ -33,7 +33,7 @@ enum { POOL_SLOTS = 8, POOL_IDLE_SECONDS = 30 };
 
 typedef struct slot {
     void *p;
-    size_t bytes; /* array_capacity: what the array can really hold */
+    size_t bytes; /* malloc_usable_size: what the array can really hold */
     time_t freed;
 } slot;
 
@@ -63,7 +63,7 @@ static time_t now_s(void)
 /* Frees slot i; under pool_lock. */
 static void drop(int i)
 {
-    util_large_free(slots[i].p);
+    free(slots[i].p);
     pooled_bytes -= slots[i].bytes;
     slots[i].p = NULL;
     slots[i].bytes = 0;
@@ -97,19 +97,11 @@ static void *pool_take(size_t bytes)
     return p;
 }
 
-/* What array p can hold: a large block's mapping (util_large_size), which
- * malloc_usable_size must not be asked about, or malloc's block. */
-static size_t array_capacity(void *p)
-{
-    size_t bytes = util_large_size(p);
-    return bytes ? bytes : malloc_usable_size(p);
-}
-
 /* Keeps p when it is large and fits under the cap, evicting the oldest
  * arrays to make room: the newest is the likeliest to be asked for next. */
 static int pool_give(void *p)
 {
-    size_t bytes = array_capacity(p);
+    size_t bytes = malloc_usable_size(p);
     time_t t;
     int i, kept = 0;
     if (bytes < POOL_MIN_BYTES || bytes > cap_bytes) return 0;

@@ -47,9 +47,8 @@ static int h_too_big(double bytes)
 /* Plugins' arrays come from the array pool like values' arrays
  * (val_array_alloc): a factorization's copy of a dense matrix is as large as
  * the matrix, and from fresh pages each solve it paid ~1 % of a dgetrf in
- * page faults.  Arrays of either kind are malloc's blocks or the large-block
- * allocator's (util_large_*), so realloc and free go through the functions
- * that tell the two apart. */
+ * page faults.  Pooled arrays are plain malloc blocks, so realloc and free
+ * of either kind stay correct. */
 static void *h_alloc(size_t bytes)
 {
     if (h_too_big((double)bytes)) return NULL;
@@ -66,7 +65,7 @@ static void *h_calloc(size_t count, size_t size)
 static void *h_realloc(void *p, size_t bytes)
 {
     if (h_too_big((double)bytes)) return NULL;
-    return util_large_realloc(p, bytes ? bytes : 1);
+    return realloc(p, bytes ? bytes : 1);
 }
 
 static void h_free(void *p)

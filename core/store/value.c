@@ -33,9 +33,7 @@ static int64_t count_mul(int64_t a, int64_t b)
     return a * b;
 }
 
-/* The array pool (val_set_array_pool); NULL: the large-block allocator
- * (util_large_*: arrays of 4 MiB and more on huge pages, smaller ones
- * malloc's) and its free.
+/* The array pool (val_set_array_pool); NULL: plain calloc/malloc and free.
  * Set once before the threads that use values start. */
 static void *(*pool_take)(size_t bytes);
 static int (*pool_give)(void *p);
@@ -47,12 +45,7 @@ void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p))
 }
 
 /* A pooled array is already mapped: zeroing it in place is far cheaper than
- * faulting in fresh pages, and an unset one costs nothing.  A new large array
- * is on transparent huge pages (util_large_*): a dense solve's LU sweeps its
- * copy of the matrix with one TLB entry per 2 MiB instead of per 4 KiB
- * (docs/overhead.md, dense section).  Every array of a value or an
- * envelope is freed by val_array_free, and realloc'd (the plugins' host
- * table) by util_large_realloc, which take malloc's blocks too. */
+ * faulting in fresh pages, and an unset one costs nothing. */
 void *val_array_alloc(int64_t count, size_t size, int zero)
 {
     size_t bytes = (count > 0 ? (size_t)count : 1) * size;
@@ -61,12 +54,12 @@ void *val_array_alloc(int64_t count, size_t size, int zero)
         if (zero) memset(p, 0, bytes);
         return p;
     }
-    return zero ? util_large_calloc(bytes / size, size) : util_large_malloc(bytes);
+    return zero ? calloc(bytes / size, size) : malloc(bytes);
 }
 
 void val_array_free(void *p)
 {
-    if (p && !(pool_give && pool_give(p))) util_large_free(p);
+    if (p && !(pool_give && pool_give(p))) free(p);
 }
 
 /* The largest value this process makes (val_set_max_bytes).  Every size a

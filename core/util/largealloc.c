@@ -108,11 +108,6 @@ int util_large_owns(const void *p)
     return large_lookup(p, 0) != 0;
 }
 
-size_t util_large_size(const void *p)
-{
-    return large_lookup(p, 0);
-}
-
 /* Records a block; 0, or -1 when the registry is full. */
 static int large_record(void *p, size_t len)
 {

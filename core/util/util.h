@@ -137,10 +137,6 @@ void *util_large_realloc(void *p, size_t bytes);
 void util_large_free(void *p);
 /* 1 when p is a live block of the large allocator's own mappings. */
 int util_large_owns(const void *p);
-/* The bytes p's mapping can hold when it is one of those blocks (a whole
- * number of huge pages, at least what was asked for), else 0: the
- * allocator's malloc_usable_size, which knows nothing of these blocks. */
-size_t util_large_size(const void *p);
 /* 1 when the kernel gives transparent huge pages to an madvise'd mapping
  * (mode "always" or "madvise"); otherwise the functions above are libc's. */
 int util_huge_pages_available(void);
