@@ -335,6 +335,13 @@ static const char *iter_reason(lapack_int iter)
     }
 }
 
+/* accuracy.condest = off: the host says so in the report (ABI 1.7), and no
+ * estimate is made. */
+static int condest_off(const silc_call *call)
+{
+    return lp_host->abi_minor >= 7 && call->report->condest_off;
+}
+
 /* lapack.precision = mixed: dsgesv / dsposv factor in single precision and
  * refine in double, falling back to a double factorization themselves when
  * that fails (too ill-conditioned, out of single range).  The single factors
@@ -385,7 +392,7 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
      * sgecon / spocon estimate from them: as good as single precision, which
      * is all a condition estimate needs, since a matrix too ill-conditioned
      * for single precision makes LAPACK fall back to double anyway. */
-    int estimate = !(lp_host->abi_minor >= 7 && r->condest_off); /* accuracy.condest = off: none */
+    int estimate = !condest_off(call);
     if (estimate && iter < 0) {
         if (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
                  : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork))
@@ -487,7 +494,7 @@ static int op_solve(silc_call *call)
     /* The condition estimate, unless accuracy.condest = off: made with a
      * fresh factorization (and timed with it), or by the first solve that
      * wants it from a factor made without. */
-    if (F->rcond_owed && !(lp_host->abi_minor >= 7 && call->report->condest_off)) {
+    if (F->rcond_owed && !condest_off(call)) {
         te = lp_host->now();
         if ((rc = lp_dense_estimate(call, F, &A, P->norm1))) {
             lp_factor_free(owned);

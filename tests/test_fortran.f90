@@ -14,8 +14,8 @@
 program test_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_double_complex, c_int64_t
   use silc
+  use silc_checks
   implicit none
-  integer :: passed = 0, failed = 0
 
   call check_ok(silc_init(), 'silc_init')
   call test_scalars()
@@ -281,14 +281,6 @@ contains
     call check(w == (-3.0_c_double, 4.0_c_double), '(1 + 2i)^2 = -3 + 4i')
   end subroutine test_complex
 
-  pure function real_text(x) result(s)
-    real(c_double), intent(in) :: x
-    character(len=:), allocatable :: s
-    character(len=32) :: buf
-    write (buf, '(es12.4)') x
-    s = trim(adjustl(buf))
-  end function real_text
-
   ! One process: rank 0 of 1, and a block of rows is the whole value.
   subroutine test_rows()
     real(c_double) :: v(3) = [1, 2, 3], x(2, 3)
@@ -409,42 +401,6 @@ contains
     call check_fails(silc_put_rows('v', 1, [1.0_c_double]), 'silc_init', 'put_rows without a context')
     call check_fails(silc_get_rows('v', first, got), 'silc_init', 'get_rows without a context')
   end subroutine test_rows_closed
-
-  ! Passes when status is 0; otherwise shows the library's message.
-  subroutine check_ok(status, what)
-    integer, intent(in) :: status
-    character(len=*), intent(in) :: what
-    if (status == 0) then
-      call check(.true., what)
-    else
-      call check(.false., what // ': ' // silc_errmsg())
-    end if
-  end subroutine check_ok
-
-  ! Passes when status is non-zero with a non-empty message containing part.
-  subroutine check_fails(status, part, what)
-    integer, intent(in) :: status
-    character(len=*), intent(in) :: part, what
-    character(len=:), allocatable :: msg
-    msg = silc_errmsg()
-    if (status == 0) then
-      call check(.false., what // ' should fail but returned 0')
-    else
-      call check(len(msg) > 0 .and. index(msg, part) > 0, what // ' fails with a message containing "' &
-                 // part // '": ' // msg)
-    end if
-  end subroutine check_fails
-
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      passed = passed + 1
-    else
-      failed = failed + 1
-      print '(a)', 'FAIL: ' // what
-    end if
-  end subroutine check
 
   subroutine check_near(got, want, tol, what)
     real(c_double), intent(in) :: got, want, tol

@@ -19,6 +19,7 @@ program test_fortran_mpi
   use, intrinsic :: iso_c_binding, only: c_double, c_double_complex
   use mpi
   use silc
+  use silc_checks
   implicit none
   integer, parameter :: n = 400
   complex(c_double_complex), parameter :: d = (2.5_c_double, 0.5_c_double), o = (-1.0_c_double, 0.1_c_double)
@@ -28,11 +29,11 @@ program test_fortran_mpi
   real(c_double), allocatable :: rx(:)
   real(c_double) :: err, bound
   real(c_double), parameter :: xt_max = sqrt(13.0_c_double) ! max_i |xt_i| = |3 +- 2i|
-  integer :: passed = 0, failed = 0
 
   call MPI_Init(ierr)
   call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
   call MPI_Comm_size(MPI_COMM_WORLD, nranks, ierr)
+  write (check_prefix, '(a, i0, a)') ' (rank ', rank, ')'
   rows = n / nranks + merge(1, 0, rank < mod(n, nranks))
   first = rank * (n / nranks) + min(rank, mod(n, nranks)) + 1
 
@@ -99,46 +100,5 @@ contains
     integer, intent(in) :: i
     exact = cmplx(1 + mod(i - 1, 3), 2 - mod(i - 1, 5), c_double_complex)
   end function exact
-
-  subroutine check_ok(status, what)
-    integer, intent(in) :: status
-    character(len=*), intent(in) :: what
-    if (status == 0) then
-      call check(.true., what)
-    else
-      call check(.false., what // ': ' // silc_errmsg())
-    end if
-  end subroutine check_ok
-
-  subroutine check_fails(status, part, what)
-    integer, intent(in) :: status
-    character(len=*), intent(in) :: part, what
-    character(len=:), allocatable :: msg
-    msg = silc_errmsg()
-    if (status == 0) then
-      call check(.false., what // ' should fail but returned 0')
-    else
-      call check(index(msg, part) > 0, what // ' fails with a message containing "' // part // '": ' // msg)
-    end if
-  end subroutine check_fails
-
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      passed = passed + 1
-    else
-      failed = failed + 1
-      print '(a, i0, a)', 'FAIL (rank ', rank, '): ' // what
-    end if
-  end subroutine check
-
-  pure function real_text(x) result(s)
-    real(c_double), intent(in) :: x
-    character(len=:), allocatable :: s
-    character(len=32) :: buf
-    write (buf, '(es12.4)') x
-    s = trim(adjustl(buf))
-  end function real_text
 
 end program test_fortran_mpi
