@@ -158,12 +158,15 @@ double ref_inv_norm1_est_block(int64_t n, int t, int itmax,
         if (k >= 2 && all_parallel(n, t, S, Sold)) break;
         memcpy(X, S, nt * sizeof(double));
         if (apply(ctx, X, t, 1)) goto fail;
-        for (int64_t i = 0; i < n; i++) {
-            double m = 0.0;
-            for (int j = 0; j < t; j++)
-                if (fabs(X[i + (size_t)j * n]) > m) m = fabs(X[i + (size_t)j * n]);
-            h[i] = m;
-        }
+        if (t == 1) /* the one-column form (SuiteSparse, dlacon's): no inner loop; a NaN gives 0 as below */
+            for (int64_t i = 0; i < n; i++) h[i] = fabs(X[i]) > 0.0 ? fabs(X[i]) : 0.0;
+        else
+            for (int64_t i = 0; i < n; i++) {
+                double m = 0.0;
+                for (int j = 0; j < t; j++)
+                    if (fabs(X[i + (size_t)j * n]) > m) m = fabs(X[i + (size_t)j * n]);
+                h[i] = m;
+            }
         select_top(n, t, h, used, top, &ntop, ind, &nfresh);
         /* The gradient points at the unit vector already best: converged. */
         if (ind_best >= 0 && h[top[0]] == h[ind_best]) break;
