@@ -38,11 +38,35 @@
  * O(n^2) after an O(n^3) factorization) is made whatever accuracy.condest
  * says, so every mode times the same work.
  *
- *   ./build/bench/accuracy_condest [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING]
+ * --floor adds what no cut can go below, for a row that must make its
+ * estimate (or its bound) at solve time to give every condition warning
+ * there (docs/accuracy.md, "The warning is not lost"):
+ *
+ *   1 solve  the backend's own time of one solve with the factors (`solve
+ *            time` in `info` of the second solve, best of the repetitions:
+ *            KLU's, UMFPACK's, CHOLMOD's or the reference's pass over the
+ *            factors for one column, one MUMPS solve phase, JOB=3), without
+ *            SILC's per-statement work;
+ *   floor    min x 1 solve / factor, min the solves the warning needs:
+ *            where auto made the estimate at solve time, the whole
+ *            Hager-Higham estimate from its start block, i.e. four column
+ *            solves (the start's two and one A', one A step: an estimate
+ *            whose last step may raise it past the warning threshold
+ *            cannot stop earlier) for SuiteSparse and the reference, two
+ *            solve phases after the user's for MUMPS (its start block
+ *            rides along with the user's columns in one phase), none for
+ *            PETSc (it never defers: not a floor of this rule); where the
+ *            estimate was deferred, the start block's bound (two column
+ *            solves) where the backend solves it at once: the reference,
+ *            and UMFPACK and KLU when their pivot ratio exceeds
+ *            SILC_CONDEST_PIVOT_HINT.
+ *
+ *   ./build/bench/accuracy_condest [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING] [--floor]
  *   (OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1)
  */
 #define _POSIX_C_SOURCE 200809L
 #include "testlib.h"
+#include "../plugins/silc_plugin.h" /* SILC_CONDEST_PIVOT_HINT */
 
 #include <float.h>
 #include <time.h>
@@ -96,10 +120,20 @@ static void keep_text(void *user, const char *text)
  * symbolic or numeric, is found again by its values. */
 typedef struct timing {
     double first, info, again;
+    double solve;       /* the backend's own time of the second solve (--floor), else INFINITY */
+    double pivot_ratio; /* the factor-diagonal ratio info showed, 0 when none */
     int read;
 } timing;
 
-static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest, timing *t)
+/* The number after label in info's text, or fallback. */
+static double info_number(const char *label, double fallback)
+{
+    const char *p = strstr(info_text, label);
+    return p ? strtod(p + strlen(label), NULL) : fallback;
+}
+
+static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest, int floor,
+                       timing *t)
 {
     char stmt[512];
     A->values[0] = nextafter(A->values[0], INFINITY);
@@ -115,13 +149,31 @@ static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, c
     if (silc_exec(c, "info x")) return -1;
     t->info = cpu_now() - t->info;
     t->read = strstr(info_text, "deferred at solve time") != NULL;
+    t->pivot_ratio = info_number("condition (factor-diagonal ratio, not a bound): ", 0);
     t->again = cpu_now();
     if (silc_exec(c, stmt)) return -1;
     t->again = cpu_now() - t->again;
+    t->solve = INFINITY;
+    if (floor) { /* untimed: the backend's own clock of that solve */
+        info_text[0] = 0;
+        if (silc_exec(c, "info x")) return -1;
+        t->solve = info_number("solve time: ", INFINITY);
+    }
     /* Its backward error is deferred and keeps A alive: dropped, so that
      * every timed first solve finds A's predecessor dead (KLU refactors
      * into its factors then, as in a time loop). */
     return silc_exec(c, "x = 0") ? -1 : 0;
+}
+
+/* The fewest solves the condition warnings need at solve time (--floor, in
+ * the header): made_now when auto made the whole estimate then, else the
+ * start block's bound where the backend solves it. */
+static int floor_solves(const backend *be, int made_now, double pivot_ratio)
+{
+    int ss = !strncmp(be->name, "suitesparse.", 12), ref = !strcmp(be->name, "reference");
+    if (made_now) return ss || ref ? 4 : !strcmp(be->name, "mumps") ? 2 : 0;
+    if (ref) return 2;
+    return ss && strcmp(be->name, "suitesparse.cholmod") && pivot_ratio > SILC_CONDEST_PIVOT_HINT ? 2 : 0;
 }
 
 static double median(double *v, int n)
@@ -137,15 +189,17 @@ int main(int argc, char **argv)
     char path[1024], line[1024];
     const char *only_matrix = NULL, *only_backend = NULL;
     FILE *idx;
-    int over = 0, rows = 0, reps = CE_REPS;
+    int over = 0, rows = 0, reps = CE_REPS, floor = 0;
     int nrow[NB] = {0}, nover[NB] = {0}, nread[NB] = {0};
     static double now_share[NB][MAX_ROWS], auto_share[NB][MAX_ROWS], read_solves[NB][MAX_ROWS];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc && atoi(argv[i + 1]) > 0) reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--matrix") && i + 1 < argc) only_matrix = argv[++i];
         else if (!strcmp(argv[i], "--backend") && i + 1 < argc) only_backend = argv[++i];
+        else if (!strcmp(argv[i], "--floor")) floor = 1;
         else {
-            fprintf(stderr, "usage: %s [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING]\n", argv[0]);
+            fprintf(stderr, "usage: %s [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING] [--floor]\n",
+                    argv[0]);
             return 2;
         }
     }
@@ -161,8 +215,8 @@ int main(int argc, char **argv)
     }
     printf("condition estimate cost: first solve (factorization + solve) with accuracy.condest = off, now and "
            "auto, CPU time, best of %d (%d under 20000 entries)\n\n", reps, 3 * reps);
-    printf("  %-17s %-20s %6s  %10s  %10s  %6s  %6s  %-5s  %12s  %6s\n", "matrix", "backend", "n", "factor [s]",
-           "solve [s]", "now", "auto", "at", "read [solves]", "read");
+    printf("  %-17s %-20s %6s  %10s  %10s  %6s  %6s  %-5s  %12s  %6s%s\n", "matrix", "backend", "n", "factor [s]",
+           "solve [s]", "now", "auto", "at", "read [solves]", "read", floor ? "   1 solve [s]  min   floor" : "");
     while (fgets(line, sizeof line, idx)) {
         char file[256], field[32], sym[32], cls[32];
         long long m, n, nnz;
@@ -186,7 +240,7 @@ int main(int argc, char **argv)
         }
         for (size_t k = 0; k < NB; k++) {
             const backend *be = &backends[k];
-            timing off = {INFINITY, INFINITY, INFINITY, 0}, now = off, au = off, t = off;
+            timing off = {INFINITY, INFINITY, INFINITY, INFINITY, 0, 0}, now = off, au = off, t = off;
             /* info's best where it made the estimate */
             double auto_d, now_d, read_d, info_read = INFINITY;
             /* Small rows are cheap and the noisiest next to the budget:
@@ -200,8 +254,10 @@ int main(int argc, char **argv)
                 static const char *const modes[3] = {"off", "now", "auto"};
                 timing *best[3] = {&off, &now, &au};
                 for (int m = 0; m < 3 && ok; m++) {
-                    ok = timed_solve(c, &A, be, modes[m], &t) == 0;
+                    ok = timed_solve(c, &A, be, modes[m], floor && m == 0, &t) == 0;
                     if (t.first < best[m]->first) best[m]->first = t.first;
+                    if (t.solve < best[m]->solve) best[m]->solve = t.solve;
+                    if (m == 0) off.pivot_ratio = t.pivot_ratio;
                     if (t.info < best[m]->info) best[m]->info = t.info;
                     if (t.again < best[m]->again) best[m]->again = t.again;
                     if (m == 2) read += t.read;
@@ -225,8 +281,13 @@ int main(int argc, char **argv)
             else snprintf(at, sizeof at, "%s", read ? "read" : "solve");
             printf("%c %-17s %-20s %6lld  %10.3g  %10.3g  %5.1f%%  %5.1f%%  %-5s", auto_d > CE_BUDGET ? '!' : ' ',
                    file, be->name, n, off.first, off.again, 100 * now_d, 100 * auto_d, at);
-            if (read) printf("  %12.1f  %5.1f%%\n", read_d / off.again, 100 * read_d / off.first);
-            else printf("  %12s  %6s\n", "--", "--");
+            if (read) printf("  %12.1f  %5.1f%%", read_d / off.again, 100 * read_d / off.first);
+            else printf("  %12s  %6s", "--", "--");
+            if (floor) {
+                int least = floor_solves(be, !read, off.pivot_ratio);
+                printf("   %11.3g  %3d  %5.1f%%", off.solve, least, 100 * least * off.solve / off.first);
+            }
+            printf("\n");
             fflush(stdout);
         }
         silc_envelope_free(&A);
