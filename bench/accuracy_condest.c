@@ -47,18 +47,26 @@
  *            KLU's, UMFPACK's, CHOLMOD's or the reference's pass over the
  *            factors for one column, one MUMPS solve phase, JOB=3), without
  *            SILC's per-statement work;
- *   floor    min x 1 solve / factor, min the solves the warning needs:
+ *   column   what one more column costs in such a solve: (the backend's
+ *            time of a solve of [b, b, b] - 1 solve) / 2, best times of
+ *            each: the cost of a column that rides along with others, and
+ *            at most that of a column solved alone (the estimator's);
+ *            1 solve and column are not the unit of UMFPACK's and the
+ *            reference's estimates, whose solves for the user refine
+ *            (UMFPACK_IRSTEP 2, the reference up to two steps) where the
+ *            estimator's do not: their floor is printed "--";
+ *   floor    min x unit / factor, min the solves the warning needs (unit:
+ *            column for KLU and CHOLMOD, 1 solve for MUMPS's phases):
  *            where auto made the estimate at solve time, the whole
  *            Hager-Higham estimate from its start block, i.e. four column
  *            solves (the start's two and one A', one A step: an estimate
  *            whose last step may raise it past the warning threshold
- *            cannot stop earlier) for SuiteSparse and the reference, two
- *            solve phases after the user's for MUMPS (its start block
- *            rides along with the user's columns in one phase), none for
- *            PETSc (it never defers: not a floor of this rule); where the
- *            estimate was deferred, the start block's bound (two column
- *            solves) where the backend solves it at once: the reference,
- *            and UMFPACK and KLU when their pivot ratio exceeds
+ *            cannot stop earlier) for KLU and CHOLMOD, two solve phases
+ *            after the user's for MUMPS (its start block rides along with
+ *            the user's columns in one phase), none for PETSc (it never
+ *            defers: not a floor of this rule); where the estimate was
+ *            deferred, the start block's bound (two column solves) where
+ *            KLU solves it at once, when its pivot ratio exceeds
  *            SILC_CONDEST_PIVOT_HINT.
  *
  *   ./build/bench/accuracy_condest [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING] [--floor]
@@ -121,6 +129,7 @@ static void keep_text(void *user, const char *text)
 typedef struct timing {
     double first, info, again;
     double solve;       /* the backend's own time of the second solve (--floor), else INFINITY */
+    double solve3;      /* the same for a solve of three columns (--floor), else INFINITY */
     double pivot_ratio; /* the factor-diagonal ratio info showed, 0 when none */
     int read;
 } timing;
@@ -153,11 +162,15 @@ static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, c
     t->again = cpu_now();
     if (silc_exec(c, stmt)) return -1;
     t->again = cpu_now() - t->again;
-    t->solve = INFINITY;
-    if (floor) { /* untimed: the backend's own clock of that solve */
+    t->solve = t->solve3 = INFINITY;
+    if (floor) { /* untimed: the backend's own clock of those solves */
         info_text[0] = 0;
         if (silc_exec(c, "info x")) return -1;
         t->solve = info_number("solve time: ", INFINITY);
+        snprintf(stmt, sizeof stmt, "x3 = solve(A, [b, b, b], \"backend = %s%s\")", be->name, be->opts);
+        info_text[0] = 0;
+        if (silc_exec(c, stmt) || silc_exec(c, "info x3; x3 = 0")) return -1;
+        t->solve3 = info_number("solve time: ", INFINITY);
     }
     /* Its backward error is deferred and keeps A alive: dropped, so that
      * every timed first solve finds A's predecessor dead (KLU refactors
@@ -167,13 +180,14 @@ static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, c
 
 /* The fewest solves the condition warnings need at solve time (--floor, in
  * the header): made_now when auto made the whole estimate then, else the
- * start block's bound where the backend solves it. */
+ * start block's bound where the backend solves it; -1 where the backend's
+ * solve time is no unit of its estimate (UMFPACK, the reference). */
 static int floor_solves(const backend *be, int made_now, double pivot_ratio)
 {
-    int ss = !strncmp(be->name, "suitesparse.", 12), ref = !strcmp(be->name, "reference");
-    if (made_now) return ss || ref ? 4 : !strcmp(be->name, "mumps") ? 2 : 0;
-    if (ref) return 2;
-    return ss && strcmp(be->name, "suitesparse.cholmod") && pivot_ratio > SILC_CONDEST_PIVOT_HINT ? 2 : 0;
+    int klu = !strcmp(be->name, "suitesparse.klu");
+    if (!strcmp(be->name, "suitesparse.umfpack") || !strcmp(be->name, "reference")) return -1;
+    if (made_now) return klu || !strcmp(be->name, "suitesparse.cholmod") ? 4 : !strcmp(be->name, "mumps") ? 2 : 0;
+    return klu && pivot_ratio > SILC_CONDEST_PIVOT_HINT ? 2 : 0;
 }
 
 static double median(double *v, int n)
@@ -216,7 +230,8 @@ int main(int argc, char **argv)
     printf("condition estimate cost: first solve (factorization + solve) with accuracy.condest = off, now and "
            "auto, CPU time, best of %d (%d under 20000 entries)\n\n", reps, 3 * reps);
     printf("  %-17s %-20s %6s  %10s  %10s  %6s  %6s  %-5s  %12s  %6s%s\n", "matrix", "backend", "n", "factor [s]",
-           "solve [s]", "now", "auto", "at", "read [solves]", "read", floor ? "   1 solve [s]  min   floor" : "");
+           "solve [s]", "now", "auto", "at", "read [solves]", "read",
+           floor ? "   1 solve [s]  column [s]  min   floor" : "");
     while (fgets(line, sizeof line, idx)) {
         char file[256], field[32], sym[32], cls[32];
         long long m, n, nnz;
@@ -240,7 +255,7 @@ int main(int argc, char **argv)
         }
         for (size_t k = 0; k < NB; k++) {
             const backend *be = &backends[k];
-            timing off = {INFINITY, INFINITY, INFINITY, INFINITY, 0, 0}, now = off, au = off, t = off;
+            timing off = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, 0, 0}, now = off, au = off, t = off;
             /* info's best where it made the estimate */
             double auto_d, now_d, read_d, info_read = INFINITY;
             /* Small rows are cheap and the noisiest next to the budget:
@@ -257,6 +272,7 @@ int main(int argc, char **argv)
                     ok = timed_solve(c, &A, be, modes[m], floor && m == 0, &t) == 0;
                     if (t.first < best[m]->first) best[m]->first = t.first;
                     if (t.solve < best[m]->solve) best[m]->solve = t.solve;
+                    if (t.solve3 < best[m]->solve3) best[m]->solve3 = t.solve3;
                     if (m == 0) off.pivot_ratio = t.pivot_ratio;
                     if (t.info < best[m]->info) best[m]->info = t.info;
                     if (t.again < best[m]->again) best[m]->again = t.again;
@@ -285,7 +301,10 @@ int main(int argc, char **argv)
             else printf("  %12s  %6s", "--", "--");
             if (floor) {
                 int least = floor_solves(be, !read, off.pivot_ratio);
-                printf("   %11.3g  %3d  %5.1f%%", off.solve, least, 100 * least * off.solve / off.first);
+                double column = (off.solve3 - off.solve) / 2, unit = strcmp(be->name, "mumps") ? column : off.solve;
+                printf("   %11.3g  %10.3g", off.solve, column);
+                if (least < 0) printf("  %3s  %6s", "--", "--");
+                else printf("  %3d  %5.1f%%", least, 100 * least * unit / off.first);
             }
             printf("\n");
             fflush(stdout);
