@@ -30,6 +30,12 @@ target_link_libraries(test_server PRIVATE Threads::Threads)
 add_dependencies(test_server silc_test_crash silcd)
 set_tests_properties(test_server PROPERTIES TIMEOUT 300)
 
+# A backend silcd's config names that is not installed stops its start
+# (issue 28): exit 2 naming the plugin; "name?" makes it optional.
+add_test(NAME silcd_missing_plugin COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/silcd_missing_plugin.sh
+  $<TARGET_FILE:silcd> ${CMAKE_CURRENT_BINARY_DIR})
+set_tests_properties(silcd_missing_plugin PROPERTIES TIMEOUT 120)
+
 # Interrupts (silc_cancel from a thread): embedded, inside a plugin call that
 # polls host->cancelled() (the crash plugin), and over a private silcd.
 silc_add_test(test_interrupt INTERNAL SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_interrupt.c)
