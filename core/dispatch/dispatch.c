@@ -192,6 +192,23 @@ static int sparse_governs_band(const silc_engine *E)
            (cfg_get(E, "dispatch.solve.sparse") || cfg_get(E, "dispatch.solve.sparse.spd"));
 }
 
+/* The properties a solve's classification asks of A.  A dense A's norms
+ * come in the shape's own pass for little more, and a first solve's report
+ * needs them (||A||_inf for the backward error, ||A||_1 for the estimate),
+ * so they are asked together; a solve that reports neither
+ * (accuracy.condest = off, solve.backward_error = on_request) takes the
+ * shape alone, a pass with no ordered sums (val_props_part), and the norms
+ * come later if `info` wants them. */
+static int solve_parts(const silc_engine *E, const silc_value *A)
+{
+    const char *c, *b;
+    if (!E || A->format != SILC_FMT_DENSE) return SILC_PROPS_SHAPE;
+    c = cfg_get(E, "accuracy.condest");
+    b = cfg_get(E, "solve.backward_error");
+    if (c && !strcmp(c, "off") && b && !strcmp(b, "on_request")) return SILC_PROPS_SHAPE;
+    return SILC_PROPS_SHAPE | SILC_PROPS_NORMS;
+}
+
 /* The class chain of call, with a readable reason in why (may be NULL). */
 static int classify(const silc_engine *E, const silc_call *call, const char *out[4], char *why, size_t whylen)
 {
@@ -207,7 +224,7 @@ static int classify(const silc_engine *E, const silc_call *call, const char *out
     B = call->nin > 1 ? call->in[1] : NULL;
     switch (call->op) {
     case SILC_OP_SOLVE:
-        p = val_props_part(A, SILC_PROPS_SHAPE); /* symmetry only if the shape leaves it open */
+        p = val_props_part(A, solve_parts(E, A)); /* symmetry only if the shape leaves it open */
         if (!p) return 0;
         sparse = A->format == SILC_FMT_CSR;
         if (A->m != A->n) {

@@ -1005,6 +1005,37 @@ static void shape_start(const silc_value *v, silc_props *p)
     p->has_nonfinite = 0;
 }
 
+/* The shape of a real dense value alone, for a solve that reports neither a
+ * condition estimate nor a backward error (the dispatcher's solve_parts):
+ * the answers norms_shape_pass_dense gives, without its ordered sums, which
+ * GCC does not vectorize (a third of a dgesv's time at n = 1000 went to
+ * them).  A column is one branch-free pass of max_abs_bits (its zeros, and
+ * Inf or NaN as a magnitude at or above Inf's), then its outermost nonzeros
+ * from either end.  A NaN counts as a nonzero, as c[i] != 0 says. */
+static void shape_pass_dense(const silc_value *v, silc_props *p)
+{
+    const int64_t m = v->m, n = v->n;
+    int64_t nnz = 0, pos = 0;
+    uint64_t top = 0;
+    shape_start(v, p);
+    for (int64_t j = 0; j < n; j++) {
+        const double *c = v->val + j * m;
+        int64_t zeros = 0, first, last;
+        uint64_t mx = max_abs_bits(c, m, 1, &zeros);
+        top = mx > top ? mx : top;
+        if (j < m && c[j] > 0) pos++;
+        if (zeros == m) continue;
+        nnz += m - zeros;
+        for (first = 0; c[first] == 0; first++) {}
+        for (last = m - 1; c[last] == 0; last--) {}
+        if (first != j) shape_off_diagonal(p, first, j);
+        if (last != j && last != first) shape_off_diagonal(p, last, j);
+    }
+    p->nnz = nnz;
+    p->has_nonfinite = top >= 0x7ff0000000000000ULL;
+    p->pos_diag = p->square && n > 0 && pos == n;
+}
+
 /* What a pass over a CSR value's rows gathers for the shape.  A local of
  * that pass: p's int64_t fields could alias colind, and the compiler would
  * reload them on every row. */
@@ -1321,7 +1352,8 @@ static int compute_norms(const silc_value *v, silc_props *p, int shape)
     } else if (!shape && v->format == SILC_FMT_CSR && !p->has_nonfinite) {
         norms_pass_csr(v, &acc);
         fast = isfinite(acc.total) && isfinite(acc.sumsq);
-    } else if (shape && v->format == SILC_FMT_DENSE && acc.colsum && acc.rowsum) {
+    } else if (v->format == SILC_FMT_DENSE && acc.colsum && acc.rowsum) {
+        /* without shape, its shape answers are the ones already known */
         fast = norms_shape_pass_dense(v, &acc) == 0;
     }
     if (!fast) {
@@ -1373,6 +1405,11 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR &&
         v->field == SILC_FIELD_REAL)
         shape_csr(v);
+    if ((parts & SILC_PROPS_SHAPE) && !(parts & SILC_PROPS_NORMS) && !(v->props_have & SILC_PROPS_SHAPE) &&
+        v->format == SILC_FMT_DENSE && v->field == SILC_FIELD_REAL) {
+        shape_pass_dense(v, p);
+        v->props_have |= SILC_PROPS_SHAPE;
+    }
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
         int shape = !(v->props_have & SILC_PROPS_SHAPE);
         if (compute_norms(v, p, shape) == 0) v->props_have |= SILC_PROPS_NORMS;
