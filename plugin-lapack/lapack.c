@@ -182,7 +182,7 @@ static int accepts_solve(const silc_call *call, const char **why)
         *why = "band storage is solved under solve.band only";
         return 0;
     }
-    P = lp_host->props(call->in[0]);
+    P = silc_props_of(lp_host, call->in[0], SILC_PROPS_SHAPE | SILC_PROPS_SYMMETRY);
     if (P->has_nonfinite) {
         *why = "matrix has NaN or Inf entries";
         return 0;
@@ -259,6 +259,15 @@ enum lp_route { R_LU, R_CHOL, R_LDLT, R_TRI, R_BAND, R_RECT };
 static const char *const route_key[] = {"lapack.lu", "lapack.chol", "lapack.ldlt",
                                         "lapack.tri", "lapack.band", "lapack.qr"};
 
+/* ||A||_1 for an estimate or a band factorization.  The solve's other
+ * reads of A's properties ask for the shape and the symmetry only, so a
+ * dense solve that wants no estimate (accuracy.condest = off) never pays
+ * the norms' pass; this asks for it where it is needed. */
+static double norm1_of(const silc_call *call)
+{
+    return silc_props_of(lp_host, call->in[0], SILC_PROPS_NORMS)->norm1;
+}
+
 /* Which LAPACK path serves this call.  Without a class (a direct call) the
  * structure decides, as the dispatcher would. */
 static int route_of(const silc_call *call, const silc_view *A, const silc_props *P)
@@ -278,7 +287,7 @@ static int factor(silc_call *call, int route, const silc_view *A, const silc_pro
     case R_CHOL: return lp_dense_chol(call, A, F);
     case R_LDLT: return lp_dense_ldlt(call, A, F);
     case R_TRI: return lp_dense_tri(call, A, P->lower ? 'L' : 'U', F);
-    case R_BAND: return lp_band(call, A, P->kl, P->ku, P->symmetric && P->pos_diag, P->norm1, F);
+    case R_BAND: return lp_band(call, A, P->kl, P->ku, P->symmetric && P->pos_diag, norm1_of(call), F);
     default: return lp_dense_qr(call, A, rank_tol, F);
     }
 }
@@ -347,8 +356,7 @@ static int condest_off(const silc_call *call)
  * that fails (too ill-conditioned, out of single range).  The single factors
  * live inside the call, so nothing is attached and every solve factors anew;
  * the condition estimate comes from whichever factors the call ended with. */
-static int solve_mixed(silc_call *call, int route, const silc_view *A, const silc_view *B,
-                       const silc_props *P)
+static int solve_mixed(silc_call *call, int route, const silc_view *A, const silc_view *B)
 {
     lapack_int n = (lapack_int)A->n, nrhs = (lapack_int)B->n, iter = 0, info, *ipiv, *iwork;
     double *a = lp_alloc((size_t)n * (size_t)n, sizeof(double));
@@ -394,14 +402,14 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
      * for single precision makes LAPACK fall back to double anyway. */
     int estimate = !condest_off(call);
     if (estimate && iter < 0) {
-        if (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, P->norm1, &rcond, work, iwork)
-                 : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, P->norm1, &rcond, work, iwork))
+        if (chol ? LAPACKE_dpocon_work(LAPACK_COL_MAJOR, 'L', n, a, n, norm1_of(call), &rcond, work, iwork)
+                 : LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', n, a, n, norm1_of(call), &rcond, work, iwork))
             rcond = -1;
     } else if (estimate) {
         float srcond = -1, *fwork = lp_alloc((size_t)4 * (size_t)n, sizeof(float));
-        if (fwork && !(chol ? LAPACKE_spocon_work(LAPACK_COL_MAJOR, 'L', n, swork, n, (float)P->norm1,
+        if (fwork && !(chol ? LAPACKE_spocon_work(LAPACK_COL_MAJOR, 'L', n, swork, n, (float)norm1_of(call),
                                                    &srcond, fwork, iwork)
-                            : LAPACKE_sgecon_work(LAPACK_COL_MAJOR, '1', n, swork, n, (float)P->norm1,
+                            : LAPACKE_sgecon_work(LAPACK_COL_MAJOR, '1', n, swork, n, (float)norm1_of(call),
                                                    &srcond, fwork, iwork)))
             rcond = srcond;
         lp_free(fwork);
@@ -458,12 +466,12 @@ static int op_solve(silc_call *call)
         snprintf(call->report->method, sizeof call->report->method, "empty system");
         return SILC_OK;
     }
-    P = lp_host->props(call->in[0]);
+    P = silc_props_of(lp_host, call->in[0], SILC_PROPS_SHAPE | SILC_PROPS_SYMMETRY);
     route = route_of(call, &A, P);
     if ((route == R_LU || route == R_CHOL) && A.format == SILC_FMT_DENSE) {
         const char *prec = lp_host->option_string(call, "precision", "double");
         mixed_asked = cx && strcmp(prec, "mixed") == 0; /* real only: complex factors in double */
-        if (!cx && strcmp(prec, "mixed") == 0) return solve_mixed(call, route, &A, &B, P);
+        if (!cx && strcmp(prec, "mixed") == 0) return solve_mixed(call, route, &A, &B);
         if (strcmp(prec, "double") != 0 && !mixed_asked)
             return lp_host->error(call, SILC_EARG,
                                   "option 'lapack.precision' expects double or mixed, got '%s'", prec);
@@ -496,7 +504,7 @@ static int op_solve(silc_call *call)
      * wants it from a factor made without. */
     if (F->rcond_owed && !condest_off(call)) {
         te = lp_host->now();
-        if ((rc = lp_dense_estimate(call, F, &A, P->norm1))) {
+        if ((rc = lp_dense_estimate(call, F, &A, norm1_of(call)))) {
             lp_factor_free(owned);
             return rc;
         }
