@@ -166,6 +166,9 @@ check "--profile status" status_is 0
 check "--profile: statements" has err "for i = 1:3 ..."
 check "--profile: three solves counted" grep -q '^  solve: [^ ]* *3 ' err
 check "--profile: the table header" has err "bytes in"
+# x is 2 doubles, 16 bytes, each time; A's factorization is made once and
+# reused by the two later solves.
+check "--profile: bytes out and reused factorizations" grep -q '^  solve: [^ ]* *3 .* 48 *2$' err
 
 run "$SILC" run no-such-file.silc
 check "run missing file status" status_is 1
