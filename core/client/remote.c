@@ -243,11 +243,11 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
             return bad_reply(c, rc, why, err, errlen);
         switch (r.op) {
         case PROTO_TEXT:
-            /* After a CANCEL the output the statement made before it
-             * stopped is still queued in silcd's pipe and the sockets
-             * (a loop that shows a value per iteration: 100-200 KB, half
-             * a second on a terminal); embedded, that output was never
-             * made.  The interrupt should be seen at once, so it is
+            /* After a CANCEL, output the statement made before it
+             * stopped may still be on its way (silcd sends it every 20
+             * ms, and the sockets hold hundreds of KB of a loop that
+             * shows a value per iteration: half a second on a terminal).
+             * The interrupt should be seen at once, so that output is
              * dropped and counted in a warning. */
             if (atomic_load(&c->cancel_sent)) dropped += strlen(r.text);
             else if (fn) fn(user, r.text);
@@ -450,6 +450,7 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
         if (state == EXEC_IDLE) break;
         sched_yield();
     }
+    atomic_store(&c->cancel_sent, 0); /* the next request's text is shown */
     return rc;
 }
 
