@@ -170,10 +170,11 @@ static void read_slowly(void *user, const char *text)
 /* Remote, a loop that shows a value every iteration: its output reaches
  * the callback while it runs (silcd streams it), and once silc_cancel has
  * returned at most the piece being handed over then: what is still on the
- * way is dropped, and a warning counts it (the reader is slower than the
- * loop, so some always is).  Before, silcd sent the whole run's output
- * after the interrupt, and the REPL showed "interrupted" only once it had
- * printed it all. */
+ * way is dropped, and a warning counts it (some always is: at the poll
+ * that reads the CANCEL, silcd first sends what the loop printed since the
+ * last one).  Before, silcd sent the whole run's output after the
+ * interrupt, and the REPL showed "interrupted" only once it had printed it
+ * all. */
 static void check_output_cancelled(silc_context *ctx)
 {
     slow_reader r = {0, 0};
