@@ -247,7 +247,8 @@ int srv_watch_check(void *user, char *why, size_t whylen)
     if (now < w->next_poll) return 0;
     w->next_poll = now + SRV_WATCH_POLL_S;
     srv_output_drain(); /* room in the pipe for what a library prints next */
-    if (client_gone(w->fd)) return stop_because(w, SRV_STOP_GONE, why, whylen);
+    if ((w->flush && w->flush(w->flush_user)) || client_gone(w->fd))
+        return stop_because(w, SRV_STOP_GONE, why, whylen);
     if (cancel_arrived(w->fd)) {
         w->cancelled = 1;
         snprintf(why, whylen, "%s", ENG_INTERRUPTED);

@@ -144,6 +144,10 @@ typedef struct srv_watch {
     int stop;
     int cancelled;   /* the client sent CANCEL: "interrupted", an ordinary failure (no stop) */
     char why[256];   /* the client's message once stop is set */
+    /* Called at each poll: sends what the request has printed so far;
+     * nonzero when the client cannot be written to (it has gone). */
+    int (*flush)(void *user);
+    void *flush_user;
 } srv_watch;
 void srv_watch_begin(srv_watch *w, int fd);
 /* A request's library output (output.c): while it runs, descriptor 1 is a

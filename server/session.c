@@ -61,12 +61,19 @@ typedef struct reply_queue {
     uint64_t bytes;          /* still to write */
 } reply_queue;
 
-/* Frames an EXEC produces (who, info, explain), sent with its reply. */
+/* Frames an EXEC produces (who, info, explain), sent while it runs and
+ * with its reply.  Consecutive pieces of text share one TEXT frame (up to
+ * OUT_FRAME_TEXT bytes): a loop that shows a value per iteration would
+ * otherwise send a frame per line, and a client reading frame by frame
+ * falls behind a server writing them. */
 typedef struct outbuf {
     uint8_t *p;
     size_t len, cap;
+    size_t text_at;          /* 1 + where the last frame starts, when it is TEXT; else 0 */
     int failed;
 } outbuf;
+
+enum { OUT_FRAME_TEXT = 1 << 20 };
 
 struct session {
     int fd;
@@ -91,8 +98,12 @@ srv_ranks *srv_mpi;
 
 static void out_frame(outbuf *o, uint32_t op, const char *text)
 {
-    size_t n = strlen(text), need = o->len + PROTO_HEADER_BYTES + n;
+    size_t n = strlen(text), start = o->text_at ? o->text_at - 1 : 0, had = 0, need;
+    int join;
     if (o->failed) return;
+    if (o->text_at) had = o->len - start - PROTO_HEADER_BYTES; /* the last TEXT frame's body */
+    join = op == PROTO_TEXT && o->text_at && had + n <= OUT_FRAME_TEXT;
+    need = o->len + (join ? 0 : PROTO_HEADER_BYTES) + n;
     if (need > o->cap) {
         size_t cap = o->cap ? o->cap : 256;
         uint8_t *p;
@@ -104,8 +115,14 @@ static void out_frame(outbuf *o, uint32_t op, const char *text)
         o->p = p;
         o->cap = cap;
     }
-    proto_encode_header(o->p + o->len, op, n);
-    memcpy(o->p + o->len + PROTO_HEADER_BYTES, text, n);
+    if (join) {
+        proto_encode_header(o->p + start, op, had + n);
+        memcpy(o->p + o->len, text, n);
+    } else {
+        proto_encode_header(o->p + o->len, op, n);
+        memcpy(o->p + o->len + PROTO_HEADER_BYTES, text, n);
+        o->text_at = op == PROTO_TEXT ? o->len + 1 : 0;
+    }
     o->len = need;
 }
 
@@ -266,7 +283,7 @@ static int finish_exec(session *S, int rc, const char *warnings)
     struct iovec iov;
     if (S->out.failed) {
         S->out.failed = 0;
-        S->out.len = 0;
+        S->out.len = S->out.text_at = 0;
         if (!rc) {
             snprintf(S->err, sizeof S->err, "out of memory collecting the statement's output");
             rc = -1;
@@ -274,11 +291,27 @@ static int finish_exec(session *S, int rc, const char *warnings)
     }
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
-    S->out.len = 0;
+    S->out.len = S->out.text_at = 0;
     *S->state = SLOT_REPLYING;
     if (iov.iov_len && send_parts(S, &iov, 1, NULL, 1)) return -1;
     if (warnings && *warnings && reply_text(S, PROTO_WARN, warnings)) return -1;
     return rc ? reply_error(S, S->err) : reply_text(S, PROTO_OK, NULL);
+}
+
+/* The output an EXEC has made so far, sent while it runs (the watch's
+ * poll, every 20 ms): a long loop shows its progress as it goes, as it does
+ * embedded, the session holds 20 ms of it rather than the whole run's, and
+ * an interrupt is not followed by everything the run printed.  silcd --mpi
+ * queues its replies for rank 0's loop and sends the output with the reply. */
+static int stream_output(void *user)
+{
+    session *S = user;
+    struct iovec iov;
+    if (S->queued || S->out.failed || !S->out.len) return 0;
+    iov.iov_base = S->out.p;
+    iov.iov_len = S->out.len;
+    S->out.len = S->out.text_at = 0;
+    return send_parts(S, &iov, 1, NULL, 1);
 }
 
 /* An EXEC runs against a snapshot (rolled back whole on a verdict) when a
@@ -336,6 +369,8 @@ static int do_exec(session *S, const char *text)
     *S->state = SLOT_RUNNING;
     exec_budget(E, 1);
     srv_watch_begin(&S->watch, S->fd);
+    S->watch.flush = stream_output;
+    S->watch.flush_user = S;
     srv_output_begin();
     rc = api_exec(E, text, S->err, sizeof S->err);
     library_output(S);

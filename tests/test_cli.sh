@@ -136,6 +136,23 @@ run "$SILC" -e 'help lapack'
 check "help PLUGIN lists its options with defaults" has out "lapack.precision [double] (text): "
 run "$SILC" --complete lapack.pre
 check "--complete covers plugin options" [ "$(cat out)" = "lapack.precision" ]
+# Every plugin: `help` names it, `help NAME` shows it with each of its
+# options, and Tab offers exactly those options after `NAME.` (issue 29).
+run "$SILC" -e 'help'
+plugins=$(sed -n '/^plugins (/{n;p;}' out)
+check "help lists the plugins (reference, lapack among them)" \
+    sh -c 'echo " $1 " | grep -q " reference " && echo " $1 " | grep -q " lapack "' - "$plugins"
+for p in $plugins; do
+    run "$SILC" -e "help $p"
+    check "help $p names it" sh -c 'head -n 1 out | grep -q -F "plugin $1 "' - "$p"
+    sed -n "s/^    \($p\.[^ ]*\) \[.*/\1/p" out | sort >help_keys
+    check "help $p: options, or 'no options'" sh -c '[ -s help_keys ] || grep -q "^  no options$" out'
+    run "$SILC" --complete "$p."
+    sort out >complete_keys
+    check "--complete $p. offers the options help $p lists" cmp -s help_keys complete_keys
+done
+run "$SILC" --complete refer
+check "--complete offers plugin names" [ "$(cat out)" = "reference" ]
 run "$SILC" --complete solve.ver
 check "--complete covers keys" [ "$(cat out)" = "solve.verify" ]
 run "$SILC" -e 'alpha = 1; alpah'
@@ -149,6 +166,9 @@ check "--profile status" status_is 0
 check "--profile: statements" has err "for i = 1:3 ..."
 check "--profile: three solves counted" grep -q '^  solve: [^ ]* *3 ' err
 check "--profile: the table header" has err "bytes in"
+# x is 2 doubles, 16 bytes, each time; A's factorization is made once and
+# reused by the two later solves.
+check "--profile: bytes out and reused factorizations" grep -q '^  solve: [^ ]* *3 .* 48 *2$' err
 
 run "$SILC" run no-such-file.silc
 check "run missing file status" status_is 1

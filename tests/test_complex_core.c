@@ -119,6 +119,7 @@ static void round_trip(silc_context *c, const char *label)
     int64_t rp[4] = {0, 1, 3, 4}, ci[4] = {1, 2, 0, 2};
     double cv[8] = {1, -2, 4, 0, 0, 3, -5, 0.25};
     double dense[18];
+    int64_t first = -1;
     silc_envelope_t a, z, out;
     CHECK(silc_envelope_dense_complex(&z, 2, 2, herm) == 0, "%s: dense complex envelope", label);
     CHECK(silc_envelope_is_complex(&z) && z.format == SILC_DENSE_COMPLEX, "%s: envelope format", label);
@@ -131,6 +132,19 @@ static void round_trip(silc_context *c, const char *label)
     CHECK(silc_put(c, "A", &a) == 0, "%s: put A: %s", label, silc_context_errmsg(c));
     CHECK(silc_get(c, &out, "z") != 0 && strstr(silc_context_errmsg(c), "'z' is complex"),
           "%s: silc_get of a complex value: %s", label, silc_context_errmsg(c));
+    silc_envelope_free(&out);
+    /* silc_get_rows is pointed to its own complex call, remote as embedded
+     * (silcd's GET names silc_get_complex); silc_get_rows_complex brings
+     * the whole value from row 0 on one process. */
+    CHECK(silc_get_rows(c, &out, &first, "z") != 0 && out.values == NULL &&
+              strstr(silc_context_errmsg(c), "'z' is complex") &&
+              strstr(silc_context_errmsg(c), "fetch it with silc_get_rows_complex,"),
+          "%s: silc_get_rows of a complex value: %s", label, silc_context_errmsg(c));
+    silc_envelope_free(&out);
+    first = -1;
+    CHECK(silc_get_rows_complex(c, &out, &first, "z") == 0 && first == 0 && out.format == SILC_DENSE_COMPLEX &&
+              out.m == 2 && out.n == 2 && !memcmp(out.values, herm, sizeof herm),
+          "%s: silc_get_rows_complex z: first %lld, %s", label, (long long)first, silc_context_errmsg(c));
     silc_envelope_free(&out);
     CHECK(silc_get_complex(c, &out, "z") == 0, "%s: get_complex z: %s", label, silc_context_errmsg(c));
     CHECK(out.format == SILC_DENSE_COMPLEX && out.m == 2 && out.n == 2 &&

@@ -7,7 +7,9 @@
  * docs/protocol.md) and inside a plugin call that polls host->cancelled()
  * (the "crash" test plugin, alpha 19, which spins until told to stop; a
  * lis-style and a PETSc iterative solve, which ask between iterations; the
- * reference plugin's dense LU, which asks every 64 columns).
+ * reference plugin's dense LU, which asks every 64 columns).  Remote, the
+ * output of a loop that prints reaches the program while it runs, and what
+ * is still on the way when it is cancelled is dropped, with a warning.
  * With SILC_SERVER set, only the remote part, against that server (run so
  * against silcd --mpi by tests/mpi.cmake).
  *
@@ -60,6 +62,9 @@ static double cpu_seconds(clockid_t clock)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Set once silc_cancel has returned in cancel_later (the output test). */
+static atomic_int cancel_returned;
+
 /* Waits until the EXEC has surely started (it runs for minutes), cancels
  * it, and waits for it to return. */
 static void *cancel_later(void *arg)
@@ -70,6 +75,7 @@ static void *cancel_later(void *arg)
     CHECK(!atomic_load(&c->exec_done), "the EXEC ended before it was cancelled");
     c->cpu_at_cancel = cpu_seconds(c->exec_cpu);
     silc_cancel(c->ctx);
+    atomic_store(&cancel_returned, 1);
     t0 = util_now();
     while (!atomic_load(&c->exec_done) && util_now() - t0 < bound_s()) sleep_ms(10);
     c->returned_in_time = atomic_load(&c->exec_done);
@@ -85,6 +91,7 @@ static int exec_cancelled(silc_context *ctx, const char *text)
     double cpu_after;
     int rc;
     c.ctx = ctx;
+    atomic_store(&cancel_returned, 0);
     atomic_init(&c.exec_done, 0);
     c.returned_in_time = 0;
     c.cpu_at_cancel = 0;
@@ -142,6 +149,50 @@ static void check_loop_cancelled(silc_context *ctx, const char *where)
     CHECK(silc_exec(ctx, "i = 0; while (i < 1000) { i = i + 1 }") == 0, "%s: next EXEC: %s", where,
           silc_context_errmsg(ctx));
     CHECK_NEAR(scalar(ctx, "i"), 1000, 0);
+}
+
+/* The output callback of check_output_cancelled: reads slowly, as a
+ * terminal does, counting the pieces that came before and after
+ * silc_cancel returned. */
+typedef struct slow_reader {
+    int before, after;
+} slow_reader;
+
+static void read_slowly(void *user, const char *text)
+{
+    slow_reader *r = user;
+    (void)text;
+    if (atomic_load(&cancel_returned)) r->after++;
+    else r->before++;
+    sleep_ms(5);
+}
+
+/* Remote, a loop that shows a value every iteration: its output reaches
+ * the callback while it runs (silcd streams it), and once silc_cancel has
+ * returned at most the piece being handed over then: what is still on the
+ * way is dropped, and a warning counts it (some always is: at the poll
+ * that reads the CANCEL, silcd first sends what the loop printed since the
+ * last one).  Before, silcd sent the whole run's output after the
+ * interrupt, and the REPL showed "interrupted" only once it had printed it
+ * all. */
+static void check_output_cancelled(silc_context *ctx)
+{
+    slow_reader r = {0, 0};
+    int rc;
+    CHECK(silc_exec(ctx, "i = 0") == 0, "output: setup: %s", silc_context_errmsg(ctx));
+    silc_set_output(ctx, read_slowly, &r);
+    rc = exec_cancelled(ctx, "while (i < 1e9) { i = i + 1; disp(i) }");
+    silc_set_output(ctx, NULL, NULL);
+    CHECK(rc != 0 && !strcmp(silc_context_errmsg(ctx), "interrupted"), "output: message '%s', want 'interrupted'",
+          silc_context_errmsg(ctx));
+    CHECK(r.before > 0, "output: nothing reached the callback while the loop ran (not streamed)");
+    CHECK(r.after <= 1, "output: %d pieces reached the callback after silc_cancel returned", r.after);
+    CHECK(strstr(silc_context_warnings(ctx), "of the statement's output, still on the way from the server, "
+                                             "were not shown") != NULL,
+          "output: no warning of the dropped output: '%s'", silc_context_warnings(ctx));
+    CHECK_NEAR(scalar(ctx, "i"), 0, 0);
+    printf("  remote printing loop: %d pieces shown before the cancel, %d after; %s", r.before, r.after,
+           silc_context_warnings(ctx));
 }
 
 /* An iterative solve of lis-style (which asks host->cancelled() once an
@@ -280,6 +331,7 @@ int main(void)
             CHECK(0, "silc_open_remote %s: %s", srv.url, silc_errmsg());
         } else {
             check_loop_cancelled(ctx, "remote");
+            check_output_cancelled(ctx);
             /* After the cancels the session is in step (a CANCEL that
              * came late would have been answered by nothing). */
             CHECK(silc_exec(ctx, "q = 2") == 0, "after cancels: %s", silc_context_errmsg(ctx));

@@ -244,6 +244,19 @@ try:
 except silc.Error as e:
     check(missing in str(e) and "No such file" in str(e), "missing socket: %s" % e)
 
+# A host that refuses the connection: the error names it (a port just
+# bound and closed again, so nothing listens there).
+import socket  # noqa: E402
+probe = socket.socket()
+probe.bind(("127.0.0.1", 0))
+refusing = "tcp://127.0.0.1:%d" % probe.getsockname()[1]
+probe.close()
+try:
+    silc.Session(refusing)
+    check(False, "no error for a host that refuses")
+except silc.Error as e:
+    check(refusing in str(e) and "refused" in str(e), "refusing host: %s" % e)
+
 # Limits given wrong are errors naming them.
 expect_error(lambda: silc.Session(missing, timeout=-1), "a timeout must be >= 0", "timeout=-1")
 os.environ["SILC_IO_TIMEOUT"] = "soon"

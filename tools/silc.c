@@ -64,9 +64,9 @@ static const char usage_text[] =
     "  --profile            time every statement and plugin call (bytes in and out,\n"
     "                       reused factorizations) and print the tables to standard\n"
     "                       error at the end, as PETSc's -log_view (core.profile)\n"
-    "  --complete WORD      after running, print the names, statements, built-ins and\n"
-    "                       settings (plugin options too) that start with WORD, one a\n"
-    "                       line (what Tab completes)\n"
+    "  --complete WORD      after running, print the names, statements, built-ins,\n"
+    "                       plugins and settings (plugin options too) that start with\n"
+    "                       WORD, one a line (what Tab completes)\n"
     "In the interactive session a line that ends inside an unclosed ( [ or {, or an\n"
     "if, while or for without its end, continues on the next line; 'quit', 'exit' or\n"
     "end of input (Ctrl-D) leaves.  Ctrl-C stops the running statement\n"
@@ -521,6 +521,23 @@ static char *output_of(silc_context *ctx, const char *stmt)
  * statements and built-ins (from `help`), the settings' keys with every
  * loaded plugin's options (from `set`), quit and exit; a malloc'd array of
  * malloc'd strings ending in NULL, in that order, without repeats. */
+/* Drops the lines of text that do not start with a blank: `help`'s
+ * headings, leaving its lists (statements and built-ins, plugins). */
+static void keep_indented_lines(char *text)
+{
+    char *to = text, *line = text;
+    while (text && *line) {
+        size_t len = strcspn(line, "\n");
+        len += line[len] == '\n';
+        if (*line == ' ') {
+            memmove(to, line, len);
+            to += len;
+        }
+        line += len;
+    }
+    if (text) *to = '\0';
+}
+
 static char **completions(silc_context *ctx, const char *prefix)
 {
     char *who = output_of(ctx, "who"), *help = output_of(ctx, "help"), *p;
@@ -528,13 +545,14 @@ static char **completions(silc_context *ctx, const char *prefix)
     size_t n = 0, cap = 16, plen = strlen(prefix), k;
     char **out = malloc(cap * sizeof *out);
     const char *fixed = "quit exit";
+    keep_indented_lines(help);
     for (int src = 0; src < 4 && out; src++) {
         /* who: the first word of each line after the header; help: every
-         * word after the first line; set: the first word of every line;
-         * then the REPL's own commands */
+         * word of its lists; set: the first word of every line; then the
+         * REPL's own commands */
         p = src == 0 ? who : src == 1 ? help : src == 2 ? keys : (char *)fixed;
         if (!p) continue;
-        if (src < 2) p = strchr(p, '\n');
+        if (src == 0) p = strchr(p, '\n');
         while (p && *p && out) {
             size_t wl;
             p += strspn(p, " \t\n");

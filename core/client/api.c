@@ -342,9 +342,23 @@ int silc_put_rows(silc_context *ctx, const char *name, int64_t first_row, const 
     return 0;
 }
 
-/* silc_get and silc_get_complex: a caller that did not ask for complex
- * values gets none (silc.h). */
-static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, int accept_complex)
+/* silcd answers a GET of a complex value with the refusal that names
+ * silc_get_complex, the call behind a GET; silc_get_rows sends the same
+ * GET, so its caller is pointed to its own call (complex_getter), as the
+ * embedded refusal does.  Any other message is left as it came. */
+static void name_complex_getter(silc_context *ctx, const char *name, const char *complex_getter)
+{
+    char server_text[sizeof ctx->err];
+    if (!strcmp(complex_getter, "silc_get_complex")) return;
+    env_complex_refusal(name, "silc_get_complex", server_text, sizeof server_text);
+    if (!strcmp(ctx->err, server_text)) env_complex_refusal(name, complex_getter, ctx->err, sizeof ctx->err);
+}
+
+/* silc_get and silc_get_complex (and silc_get_rows on a remote context): a
+ * caller that did not ask for complex values gets none (silc.h), and the
+ * refusal names complex_getter, the call that would fetch it. */
+static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, int accept_complex,
+                     const char *complex_getter)
 {
     const silc_value *v;
     const char *fn = accept_complex ? "silc_get_complex" : "silc_get";
@@ -352,10 +366,13 @@ static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, in
     if (!ctx) return env_error("%s: NULL context", fn);
     if (!e) return ctx_error(ctx, "%s: NULL envelope", fn);
     if (!name) return ctx_error(ctx, "%s: NULL name", fn);
-    if (ctx->R)
-        return ctx_result(ctx, rem_get(ctx->R, e, name, accept_complex, ctx->err, sizeof ctx->err));
+    if (ctx->R) {
+        if (!rem_get(ctx->R, e, name, accept_complex, ctx->err, sizeof ctx->err)) return 0;
+        if (!accept_complex) name_complex_getter(ctx, name, complex_getter);
+        return ctx_result(ctx, -1);
+    }
     v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err);
-    if (v && !accept_complex && env_refuse_complex(name, v, "silc_get_complex", ctx->err, sizeof ctx->err)) v = NULL;
+    if (v && !accept_complex && env_refuse_complex(name, v, complex_getter, ctx->err, sizeof ctx->err)) v = NULL;
     if (spmd_enter(ctx, "GET", name, v ? 0 : -1)) return ctx_result(ctx, -1);
     if (dist_is(v) && !(v = dist_whole(ctx->E, v, 1))) { /* every rank gets the whole value */
         snprintf(ctx->err, sizeof ctx->err, "%s", ctx->E->err);
@@ -369,12 +386,12 @@ static int get_value(silc_context *ctx, silc_envelope_t *e, const char *name, in
 
 int silc_get(silc_context *ctx, silc_envelope_t *e, const char *name)
 {
-    return get_value(ctx, e, name, 0);
+    return get_value(ctx, e, name, 0, "silc_get_complex");
 }
 
 int silc_get_complex(silc_context *ctx, silc_envelope_t *e, const char *name)
 {
-    return get_value(ctx, e, name, 1);
+    return get_value(ctx, e, name, 1, "silc_get_complex");
 }
 
 /* silc_get_rows and silc_get_rows_complex: as get_value, a caller that did
@@ -393,7 +410,8 @@ static int get_rows(silc_context *ctx, silc_envelope_t *e, int64_t *first_row, c
     if (!ctx) return env_error("%s: NULL context", fn);
     if (!e) rc = ctx_error(ctx, "%s: NULL envelope", fn);
     else if (!name) rc = ctx_error(ctx, "%s: NULL name", fn);
-    if (ctx->R) return rc ? ctx_result(ctx, rc) : get_value(ctx, e, name, accept_complex);
+    if (ctx->R)
+        return rc ? ctx_result(ctx, rc) : get_value(ctx, e, name, accept_complex, "silc_get_rows_complex");
     if (!rc && !(v = api_lookup(ctx->E, name, ctx->err, sizeof ctx->err))) rc = -1;
     if (!rc && !accept_complex && env_refuse_complex(name, v, "silc_get_rows_complex", ctx->err, sizeof ctx->err))
         rc = -1;

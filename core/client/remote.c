@@ -68,6 +68,7 @@ struct rem_conn {
     int exec_timeout_ms;       /* SILC_EXEC_TIMEOUT: the longest wait for an EXEC's reply; -1 none */
     proto_limits limits;       /* SILC_MAX_REPLY_BYTES per value; text as silcd's statements */
     atomic_int exec_state;   /* EXEC_*; lock-free, so rem_cancel is async-signal-safe */
+    atomic_int cancel_sent;    /* a CANCEL went out for the EXEC awaited: its TEXT is dropped */
     proto_spin_memo spin;      /* how long the first reply to each kind of request took */
     char url[512];
 };
@@ -221,6 +222,7 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
     proto_stream s = {c->fd, c->io_timeout_ms, NULL, 0, 0};
     int64_t spin_ns = kind ? proto_spin_budget(&c->spin, kind) : PROTO_SPIN_NS,
             started = proto_now_ns();
+    size_t dropped = 0; /* bytes of TEXT dropped after a CANCEL */
     for (;;) {
         proto_reply r;
         char why[512];
@@ -241,7 +243,14 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
             return bad_reply(c, rc, why, err, errlen);
         switch (r.op) {
         case PROTO_TEXT:
-            if (fn) fn(user, r.text);
+            /* After a CANCEL, output the statement made before it
+             * stopped may still be on its way (silcd sends it every 20
+             * ms, and the sockets hold hundreds of KB of a loop that
+             * shows a value per iteration: half a second on a terminal).
+             * The interrupt should be seen at once, so that output is
+             * dropped and counted in a warning. */
+            if (atomic_load(&c->cancel_sent)) dropped += strlen(r.text);
+            else if (fn) fn(user, r.text);
             else fputs(r.text, stdout);
             break;
         case PROTO_WARN:
@@ -253,6 +262,9 @@ static int await_reply(rem_conn *c, silc_envelope_t *env, silc_output_fn fn, voi
         case PROTO_ERROR:
             snprintf(err, errlen, "%s", r.text);
             proto_reply_free(&r);
+            if (dropped && warnings)
+                sb_printf(warnings, "interrupted: %zu bytes of the statement's output, still on the way "
+                          "from the server, were not shown\n", dropped);
             return -1;
         default: /* PROTO_VALUE */
             if (!env) {
@@ -426,6 +438,7 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
     if (usable(c, err, errlen)) return -1;
     if (proto_send_text(c->fd, PROTO_EXEC, statements, c->io_timeout_ms, why, sizeof why))
         return lost(c, why, err, errlen);
+    atomic_store(&c->cancel_sent, 0);
     atomic_store(&c->exec_state, EXEC_AWAITING);
     rc = await_reply(c, NULL, fn, user, warnings, 1, proto_spin_kind(PROTO_EXEC, statements), err,
                      errlen);
@@ -437,6 +450,7 @@ int rem_exec(rem_conn *c, const char *statements, silc_output_fn fn, void *user,
         if (state == EXEC_IDLE) break;
         sched_yield();
     }
+    atomic_store(&c->cancel_sent, 0); /* the next request's text is shown */
     return rc;
 }
 
@@ -455,6 +469,7 @@ int rem_cancel(rem_conn *c)
         else if (n < 0 && errno == EINTR) continue;
         else break; /* the connection is failing: the reply's read says so */
     }
+    atomic_store(&c->cancel_sent, 1);
     atomic_store(&c->exec_state, EXEC_AWAITING);
     errno = saved_errno; /* a signal handler must leave errno as it found it */
     return 0;

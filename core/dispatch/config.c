@@ -775,6 +775,14 @@ int cfg_describe_plugin(const silc_engine *E, const char *name, strbuf *b)
     return 0;
 }
 
+void cfg_list_plugins(const silc_engine *E, strbuf *b)
+{
+    size_t i, n = ld_plugin_count(E);
+    sb_puts(b, "plugins ('help PLUGIN' for its backends and options):\n ");
+    for (i = 0; i < n; i++) sb_printf(b, " %s", ld_plugin_at(E, i)->table->name);
+    sb_puts(b, "\n");
+}
+
 /* Words in a free-form option's name that make it a server's business: what
  * views, monitors, logs, dumps or names a file, loads code (-dll_append,
  * -python), starts a debugger, or sets a thread count (PETSc's -*_view

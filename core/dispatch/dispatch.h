@@ -56,6 +56,9 @@ int cfg_show_key(silc_engine *E, const char *key, strbuf *b, int describe);
 /* A loaded plugin's backends and options with their types, defaults and
  * help, from its own option table (`help mumps`); -1 if no such plugin. */
 int cfg_describe_plugin(const silc_engine *E, const char *name, strbuf *b);
+/* The names of every plugin the engine can load, on one line after a
+ * heading that points to `help PLUGIN` (the end of a bare `help`). */
+void cfg_list_plugins(const silc_engine *E, strbuf *b);
 /* The built-in backend list of a dispatch class ("reference" for most). */
 const char *disp_default_list(const char *cls);
 /* Appends the table of server and session settings (for `help set`). */

@@ -1766,6 +1766,7 @@ static int exec_stmt_here(lang_ev *V, const ast_node *s, int *flow)
             sb_free(&b);
             return eng_error(V->E, "%s", err);
         }
+        if (!s->name) cfg_list_plugins(V->E, &b);
         return print_whole(V->E, &b, "help");
     }
     case ST_BREAK:

@@ -63,7 +63,7 @@ static const help_entry entries[] = {
      "running solves or changing the store"},
     {"tune", 1, "`tune on [N]`, `tune off`, `tune status`, `tune step`, `tune report [\"f.svg\"]`, `tune forget`",
      "the tuner: thread count and backend for a time loop (docs/tuner.md)"},
-    {"help", 1, "`help`, `help name`", "the statements and built-ins, or one of them"},
+    {"help", 1, "`help`, `help name`", "the statements, built-ins and loaded plugins, or one of them"},
     {"save load", 1, "`save \"f.h5\" [a b ...]`, `load \"f.h5\" [a b ...]`",
      "values to and from HDF5 (all names, or those given): dense as a 2-D dataset, CSR as a group with "
      "`data`, `indices`, `indptr` and a `shape` attribute (scipy's and anndata's layout), band as LAPACK "

@@ -125,11 +125,16 @@ int env_format_code(int format, int field)
     return format | (field == SILC_FIELD_COMPLEX ? SILC_COMPLEX : 0);
 }
 
+int env_complex_refusal(const char *name, const char *getter, char *err, size_t errlen)
+{
+    return check_fail(err, errlen, "'%s' is complex: this client did not ask for complex values "
+                      "(fetch it with %s, or take real(%s) or abs(%s))", name, getter, name, name);
+}
+
 int env_refuse_complex(const char *name, const silc_value *v, const char *getter, char *err, size_t errlen)
 {
     if (!v || v->field != SILC_FIELD_COMPLEX) return 0;
-    return check_fail(err, errlen, "'%s' is complex: this client did not ask for complex values "
-                      "(fetch it with %s, or take real(%s) or abs(%s))", name, getter, name, name);
+    return env_complex_refusal(name, getter, err, errlen);
 }
 
 /* Doubles per entry of an envelope's values. */

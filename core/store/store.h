@@ -359,6 +359,9 @@ int env_format_code(int format, int field);
  * GET, silc_get_rows); getter names the call that would fetch it
  * (silc_get_complex, silc_get_rows_complex).  0 for a real v. */
 int env_refuse_complex(const char *name, const silc_value *v, const char *getter, char *err, size_t errlen);
+/* That refusal's text, whatever v: a remote client compares silcd's answer
+ * to a GET with it to name its own getter instead of silc_get_complex. */
+int env_complex_refusal(const char *name, const char *getter, char *err, size_t errlen);
 
 /* Records a context-free failure message; returns -1. */
 int env_error(const char *fmt, ...)
