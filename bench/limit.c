@@ -78,6 +78,15 @@ static double (*now)(void) = bench_now;
 static const char *clock_name = "wall clock";
 
 
+/* Page faults of this process so far: an array that comes from fresh pages
+ * each time shows here, whatever the load. */
+static double minor_faults(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_minflt;
+}
+
 static int check(int rc, const char *what)
 {
     if (rc) fprintf(stderr, "limit: %s: %s\n", what, silc_context_errmsg(ctx));
@@ -106,7 +115,7 @@ static int spmv_row(int64_t k)
     silc_envelope_t A = {0};
     int64_t n = k * k;
     double *x = malloc((size_t)n * SPMV_XS * sizeof *x), *y = malloc((size_t)n * sizeof *y);
-    double ts[BATCHES], tc[BATCHES], ratio[BATCHES];
+    double ts[BATCHES], tc[BATCHES], ratio[BATCHES], faults[BATCHES];
     char text[SPMV_XS][32];
     int rc = !x || !y;
     if (rc) fprintf(stderr, "limit: out of memory\n");
@@ -128,9 +137,10 @@ static int spmv_row(int64_t k)
     reps = reps > 40000 ? 40000 : reps;
     reps = reps < SPMV_XS ? SPMV_XS : reps / SPMV_XS * SPMV_XS;
     for (int b = 0; !rc && b < BATCHES; b++) {
-        double t0 = now();
+        double f0 = minor_faults(), t0 = now();
         for (int r = 0; !rc && r < reps; r++) rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
         ts[b] = (now() - t0) / reps;
+        faults[b] = (minor_faults() - f0) / reps;
         t0 = now();
         for (int r = 0; r < reps; r++) {
             spmv_c(&A, x + (size_t)(r % SPMV_XS) * (size_t)n, y);
@@ -140,8 +150,9 @@ static int spmv_row(int64_t k)
         ratio[b] = ts[b] / tc[b];
     }
     if (!rc)
-        printf("%9lld %10lld %12.1f %12.1f %8.3f\n", (long long)A.nnz, (long long)n, bench_median(ts, BATCHES) * 1e6,
-               bench_median(tc, BATCHES) * 1e6, bench_median(ratio, BATCHES));
+        printf("%9lld %10lld %12.1f %12.1f %8.3f %12.2f\n", (long long)A.nnz, (long long)n,
+               bench_median(ts, BATCHES) * 1e6, bench_median(tc, BATCHES) * 1e6, bench_median(ratio, BATCHES),
+               bench_median(faults, BATCHES));
     silc_envelope_free(&A);
     free(x);
     free(y);
@@ -151,8 +162,9 @@ static int spmv_row(int64_t k)
 static int spmv(double max_nnz)
 {
     printf("SpMV y = A * x, 5-point matrix of a k x k grid; microseconds per product (%s), median of %d\n"
-           "alternating batches; ratio = SILC / plain C, median of the per-batch ratios\n", clock_name, BATCHES);
-    printf("%9s %10s %12s %12s %8s\n", "nnz", "rows", "SILC us", "plain C us", "ratio");
+           "alternating batches; ratio = SILC / plain C, median of the per-batch ratios; faults: page faults\n"
+           "per SILC statement\n", clock_name, BATCHES);
+    printf("%9s %10s %12s %12s %8s %12s\n", "nnz", "rows", "SILC us", "plain C us", "ratio", "faults/stmt");
     /* k x k grids of about 1e4, 1e5 and 1e6 nonzeros (5 k^2 of them), after
      * a 2 x 2 grid whose SILC column is the fixed cost of a statement */
     return spmv_row(2) || spmv_row(45) || (max_nnz >= 1e5 && spmv_row(141)) ||
@@ -176,13 +188,6 @@ static const char *const mode_settings[MODES] = {
     "set accuracy.condest = off; set solve.backward_error = deferred",
     "set accuracy.condest = auto; set solve.backward_error = deferred",
 };
-
-static double minor_faults(void)
-{
-    struct rusage u;
-    getrusage(RUSAGE_SELF, &u);
-    return (double)u.ru_minflt;
-}
 
 /* Seconds and page faults of one EXEC "x = A \ b" after a fresh PUT of A. */
 static int silc_solve_time(const silc_envelope_t *A, double *t, double *faults)
