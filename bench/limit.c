@@ -22,7 +22,11 @@
  * the memo's key, binding).  The two are timed in alternating batches (SILC, then C, then
  * SILC, ...) and the ratio taken batch by batch, so that load from other
  * processes shifts both sides of a ratio alike; the table shows the
- * medians.
+ * medians, and the page faults of a SILC statement (0 when its result
+ * array comes back from the allocator warm).  A last line times the 2 x 2
+ * grid's statement right after the C loop has streamed the 1e5 matrix
+ * through the caches: what a 1e5 product pays above the C loop is that
+ * statement from L3, not the back-to-back fixed cost.
  *
  * Part 2, dense solve: "x = A \ b" (a fresh PUT of A before each EXEC, so
  * every EXEC factors) against LAPACK's dgesv (LAPACKE_dgesv_work: the
