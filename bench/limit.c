@@ -22,7 +22,11 @@
  * the memo's key, binding).  The two are timed in alternating batches (SILC, then C, then
  * SILC, ...) and the ratio taken batch by batch, so that load from other
  * processes shifts both sides of a ratio alike; the table shows the
- * medians.
+ * medians, and the page faults of a SILC statement (0 when its result
+ * array comes back from the allocator warm).  A last line times the 2 x 2
+ * grid's statement right after the C loop has streamed the 1e5 matrix
+ * through the caches: what a 1e5 product pays above the C loop is that
+ * statement from L3, not the back-to-back fixed cost.
  *
  * Part 2, dense solve: "x = A \ b" (a fresh PUT of A before each EXEC, so
  * every EXEC factors) against LAPACK's dgesv (LAPACKE_dgesv_work: the
@@ -78,6 +82,15 @@ static double (*now)(void) = bench_now;
 static const char *clock_name = "wall clock";
 
 
+/* Page faults of this process so far: an array that comes from fresh pages
+ * each time shows here, whatever the load. */
+static double minor_faults(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_minflt;
+}
+
 static int check(int rc, const char *what)
 {
     if (rc) fprintf(stderr, "limit: %s: %s\n", what, silc_context_errmsg(ctx));
@@ -101,36 +114,44 @@ static void spmv_c(const silc_envelope_t *A, const double *x, double *y)
  * same vectors, so both sides read x from the same level of the cache. */
 #define SPMV_XS 80
 
+/* PUTs A and SPMV_XS vectors x0, x1, ... (A's m entries each, from x),
+ * writes the statements "y = A * xV" into text and runs each once. */
+static int put_operands(const silc_envelope_t *A, const double *x, char text[][32])
+{
+    int rc = check(silc_put(ctx, "A", A), "PUT A");
+    for (int v = 0; !rc && v < SPMV_XS; v++) {
+        silc_envelope_t xe = {0};
+        char name[16];
+        snprintf(name, sizeof name, "x%d", v);
+        snprintf(text[v], 32, "y = A * x%d", v);
+        rc = silc_envelope_vector(&xe, A->m, x + (size_t)v * (size_t)A->m) || check(silc_put(ctx, name, &xe), "PUT x");
+        silc_envelope_free(&xe);
+    }
+    for (int v = 0; !rc && v < SPMV_XS; v++) rc = check(silc_exec(ctx, text[v]), text[v]); /* warm */
+    return rc;
+}
+
 static int spmv_row(int64_t k)
 {
     silc_envelope_t A = {0};
     int64_t n = k * k;
     double *x = malloc((size_t)n * SPMV_XS * sizeof *x), *y = malloc((size_t)n * sizeof *y);
-    double ts[BATCHES], tc[BATCHES], ratio[BATCHES];
+    double ts[BATCHES], tc[BATCHES], ratio[BATCHES], faults[BATCHES];
     char text[SPMV_XS][32];
     int rc = !x || !y;
     if (rc) fprintf(stderr, "limit: out of memory\n");
     for (int64_t i = 0; !rc && i < n * SPMV_XS; i++) x[i] = 1.0 + (double)(i % 7) + (double)(i / n);
-    if (!rc) rc = diff_shifted_laplacian(2, k, diff2d_h(k), -1.0, &A);
-    if (!rc) rc = check(silc_put(ctx, "A", &A), "PUT A");
-    for (int v = 0; !rc && v < SPMV_XS; v++) {
-        silc_envelope_t xe = {0};
-        char name[16];
-        snprintf(name, sizeof name, "x%d", v);
-        snprintf(text[v], sizeof text[v], "y = A * x%d", v);
-        rc = silc_envelope_vector(&xe, n, x + (size_t)v * (size_t)n) || check(silc_put(ctx, name, &xe), "PUT x");
-        silc_envelope_free(&xe);
-    }
-    for (int v = 0; !rc && v < SPMV_XS; v++) rc = check(silc_exec(ctx, text[v]), text[v]); /* warm */
+    if (!rc) rc = diff_shifted_laplacian(2, k, diff2d_h(k), -1.0, &A) || put_operands(&A, x, text);
     /* about 0.1 s of work per batch and side, whole cycles (at most 40000
      * statements: the tiny row's products are all fixed cost) */
     int reps = (int)(2e7 / (double)(A.nnz > 0 ? A.nnz : 1));
     reps = reps > 40000 ? 40000 : reps;
     reps = reps < SPMV_XS ? SPMV_XS : reps / SPMV_XS * SPMV_XS;
     for (int b = 0; !rc && b < BATCHES; b++) {
-        double t0 = now();
+        double f0 = minor_faults(), t0 = now();
         for (int r = 0; !rc && r < reps; r++) rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
         ts[b] = (now() - t0) / reps;
+        faults[b] = (minor_faults() - f0) / reps;
         t0 = now();
         for (int r = 0; r < reps; r++) {
             spmv_c(&A, x + (size_t)(r % SPMV_XS) * (size_t)n, y);
@@ -140,23 +161,77 @@ static int spmv_row(int64_t k)
         ratio[b] = ts[b] / tc[b];
     }
     if (!rc)
-        printf("%9lld %10lld %12.1f %12.1f %8.3f\n", (long long)A.nnz, (long long)n, bench_median(ts, BATCHES) * 1e6,
-               bench_median(tc, BATCHES) * 1e6, bench_median(ratio, BATCHES));
+        printf("%9lld %10lld %12.1f %12.1f %8.3f %12.2f\n", (long long)A.nnz, (long long)n,
+               bench_median(ts, BATCHES) * 1e6, bench_median(tc, BATCHES) * 1e6, bench_median(ratio, BATCHES),
+               bench_median(faults, BATCHES));
     silc_envelope_free(&A);
     free(x);
     free(y);
     return rc || check(silc_exec(ctx, "clear"), "clear");
 }
 
+static int spmv_after_stream(void);
+
 static int spmv(double max_nnz)
 {
     printf("SpMV y = A * x, 5-point matrix of a k x k grid; microseconds per product (%s), median of %d\n"
-           "alternating batches; ratio = SILC / plain C, median of the per-batch ratios\n", clock_name, BATCHES);
-    printf("%9s %10s %12s %12s %8s\n", "nnz", "rows", "SILC us", "plain C us", "ratio");
+           "alternating batches; ratio = SILC / plain C, median of the per-batch ratios; faults: page faults\n"
+           "per SILC statement\n", clock_name, BATCHES);
+    printf("%9s %10s %12s %12s %8s %12s\n", "nnz", "rows", "SILC us", "plain C us", "ratio", "faults/stmt");
     /* k x k grids of about 1e4, 1e5 and 1e6 nonzeros (5 k^2 of them), after
      * a 2 x 2 grid whose SILC column is the fixed cost of a statement */
     return spmv_row(2) || spmv_row(45) || (max_nnz >= 1e5 && spmv_row(141)) ||
-           (max_nnz >= 1e6 && spmv_row(447));
+           (max_nnz >= 1e6 && spmv_row(447)) || (max_nnz >= 1e5 && spmv_after_stream());
+}
+
+/* The fixed cost of a statement as a product of about 1e5 nonzeros leaves
+ * the caches: the statement on the 2 x 2 grid (all fixed cost) right after
+ * the C loop has streamed the k = 141 matrix (1.7 MB, more than an L2)
+ * through them -- the median of the per-batch differences between batches
+ * of (C loop, statement) and of the C loop alone -- against the same
+ * statement back to back, whose code and data stay cached (the first
+ * row's SILC column).  The first is what a 1e5 product pays above the C
+ * loop's time (docs/overhead.md). */
+static int spmv_after_stream(void)
+{
+    silc_envelope_t A = {0}, B = {0};
+    const int64_t kb = 141, nb = kb * kb, reps = 800;
+    double *x = malloc(4 * SPMV_XS * sizeof *x), *xb = malloc((size_t)nb * sizeof *xb),
+           *yb = malloc((size_t)nb * sizeof *yb);
+    double alone[BATCHES], diff[BATCHES];
+    char text[SPMV_XS][32];
+    int rc = !x || !xb || !yb;
+    if (rc) fprintf(stderr, "limit: out of memory\n");
+    for (int64_t i = 0; !rc && i < 4 * SPMV_XS; i++) x[i] = 1.0 + (double)i;
+    for (int64_t i = 0; !rc && i < nb; i++) xb[i] = 1.0 + (double)(i % 7);
+    if (!rc)
+        rc = diff_shifted_laplacian(2, 2, diff2d_h(2), -1.0, &A) ||
+             diff_shifted_laplacian(2, kb, diff2d_h(kb), -1.0, &B) || put_operands(&A, x, text);
+    for (int b = 0; !rc && b < BATCHES; b++) {
+        double t0 = now(), without;
+        for (int r = 0; r < reps; r++) {
+            spmv_c(&B, xb, yb);
+            sink = yb[r % nb];
+        }
+        without = now() - t0;
+        t0 = now();
+        for (int r = 0; !rc && r < reps; r++) {
+            spmv_c(&B, xb, yb);
+            sink = yb[r % nb];
+            rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
+        }
+        diff[b] = (now() - t0 - without) / (double)reps;
+        t0 = now();
+        for (int r = 0; !rc && r < reps; r++) rc = check(silc_exec(ctx, text[r % SPMV_XS]), "y = A * x");
+        alone[b] = (now() - t0) / (double)reps;
+    }
+    if (!rc)
+        printf("the 2 x 2 grid's statement: %.2f us back to back, %.2f us right after a C loop over %lld nonzeros\n",
+               bench_median(alone, BATCHES) * 1e6, bench_median(diff, BATCHES) * 1e6, (long long)B.nnz);
+    silc_envelope_free(&A);
+    silc_envelope_free(&B);
+    free(x), free(xb), free(yb);
+    return rc || check(silc_exec(ctx, "clear"), "clear");
 }
 
 /* ---- part 2: dense solve ------------------------------------------------------ */
@@ -176,13 +251,6 @@ static const char *const mode_settings[MODES] = {
     "set accuracy.condest = off; set solve.backward_error = deferred",
     "set accuracy.condest = auto; set solve.backward_error = deferred",
 };
-
-static double minor_faults(void)
-{
-    struct rusage u;
-    getrusage(RUSAGE_SELF, &u);
-    return (double)u.ru_minflt;
-}
 
 /* Seconds and page faults of one EXEC "x = A \ b" after a fresh PUT of A. */
 static int silc_solve_time(const silc_envelope_t *A, double *t, double *faults)

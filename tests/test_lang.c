@@ -709,6 +709,23 @@ static void test_info(void)
     CHECK(silc_exec(c, "z = v + 1\ninfo z") == 0, "info z");
     CHECK(strstr(captured, "  statement: z = v + 1\n") && strstr(captured, "  no solve in this statement\n"),
           "info without solve: %s", captured);
+    /* Rebinding a name writes its record in place (eval.c's bind): each
+     * statement's own text, longer or shorter than the one before, and no
+     * solve report left over from an earlier statement. */
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = v + 1\ninfo y") == 0 && strstr(captured, "  statement: y = v + 1\n") &&
+              strstr(captured, "  no solve in this statement\n") && !strstr(captured, "backward error"),
+          "info after a solve's name is rebound without one: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = v + v + v + 1\ninfo y") == 0 && strstr(captured, "  statement: y = v + v + v + 1\n"),
+          "info of a longer statement: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = v\ninfo y") == 0 && strstr(captured, "  statement: y = v\n"),
+          "info of a shorter statement: %s", captured);
+    captured[0] = 0;
+    CHECK(silc_exec(c, "y = D \\ v\ninfo y") == 0 && strstr(captured, "  statement: y = D \\ v\n") &&
+              strstr(captured, "  backend: reference\n") && !strstr(captured, "no solve"),
+          "info of a solve again: %s", captured);
     CHECK(silc_exec(c, "info vv") != 0 &&
               !strcmp(silc_context_errmsg(c), "undefined name 'vv' (did you mean 'v'?)"),
           "info of a missing name: %s", silc_context_errmsg(c));

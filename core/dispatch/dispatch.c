@@ -31,6 +31,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1183,7 +1184,8 @@ static int walk(silc_engine *E, silc_call *call, const char *const *chain, int n
                           b->full_name);
                 continue;
             }
-            memset(&ctx, 0, sizeof ctx);
+            memset(&ctx, 0, offsetof(host_call_ctx, err)); /* err is a string (dispatch.h) */
+            ctx.err[0] = '\0';
             ctx.E = E;
             ctx.backend = b;
             call->host_private = &ctx;

@@ -170,9 +170,12 @@ void host_set_threads(int nthreads);
 typedef struct host_call_ctx {
     silc_engine *E;
     const ld_backend *backend;      /* backend running the call (options prefix) */
-    char err[1024];
     int status;
     int collective;                 /* runs on the row blocks of every rank (dist.h) */
+    /* Last: a string, so a call's context zeroes what comes before it and
+     * empties it (dispatch.c's walk; zeroing its 1 KB too wrote 17 cache
+     * lines a call: docs/overhead.md, SpMV). */
+    char err[1024];
 } host_call_ctx;
 
 /* ---- dispatch.c ------------------------------------------------------------ */

@@ -19,6 +19,7 @@
 #include "dist.h"
 
 #include <float.h>
+#include <stddef.h>
 #include <complex.h>
 #include <math.h>
 #include <stdio.h>
@@ -1008,32 +1009,25 @@ static char *stmt_text(const lang_ev *V, const ast_node *n)
     return s;
 }
 
-/* The text of stmt for name's new `info` record.  A loop rebinds a name by
- * a statement of the same length or shorter (often the same one) each
- * time: the buffer the record holds is taken over and written again (the
- * record is then found by eng_info_take, which cannot fail), not a new copy
- * made and the old one freed -- a malloc and a free a statement. */
-static char *bind_text_for(const lang_ev *V, const ast_node *stmt, const char *name)
-{
-    size_t len = stmt->end - stmt->start;
-    eng_info *old = eng_info_get(V->E, name);
-    if (old && old->statement && strlen(old->statement) >= len) {
-        char *s = old->statement;
-        old->statement = NULL;
-        memcpy(s, V->src + stmt->start, len);
-        s[len] = 0;
-        return s;
-    }
-    return stmt_text(V, stmt);
-}
-
 _Static_assert(sizeof ((eng_info *)0)->backends == sizeof ((lang_ev *)0)->backends,
                "bind copies the statement's backends whole");
 
-/* Binds name to v (taking over the caller's reference) and records how it was computed. */
+/* Binds name to v (taking over the caller's reference) and records how it
+ * was computed.
+ *
+ * The record `info` shows is written in place: a loop rebinds a name each
+ * step, and building a 1.2 KB record on the stack to copy it over the old
+ * one wrote 40 cache lines a statement, which a product that has streamed
+ * its matrix through the cache finds evicted (docs/overhead.md, SpMV).  The
+ * statement's text goes into the buffer the record holds when it fits (a
+ * loop's statement is often the same each time), else into a new one; the
+ * report is copied only for a statement that solved (`info` reads it only
+ * then: has_solve). */
 static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *v, double t0)
 {
-    eng_info info;
+    size_t len = stmt->end - stmt->start;
+    eng_info *rec;
+    char *text;
     int rc;
     if (V->explain) {
         char shape[48];
@@ -1043,37 +1037,50 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
         val_release(v);
         return 0;
     }
-    /* The record `info` shows is made first, so that running out of memory
-     * leaves neither a binding without its record nor a record without
-     * its binding: rebinding a name never allocates, and a new name has no
-     * record to restore.  (An update in place made both beforehand,
+    /* What can fail is done first, so that running out of memory leaves
+     * neither a binding without its record nor a record without its
+     * binding: the text, then the record of a new name (rebinding a name
+     * allocates nothing more).  (An update in place made both beforehand,
      * bind_reserve, since it cannot be undone.) */
     if (V->E->warnings.failed) {   /* a result without its warning would be trusted */
         val_release(v);
         return eng_error(V->E, "out of memory recording a warning of '%s'", name);
     }
-    memset(&info, 0, sizeof info);
-    info.statement = V->bind_text ? V->bind_text : bind_text_for(V, stmt, name);
+    rec = eng_info_get(V->E, name);
+    text = V->bind_text;
     V->bind_text = NULL;
-    if (!info.statement) {
+    if (!text && !(rec && rec->statement && strlen(rec->statement) >= len) && !(text = stmt_text(V, stmt))) {
         val_release(v);
         return eng_error(V->E, "out of memory binding '%s'", name);
     }
-    info.has_solve = V->has_solve;
-    if (V->has_solve) info.report = V->report;
-    info.pending = V->pending; /* handed over */
-    memset(&V->pending, 0, sizeof V->pending);
-    info.seconds = util_now() - t0;
-    memcpy(info.backends, V->backends, sizeof info.backends); /* the same size, terminated */
-    if (V->E->dist) {
-        info.ranks = V->E->dist->size;
-        info.moved_matrix = V->E->dist->moved_matrix - V->moved0[0];
-        info.moved_vector = V->E->dist->moved_vector - V->moved0[1];
+    if (!rec) {
+        if (eng_info_reserve(V->E, name)) { /* "out of memory recording info for 'x'" */
+            free(text);
+            val_release(v);
+            return -1;
+        }
+        rec = eng_info_get(V->E, name); /* the record just made, zeroed */
     }
-    rc = eng_info_take(V->E, name, &info);
-    if (rc) {
-        val_release(v);
-        return -1;   /* "out of memory recording info for 'x'" */
+    if (text) {
+        free(rec->statement);
+        rec->statement = text;
+    } else {
+        memcpy(rec->statement, V->src + stmt->start, len);
+        rec->statement[len] = 0;
+    }
+    rec->has_solve = V->has_solve;
+    if (V->has_solve) rec->report = V->report;
+    eng_pending_release(&rec->pending);
+    rec->pending = V->pending; /* handed over */
+    memset(&V->pending, 0, sizeof V->pending);
+    rec->seconds = util_now() - t0;
+    memcpy(rec->backends, V->backends, sizeof rec->backends); /* the same size, terminated */
+    rec->ranks = 0;
+    rec->moved_matrix = rec->moved_vector = 0;
+    if (V->E->dist) {
+        rec->ranks = V->E->dist->size;
+        rec->moved_matrix = V->E->dist->moved_matrix - V->moved0[0];
+        rec->moved_vector = V->E->dist->moved_vector - V->moved0[1];
     }
     rc = store_set(&V->E->store, name, v);
     val_release(v);
@@ -1992,7 +1999,7 @@ int lang_exec(silc_engine *E, const char *text)
                              "or PUT large data as a value", len, E->max_statement_bytes);
     }
     if (program_for(E, text, &prog)) return -1;
-    memset(&V, 0, sizeof V);
+    memset(&V, 0, offsetof(lang_ev, report)); /* the report is written by the solve that sets has_solve */
     V.E = E;
     V.src = prog->text;
     V.t_first = t0;

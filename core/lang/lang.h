@@ -140,7 +140,6 @@ typedef struct lang_ev {
     int in_subscript;
     int has_solve;         /* the current statement ran a solve */
     uint64_t moved0[2];    /* dist.h's byte counters (matrices, vectors) when the statement began */
-    silc_report report;    /* its last solve report */
     eng_pending pending;   /* its operands when its backward error is deferred */
     char backends[128];    /* solve backends of the current statement */
     char *bind_text;       /* the statement's text, made before an update in place */
@@ -154,6 +153,10 @@ typedef struct lang_ev {
     silc_value *warm_held; /* the reference to the guess that exec_assign releases */
     int profile;           /* core.profile = on when the exec began: time statements and calls */
     double t_first;        /* the exec's start on the clock, for its first statement; then 0 */
+    /* Last, and not zeroed by lang_exec: 1.2 KB that a statement without a
+     * solve never reads (has_solve says when it holds one), whose zeroing
+     * was 19 cache lines written per EXEC (docs/overhead.md, SpMV). */
+    silc_report report;    /* the statement's last solve report, when has_solve */
 } lang_ev;
 
 /* Operand description for messages: "'A'" when the node is short source text,

@@ -257,9 +257,10 @@ int64_t val_attach_bytes(const silc_value *v);
 
 /* ---- the store ------------------------------------------------------------- */
 typedef struct store_entry {
-    char *name;
     silc_value *value;
     struct store_entry *next;
+    size_t hash;            /* of name (value.c): compared before the name */
+    char name[];            /* in the entry: a lookup reads one allocation, not two */
 } store_entry;
 
 typedef struct silc_store {

@@ -1560,7 +1560,6 @@ void store_clear(silc_store *s)
             next = e->next;
             e->value->bindings--;
             val_release(e->value);
-            free(e->name);
             free(e);
         }
         s->buckets[b] = NULL;
@@ -1577,10 +1576,13 @@ void store_free(silc_store *s)
     s->nbuckets = 0;
 }
 
-static store_entry **store_slot(const silc_store *s, const char *name)
+/* Where name's entry is, or would go, in the chain of its hash.  An entry
+ * of another name in the chain is passed on its hash alone, without
+ * reading its name. */
+static store_entry **store_slot(const silc_store *s, const char *name, size_t hash)
 {
-    store_entry **pe = &s->buckets[hash_name(name) % s->nbuckets];
-    while (*pe && strcmp((*pe)->name, name) != 0) pe = &(*pe)->next;
+    store_entry **pe = &s->buckets[hash % s->nbuckets];
+    while (*pe && ((*pe)->hash != hash || strcmp((*pe)->name, name) != 0)) pe = &(*pe)->next;
     return pe;
 }
 
@@ -1588,7 +1590,7 @@ silc_value *store_get(const silc_store *s, const char *name)
 {
     store_entry **pe;
     if (!s || !s->buckets || !name) return NULL;
-    pe = store_slot(s, name);
+    pe = store_slot(s, name, hash_name(name));
     return *pe ? (*pe)->value : NULL;
 }
 
@@ -1602,7 +1604,7 @@ static void store_grow(silc_store *s)
     for (b = 0; b < s->nbuckets; b++) {
         store_entry *e = s->buckets[b], *next;
         for (; e; e = next) {
-            size_t h = hash_name(e->name) % nb;
+            size_t h = e->hash % nb;
             next = e->next;
             e->next = nbk[h];
             nbk[h] = e;
@@ -1616,8 +1618,10 @@ static void store_grow(silc_store *s)
 int store_set(silc_store *s, const char *name, silc_value *v)
 {
     store_entry **pe, *e;
+    size_t hash, len;
     if (!s || !s->buckets || !name || !v) return -1;
-    pe = store_slot(s, name);
+    hash = hash_name(name);
+    pe = store_slot(s, name, hash);
     if (*pe) {
         silc_value *old = (*pe)->value;
         (*pe)->value = val_retain(v);
@@ -1626,13 +1630,11 @@ int store_set(silc_store *s, const char *name, silc_value *v)
         val_release(old);
         return 0;
     }
-    e = malloc(sizeof *e);
+    len = strlen(name);
+    e = malloc(sizeof *e + len + 1);
     if (!e) return -1;
-    e->name = util_strdup(name);
-    if (!e->name) {
-        free(e);
-        return -1;
-    }
+    memcpy(e->name, name, len + 1);
+    e->hash = hash;
     e->value = val_retain(v);
     v->bindings++;
     e->next = NULL;
@@ -1645,13 +1647,12 @@ int store_remove(silc_store *s, const char *name)
 {
     store_entry **pe, *e;
     if (!s || !s->buckets || !name) return 1;
-    pe = store_slot(s, name);
+    pe = store_slot(s, name, hash_name(name));
     if (!*pe) return 1;
     e = *pe;
     *pe = e->next;
     e->value->bindings--;
     val_release(e->value);
-    free(e->name);
     free(e);
     s->count--;
     return 0;
