@@ -59,7 +59,7 @@ foreach(h lang config)
             -I${PROJECT_SOURCE_DIR}/core/include ${_core_inc}
             -I${PROJECT_SOURCE_DIR}/plugins -I${PROJECT_SOURCE_DIR}/plugin-reference ${_fz_inih_flags}
             ${_fz_dir}/fuzz_${h}.c ${_fz_engine} ${INIH_LDFLAGS} -ldl -lm -lpthread -o ${_fz}
-    DEPENDS ${_fz_dir}/fuzz_${h}.c ${_fz_engine} VERBATIM)
+    DEPENDS ${_fz_dir}/fuzz_${h}.c ${_fz_engine} ${SILC_FUZZ_HEADERS} VERBATIM)
   add_custom_target(fuzz_${h}_libfuzzer ALL DEPENDS ${_fz})
   # libFuzzer adds what it finds to its first directory: a scratch one.
   file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fuzz-corpus-${h})

@@ -67,7 +67,7 @@ if(SILC_CLANG AND NOT SILC_SANITIZE)
       COMMAND ${SILC_CLANG} -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined
               -I${PROJECT_SOURCE_DIR}/core/include ${_core_inc}
               -I${PROJECT_SOURCE_DIR}/plugins ${_src} -lm -o ${_fz}
-      DEPENDS ${_src} VERBATIM)
+      DEPENDS ${_src} ${SILC_FUZZ_HEADERS} VERBATIM)
     add_custom_target(fuzz_frame_libfuzzer ALL DEPENDS ${_fz})
     # libFuzzer adds what it finds to its first directory: a scratch one.
     file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fuzz-corpus)
