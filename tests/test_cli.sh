@@ -200,6 +200,17 @@ run "$SILC" --put A=missing.mtx -e 'x = 1'
 check "--put of a missing file fails" status_is 1
 check "--put error names the option" has err "silc: --put A=missing.mtx"
 
+# Values Matrix Market does not allow in a real field (overflow to inf, inf,
+# nan) are refused, naming line and column, unless the user asks.
+printf '%%%%MatrixMarket matrix coordinate real general\n2 1 2\n1 1 1e400\n2 1 -inf\n' >inf.mtx
+run "$SILC" --put A=inf.mtx -e 'x = 1'
+check "--put of an overflowing value: status 1" status_is 1
+check "--put of an overflowing value" has err "inf.mtx:3:5: value '1e400' overflows the doubles"
+run "$SILC" --put-allow-nonfinite --put A=inf.mtx -e 'B = A;' --get B
+check "--put-allow-nonfinite: status 0" status_is 0
+check "--put-allow-nonfinite: 1e400 read as inf" grep -q -x '1 1 inf' out
+check "--put-allow-nonfinite: -inf kept" grep -q -x '2 1 -inf' out
+
 # ---- usage -----------------------------------------------------------------------------
 run "$SILC" --bogus
 check "unknown option is a usage error" status_is 2
@@ -244,6 +255,22 @@ head -c 68000000 /dev/zero | tr '\0' '\n' >big.silc
 run timeout 20 "$SILC" run big.silc
 check "a script over 64 MiB" has err "'big.silc' is over 64 MiB: not a script silc runs"
 rm -f big.silc
+# Embedded, `load` and the configuration read the caller's files the same
+# way (a silcd session loads only beneath its --data-dir, and the server's
+# configuration applies): a FIFO or a device is refused before any read, a
+# directory as the configuration too (SILC_CONFIG=DIR was silently accepted).
+if [ -z "${SILC_SERVER:-}" ]; then
+    run timeout 10 "$SILC" -e 'load "fifo"'
+    check "load of a fifo with no writer" has err "silc: load: 'fifo' is not a regular file"
+    run timeout 10 "$SILC" -e 'load "/dev/zero"'
+    check "load of a device" has err "silc: load: '/dev/zero' is not a regular file"
+    mkdir confdir
+    run env SILC_CONFIG=confdir timeout 10 "$SILC" -e 'x = 1'
+    check "SILC_CONFIG a directory: status 1" status_is 1
+    check "SILC_CONFIG a directory" has err "silc: config file confdir is not a regular file"
+    run timeout 10 "$SILC" --config fifo -e 'x = 1'
+    check "--config a fifo" has err "silc: config file fifo is not a regular file"
+fi
 printf 'x = 6 * 7\n' | (run timeout 10 "$SILC" run - --get x; same_numbers out "42")
 check "run - from a pipe" [ $? -eq 0 ]
 
