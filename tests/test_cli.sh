@@ -211,6 +211,17 @@ check "--put-allow-nonfinite: status 0" status_is 0
 check "--put-allow-nonfinite: 1e400 read as inf" grep -q -x '1 1 inf' out
 check "--put-allow-nonfinite: -inf kept" grep -q -x '2 1 -inf' out
 
+# A client's time values are 0 (none) or 1 ms to a year (1e-7 was rounded up
+# to 1 ms without a word, 1e30 refused without naming the maximum).
+if [ -n "${SILC_SERVER:-}" ]; then
+    run env SILC_IO_TIMEOUT=1e30 "$SILC" -e 'x = 1'
+    check "SILC_IO_TIMEOUT=1e30" has err "SILC_IO_TIMEOUT = '1e30': expected 0 (no timeout) or seconds from 0.001 to 31536000"
+    run env SILC_EXEC_TIMEOUT=0.0000001 "$SILC" -e 'x = 1'
+    check "SILC_EXEC_TIMEOUT=1e-7" has err "SILC_EXEC_TIMEOUT = '0.0000001': expected 0 (no timeout) or seconds"
+    run env SILC_EXEC_TIMEOUT=0 "$SILC" -e 'x = 1;' --get x
+    check "SILC_EXEC_TIMEOUT=0 is no timeout" same_numbers out "1"
+fi
+
 # ---- usage -----------------------------------------------------------------------------
 run "$SILC" --bogus
 check "unknown option is a usage error" status_is 2

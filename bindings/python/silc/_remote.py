@@ -62,6 +62,11 @@ def _token_from_env():
     return None
 
 
+# A timeout other than 0 (none) lies in [1 ms, a year], as in the C client:
+# 1e30 reached the socket as an OverflowError.
+TIMEOUT_MIN, TIMEOUT_MAX = 0.001, 31536000.0
+
+
 def _seconds(value, var, default):
     """A timeout in seconds from the argument, else the variable var, else
     default; 0 means none (None to the socket)."""
@@ -74,11 +79,11 @@ def _seconds(value, var, default):
                 value = float(text)
             except ValueError:
                 value = -1
-            if not value >= 0:
-                raise Error("%s = '%s': expected seconds (a number >= 0; 0 for no timeout)"
+            if not (value == 0 or TIMEOUT_MIN <= value <= TIMEOUT_MAX):
+                raise Error("%s = '%s': expected 0 (no timeout) or seconds from 0.001 to 31536000"
                             % (var, text))
-    if value is not None and value < 0:
-        raise Error("a timeout must be >= 0 seconds (0 for none), not %r" % value)
+    if value is not None and not (value == 0 or TIMEOUT_MIN <= value <= TIMEOUT_MAX):
+        raise Error("a timeout must be 0 (none) or seconds from 0.001 to 31536000, not %r" % value)
     return value or None
 
 
