@@ -20,6 +20,7 @@ closed and later calls say so.
 import os
 import signal
 import socket
+import stat
 import struct
 import sys
 import threading
@@ -54,11 +55,19 @@ def _token_from_env():
         return tok
     path = os.environ.get("SILC_TOKEN_FILE")
     if path:
+        # A regular file only, opened without blocking and read up to 8 KiB:
+        # a FIFO with no writer hung the client, /dev/zero filled its memory.
         try:
-            with open(path) as f:
-                return f.readline().rstrip("\r\n")
+            fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+            try:
+                if not stat.S_ISREG(os.fstat(fd).st_mode):
+                    raise Error("SILC_TOKEN_FILE '%s' is not a regular file" % path)
+                data = os.read(fd, 8192)
+            finally:
+                os.close(fd)
         except OSError as e:
             raise Error("cannot read SILC_TOKEN_FILE '%s': %s" % (path, e.strerror)) from None
+        return data.decode("utf-8", "replace").split("\n", 1)[0].rstrip("\r")
     return None
 
 

@@ -408,9 +408,15 @@ public final class SILC implements AutoCloseable {
         if (t != null && !t.isEmpty()) return t;
         String f = System.getenv("SILC_TOKEN_FILE");
         if (f == null || f.isEmpty()) return "";
-        try {
-            List<String> lines = Files.readAllLines(Path.of(f), StandardCharsets.UTF_8);
-            return lines.isEmpty() ? "" : lines.get(0);
+        // A regular file only, read up to 8 KiB: a FIFO with no writer hung
+        // the client, /dev/zero filled its memory.
+        Path p = Path.of(f);
+        if (Files.exists(p) && !Files.isRegularFile(p))
+            throw new SILCException("SILC_TOKEN_FILE '" + f + "' is not a regular file");
+        try (java.io.InputStream in = Files.newInputStream(p)) {
+            String text = new String(in.readNBytes(8192), StandardCharsets.UTF_8);
+            int end = text.indexOf('\n');
+            return (end < 0 ? text : text.substring(0, end)).replaceAll("\r$", "");
         } catch (IOException e) {
             throw new SILCException("SILC_TOKEN_FILE '" + f + "': " + e.getMessage(), e);
         }
