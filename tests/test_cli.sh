@@ -258,6 +258,9 @@ check "help of an unknown word" has err "no statement or built-in 'sparce' (did 
 mkfifo fifo
 run timeout 10 "$SILC" --put A=fifo -e 'x = 1'
 check "--put of a fifo with no writer" has err "--put A=fifo: fifo:1: empty file (expected a %%MatrixMarket banner)"
+mkdir adir
+run "$SILC" --put A=adir -e 'x = 1'
+check "--put of a directory" has err "--put A=adir: adir:1: cannot read: Is a directory"
 run timeout 10 "$SILC" run fifo
 check "run a fifo with no writer: nothing to run" status_is 0
 run timeout 10 "$SILC" run /dev/zero
