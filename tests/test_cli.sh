@@ -220,6 +220,28 @@ run "$SILC" --put A=missing.mtx -e 'x = 1'
 check "--put of a missing file fails" status_is 1
 check "--put error names the option" has err "silc: --put A=missing.mtx"
 
+# Values Matrix Market does not allow in a real field (overflow to inf, inf,
+# nan) are refused, naming line and column, unless the user asks.
+printf '%%%%MatrixMarket matrix coordinate real general\n2 1 2\n1 1 1e400\n2 1 -inf\n' >inf.mtx
+run "$SILC" --put A=inf.mtx -e 'x = 1'
+check "--put of an overflowing value: status 1" status_is 1
+check "--put of an overflowing value" has err "inf.mtx:3:5: value '1e400' overflows the doubles"
+run "$SILC" --put-allow-nonfinite --put A=inf.mtx -e 'B = A;' --get B
+check "--put-allow-nonfinite: status 0" status_is 0
+check "--put-allow-nonfinite: 1e400 read as inf" grep -q -x '1 1 inf' out
+check "--put-allow-nonfinite: -inf kept" grep -q -x '2 1 -inf' out
+
+# A client's time values are 0 (none) or 1 ms to a year (1e-7 was rounded up
+# to 1 ms without a word, 1e30 refused without naming the maximum).
+if [ -n "${SILC_SERVER:-}" ]; then
+    run env SILC_IO_TIMEOUT=1e30 "$SILC" -e 'x = 1'
+    check "SILC_IO_TIMEOUT=1e30" has err "SILC_IO_TIMEOUT = '1e30': expected 0 (no timeout) or seconds from 0.001 to 31536000"
+    run env SILC_EXEC_TIMEOUT=0.0000001 "$SILC" -e 'x = 1'
+    check "SILC_EXEC_TIMEOUT=1e-7" has err "SILC_EXEC_TIMEOUT = '0.0000001': expected 0 (no timeout) or seconds"
+    run env SILC_EXEC_TIMEOUT=0 "$SILC" -e 'x = 1;' --get x
+    check "SILC_EXEC_TIMEOUT=0 is no timeout" same_numbers out "1"
+fi
+
 # ---- usage -----------------------------------------------------------------------------
 run "$SILC" --bogus
 check "unknown option is a usage error" status_is 2
@@ -256,6 +278,9 @@ check "help of an unknown word" has err "no statement or built-in 'sparce' (did 
 mkfifo fifo
 run timeout 10 "$SILC" --put A=fifo -e 'x = 1'
 check "--put of a fifo with no writer" has err "--put A=fifo: fifo:1: empty file (expected a %%MatrixMarket banner)"
+mkdir adir
+run "$SILC" --put A=adir -e 'x = 1'
+check "--put of a directory" has err "--put A=adir: adir:1: cannot read: Is a directory"
 run timeout 10 "$SILC" run fifo
 check "run a fifo with no writer: nothing to run" status_is 0
 run timeout 10 "$SILC" run /dev/zero
@@ -264,6 +289,22 @@ head -c 68000000 /dev/zero | tr '\0' '\n' >big.silc
 run timeout 20 "$SILC" run big.silc
 check "a script over 64 MiB" has err "'big.silc' is over 64 MiB: not a script silc runs"
 rm -f big.silc
+# Embedded, `load` and the configuration read the caller's files the same
+# way (a silcd session loads only beneath its --data-dir, and the server's
+# configuration applies): a FIFO or a device is refused before any read, a
+# directory as the configuration too (SILC_CONFIG=DIR was silently accepted).
+if [ -z "${SILC_SERVER:-}" ]; then
+    run timeout 10 "$SILC" -e 'load "fifo"'
+    check "load of a fifo with no writer" has err "silc: load: 'fifo' is not a regular file"
+    run timeout 10 "$SILC" -e 'load "/dev/zero"'
+    check "load of a device" has err "silc: load: '/dev/zero' is not a regular file"
+    mkdir confdir
+    run env SILC_CONFIG=confdir timeout 10 "$SILC" -e 'x = 1'
+    check "SILC_CONFIG a directory: status 1" status_is 1
+    check "SILC_CONFIG a directory" has err "silc: config file confdir is not a regular file"
+    run timeout 10 "$SILC" --config fifo -e 'x = 1'
+    check "--config a fifo" has err "silc: config file fifo is not a regular file"
+fi
 printf 'x = 6 * 7\n' | (run timeout 10 "$SILC" run - --get x; same_numbers out "42")
 check "run - from a pipe" [ $? -eq 0 ]
 

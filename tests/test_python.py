@@ -258,10 +258,14 @@ except silc.Error as e:
     check(refusing in str(e) and "refused" in str(e), "refusing host: %s" % e)
 
 # Limits given wrong are errors naming them.
-expect_error(lambda: silc.Session(missing, timeout=-1), "a timeout must be >= 0", "timeout=-1")
-os.environ["SILC_IO_TIMEOUT"] = "soon"
-expect_error(lambda: silc.Session(missing), "SILC_IO_TIMEOUT = 'soon': expected seconds",
-             "SILC_IO_TIMEOUT=soon")
+expect_error(lambda: silc.Session(missing, timeout=-1),
+             "a timeout must be 0 (none) or seconds from 0.001 to 31536000, not -1", "timeout=-1")
+# Time values outside [1 ms, a year] (issue 32): 1e30 was an OverflowError
+# from the socket, 1e-7 a timeout no reply can meet.
+for text in ["soon", "1e30", "inf", "0.0000001", "-1"]:
+    os.environ["SILC_IO_TIMEOUT"] = text
+    expect_error(lambda: silc.Session(missing), "SILC_IO_TIMEOUT = '%s': expected 0 (no timeout) or "
+                 "seconds from 0.001 to 31536000" % text, "SILC_IO_TIMEOUT=%s" % text)
 del os.environ["SILC_IO_TIMEOUT"]
 
 # __version__ is the CMake project's, and help(silc.Session) shows examples.

@@ -122,6 +122,11 @@ static const row rows[] = {
     LANG("x = dense(eye(1e7))", "reference: a 10000000x10000000 dense value needs 800000000000000 bytes "
          "(727.6 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "
          "(the machine's memory)"),
+    /* a band value's storage, (kl + ku + 1) x n, is claimed before it is
+     * allocated, by band() as by every band constructor (issue 32) */
+    LANG("x = band(M, 1e12, 1)", "reference: a 2x2 band value needs 16000000000064 bytes (14.6 TiB), "
+         "over the limit of # bytes (# GiB) by # TiB: the most one value may hold (the machine's "
+         "memory)"),
     /* a work array is held to the same limit (fuzz_lang: calloc'd 4.4 TiB before) */
     LANG("x = max(eye(2, 61e10))", "reference: a plugin's work array needs 4880000000008 bytes "
          "(4.4 TiB), over the limit of # bytes (# GiB) by # TiB: the most one value may hold "

@@ -2,7 +2,8 @@
  * test_server.c -- silcd's process model under faults (issue 14): a session
  * that crashes loses only itself, sessions compute at once, connections
  * that never speak cannot lock real clients out, and killed clients, a
- * killed server and SIGTERM lose nothing that was promised.
+ * killed server and SIGTERM lose nothing that was promised; a plugin file
+ * that cannot be loaded is warned about once in silcd's log (issue 32).
  *
  * Every server here is private (remote_util.h), on loopback or a Unix
  * socket in a private directory; every wait is bounded and every loop
@@ -554,6 +555,75 @@ static void test_huge_page_heap(void)
     free(keep);
 }
 
+/* ---- 8. a plugin that cannot be loaded is warned about once ---------- */
+
+/* Occurrences of sub in the file at path (at most its first 64 KiB); -1 if
+ * it cannot be read. */
+static int count_in_file(const char *path, const char *sub)
+{
+    static char text[65536];
+    FILE *f = fopen(path, "r");
+    size_t len;
+    int n = 0;
+    const char *p;
+    if (!f) return -1;
+    len = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[len] = '\0';
+    for (p = text; (p = strstr(p, sub)); p += strlen(sub)) n++;
+    return n;
+}
+
+/* A file on silcd's plugin path that is not a shared object: its log says
+ * so once, however many sessions and commands meet it (issue 32: three
+ * times per command), and every session still computes. */
+static void test_plugin_warned_once(const char *plugin_dir)
+{
+    test_server srv;
+    char dir[512], bogus[600], conf[600], logf[300], want[700];
+    FILE *f;
+    int i, n;
+    snprintf(dir, sizeof dir, "%s/bogus-plugin", plugin_dir);
+    snprintf(bogus, sizeof bogus, "%s/libsilc_plugin_bogus.so", dir);
+    snprintf(conf, sizeof conf, "%s/bogus.conf", plugin_dir);
+    mkdir(dir, 0700);
+    if (!(f = fopen(bogus, "w")) || fputs("not a shared object\n", f) < 0 || fclose(f)) {
+        CHECK(0, "cannot write %s", bogus);
+        return;
+    }
+    if (!(f = fopen(conf, "w")) || fprintf(f, "[core]\nplugin_path = %s\n", dir) < 0 || fclose(f)) {
+        CHECK(0, "cannot write %s", conf);
+        return;
+    }
+    if (server_start(&srv, NULL, (const char *const[]){"--config", conf, NULL})) {
+        CHECK(0, "silcd with a bogus plugin file did not start");
+        return;
+    }
+    for (i = 0; i < 3; i++) {
+        silc_context *c = open_client(srv.url);
+        silc_envelope_t x;
+        double got[2] = {0, 0};
+        if (!c) break;
+        /* a sparse solve asks for backends; a misspelt one lists them all,
+         * which opens every file on the path */
+        CHECK(silc_exec(c, "A = sparse([4, 1; 1, 3]); x = A \\ [5; 4]") == 0 && silc_get(c, &x, "x") == 0 &&
+                  silc_envelope_to_dense(&x, got) == 0 && fabs(got[0] - 1) < 1e-12 && fabs(got[1] - 1) < 1e-12,
+              "session %d with a bogus plugin file: x = (%g, %g) %s", i, got[0], got[1], silc_context_errmsg(c));
+        silc_envelope_free(&x);
+        CHECK(silc_exec(c, "set dispatch.solve.sparse = nosuch_backend") != 0,
+              "session %d: a misspelt backend was accepted", i);
+        silc_close(&c);
+    }
+    snprintf(logf, sizeof logf, "%s/log", srv.dir);
+    snprintf(want, sizeof want, "warning: cannot load plugin %s:", bogus);
+    n = count_in_file(logf, want);
+    CHECK(n == 1, "silcd's log warns about a plugin that cannot be loaded %d times over 3 sessions, not once", n);
+    CHECK(server_stop(&srv) == 0, "silcd with a bogus plugin file did not stop cleanly");
+    remove(bogus);
+    remove(conf);
+    rmdir(dir);
+}
+
 int main(int argc, char **argv)
 {
     const char *plugin_dir = argc > 1 ? argv[1] : CRASH_PLUGIN_DIR;
@@ -565,5 +635,6 @@ int main(int argc, char **argv)
     test_killed_server();
     test_sigterm_drains();
     test_huge_page_heap();
+    test_plugin_warned_once(plugin_dir);
     return check_done();
 }

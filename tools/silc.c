@@ -56,6 +56,10 @@ static const char usage_text[] =
     "                                    plot to FILE.svg (default silc-tune.svg)\n"
     "options:\n"
     "  --put NAME=FILE.mtx  load a Matrix Market file as NAME before running (repeatable)\n"
+    "  --put-allow-nonfinite\n"
+    "                       let --put read inf, nan and values that overflow to inf\n"
+    "                       (refused by default, naming line and column; the same as\n"
+    "                       SILC_MM_ALLOW_NONFINITE=1)\n"
     "  --get NAME           after running, print NAME to standard output in Matrix\n"
     "                       Market format (repeatable, in the order given)\n"
     "  --config FILE        configuration file (default: $SILC_CONFIG, else ./silc.conf)\n"
@@ -85,6 +89,7 @@ typedef struct {
     char *tune_text;        /* statement built from `tune ...` arguments */
     const char *complete;   /* --complete WORD */
     int profile;            /* --profile */
+    int allow_nonfinite;    /* --put-allow-nonfinite */
 } cli_options;
 
 static void fail(const char *fmt, ...)
@@ -162,6 +167,8 @@ static int parse_args(int argc, char **argv, cli_options *o)
             o->get_names[o->nget++] = v;
         } else if (!strcmp(a, "--profile")) {
             o->profile = 1;
+        } else if (!strcmp(a, "--put-allow-nonfinite")) {
+            o->allow_nonfinite = 1;
         } else if (take_option(argc, argv, &i, "--complete", &v)) {
             if (!v) return fail("--complete needs a word (it may be empty)"), 2;
             o->complete = v;
@@ -448,6 +455,10 @@ static int run_text(silc_context *ctx, const char *text)
 
 static int load_puts(silc_context *ctx, const cli_options *o)
 {
+    /* silc_mm_read takes the user's leave from the environment (silc.h), so
+     * the option sets the variable rather than carry a second switch */
+    if (o->allow_nonfinite && setenv("SILC_MM_ALLOW_NONFINITE", "1", 1))
+        return fail("--put-allow-nonfinite: %s", strerror(errno)), 1;
     for (int k = 0; k < o->nput; k++) {
         const char *eq = strchr(o->put_args[k], '=');
         int namelen = (int)(eq - o->put_args[k]);

@@ -16,10 +16,13 @@
 #include "silc.h"
 
 #include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "client.h"
 #include "dist.h"
@@ -114,23 +117,27 @@ int api_exec(silc_engine *E, const char *statements, char *err, size_t errlen)
 /* ---- contexts ------------------------------------------------------------ */
 
 /* The token for a remote server: SILC_TOKEN, else the first line of
- * SILC_TOKEN_FILE, else none.  Returns a malloc'd string or NULL. */
+ * SILC_TOKEN_FILE, else none.  Returns a malloc'd string or NULL.  The file
+ * must be a regular one (a FIFO with no writer hung the client; /dev/zero
+ * read as an empty token), read without blocking and at most 8 KiB. */
 static char *remote_token(char *err, size_t errlen, int *failed)
 {
     const char *t = getenv("SILC_TOKEN"), *path = getenv("SILC_TOKEN_FILE");
     char buf[8192];
-    size_t n;
-    FILE *f;
+    size_t n = 0;
+    ssize_t got;
+    int fd;
     *failed = 0;
     if (t && *t) return util_strdup(t);
     if (!path || !*path) return NULL;
-    if (!(f = fopen(path, "r"))) {
-        snprintf(err, errlen, "cannot read SILC_TOKEN_FILE '%s'", path);
+    if ((fd = util_open_read_at(AT_FDCWD, path, 1)) < 0) {
+        if (errno == EINVAL) snprintf(err, errlen, "SILC_TOKEN_FILE '%s' is not a regular file", path);
+        else snprintf(err, errlen, "cannot read SILC_TOKEN_FILE '%s': %s", path, strerror(errno));
         *failed = 1;
         return NULL;
     }
-    n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
+    while (n < sizeof buf - 1 && (got = read(fd, buf + n, sizeof buf - 1 - n)) > 0) n += (size_t)got;
+    close(fd);
     buf[n] = '\0';
     buf[strcspn(buf, "\r\n")] = '\0';
     return util_strdup(buf);

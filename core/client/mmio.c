@@ -129,6 +129,8 @@ static int mm_read_line(mm_reader *r)
         r->line[len++] = (char)ch;
         if (ch == '\n') break;
     }
+    /* a failed read is not the end of the file (a directory read as empty) */
+    if (ch == EOF && ferror(r->f)) return mm_fail(r, r->lineno + 1, "cannot read: %s", strerror(errno));
     if (len == 0) return 0;
     r->line[len] = 0;
     r->lineno++;

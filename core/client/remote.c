@@ -79,6 +79,11 @@ struct rem_conn {
 #define CLIENT_MAX_VALUE_BYTES ((uint64_t)2 << 30)
 #define CLIENT_MAX_TEXT_BYTES ((uint64_t)64 << 20)
 #define CLIENT_IO_TIMEOUT_S 300.0
+/* A timeout other than 0 (none) lies in [1 ms, poll's resolution, and a
+ * year]: 1e-7 was rounded up to 1 ms without a word, 1e30 refused without
+ * naming the maximum. */
+#define CLIENT_TIMEOUT_MIN_S 0.001
+#define CLIENT_TIMEOUT_MAX_S 31536000.0
 
 /* Seconds from the variable var (a decimal, 0 = no timeout), else dflt, as
  * poll's milliseconds (-1 for none); -1 with a message naming var. */
@@ -90,9 +95,10 @@ static int timeout_from_env(const char *var, double dflt, int *ms, char *err, si
         char *end;
         errno = 0;
         sec = strtod(v, &end);
-        if (*end || errno || !(sec >= 0) || sec > 86400 * 365) {
-            snprintf(err, errlen, "%s = '%s': expected seconds (a number >= 0; 0 for no timeout)",
-                     var, v);
+        if (*end || end == v || errno ||
+            !(sec == 0 || (sec >= CLIENT_TIMEOUT_MIN_S && sec <= CLIENT_TIMEOUT_MAX_S))) {
+            snprintf(err, errlen, "%s = '%s': expected 0 (no timeout) or seconds from 0.001 to 31536000", var,
+                     v);
             return -1;
         }
     }

@@ -166,6 +166,13 @@ public final class TestClient {
     }
 
     public static void main(String[] args) throws Exception {
+        // `TestClient badenv MESSAGE`: the caller set a variable wrong; INIT
+        // must refuse with MESSAGE before connecting.
+        if (args.length == 2 && args[0].equals("badenv")) {
+            expectError(() -> new SILC().INIT("unix:/nonexistent-dir/silc.sock"), args[1], "INIT with " + args[1]);
+            System.out.println(passed + " passed, " + failed + " failed");
+            System.exit(failed > 0 || passed == 0 ? 1 : 0);
+        }
         if (args.length == 4 && args[0].equals("token")) {
             tokenCases(args[1], Integer.parseInt(args[2]), args[3]);
             System.out.println(passed + " passed, " + failed + " failed");

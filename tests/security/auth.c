@@ -228,6 +228,10 @@ static void test_token_rules(void)
     snprintf(opt, sizeof opt, "--token-file=%s", scratch);
     snprintf(msg, sizeof msg, "silcd: token file '%s' is not a regular file", scratch);
     expect_refusal((const char *const[]){opt, NULL}, NULL, NULL, 2, msg, "a directory as token file");
+    /* a FIFO with no writer (test_strict_options made it): refused, not waited on */
+    snprintf(opt, sizeof opt, "--token-file=%s/a-fifo", scratch);
+    snprintf(msg, sizeof msg, "silcd: token file '%s/a-fifo' is not a regular file", scratch);
+    expect_refusal((const char *const[]){opt, NULL}, NULL, NULL, 2, msg, "a fifo as token file");
     snprintf(opt, sizeof opt, "--token-file=%s", tok);
     if (geteuid() == 0) {
         put_file(tok, "0123456789abcdef0123456789abcdef\n", 0600);

@@ -26,7 +26,21 @@ refused() {   # refused WHAT COMMAND...: the command must fail naming the wrong 
     *) echo "FAIL: $what: not refused with 'authentication failed: wrong token':"; echo "$out"; fail=$((fail + 1)) ;;
     esac
 }
+says() {   # says WHAT TEXT COMMAND...: the command must fail printing TEXT
+    what=$1 text=$2
+    shift 2
+    if out=$("$@" 2>&1); then echo "FAIL: $what: succeeded"; fail=$((fail + 1)); return; fi
+    case $out in
+    *"$text"*) echo "ok: $what" ;;
+    *) echo "FAIL: $what: no '$text':"; echo "$out"; fail=$((fail + 1)) ;;
+    esac
+}
 tok=$SILCD_DIR/token
+# A token file that is not a regular file (a FIFO with no writer hung every
+# client; /dev/zero read as an empty token in C, filled Python's and Java's
+# memory): refused at once, naming it.  `timeout` turns a hang into a failure.
+fifo=$SILCD_DIR/token-fifo
+mkfifo "$fifo"
 "$SILCD" --make-token "$tok" >/dev/null || { echo "FAIL: silcd --make-token"; exit 1; }
 SILCD_LISTEN=tcp://127.0.0.1:0 silcd_start "$SILCD" --token-file "$tok"
 export SILC_SERVER="$SILCD_URL"
@@ -39,6 +53,10 @@ if [ "$(echo "$out" | tail -n 1)" = 6 ]; then echo "ok: C client with SILC_TOKEN
 else echo "FAIL: C client with SILC_TOKEN_FILE: $out"; fail=$((fail + 1)); fi
 check "C client with SILC_TOKEN" env SILC_TOKEN="$(head -n 1 "$tok")" timeout 60 "$CLI" -e 'x = 1'
 refused "C client with a wrong SILC_TOKEN" env SILC_TOKEN=$wrong timeout 60 "$CLI" -e 'x = 1'
+for f in "$fifo" /dev/zero; do
+    says "C client with SILC_TOKEN_FILE=$f" "SILC_TOKEN_FILE '$f' is not a regular file" \
+        env SILC_TOKEN_FILE="$f" timeout 10 "$CLI" -e 'x = 1'
+done
 
 # Python: its own protocol implementation, the same variables.
 if [ "$PY" != none ]; then
@@ -52,6 +70,10 @@ with silc.Session() as s:
     check "Python client with SILC_TOKEN_FILE" env SILC_TOKEN_FILE="$tok" timeout 60 "$PY" -c "$pycode" "$PYDIR"
     check "Python client with SILC_TOKEN" env SILC_TOKEN="$(head -n 1 "$tok")" timeout 60 "$PY" -c "$pycode" "$PYDIR"
     refused "Python client with a wrong SILC_TOKEN" env SILC_TOKEN=$wrong timeout 60 "$PY" -c "$pycode" "$PYDIR"
+    for f in "$fifo" /dev/zero; do
+        says "Python client with SILC_TOKEN_FILE=$f" "SILC_TOKEN_FILE '$f' is not a regular file" \
+            env SILC_TOKEN_FILE="$f" timeout 10 "$PY" -c "$pycode" "$PYDIR"
+    done
 fi
 
 # Fortran, through the C library: the diffusion example exits 1 if its

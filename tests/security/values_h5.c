@@ -338,6 +338,19 @@ int main(void)
         attr_i64(g, "shape", shape, 2);
         H5Gclose(g);
     }
+    /* D: a 99 999 x 99 999 dense dataset of unallocated chunks (80 GB to
+     * load, a few KB in the file): the dense claim, as the CSR and band ones
+     * (not 100 000: "100000x1..." would hold the "0x" the address check
+     * looks for) */
+    {
+        hsize_t dims[2] = {99999, 99999}, chunk[2] = {100, 100};
+        dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        H5Pset_chunk(dcpl, 2, chunk);
+        sp = H5Screate_simple(2, dims, NULL);
+        H5Dclose(H5Dcreate2(file, "D", H5T_IEEE_F64LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+        H5Sclose(sp);
+        H5Pclose(dcpl);
+    }
     /* G: a well-formed 2 x 3 CSR group */
     {
         int64_t ip[3] = {0, 2, 3}, ci[3] = {0, 2, 1};
@@ -371,6 +384,12 @@ int main(void)
                 "limit of 67108864 bytes (64.0 MiB) by 546.4 MiB: the most one value may hold (the test's "
                 "64 MiB limit)", "Big");
         CHECK(peak_rss() - before < (32LL << 20), "peak RSS grew by %lld bytes refusing a 40M-entry claim",
+              peak_rss() - before);
+        before = peak_rss();
+        refused(ctx, path, "D", "'D'",
+                ": a 99999x99999 dense value needs 79998400008 bytes (74.5 GiB), over the limit of 67108864 "
+                "bytes (64.0 MiB) by 74.4 GiB: the most one value may hold (the test's 64 MiB limit)", "D");
+        CHECK(peak_rss() - before < (32LL << 20), "peak RSS grew by %lld bytes refusing an 80 GB dense claim",
               peak_rss() - before);
     }
     /* The whole file: the first object refused names itself, nothing bound. */

@@ -20,6 +20,7 @@ closed and later calls say so.
 import os
 import signal
 import socket
+import stat
 import struct
 import sys
 import threading
@@ -54,12 +55,25 @@ def _token_from_env():
         return tok
     path = os.environ.get("SILC_TOKEN_FILE")
     if path:
+        # A regular file only, opened without blocking and read up to 8 KiB:
+        # a FIFO with no writer hung the client, /dev/zero filled its memory.
         try:
-            with open(path) as f:
-                return f.readline().rstrip("\r\n")
+            fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+            try:
+                if not stat.S_ISREG(os.fstat(fd).st_mode):
+                    raise Error("SILC_TOKEN_FILE '%s' is not a regular file" % path)
+                data = os.read(fd, 8192)
+            finally:
+                os.close(fd)
         except OSError as e:
             raise Error("cannot read SILC_TOKEN_FILE '%s': %s" % (path, e.strerror)) from None
+        return data.decode("utf-8", "replace").split("\n", 1)[0].rstrip("\r")
     return None
+
+
+# A timeout other than 0 (none) lies in [1 ms, a year], as in the C client:
+# 1e30 reached the socket as an OverflowError.
+TIMEOUT_MIN, TIMEOUT_MAX = 0.001, 31536000.0
 
 
 def _seconds(value, var, default):
@@ -74,11 +88,11 @@ def _seconds(value, var, default):
                 value = float(text)
             except ValueError:
                 value = -1
-            if not value >= 0:
-                raise Error("%s = '%s': expected seconds (a number >= 0; 0 for no timeout)"
+            if not (value == 0 or TIMEOUT_MIN <= value <= TIMEOUT_MAX):
+                raise Error("%s = '%s': expected 0 (no timeout) or seconds from 0.001 to 31536000"
                             % (var, text))
-    if value is not None and value < 0:
-        raise Error("a timeout must be >= 0 seconds (0 for none), not %r" % value)
+    if value is not None and not (value == 0 or TIMEOUT_MIN <= value <= TIMEOUT_MAX):
+        raise Error("a timeout must be 0 (none) or seconds from 0.001 to 31536000, not %r" % value)
     return value or None
 
 

@@ -104,8 +104,8 @@ public final class SILC implements AutoCloseable {
     /** The longest silence accepted inside a reply and before the reply to
      *  any call but EXEC, and before EXEC's replies; seconds, 0 for none. */
     public void setTimeouts(double ioSeconds, double execSeconds) throws SILCException {
-        if (!(ioSeconds >= 0) || !(execSeconds >= 0))
-            throw new SILCException("a timeout must be >= 0 seconds (0 for none)");
+        if (!timeoutInRange(ioSeconds) || !timeoutInRange(execSeconds))
+            throw new SILCException("a timeout must be 0 (none) or seconds from 0.001 to 31536000");
         ioTimeoutMs = (long) Math.ceil(ioSeconds * 1000);
         execTimeoutMs = (long) Math.ceil(execSeconds * 1000);
     }
@@ -116,16 +116,21 @@ public final class SILC implements AutoCloseable {
         maxValueBytes = bytes;
     }
 
+    /* 0 (none) or [1 ms, a year], as the C and Python clients. */
+    private static boolean timeoutInRange(double x) {
+        return x == 0 || (x >= 0.001 && x <= 31536000);
+    }
+
     private static double seconds(String var, double dflt) throws SILCException {
         String v = System.getenv(var);
         if (v == null || v.isEmpty()) return dflt;
         try {
             double x = Double.parseDouble(v);
-            if (x >= 0) return x;
+            if (timeoutInRange(x)) return x;
         } catch (NumberFormatException e) {
             // reported below
         }
-        throw new SILCException(var + " = '" + v + "': expected seconds (a number >= 0; 0 for no timeout)");
+        throw new SILCException(var + " = '" + v + "': expected 0 (no timeout) or seconds from 0.001 to 31536000");
     }
 
     /* "123", "64K", "512M", "2G", "1T", as silcd's size options. */
@@ -403,9 +408,15 @@ public final class SILC implements AutoCloseable {
         if (t != null && !t.isEmpty()) return t;
         String f = System.getenv("SILC_TOKEN_FILE");
         if (f == null || f.isEmpty()) return "";
-        try {
-            List<String> lines = Files.readAllLines(Path.of(f), StandardCharsets.UTF_8);
-            return lines.isEmpty() ? "" : lines.get(0);
+        // A regular file only, read up to 8 KiB: a FIFO with no writer hung
+        // the client, /dev/zero filled its memory.
+        Path p = Path.of(f);
+        if (Files.exists(p) && !Files.isRegularFile(p))
+            throw new SILCException("SILC_TOKEN_FILE '" + f + "' is not a regular file");
+        try (java.io.InputStream in = Files.newInputStream(p)) {
+            String text = new String(in.readNBytes(8192), StandardCharsets.UTF_8);
+            int end = text.indexOf('\n');
+            return (end < 0 ? text : text.substring(0, end)).replaceAll("\r$", "");
         } catch (IOException e) {
             throw new SILCException("SILC_TOKEN_FILE '" + f + "': " + e.getMessage(), e);
         }
