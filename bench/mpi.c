@@ -31,11 +31,11 @@
  * silc_set_output) the statement's wall time on the engine and the bytes
  * moved between ranks by the first and by the last timed statement
  * (mbytes/vbytes: matrices/vectors), and for the one-shot solve the CPU
- * seconds and page faults of every process that worked on it (cpu_s,
- * faults: SPMD, the ranks summed; client, itself and the server's ranks,
- * whose pids SILC_BENCH_SERVER_PIDS lists, as bench/mpi.sh sets it; a
- * machine shared with other work changes them far less than the times).
- * status=gathered flags a solve whose
+ * seconds, their system part and the page faults of every process that
+ * worked on it (cpu_s, sys_s, faults: SPMD, the ranks summed; client,
+ * itself and the server's ranks, whose pids SILC_BENCH_SERVER_PIDS lists,
+ * as bench/mpi.sh sets it; a machine shared with other work changes them
+ * far less than the times).  status=gathered flags a solve whose
  * backend was not collective, so its matrix was gathered to every rank
  * (matrix bytes moved by the solve).  Times are wall clock between barriers
  * (SPMD) or around the calls (client, embedded).
@@ -134,13 +134,14 @@ static bench_usage usage_now(const run *R)
         char *end;
         for (long pid = strtol(pids, &end, 10); end != pids; pid = strtol(pids, &end, 10)) {
             pids = end;
-            if (pid > 0 && !bench_proc_usage(pid, &one)) u.cpu_s += one.cpu_s, u.faults += one.faults;
+            if (pid > 0 && !bench_proc_usage(pid, &one))
+                u.cpu_s += one.cpu_s, u.sys_s += one.sys_s, u.faults += one.faults;
         }
     }
     if (R->mode == SPMD) {
-        double mine[2] = {u.cpu_s, (double)u.faults}, sum[2];
-        MPI_Reduce(mine, sum, 2, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-        u.cpu_s = sum[0], u.faults = (long long)sum[1];
+        double mine[3] = {u.cpu_s, u.sys_s, (double)u.faults}, sum[3];
+        MPI_Reduce(mine, sum, 3, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+        u.cpu_s = sum[0], u.sys_s = sum[1], u.faults = (long long)sum[2];
     }
     return u;
 }
@@ -268,11 +269,11 @@ static int oneshot(const run *R, const method *m)
         rc = rc || scalar(R, "err", "norm(x - e, inf)", &err) || info_of(R, "x", &in);
         if (!rc && R->rank == 0) {
             printf("RESULT mode=%s kind=oneshot method=%s n=%lld np=%d status=%s put_s=%.4f "
-                   "time_s=%.4f err=%.3e wall_s=%.4f mbytes=%llu vbytes=%llu cpu_s=%.2f faults=%lld "
+                   "time_s=%.4f err=%.3e wall_s=%.4f mbytes=%llu vbytes=%llu cpu_s=%.2f sys_s=%.2f faults=%lld "
                    "solve=\"%s\"\n",
                    mode_names[R->mode], m->name, (long long)R->n, in.ranks,
                    gathered(R, &in) ? "gathered" : "ok", t1 - t0, t2, err, in.wall, in.mbytes,
-                   in.vbytes, used.cpu_s, used.faults, in.solve);
+                   in.vbytes, used.cpu_s, used.sys_s, used.faults, in.solve);
             fflush(stdout);
         }
     }

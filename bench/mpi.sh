@@ -19,7 +19,8 @@
 # round runs every configuration once, modes interleaved so that drift of the
 # machine hits all of them alike; a table gives the best time of the rounds
 # and the spread (max - min) / min.  One-shot rows also give the least CPU
-# time over the rounds of every process that worked on the solve (the client
+# time over the rounds (its system part in parentheses) of every process
+# that worked on the solve (the client
 # and the server's ranks; the SPMD ranks; the direct program's ranks), its
 # ratio to the direct row's and that round's page faults: on a machine
 # shared with other work these move far less than the times.  The silcd server runs only while its
@@ -48,11 +49,11 @@ else
 fi
 NPS=${NPS:-"1 2"}
 CORES=$(getconf _NPROCESSORS_ONLN)  # not nproc: it honours OMP_NUM_THREADS
-WORK=${KEEP:-$(mktemp -d /tmp/silc-mpi-bench.XXXXXX)}
+WORK=${TABLE_ONLY:-${KEEP:-$(mktemp -d /tmp/silc-mpi-bench.XXXXXX)}}
 mkdir -p "$WORK"
 RES=$WORK/results.txt
 LOG=$WORK/log.txt
-: >"$RES"; : >"$LOG"
+[ -n "${TABLE_ONLY:-}" ] || { : >"$RES"; : >"$LOG"; }
 SOCK=$WORK/silcd.sock
 SILC_METHODS=${METHODS:-mumps,petsc-mumps,petsc-cg-hypre}
 LOOP=${LOOP:-1}
@@ -82,7 +83,7 @@ direct() { # np name kind n [mpi_direct options]
     $2 ~ /^[0-9]+$/ && NF >= 13 {
       if (kind == "oneshot")
         printf "RESULT mode=direct kind=oneshot method=%s n=%s np=%s status=ok time_s=%s err=%s%s\n",
-               name, $2, $3, $4, $6, (NF >= 16 ? (" cpu_s=" $15 " faults=" $16) : "")
+               name, $2, $3, $4, $6, (NF >= 17 ? (" cpu_s=" $15 " faults=" $16 " sys_s=" $17) : "")
       else
         printf "RESULT mode=direct kind=loop method=%s n=%s np=%s status=ok time_s=%.4f first_s=%s step_s=%s heat=%s\n",
                name, $2, $3, $11 + steps * $5, $11, $5, $13
@@ -118,6 +119,9 @@ stop_server() {
 # gathers its matrix (or fails) says no; then the petsc rows are "n/a" and
 # not run, which saves their sequential solves on every rank.
 PETSC=yes
+if [ -n "${TABLE_ONLY:-}" ]; then
+  ELAPSED="not measured (tables of $TABLE_ONLY)"
+else
 record mpirun -np 2 "$MPI_BIN" spmd -n 60 -methods petsc-mumps
 if ! grep -q 'method=petsc-mumps .*status=ok' "$RES"; then
   PETSC="n/a (petsc collective not available)"
@@ -163,11 +167,12 @@ for round in $(seq "$ROUNDS"); do
     fi
   done
 done
-ELAPSED=$(( $(date +%s) - T0 ))
+ELAPSED="$(( $(date +%s) - T0 )) s"
+fi
 
 # ---- tables ----------------------------------------------------------------
 echo
-echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED} s"
+echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED}"
 echo "(bench/mpi.sh $([ $QUICK = 1 ] && echo --quick) $BUILD; raw lines: $RES)"
 echo "petsc collective: $PETSC"
 awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v partial="${METHODS:+1}" -v loop="$LOOP" '
@@ -185,7 +190,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     if (!(k in best) || t < best[k]) { best[k] = t; line[k] = $0 }
     if (!(k in worst) || t > worst[k]) worst[k] = t
     c = field($0, "cpu_s")
-    if (c != "" && (!(k in cpu) || c + 0 < cpu[k])) { cpu[k] = c + 0; faults[k] = field($0, "faults") }
+    if (c != "" && (!(k in cpu) || c + 0 < cpu[k])) { cpu[k] = c + 0; faults[k] = field($0, "faults"); sys[k] = field($0, "sys_s") }
     status[k] = st
   }
   function base_of(method, kind) {
@@ -226,7 +231,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     }
     if (kind == "oneshot")
       printf "| %s | %s | %s | %.3f | %s | %s | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
-             (k in cpu) ? sprintf("%.2f", cpu[k]) : "-", cr, (k in cpu) ? faults[k] : "-",
+             (k in cpu) ? sprintf("%.2f (%s)", cpu[k], sys[k]) : "-", cr, (k in cpu) ? faults[k] : "-",
              field(L, "err"), (mode == "direct") ? "-" : field(L, "mbytes") " / " field(L, "vbytes")
     else
       printf "| %s | %s | %s | %.4f | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
@@ -247,7 +252,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
       if (K == "oneshot") {
         print "One-shot x = A \\ b (b = A*ones), seconds for the solve statement (direct: setup + solve):"
         print ""
-        print "| n | np | mode, method | time s | spread | ratio to direct | CPU s | CPU ratio | page faults | err_inf | bytes moved (matrices / vectors) |"
+        print "| n | np | mode, method | time s | spread | ratio to direct | CPU s (sys) | CPU ratio | page faults | err_inf | bytes moved (matrices / vectors) |"
         print "|---:|---:|---|---:|---:|---|---:|---:|---:|---|---|"
       } else {
         print "Crank-Nicolson loop, " steps " steps, seconds per step after the first (direct: MatMult + KSPSolve):"

@@ -51,9 +51,10 @@
  *   oneshot_s = setup_s + solve_s
  *   lsetup_s  assembling A and B and KSPSetUp for the loop
  *   step_s    mean seconds per time step (MatMult with B plus KSPSolve)
- *   cpu_s, faults  the CPU seconds and page faults of the one-shot's setup
- *            and solve, summed over the ranks (bench/proc_usage.h): what
- *            the work cost whatever else the machine ran
+ *   cpu_s, faults, sys_s  the CPU seconds, page faults and the system
+ *            part of the CPU seconds of the one-shot's setup and solve,
+ *            summed over the ranks (bench/proc_usage.h): what the work
+ *            cost whatever else the machine ran
  * its is the one-shot iteration count (the mean per step for the loop in
  * litis); ord is the ordering MUMPS actually used, INFOG(7) (2 = AMF,
  * 4 = PORD, 5 = METIS, 3 = SCOTCH, 0 = AMD, 6 = QAMD; - for other methods).
@@ -87,12 +88,13 @@ static bench_usage usage_now(void)
 static PetscErrorCode summed_since(const bench_usage *u0, bench_usage *sum)
 {
     bench_usage u1 = usage_now(), d = bench_usage_since(u0, &u1);
-    double mine[2] = {d.cpu_s, (double)d.faults}, all[2];
+    double mine[3] = {d.cpu_s, d.sys_s, (double)d.faults}, all[3];
 
     PetscFunctionBeginUser;
-    PetscCallMPI(MPI_Allreduce(mine, all, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+    PetscCallMPI(MPI_Allreduce(mine, all, 3, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
     sum->cpu_s = all[0];
-    sum->faults = (long long)all[1];
+    sum->sys_s = all[1];
+    sum->faults = (long long)all[2];
     PetscFunctionReturn(0);
 }
 
@@ -412,7 +414,7 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
 {
     char a[32] = "-", s[32] = "-", v[32] = "-", o[32] = "-", e[32] = "-", it[32] = "-",
          ls[32] = "-", st[32] = "-", li[32] = "-", h[32] = "-", ord[32] = "-", cpu[32] = "-",
-         flt[32] = "-";
+         flt[32] = "-", sys[32] = "-";
 
     PetscFunctionBeginUser;
     if (r->did_oneshot) {
@@ -424,6 +426,7 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
         snprintf(it, sizeof it, "%" PetscInt_FMT, r->its);
         snprintf(cpu, sizeof cpu, "%.2f", r->used.cpu_s);
         snprintf(flt, sizeof flt, "%lld", r->used.faults);
+        snprintf(sys, sizeof sys, "%.2f", r->used.sys_s);
     }
     if (r->did_loop) {
         snprintf(ls, sizeof ls, "%.4f", r->lsetup_s);
@@ -433,8 +436,8 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
     }
     if (r->ord >= 0) snprintf(ord, sizeof ord, "%" PetscInt_FMT, r->ord);
     PetscCall(PetscPrintf(PETSC_COMM_WORLD,
-                          "%-14s %5" PetscInt_FMT " %3d %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s\n",
-                          r->name, n, np, o, st, e, a, s, v, it, ls, li, h, ord, cpu, flt));
+                          "%-14s %5" PetscInt_FMT " %3d %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s %6s\n",
+                          r->name, n, np, o, st, e, a, s, v, it, ls, li, h, ord, cpu, flt, sys));
     PetscFunctionReturn(0);
 }
 
@@ -474,10 +477,10 @@ int main(int argc, char **argv)
     }
     if (header)
         PetscCall(PetscPrintf(PETSC_COMM_WORLD,
-                              "%-14s %5s %3s %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s\n",
+                              "%-14s %5s %3s %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s %6s\n",
                               "method", "n", "np", "oneshot_s", "step_s", "err_inf", "asm_s",
                               "setup_s", "solve_s", "its", "lsetup_s", "litis", "heat", "ord",
-                              "cpu_s", "faults"));
+                              "cpu_s", "faults", "sys_s"));
     for (int m = first; m <= last; m++) {
         Result r;
         memset(&r, 0, sizeof r);

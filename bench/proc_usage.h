@@ -18,6 +18,7 @@
 
 typedef struct bench_usage {
     double cpu_s;     /* user + system time of all its threads (1/100 s steps on Linux) */
+    double sys_s;     /* the system part: page faults, mmap, the kernel's side of messages */
     long long faults; /* minor + major page faults */
 } bench_usage;
 
@@ -44,6 +45,7 @@ static inline int bench_proc_usage(long pid, bench_usage *u)
                &utime, &stime) != 4)
         return -1;
     u->cpu_s = (double)(utime + stime) / (double)ticks;
+    u->sys_s = (double)stime / (double)ticks;
     u->faults = (long long)(minflt + majflt);
     return 0;
 }
@@ -53,6 +55,7 @@ static inline bench_usage bench_usage_since(const bench_usage *before, const ben
 {
     bench_usage d;
     d.cpu_s = after->cpu_s - before->cpu_s;
+    d.sys_s = after->sys_s - before->sys_s;
     d.faults = after->faults - before->faults;
     return d;
 }
