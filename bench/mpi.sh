@@ -231,7 +231,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     }
     if (kind == "oneshot")
       printf "| %s | %s | %s | %.3f | %s | %s | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
-             (k in cpu) ? sprintf("%.2f (%s)", cpu[k], sys[k]) : "-", cr, (k in cpu) ? faults[k] : "-",
+             !(k in cpu) ? "-" : sys[k] == "" ? sprintf("%.2f", cpu[k]) : sprintf("%.2f (%s)", cpu[k], sys[k]), cr, (k in cpu) ? faults[k] : "-",
              field(L, "err"), (mode == "direct") ? "-" : field(L, "mbytes") " / " field(L, "vbytes")
     else
       printf "| %s | %s | %s | %.4f | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
