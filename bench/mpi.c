@@ -30,7 +30,12 @@
  * first_s, step_s, err, heat, and from `info` of the result (captured with
  * silc_set_output) the statement's wall time on the engine and the bytes
  * moved between ranks by the first and by the last timed statement
- * (mbytes/vbytes: matrices/vectors).  status=gathered flags a solve whose
+ * (mbytes/vbytes: matrices/vectors), and for the one-shot solve the CPU
+ * seconds, their system part and the page faults of every process that
+ * worked on it (cpu_s, sys_s, faults: SPMD, the ranks summed; client,
+ * itself and the server's ranks, whose pids SILC_BENCH_SERVER_PIDS lists,
+ * as bench/mpi.sh sets it; a machine shared with other work changes them
+ * far less than the times).  status=gathered flags a solve whose
  * backend was not collective, so its matrix was gathered to every rank
  * (matrix bytes moved by the solve).  Times are wall clock between barriers
  * (SPMD) or around the calls (client, embedded).
@@ -45,6 +50,7 @@
 #include <mpi.h>
 
 #include "diffusion_common.h"
+#include "proc_usage.h"
 #include "silc.h"
 #include "silc_mpi.h"
 
@@ -113,6 +119,31 @@ static int any_failed(const run *R, int rc)
     int mine = rc != 0, any = mine;
     if (R->mode == SPMD) MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     return any;
+}
+
+/* The usage so far of the processes that run this mode's statements: this
+ * one (SPMD: summed over the ranks, on rank 0) and, for a client, the
+ * server's ranks listed in SILC_BENCH_SERVER_PIDS.  A pid that cannot be
+ * read counts nothing (the table then shows less, never more). */
+static bench_usage usage_now(const run *R)
+{
+    bench_usage u, one;
+    const char *pids = getenv("SILC_BENCH_SERVER_PIDS");
+    bench_proc_usage(0, &u);
+    if (R->mode == CLIENT && pids) {
+        char *end;
+        for (long pid = strtol(pids, &end, 10); end != pids; pid = strtol(pids, &end, 10)) {
+            pids = end;
+            if (pid > 0 && !bench_proc_usage(pid, &one))
+                u.cpu_s += one.cpu_s, u.sys_s += one.sys_s, u.faults += one.faults;
+        }
+    }
+    if (R->mode == SPMD) {
+        double mine[3] = {u.cpu_s, u.sys_s, (double)u.faults}, sum[3];
+        MPI_Reduce(mine, sum, 3, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+        u.cpu_s = sum[0], u.sys_s = sum[1], u.faults = (long long)sum[2];
+    }
+    return u;
 }
 
 /* PETSc's PETSC_DECIDE split of rows over ranks, as mpi_direct's matrices. */
@@ -199,6 +230,7 @@ static int oneshot(const run *R, const method *m)
     double *ones = malloc((size_t)(rows + 1) * sizeof *ones), t0, t1, t2, err = NAN;
     char stmt[256];
     info_line in;
+    bench_usage u0, used;
     /* diffusion_common's I + c L with h = 1, c = -1 is the stencil plus I
      * (diagonal 5, neighbours -1); taking the 1 off the diagonal gives
      * mpi_direct's A (4, -1) from the shared row assembly. */
@@ -225,17 +257,23 @@ static int oneshot(const run *R, const method *m)
     rc = rc || silc_exec(R->ctx, "b = A * e");
     if (!rc) {
         barrier(R);
+        u0 = usage_now(R);
         t2 = now(R);
         rc = silc_exec(R->ctx, stmt);
         barrier(R);
         t2 = now(R) - t2;
+        {
+            bench_usage u1 = usage_now(R);
+            used = bench_usage_since(&u0, &u1);
+        }
         rc = rc || scalar(R, "err", "norm(x - e, inf)", &err) || info_of(R, "x", &in);
         if (!rc && R->rank == 0) {
             printf("RESULT mode=%s kind=oneshot method=%s n=%lld np=%d status=%s put_s=%.4f "
-                   "time_s=%.4f err=%.3e wall_s=%.4f mbytes=%llu vbytes=%llu solve=\"%s\"\n",
+                   "time_s=%.4f err=%.3e wall_s=%.4f mbytes=%llu vbytes=%llu cpu_s=%.2f sys_s=%.2f faults=%lld "
+                   "solve=\"%s\"\n",
                    mode_names[R->mode], m->name, (long long)R->n, in.ranks,
                    gathered(R, &in) ? "gathered" : "ok", t1 - t0, t2, err, in.wall, in.mbytes,
-                   in.vbytes, in.solve);
+                   in.vbytes, used.cpu_s, used.sys_s, used.faults, in.solve);
             fflush(stdout);
         }
     }

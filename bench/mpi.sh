@@ -18,7 +18,12 @@
 # 400^2 for 100 steps; --quick: 100^2/200^2 and 100^2 for 10 steps.  Each
 # round runs every configuration once, modes interleaved so that drift of the
 # machine hits all of them alike; a table gives the best time of the rounds
-# and the spread (max - min) / min.  The silcd server runs only while its
+# and the spread (max - min) / min.  One-shot rows also give the least CPU
+# time over the rounds (its system part in parentheses) of every process
+# that worked on the solve (the client
+# and the server's ranks; the SPMD ranks; the direct program's ranks), its
+# ratio to the direct row's and that round's page faults: on a machine
+# shared with other work these move far less than the times.  The silcd server runs only while its
 # client runs (its idle ranks rest, but its start and end are not measured
 # here).  bench/mpi_wake.py measures what resting ranks add to a request.
 set -u
@@ -44,11 +49,11 @@ else
 fi
 NPS=${NPS:-"1 2"}
 CORES=$(getconf _NPROCESSORS_ONLN)  # not nproc: it honours OMP_NUM_THREADS
-WORK=${KEEP:-$(mktemp -d /tmp/silc-mpi-bench.XXXXXX)}
+WORK=${TABLE_ONLY:-${KEEP:-$(mktemp -d /tmp/silc-mpi-bench.XXXXXX)}}
 mkdir -p "$WORK"
 RES=$WORK/results.txt
 LOG=$WORK/log.txt
-: >"$RES"; : >"$LOG"
+[ -n "${TABLE_ONLY:-}" ] || { : >"$RES"; : >"$LOG"; }
 SOCK=$WORK/silcd.sock
 SILC_METHODS=${METHODS:-mumps,petsc-mumps,petsc-cg-hypre}
 LOOP=${LOOP:-1}
@@ -77,8 +82,8 @@ direct() { # np name kind n [mpi_direct options]
   awk -v name="$name" -v kind="$kind" -v steps="$STEPS" '
     $2 ~ /^[0-9]+$/ && NF >= 13 {
       if (kind == "oneshot")
-        printf "RESULT mode=direct kind=oneshot method=%s n=%s np=%s status=ok time_s=%s err=%s\n",
-               name, $2, $3, $4, $6
+        printf "RESULT mode=direct kind=oneshot method=%s n=%s np=%s status=ok time_s=%s err=%s%s\n",
+               name, $2, $3, $4, $6, (NF >= 17 ? (" cpu_s=" $15 " faults=" $16 " sys_s=" $17) : "")
       else
         printf "RESULT mode=direct kind=loop method=%s n=%s np=%s status=ok time_s=%.4f first_s=%s step_s=%s heat=%s\n",
                name, $2, $3, $11 + steps * $5, $11, $5, $13
@@ -90,7 +95,17 @@ start_server() { # np
   mpirun -np "$1" "$SILCD" --mpi --listen "unix:$SOCK" --dist-min-rows 1000 \
          --ready-file "$WORK/ready" >>"$WORK/silcd.log" 2>&1 &
   SERVER_PID=$!
-  for _ in $(seq 300); do [ -s "$WORK/ready" ] && return 0; sleep 0.1; done
+  # The ranks (mpirun's children) by pid, for the client to count their CPU
+  # time and page faults with its own (bench/mpi.c, usage_now).
+  for _ in $(seq 300); do
+    if [ -s "$WORK/ready" ]; then
+      SILC_BENCH_SERVER_PIDS=$(pgrep -d ' ' -P "$SERVER_PID" silcd)
+      export SILC_BENCH_SERVER_PIDS
+      echo "silcd --mpi -np $1: ranks $SILC_BENCH_SERVER_PIDS" >>"$LOG"
+      return 0
+    fi
+    sleep 0.1
+  done
   echo "mpi.sh: silcd --mpi -np $1 did not start (see $WORK/silcd.log)" >&2
   return 1
 }
@@ -104,6 +119,9 @@ stop_server() {
 # gathers its matrix (or fails) says no; then the petsc rows are "n/a" and
 # not run, which saves their sequential solves on every rank.
 PETSC=yes
+if [ -n "${TABLE_ONLY:-}" ]; then
+  ELAPSED="not measured (tables of $TABLE_ONLY)"
+else
 record mpirun -np 2 "$MPI_BIN" spmd -n 60 -methods petsc-mumps
 if ! grep -q 'method=petsc-mumps .*status=ok' "$RES"; then
   PETSC="n/a (petsc collective not available)"
@@ -149,11 +167,12 @@ for round in $(seq "$ROUNDS"); do
     fi
   done
 done
-ELAPSED=$(( $(date +%s) - T0 ))
+ELAPSED="$(( $(date +%s) - T0 )) s"
+fi
 
 # ---- tables ----------------------------------------------------------------
 echo
-echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED} s"
+echo "SILC over MPI, $(date -u +%Y-%m-%d), $CORES cores, best of $ROUNDS round(s), run time ${ELAPSED}"
 echo "(bench/mpi.sh $([ $QUICK = 1 ] && echo --quick) $BUILD; raw lines: $RES)"
 echo "petsc collective: $PETSC"
 awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v partial="${METHODS:+1}" -v loop="$LOOP" '
@@ -170,6 +189,8 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     cnt[k]++
     if (!(k in best) || t < best[k]) { best[k] = t; line[k] = $0 }
     if (!(k in worst) || t > worst[k]) worst[k] = t
+    c = field($0, "cpu_s")
+    if (c != "" && (!(k in cpu) || c + 0 < cpu[k])) { cpu[k] = c + 0; faults[k] = field($0, "faults"); sys[k] = field($0, "sys_s") }
     status[k] = st
   }
   function base_of(method, kind) {
@@ -190,7 +211,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
   function row(kind, n, np, mode, method,   k, b, bk, r, sp, L, note) {
     k = kind "|" n "|" np "|" mode "|" method
     note = (np + 0 > cores + 0) ? " (oversubscribed: " np " ranks on " cores " cores)" : ""
-    empty = kind == "loop" ? " | | | | |" : " | | | |"
+    empty = kind == "loop" ? " | | | | |" : " | | | | | | |"
     if (method ~ /^petsc/ && petsc != "yes") {
       printf "| %s | %s | %s | %s%s\n", n, np, label(mode, method) note, petsc, empty; return
     }
@@ -202,13 +223,15 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     if (status[k] == "gathered") note = note " **not collective: matrix gathered**"
     L = line[k]
     sp = best[k] > 0 ? sprintf("%.0f%%", 100 * (worst[k] - best[k]) / best[k]) : "-"
-    r = "-"
+    r = "-"; cr = "-"
     if (mode != "direct") {
       bk = kind "|" n "|" np "|direct|" base_of(method, kind)
       if (bk in best) r = sprintf("%.2f (vs %s)", best[k] / best[bk], base_of(method, kind))
+      if ((bk in cpu) && (k in cpu) && cpu[bk] > 0) cr = sprintf("%.2f", cpu[k] / cpu[bk])
     }
     if (kind == "oneshot")
-      printf "| %s | %s | %s | %.3f | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
+      printf "| %s | %s | %s | %.3f | %s | %s | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
+             !(k in cpu) ? "-" : sys[k] == "" ? sprintf("%.2f", cpu[k]) : sprintf("%.2f (%s)", cpu[k], sys[k]), cr, (k in cpu) ? faults[k] : "-",
              field(L, "err"), (mode == "direct") ? "-" : field(L, "mbytes") " / " field(L, "vbytes")
     else
       printf "| %s | %s | %s | %.4f | %s | %s | %s | %s | %s |\n", n, np, label(mode, method) note, best[k], sp, r,
@@ -229,8 +252,8 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
       if (K == "oneshot") {
         print "One-shot x = A \\ b (b = A*ones), seconds for the solve statement (direct: setup + solve):"
         print ""
-        print "| n | np | mode, method | time s | spread | ratio to direct | err_inf | bytes moved (matrices / vectors) |"
-        print "|---:|---:|---|---:|---:|---|---|---|"
+        print "| n | np | mode, method | time s | spread | ratio to direct | CPU s (sys) | CPU ratio | page faults | err_inf | bytes moved (matrices / vectors) |"
+        print "|---:|---:|---|---:|---:|---|---:|---:|---:|---|---|"
       } else {
         print "Crank-Nicolson loop, " steps " steps, seconds per step after the first (direct: MatMult + KSPSolve):"
         print ""

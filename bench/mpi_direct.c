@@ -51,6 +51,10 @@
  *   oneshot_s = setup_s + solve_s
  *   lsetup_s  assembling A and B and KSPSetUp for the loop
  *   step_s    mean seconds per time step (MatMult with B plus KSPSolve)
+ *   cpu_s, faults, sys_s  the CPU seconds, page faults and the system
+ *            part of the CPU seconds of the one-shot's setup and solve,
+ *            summed over the ranks (bench/proc_usage.h): what the work
+ *            cost whatever else the machine ran
  * its is the one-shot iteration count (the mean per step for the loop in
  * litis); ord is the ordering MUMPS actually used, INFOG(7) (2 = AMF,
  * 4 = PORD, 5 = METIS, 3 = SCOTCH, 0 = AMD, 6 = QAMD; - for other methods).
@@ -61,13 +65,38 @@
 #include <petscksp.h>
 #include <string.h>
 
+#include "proc_usage.h"
+
 typedef struct {
     const char *name;
     double asm_s, setup_s, solve_s, lsetup_s, step_s, err, heat, litis;
+    bench_usage used; /* the one-shot's setup + solve, summed over the ranks */
     PetscInt its;
     PetscInt ord;
     PetscBool did_oneshot, did_loop;
 } Result;
+
+/* This rank's usage so far; summed_since: the usage since u0 summed over
+ * the ranks (every rank gets it). */
+static bench_usage usage_now(void)
+{
+    bench_usage u;
+    bench_proc_usage(0, &u);
+    return u;
+}
+
+static PetscErrorCode summed_since(const bench_usage *u0, bench_usage *sum)
+{
+    bench_usage u1 = usage_now(), d = bench_usage_since(u0, &u1);
+    double mine[3] = {d.cpu_s, d.sys_s, (double)d.faults}, all[3];
+
+    PetscFunctionBeginUser;
+    PetscCallMPI(MPI_Allreduce(mine, all, 3, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+    sum->cpu_s = all[0];
+    sum->sys_s = all[1];
+    sum->faults = (long long)all[2];
+    PetscFunctionReturn(0);
+}
 
 /* The 5-point stencil with diagonal d and off-diagonal o, rows owned here. */
 static PetscErrorCode assemble(PetscInt n, PetscScalar d, PetscScalar o, Mat *out)
@@ -185,6 +214,7 @@ static PetscErrorCode oneshot_dmumps(PetscInt n, Result *r)
     PetscInt N = n * n, first, rows, k;
     MUMPS_INT *irn, *jcn, *irhs, *isol;
     double *a, *rhs, *sol, t0, t1, t2, t3, err = 0;
+    bench_usage u0;
     int64_t nz = 0;
     PetscMPIInt rank, size;
 
@@ -210,6 +240,7 @@ static PetscErrorCode oneshot_dmumps(PetscInt n, Result *r)
         irhs[k - first] = (MUMPS_INT)(k + 1);
     }
     PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+    u0 = usage_now();
     t1 = MPI_Wtime();
     memset(&id, 0, sizeof id);
     id.comm_fortran = (MUMPS_INT)MPI_Comm_c2f(PETSC_COMM_WORLD);
@@ -240,6 +271,7 @@ static PetscErrorCode oneshot_dmumps(PetscInt n, Result *r)
     PetscCheck(id.infog[0] >= 0, PETSC_COMM_WORLD, PETSC_ERR_LIB, "dmumps_c JOB=3: INFOG(1)=%d", (int)id.infog[0]);
     PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
     t3 = MPI_Wtime();
+    PetscCall(summed_since(&u0, &r->used));
     for (k = 0; k < id.info[22]; k++) err = PetscMax(err, PetscAbsReal(sol[k] - 1));
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &err, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD));
     r->ord = id.infog[6];
@@ -273,6 +305,7 @@ static PetscErrorCode oneshot(const char *method, PetscInt n, Result *r)
     KSP ksp;
     PetscReal err;
     double t0, t1, t2, t3;
+    bench_usage u0;
     PetscBool ok;
 
     PetscFunctionBeginUser;
@@ -290,6 +323,7 @@ static PetscErrorCode oneshot(const char *method, PetscInt n, Result *r)
     if (ok) {
         PetscCall(make_ksp(method, A, &ksp));
         PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+        u0 = usage_now();
         t1 = MPI_Wtime();
         PetscCall(KSPSetUp(ksp));
         PetscCall(KSPSetUpOnBlocks(ksp)); /* block Jacobi's ILU, else in KSPSolve */
@@ -298,6 +332,7 @@ static PetscErrorCode oneshot(const char *method, PetscInt n, Result *r)
         PetscCall(KSPSolve(ksp, b, x));
         PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
         t3 = MPI_Wtime();
+        PetscCall(summed_since(&u0, &r->used));
         PetscCall(check_reason(ksp, "one-shot solve"));
         PetscCall(KSPGetIterationNumber(ksp, &r->its));
         PetscCall(mumps_ordering(method, ksp, &r->ord));
@@ -378,7 +413,8 @@ static PetscErrorCode loop(const char *method, PetscInt n, PetscInt steps, Petsc
 static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
 {
     char a[32] = "-", s[32] = "-", v[32] = "-", o[32] = "-", e[32] = "-", it[32] = "-",
-         ls[32] = "-", st[32] = "-", li[32] = "-", h[32] = "-", ord[32] = "-";
+         ls[32] = "-", st[32] = "-", li[32] = "-", h[32] = "-", ord[32] = "-", cpu[32] = "-",
+         flt[32] = "-", sys[32] = "-";
 
     PetscFunctionBeginUser;
     if (r->did_oneshot) {
@@ -388,6 +424,9 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
         snprintf(o, sizeof o, "%.4f", r->setup_s + r->solve_s);
         snprintf(e, sizeof e, "%.2e", r->err);
         snprintf(it, sizeof it, "%" PetscInt_FMT, r->its);
+        snprintf(cpu, sizeof cpu, "%.2f", r->used.cpu_s);
+        snprintf(flt, sizeof flt, "%lld", r->used.faults);
+        snprintf(sys, sizeof sys, "%.2f", r->used.sys_s);
     }
     if (r->did_loop) {
         snprintf(ls, sizeof ls, "%.4f", r->lsetup_s);
@@ -397,8 +436,8 @@ static PetscErrorCode print_row(const Result *r, PetscInt n, int np)
     }
     if (r->ord >= 0) snprintf(ord, sizeof ord, "%" PetscInt_FMT, r->ord);
     PetscCall(PetscPrintf(PETSC_COMM_WORLD,
-                          "%-14s %5" PetscInt_FMT " %3d %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s\n",
-                          r->name, n, np, o, st, e, a, s, v, it, ls, li, h, ord));
+                          "%-14s %5" PetscInt_FMT " %3d %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s %6s\n",
+                          r->name, n, np, o, st, e, a, s, v, it, ls, li, h, ord, cpu, flt, sys));
     PetscFunctionReturn(0);
 }
 
@@ -438,9 +477,10 @@ int main(int argc, char **argv)
     }
     if (header)
         PetscCall(PetscPrintf(PETSC_COMM_WORLD,
-                              "%-14s %5s %3s %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s\n",
+                              "%-14s %5s %3s %9s %9s %9s %9s %9s %9s %4s %9s %6s %16s %3s %6s %8s %6s\n",
                               "method", "n", "np", "oneshot_s", "step_s", "err_inf", "asm_s",
-                              "setup_s", "solve_s", "its", "lsetup_s", "litis", "heat", "ord"));
+                              "setup_s", "solve_s", "its", "lsetup_s", "litis", "heat", "ord",
+                              "cpu_s", "faults", "sys_s"));
     for (int m = first; m <= last; m++) {
         Result r;
         memset(&r, 0, sizeof r);

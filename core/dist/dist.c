@@ -706,7 +706,8 @@ oom:
 /* Entry k of an array of wd doubles per entry, as value.c's properties read
  * it: its modulus, and whether it is nonzero, finite and positive (real and
  * > 0, what Cholesky needs of a diagonal). */
-static double entry_mod(const double *val, int64_t k, int64_t wd, int *nonzero, int *finite, int *positive)
+static inline double entry_mod(const double *val, int64_t k, int64_t wd, int *nonzero, int *finite,
+                               int *positive)
 {
     double re = val[k * wd], im = wd == 2 ? val[k * wd + 1] : 0;
     *nonzero = re != 0 || im != 0;
@@ -804,17 +805,43 @@ static void norm_props(silc_value *v)
     v->props.normfro = s > 0 && isfinite(s) ? s * sqrt(fro) : s;
 }
 
-/* Symmetry of a distributed CSR value: every off-diagonal entry travels to
- * the owner of its mirror, which compares (one exchange of the entries,
- * once per value).  Returns A = A.' (-1 when out of memory); *hermitian:
- * A = A' (for a real value the same), which a complex diagonal with an
- * imaginary part already breaks. */
+/* Entry (row, col) of the CSR block b (row local, col global; sorted
+ * columns) into x[0 .. wd), zeros when it is not stored. */
+static void block_entry(const silc_value *b, int64_t row, int64_t col, int64_t wd, double x[2])
+{
+    int64_t lo = b->rowptr[row], hi = b->rowptr[row + 1] - 1;
+    x[0] = x[1] = 0;
+    while (lo <= hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (b->colind[mid] == col) {
+            memcpy(x, b->val + mid * wd, (size_t)wd * sizeof *x);
+            return;
+        }
+        if (b->colind[mid] < col) lo = mid + 1;
+        else hi = mid - 1;
+    }
+}
+
+/* An entry x against the entry y its mirror holds: bad[0] when they break
+ * A = A.', bad[1] when they break A = A'. */
+static void mirror_check(const double x[2], const double *y, int64_t wd, double bad[2])
+{
+    if (x[0] != y[0] || (wd == 2 && x[1] != y[1])) bad[0] = 1;
+    if (x[0] != y[0] || (wd == 2 && x[1] != -y[1])) bad[1] = 1;
+}
+
+/* Symmetry of a distributed CSR value: an off-diagonal entry whose mirror
+ * this rank owns is compared here; every other one travels to the owner
+ * of its mirror, which compares (one exchange of those entries, once per
+ * value).  With one rank nothing is packed or sent.  Returns A = A.' (-1
+ * when out of memory); *hermitian: A = A' (for a real value the same),
+ * which a complex diagonal with an imaginary part already breaks. */
 static int symmetric_csr(silc_value *v, int *hermitian)
 {
     dist_ctx *D = v->dist->ctx;
     const dist_part *P = v->dist->part;
     const silc_value *b = v->dist->block;
-    int64_t first = part_first(P, D->rank), i, j, n = 0;
+    int64_t first = part_first(P, D->rank), last = first + b->m, i, j, n = 0;
     int64_t *sc = calloc((size_t)D->size * 4, sizeof *sc), *sd, *rc, *rd;
     double *send = NULL, *recv = NULL, bad[2] = {0, 0}; /* not A = A.', not A = A' */
     int64_t *fill = NULL, total = 0, wd = val_width(b), rec = 2 + wd; /* row, column, the entry */
@@ -836,11 +863,18 @@ static int symmetric_csr(silc_value *v, int *hermitian)
     } while (0)
     for (i = 0; i < b->m; i++)
         for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) {
-            if (b->colind[j] == first + i) {
+            int64_t c = b->colind[j];
+            if (c == first + i) {
                 if (wd == 2 && b->val[2 * j + 1] != 0) bad[1] = 1;
                 continue;
             }
-            OWNER(b->colind[j], r);
+            if (c >= first && c < last) { /* the mirror is in this block */
+                double x[2];
+                block_entry(b, c - first, first + i, wd, x);
+                mirror_check(x, b->val + j * wd, wd, bad);
+                continue;
+            }
+            OWNER(c, r);
             sc[r] += rec;
             n++;
         }
@@ -865,20 +899,19 @@ static int symmetric_csr(silc_value *v, int *hermitian)
         free(send), free(recv), free(fill), free(sc);
         return -1;
     }
-    for (i = 0; i < b->m; i++)
+    for (i = 0; n && i < b->m; i++)
         for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++) {
             int64_t c = b->colind[j], at;
-            if (c == first + i) continue;
+            if (c >= first && c < last) continue; /* the diagonal and mirrors in this block: done */
             OWNER(c, r);
             at = sd[r] + fill[r];
             fill[r] += rec;
-            send[at] = (double)c;          /* the mirror's row, */
+            send[at] = (double)c;               /* the mirror's row, */
             send[at + 1] = (double)(first + i); /* its column */
             memcpy(send + at + 2, b->val + j * wd, (size_t)wd * sizeof *send); /* and what it must hold */
         }
 #undef OWNER
     COMM(D, alltoallv(D->ops->impl, send, sc, sd, recv, rc, rd, MSG));
-    D->moved_matrix += 0; /* counted below, summed over ranks */
     {
         double moved = 0;
         for (r = 0; r < D->size; r++)
@@ -887,21 +920,9 @@ static int symmetric_csr(silc_value *v, int *hermitian)
         D->moved_matrix += (uint64_t)moved;
     }
     for (i = 0; i < total && !(bad[0] && bad[1]); i += rec) {
-        int64_t row = (int64_t)recv[i] - first, col = (int64_t)recv[i + 1], lo, hi;
-        double x[2] = {0, 0}; /* the entry here, against its mirror's recv[i + 2 ..] */
-        lo = b->rowptr[row];
-        hi = b->rowptr[row + 1] - 1;
-        while (lo <= hi) {
-            int64_t mid = lo + (hi - lo) / 2;
-            if (b->colind[mid] == col) {
-                memcpy(x, b->val + mid * wd, (size_t)wd * sizeof *x);
-                break;
-            }
-            if (b->colind[mid] < col) lo = mid + 1;
-            else hi = mid - 1;
-        }
-        if (x[0] != recv[i + 2] || (wd == 2 && x[1] != recv[i + 3])) bad[0] = 1;
-        if (x[0] != recv[i + 2] || (wd == 2 && x[1] != -recv[i + 3])) bad[1] = 1;
+        double x[2]; /* the entry here, against its mirror's recv[i + 2 ..] */
+        block_entry(b, (int64_t)recv[i] - first, (int64_t)recv[i + 1], wd, x);
+        mirror_check(x, recv + i + 2, wd, bad);
     }
     free(send), free(recv), free(fill), free(sc);
     reduce(D, bad, 2, 1);
