@@ -751,9 +751,11 @@ static int write_ready_file(const char *path, const char *url)
  * operator's choice; =0 turns this off), a kernel whose huge pages are
  * not "madvise" (with "always" the heap has them already, with "never"
  * there are none), a secure-execution start (glibc drops the variable
- * there), and silcd --mpi, whose ranks hold their sessions in one
- * long-lived process with a warm heap.  If the exec fails silcd goes on as
- * it is. */
+ * there).  silcd --mpi too, before MPI starts (the exec keeps the pid
+ * the launcher knows): its ranks hold their sessions in one long-lived
+ * process, but a first large factorization still touched every page of
+ * MUMPS's ~150 MB afresh, a quarter of a 500^2 one-shot solve's CPU time
+ * (docs/distributed.md, item 7).  If the exec fails silcd goes on as it is. */
 static void exec_with_huge_page_heap(char **argv)
 {
     static const char tunable[] = "glibc.malloc.hugetlb=1";
@@ -771,7 +773,14 @@ static void exec_with_huge_page_heap(char **argv)
     if (!(both = malloc((old ? strlen(old) : 0) + sizeof tunable + 1))) return;
     sprintf(both, "%s%s%s", old ? old : "", old && *old ? ":" : "", tunable);
     if (setenv("GLIBC_TUNABLES", both, 1) == 0) {
-        execv("/proc/self/exe", argv);
+        /* By its own path, not /proc/self/exe: the process's name (ps,
+         * pgrep, the launcher's view) stays silcd, not "exe". */
+        char self[4096];
+        ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+        if (len > 0) {
+            self[len] = '\0';
+            execv(self, argv);
+        }
         if (old) setenv("GLIBC_TUNABLES", old, 1);
         else unsetenv("GLIBC_TUNABLES");
     }
@@ -788,7 +797,7 @@ int main(int argc, char **argv)
     int lfd, i;
     if (parse_args(argc, argv, &ready_file)) return 2;
     if (make_token) return srv_auth_make_token(make_token) ? 1 : 0;
-    if (!mpi_mode) exec_with_huge_page_heap(argv);
+    exec_with_huge_page_heap(argv);
     if (*(const uint8_t *)&probe != 1) {
         fprintf(stderr, "silcd: the wire protocol needs a little-endian host\n");
         return 1;

@@ -245,8 +245,17 @@ static int parse_value_token(mm_reader *r, const char **s, int field, double *ou
     int nonfinite;
     if (field == MM_INTEGER) {
         int64_t x;
+        const char *at = *s;
         if (parse_int_token(r, s, "integer value", &x)) return -1;
         *out = (double)x;
+        /* Values are doubles: an integer past 2^53 that has no double of its
+         * own would be stored as a neighbour, silently. */
+        if (*out >= 9223372036854775808.0 || (int64_t)*out != x) {
+            while (isspace((unsigned char)*at) && *at != '\n') at++;
+            return mm_fail_at(r, at, "integer value '%s' has no exact double (SILC stores doubles: "
+                                     "integers beyond 2^53 = 9007199254740992 only where exact)",
+                              token_text(at, token_len(at), tok, sizeof tok));
+        }
         return 0;
     }
     while (isspace((unsigned char)*p) && *p != '\n') p++;
