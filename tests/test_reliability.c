@@ -213,6 +213,9 @@ static const row rows[] = {
         ":3:5: integer value '1.5' is not an integer"),
     MMF("%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 0x10\n",
         ":3:5: integer value '0x10' is not an integer"),
+    MMF("%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 9007199254740993\n",
+        ":3:5: integer value '9007199254740993' has no exact double (SILC stores doubles: integers beyond "
+        "2^53 = 9007199254740992 only where exact)"),
     MMF("%%MatrixMarket matrix coordinate real general\n1 1 1\n1 1 1e400\n",
         ":3:5: value '1e400' overflows the doubles (set SILC_MM_ALLOW_NONFINITE=1 to accept it as inf)"),
     MMF("%%MatrixMarket matrix coordinate real general\n1 1 1\n1 1 nan\n",

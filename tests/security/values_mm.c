@@ -34,7 +34,11 @@ typedef struct mm_case {
 static const mm_case cases[] = {
     /* integer fields: integers within int64, nothing else */
     {HEAD_INT "1 1 7\n", 0, NULL, 1, 1, {7}},
-    {HEAD_INT "1 1 -9223372036854775807\n", 0, NULL, 1, 1, {-9223372036854775807.0}},
+    {HEAD_INT "1 1 -9223372036854775808\n", 0, NULL, 1, 1, {-9223372036854775808.0}},
+    /* values are doubles: an int64 with no exact double is refused, not rounded */
+    {HEAD_INT "1 1 -9223372036854775807\n", 0,
+     "3:5: integer value '-9223372036854775807' has no exact double (SILC stores doubles: integers beyond "
+     "2^53 = 9007199254740992 only where exact)", 0, 0, {0}},
     {HEAD_INT "1 1 1.5\n", 0, "3:5: integer value '1.5' is not an integer", 0, 0, {0}},
     {HEAD_INT "1 1 1e20\n", 0, "3:5: integer value '1e20' is not an integer", 0, 0, {0}},
     {HEAD_INT "1 1 1e400\n", 0, "3:5: integer value '1e400' is not an integer", 0, 0, {0}},
