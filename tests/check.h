@@ -15,6 +15,21 @@
 
 static int check_passed_, check_failed_;
 
+/* The text of file path into buf (len bytes with the NUL; "" when the file
+ * is absent); returns the bytes read.  For tests that read what a program
+ * wrote (its log, its stderr). */
+static inline size_t check_read_file(const char *path, char *buf, size_t len)
+{
+    FILE *f = fopen(path, "r");
+    size_t n = 0;
+    if (f) {
+        n = fread(buf, 1, len - 1, f);
+        fclose(f);
+    }
+    buf[n] = '\0';
+    return n;
+}
+
 static void check_report_(int ok, const char *file, int line, const char *fmt, ...)
 {
     if (ok) {

@@ -185,18 +185,6 @@ static void check_monitor_flags(void)
         CHECK(mon.count[CLOTH_CHECK_TUNNEL] == 0, "drape at dt = 0.005: %s", mon.first[CLOTH_CHECK_TUNNEL]);
 }
 
-/* The text of file path into buf (len bytes with the NUL), "" when absent. */
-static void read_text(const char *path, char *buf, size_t len)
-{
-    FILE *f = fopen(path, "r");
-    size_t n = 0;
-    if (f) {
-        n = fread(buf, 1, len - 1, f);
-        fclose(f);
-    }
-    buf[n] = '\0';
-}
-
 /* Runs the program; its exit status, its stderr in err, and its stdout in
  * out when out is not NULL. */
 static int program_out(const char *cloth, const char *dir, const char *args, char *err, size_t errlen, char *out,
@@ -208,8 +196,8 @@ static int program_out(const char *cloth, const char *dir, const char *args, cha
     snprintf(opath, sizeof opath, "%s/cloth-physics.out", dir);
     snprintf(cmd, sizeof cmd, "'%s' %s >'%s' 2>'%s'", cloth, args, out ? opath : "/dev/null", path);
     st = system(cmd);
-    read_text(path, err, errlen);
-    if (out) read_text(opath, out, outlen);
+    check_read_file(path, err, errlen);
+    if (out) check_read_file(opath, out, outlen);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 

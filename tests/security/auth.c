@@ -34,18 +34,6 @@ static void put_file(const char *path, const char *text, mode_t mode)
     }
 }
 
-static size_t read_file(const char *path, char *buf, size_t len)
-{
-    FILE *f = fopen(path, "r");
-    size_t n = 0;
-    if (f) {
-        n = fread(buf, 1, len - 1, f);
-        fclose(f);
-    }
-    buf[n] = '\0';
-    return n;
-}
-
 /* Runs silcd with argv (NULL-terminated), in directory cwd (NULL: here),
  * SILC_CONFIG set to config (NULL: unset); its stdout and stderr in out.
  * The exit status, or -1 if it was still running after 20 s (killed). */
@@ -73,14 +61,14 @@ static int run_silcd(const char *const *args, const char *cwd, const char *confi
     }
     for (i = 0; i < 800; i++) {
         if (waitpid(pid, &status, WNOHANG) == pid) {
-            read_file(log, out, outlen);
+            check_read_file(log, out, outlen);
             return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
         }
         sleep_ms(25);
     }
     kill(pid, SIGKILL);
     waitpid(pid, &status, 0);
-    read_file(log, out, outlen);
+    check_read_file(log, out, outlen);
     return -1;
 }
 
@@ -203,7 +191,7 @@ static void test_token_rules(void)
     if (server_start(&srv, "tcp://127.0.0.1:0", (const char *const[]){"--insecure", NULL}) == 0) {
         char logf[400];
         snprintf(logf, sizeof logf, "%s/log", srv.dir);
-        read_file(logf, out, sizeof out);
+        check_read_file(logf, out, sizeof out);
         CHECK(contains(out, "WARNING: --insecure: listening on 127.0.0.1:0 with no token: every local "
                             "user can run code and read and write files as this user"),
               "--insecure: no loud warning in the log: '%s'", out);
@@ -255,7 +243,7 @@ static void test_token_rules(void)
     CHECK(stat(tok, &st) == 0 && S_ISREG(st.st_mode) && (st.st_mode & 07777) == 0600 &&
               st.st_size == 33 && st.st_uid == geteuid(),
           "--make-token wrote mode %o, %lld bytes", (unsigned)(st.st_mode & 07777), (long long)st.st_size);
-    n = read_file(tok, text, sizeof text);
+    n = check_read_file(tok, text, sizeof text);
     for (i = 0, ok = n == 33 && text[32] == '\n'; i < 32 && ok; i++)
         ok = (text[i] >= '0' && text[i] <= '9') || (text[i] >= 'a' && text[i] <= 'f');
     CHECK(ok, "--make-token wrote '%s', not 32 hex digits and a newline", text);
@@ -265,7 +253,7 @@ static void test_token_rules(void)
                  "token file is never overwritten)", tok);
         expect_refusal((const char *const[]){"--make-token", tok, NULL}, NULL, NULL, 1, msg,
                        "--make-token over an existing file");
-        read_file(tok, again, sizeof again);
+        check_read_file(tok, again, sizeof again);
         CHECK(strcmp(again, text) == 0, "--make-token changed an existing file");
     }
     if (server_start(&srv, "tcp://127.0.0.1:0", (const char *const[]){opt, NULL}) == 0) {
@@ -392,7 +380,7 @@ static void test_guessing(void)
     snprintf(logf, sizeof logf, "%s/log", srv.dir);
     log = calloc(1, 1 << 20);
     if (log) {
-        read_file(logf, log, 1 << 20);
+        check_read_file(logf, log, 1 << 20);
         CHECK(count_lines(log, "refused: authentication failed: wrong token from 127.0.0.1;") == 1,
               "the burst from 127.0.0.1 was not logged exactly once:\n%s", log);
         CHECK(count_lines(log, "refused: authentication failed: wrong token from 127.0.0.3;") == 1,
