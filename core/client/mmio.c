@@ -212,15 +212,21 @@ static const char *token_text(const char *p, size_t len, char *buf, size_t bufle
     return buf;
 }
 
+/* p past the blanks before a token, not past the line's end. */
+static const char *skip_blanks(const char *p)
+{
+    while (isspace((unsigned char)*p) && *p != '\n') p++;
+    return p;
+}
+
 /* Skips white space, then reads one whole integer token within int64.
  * what names the field in messages ("row index", "value"). */
 static int parse_int_token(mm_reader *r, const char **s, const char *what, int64_t *out)
 {
-    const char *p = *s;
+    const char *p = skip_blanks(*s);
     char *end, tok[64];
     size_t len;
     long long x;
-    while (isspace((unsigned char)*p) && *p != '\n') p++;
     len = token_len(p);
     if (len == 0) return mm_fail_at(r, p, "expected %s, found the end of the line", what);
     if (!is_integer_token(p, len))
@@ -239,26 +245,22 @@ static int parse_int_token(mm_reader *r, const char **s, const char *what, int64
  * reals beyond the doubles only when the reader allows non-finite values. */
 static int parse_value_token(mm_reader *r, const char **s, int field, double *out)
 {
-    const char *p = *s;
+    const char *p = skip_blanks(*s);
     char *end, tok[64];
     size_t len;
     int nonfinite;
     if (field == MM_INTEGER) {
         int64_t x;
-        const char *at = *s;
         if (parse_int_token(r, s, "integer value", &x)) return -1;
         *out = (double)x;
         /* Values are doubles: an integer past 2^53 that has no double of its
          * own would be stored as a neighbour, silently. */
-        if (*out >= 9223372036854775808.0 || (int64_t)*out != x) {
-            while (isspace((unsigned char)*at) && *at != '\n') at++;
-            return mm_fail_at(r, at, "integer value '%s' has no exact double (SILC stores doubles: "
-                                     "integers beyond 2^53 = 9007199254740992 only where exact)",
-                              token_text(at, token_len(at), tok, sizeof tok));
-        }
+        if (*out >= 9223372036854775808.0 || (int64_t)*out != x)
+            return mm_fail_at(r, p, "integer value '%s' has no exact double (SILC stores doubles: "
+                                    "integers beyond 2^53 = 9007199254740992 only where exact)",
+                              token_text(p, token_len(p), tok, sizeof tok));
         return 0;
     }
-    while (isspace((unsigned char)*p) && *p != '\n') p++;
     len = token_len(p);
     if (len == 0) return mm_fail_at(r, p, "expected a value, found the end of the line");
     nonfinite = !is_decimal_token(p, len);

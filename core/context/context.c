@@ -210,11 +210,15 @@ static eng_info_entry *info_entry(silc_engine *E, const char *name)
     return e;
 }
 
-int eng_info_reserve(silc_engine *E, const char *name)
+eng_info *eng_info_make(silc_engine *E, const char *name)
 {
-    if (!E || !name) return -1;
-    if (!info_entry(E, name)) return eng_error(E, "out of memory recording info for '%s'", name);
-    return 0;
+    eng_info_entry *e;
+    if (!E || !name) return NULL;
+    if (!(e = info_entry(E, name))) {
+        eng_error(E, "out of memory recording info for '%s'", name);
+        return NULL;
+    }
+    return &e->info;
 }
 
 int eng_info_take(silc_engine *E, const char *name, eng_info *info)

@@ -150,11 +150,13 @@ void eng_snapshot_free(eng_snapshot *s);
 /* Copies info; takes over its pending references (also on failure). */
 int eng_info_set(silc_engine *E, const char *name, eng_info *info);
 /* As eng_info_set, but takes over info->statement (malloc'd) too; allocates
- * nothing when name already has a record (see eng_info_reserve). */
+ * nothing when name already has a record (see eng_info_make). */
 int eng_info_take(silc_engine *E, const char *name, eng_info *info);
-/* Makes sure name has a record, so that the next eng_info_take of name
- * cannot fail: for a change that cannot be undone (an update in place). */
-int eng_info_reserve(silc_engine *E, const char *name);
+/* name's record, made (empty) when it has none; NULL, with the engine's
+ * error set, when out of memory.  A binding fills it in place (eval.c's
+ * bind); a change that cannot be undone (an update in place) makes it
+ * beforehand, so that the binding after it allocates nothing. */
+eng_info *eng_info_make(silc_engine *E, const char *name);
 eng_info *eng_info_get(const silc_engine *E, const char *name);
 void eng_info_remove(silc_engine *E, const char *name);
 /* Every record, at the engine's end. */

@@ -1053,13 +1053,10 @@ static int bind(lang_ev *V, const ast_node *stmt, const char *name, silc_value *
         val_release(v);
         return eng_error(V->E, "out of memory binding '%s'", name);
     }
-    if (!rec) {
-        if (eng_info_reserve(V->E, name)) { /* "out of memory recording info for 'x'" */
-            free(text);
-            val_release(v);
-            return -1;
-        }
-        rec = eng_info_get(V->E, name); /* the record just made, zeroed */
+    if (!rec && !(rec = eng_info_make(V->E, name))) { /* "out of memory recording info for 'x'" */
+        free(text);
+        val_release(v);
+        return -1;
     }
     if (text) {
         free(rec->statement);
@@ -1098,7 +1095,7 @@ static int bind_reserve(lang_ev *V, const ast_node *stmt)
 {
     if (!V->bind_text && !(V->bind_text = stmt_text(V, stmt)))
         return eng_error(V->E, "out of memory binding '%s'", stmt->name);
-    return eng_info_reserve(V->E, stmt->name);
+    return eng_info_make(V->E, stmt->name) ? 0 : -1;
 }
 
 static int opassign_token(int op)
