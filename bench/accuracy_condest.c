@@ -141,7 +141,7 @@ static double info_number(const char *label, double fallback)
     return p ? strtod(p + strlen(label), NULL) : fallback;
 }
 
-static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest, int floor,
+static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, const char *condest, int with_floor,
                        timing *t)
 {
     char stmt[512];
@@ -163,7 +163,7 @@ static int timed_solve(silc_context *c, silc_envelope_t *A, const backend *be, c
     if (silc_exec(c, stmt)) return -1;
     t->again = cpu_now() - t->again;
     t->solve = t->solve3 = INFINITY;
-    if (floor) { /* untimed: the backend's own clock of those solves */
+    if (with_floor) { /* untimed: the backend's own clock of those solves */
         info_text[0] = 0;
         if (silc_exec(c, "info x")) return -1;
         t->solve = info_number("solve time: ", INFINITY);
@@ -203,14 +203,14 @@ int main(int argc, char **argv)
     char path[1024], line[1024];
     const char *only_matrix = NULL, *only_backend = NULL;
     FILE *idx;
-    int over = 0, rows = 0, reps = CE_REPS, floor = 0;
+    int over = 0, rows = 0, reps = CE_REPS, with_floor = 0;
     int nrow[NB] = {0}, nover[NB] = {0}, nread[NB] = {0};
     static double now_share[NB][MAX_ROWS], auto_share[NB][MAX_ROWS], read_solves[NB][MAX_ROWS];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc && atoi(argv[i + 1]) > 0) reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--matrix") && i + 1 < argc) only_matrix = argv[++i];
         else if (!strcmp(argv[i], "--backend") && i + 1 < argc) only_backend = argv[++i];
-        else if (!strcmp(argv[i], "--floor")) floor = 1;
+        else if (!strcmp(argv[i], "--floor")) with_floor = 1;
         else {
             fprintf(stderr, "usage: %s [--reps N] [--matrix SUBSTRING] [--backend SUBSTRING] [--floor]\n",
                     argv[0]);
@@ -231,7 +231,7 @@ int main(int argc, char **argv)
            "auto, CPU time, best of %d (%d under 20000 entries)\n\n", reps, 3 * reps);
     printf("  %-17s %-20s %6s  %10s  %10s  %6s  %6s  %-5s  %12s  %6s%s\n", "matrix", "backend", "n", "factor [s]",
            "solve [s]", "now", "auto", "at", "read [solves]", "read",
-           floor ? "   1 solve [s]  column [s]  min   floor" : "");
+           with_floor ? "   1 solve [s]  column [s]  min   floor" : "");
     while (fgets(line, sizeof line, idx)) {
         char file[256], field[32], sym[32], cls[32];
         long long m, n, nnz;
@@ -269,7 +269,7 @@ int main(int argc, char **argv)
                 static const char *const modes[3] = {"off", "now", "auto"};
                 timing *best[3] = {&off, &now, &au};
                 for (int m = 0; m < 3 && ok; m++) {
-                    ok = timed_solve(c, &A, be, modes[m], floor && m == 0, &t) == 0;
+                    ok = timed_solve(c, &A, be, modes[m], with_floor && m == 0, &t) == 0;
                     if (t.first < best[m]->first) best[m]->first = t.first;
                     if (t.solve < best[m]->solve) best[m]->solve = t.solve;
                     if (t.solve3 < best[m]->solve3) best[m]->solve3 = t.solve3;
@@ -299,7 +299,7 @@ int main(int argc, char **argv)
                    file, be->name, n, off.first, off.again, 100 * now_d, 100 * auto_d, at);
             if (read) printf("  %12.1f  %5.1f%%", read_d / off.again, 100 * read_d / off.first);
             else printf("  %12s  %6s", "--", "--");
-            if (floor) {
+            if (with_floor) {
                 int least = floor_solves(be, !read, off.pivot_ratio);
                 double column = (off.solve3 - off.solve) / 2, unit = strcmp(be->name, "mumps") ? column : off.solve;
                 printf("   %11.3g  %10.3g", off.solve, column);
