@@ -533,6 +533,7 @@ static const lang_case cases[] = {
     ERR("x = diag(M)", "diag needs a vector, got 2x2 (diagvec(A) gives the diagonal of a matrix)"),
     ERR("x = zeros(-1)", "zeros: argument 1 must be an integer >= 0, got -1"),
     ERR("x = ones(2, 1.5)", "ones: argument 2 must be an integer >= 0, got 1.5"),
+    ERR("x = band(eye(3), 1e16, 0)", "band: argument 2 must be an integer below 9e15, got 1e+16"),
     ERR("x = zeros(v)", "zeros: argument 1 must be a scalar, got 3x1"),
     ERR("x = sparse(idx, idx, 1, 2, 3)", "sparse: row index 3 (entry 2) is out of range 1..2"),
     ERR("x = sparse(idx, idx, 1, 3, 2)", "sparse: column index 3 (entry 2) is out of range 1..2"),

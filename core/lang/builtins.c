@@ -54,6 +54,9 @@ static int int_arg(lang_ev *V, const ast_node *call, silc_value **a, int i, int6
     x = val_scalar(a[i]);
     if (!(x == floor(x) && x >= (double)lo && x < 9.0e15)) {
         util_fmt_double(num, sizeof num, x);
+        if (x == floor(x) && x >= 9.0e15) /* past every exact index: say where the range ends */
+            return eng_error(V->E, "%s: argument %d must be an integer below 9e15, got %s", call->name,
+                             i + 1, num);
         return eng_error(V->E, "%s: argument %d must be an integer >= %lld, got %s", call->name,
                          i + 1, (long long)lo, num);
     }
