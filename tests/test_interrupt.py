@@ -226,6 +226,29 @@ def check_python(s, what, remote):
     if values(s, ["a", "x", "i"]) != [7, 1, 0]:
         fail("%s: a x i = %s after SIGINT" % (what, values(s, ["a", "x", "i"])))
     if remote:
+        # A loop that prints: its output streams while it runs, and what is
+        # still on the way when the CANCEL goes out is dropped and counted
+        # in a warning (as the C client does), not shown after the interrupt.
+        s.exec("i = 0")
+        out = []
+        t = threading.Timer(0.3 * SLOW, s.cancel)
+        t.start()
+        try:
+            s.exec("while (i < 1e9) { i = i + 1; disp(i) }", out=out)
+            fail("%s: an interrupted printing loop returned normally" % what)
+        except silc.Error as e:
+            if str(e) != "interrupted":
+                fail("%s: printing loop: message %r, want 'interrupted'" % (what, str(e)))
+        t.join()
+        if not out:
+            fail("%s: printing loop: no output reached the caller while it ran (not streamed)" % what)
+        if "of the statement's output, still on the way from the server, were not shown" not in s.warnings:
+            fail("%s: printing loop: no warning of the dropped output: %r" % (what, s.warnings))
+        if values(s, ["i"]) != [0]:
+            fail("%s: printing loop: i = %s after cancel, want 0" % (what, values(s, ["i"])))
+        s.exec("disp(42)", out=out)
+        if not out[-1].strip().endswith("42"):
+            fail("%s: the exec after a cancel did not show its output: %r" % (what, out[-1]))
         # A CANCEL that comes when nothing runs gets no reply: the session stays in step.
         s._s.sock.sendall(struct.pack("<IIQ", 9, 0, 0))
     s.cancel()  # nothing running: nothing happens

@@ -309,6 +309,31 @@ public final class TestClient {
             canceller.join();
             check(s.GETScalar("ca") == 7 && s.GETScalar("cx") == 1 && s.GETScalar("ci") == 0,
                   "the store as before the cancelled loop");
+            // A loop that prints: what is still on its way when the CANCEL goes
+            // out is dropped and counted in a warning, not shown afterwards.
+            StringBuilder shown = new StringBuilder();
+            s.setOutput(shown::append);
+            s.EXEC("ci = 0");
+            Thread canceller2 = new Thread(() -> {
+                try {
+                    Thread.sleep(300);
+                    s.cancel();
+                } catch (Exception e) {
+                    check(false, "cancel: " + e);
+                }
+            });
+            canceller2.start();
+            expectError(() -> s.EXEC("while (ci < 1e9) { ci = ci + 1; disp(ci) }"), "interrupted",
+                        "printing loop cancelled");
+            canceller2.join();
+            check(shown.length() > 0, "a printing loop's output streams while it runs");
+            check(s.warnings().contains("of the statement's output, still on the way from the server, were not shown"),
+                  "a warning counts the output dropped after cancel(): '" + s.warnings() + "'");
+            check(s.GETScalar("ci") == 0, "the store as before the cancelled printing loop");
+            int before = shown.length();
+            s.EXEC("disp(42)");
+            check(shown.substring(before).trim().endsWith("42"), "the EXEC after cancel() shows its output");
+            s.setOutput(System.out::print);
             s.cancel(); // nothing running: nothing sent
             s.EXEC("ci = 2");
             check(s.GETScalar("ci") == 2, "an EXEC after cancel()");

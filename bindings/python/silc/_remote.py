@@ -138,6 +138,11 @@ class RemoteSession:
         # critical section.
         self._cancel_lock = threading.RLock()
         self._awaiting = False
+        # A CANCEL went out for the EXEC awaited: the output still on its
+        # way is dropped (and counted in a warning), as the C client does,
+        # so the interrupt shows at once, not after a loop's backlog.
+        self._cancel_sent = False
+        self._dropped = 0
         self._old_server = False          # answers GET_COMPLEX "unknown request opcode"
         try:
             self.sock = self._connect(url)
@@ -324,7 +329,9 @@ class RemoteSession:
                           % (_OPS[op], length, _MAX_TEXT))
             text = self._recv_text(length)
             if op == TEXT:
-                if out is not None:
+                if self._cancel_sent:
+                    self._dropped += len(text.encode())
+                elif out is not None:
                     out.append(text)
                 else:
                     sys.stdout.write(text)
@@ -333,6 +340,9 @@ class RemoteSession:
             elif op == OK:
                 return text
             else:
+                if self._dropped:
+                    self.warnings += ("interrupted: %d bytes of the statement's output, still on the "
+                                      "way from the server, were not shown\n" % self._dropped)
                 if text.startswith("undefined name '"):
                     raise UndefinedName(text)
                 raise Error(text)
@@ -369,6 +379,8 @@ class RemoteSession:
         server's reply and raises KeyboardInterrupt; a second Ctrl-C gives
         up waiting and closes the session."""
         self.warnings = ""
+        self._cancel_sent = False
+        self._dropped = 0
         self._send(EXEC, statements.encode())
         presses = []
 
@@ -398,6 +410,7 @@ class RemoteSession:
         finally:
             with self._cancel_lock:
                 self._awaiting = False
+                self._cancel_sent = False  # the next request's text is shown
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
         if presses:
@@ -411,6 +424,7 @@ class RemoteSession:
         with self._cancel_lock:
             if self._awaiting and self.sock is not None:
                 self.sock.sendall(_HEADER.pack(CANCEL, 0, 0))
+                self._cancel_sent = True
 
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""

@@ -85,6 +85,12 @@ public final class SILC implements AutoCloseable {
      * never lands inside another request. */
     private final Object cancelLock = new Object();
     private boolean awaitingExec;
+    /* A CANCEL went out for the EXEC awaited: the output still on its way
+     * is dropped and its bytes counted in a warning, as the C and Python
+     * clients do, so the interrupt shows at once, not after a loop's backlog.
+     * Volatile: cancel() runs on another thread than the EXEC's reader. */
+    private volatile boolean cancelSent;
+    private long droppedBytes;
 
     /* A malformed SILC_* limit variable, reported by INIT. */
     private String envError;
@@ -333,12 +339,15 @@ public final class SILC implements AutoCloseable {
         request(EXEC, text(statements, "EXEC"));
         synchronized (cancelLock) {
             awaitingExec = true;
+            cancelSent = false;
+            droppedBytes = 0;
         }
         try {
             reply(output, null, execTimeoutMs, "SILC_EXEC_TIMEOUT", false);
         } finally {
             synchronized (cancelLock) {
                 awaitingExec = false;
+                cancelSent = false; // the next request's text is shown
             }
         }
     }
@@ -356,6 +365,7 @@ public final class SILC implements AutoCloseable {
             frame.putInt(CANCEL).putInt(0).putLong(0).flip();
             try {
                 while (frame.hasRemaining()) channel.write(frame);
+                cancelSent = true;
             } catch (IOException e) {
                 /* The EXEC's own read meets the broken connection and says so. */
                 throw new SILCException("cancel: cannot write to silc server " + url + ": " + e.getMessage(), e);
@@ -667,12 +677,21 @@ public final class SILC implements AutoCloseable {
                 }
                 String s = t.toString(StandardCharsets.UTF_8);
                 switch (op) {
-                    case TEXT -> (out != null ? out : output).accept(s);
+                    case TEXT -> {
+                        if (cancelSent) droppedBytes += length;
+                        else (out != null ? out : output).accept(s);
+                    }
                     case WARN -> warnings += s;
                     case OK -> {
                         return s;
                     }
-                    case ERROR -> throw new SILCException(s);
+                    case ERROR -> {
+                        if (droppedBytes > 0)
+                            warnings += "interrupted: " + droppedBytes + " bytes of the statement's output, still on "
+                                    + "the way from the server, were not shown\n";
+                        droppedBytes = 0;
+                        throw new SILCException(s);
+                    }
                     default -> throw new IOException("unknown reply opcode " + op);
                 }
             }
