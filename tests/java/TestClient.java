@@ -53,6 +53,21 @@ public final class TestClient {
         }
     }
 
+    /* A thread that calls s.cancel() after 300 ms, as a user's Ctrl-C would
+     * during a long EXEC; started, for the caller to join. */
+    private static Thread cancelSoon(SILC s) {
+        Thread t = new Thread(() -> {
+            try {
+                Thread.sleep(300);
+                s.cancel();
+            } catch (Exception e) {
+                check(false, "cancel: " + e);
+            }
+        });
+        t.start();
+        return t;
+    }
+
     /* The n x n tridiagonal (off, diag, off) matrix, built from triplets. */
     static CRS tridiagonal(int n, double diag, double off) {
         int[] i = new int[3 * n], j = new int[3 * n];
@@ -295,15 +310,7 @@ public final class TestClient {
             // cancel() from another thread: a loop of 1e9 iterations (minutes) ends
             // "interrupted", the loop's assignments undone, the session going on.
             s.EXEC("ca = 7; cx = 1; ci = 0");
-            Thread canceller = new Thread(() -> {
-                try {
-                    Thread.sleep(300);
-                    s.cancel();
-                } catch (Exception e) {
-                    check(false, "cancel: " + e);
-                }
-            });
-            canceller.start();
+            Thread canceller = cancelSoon(s);
             expectError(() -> s.EXEC("while (ci < 1e9) { ci = ci + 1; cx = ci }"), "interrupted",
                         "EXEC cancelled from another thread");
             canceller.join();
@@ -314,15 +321,7 @@ public final class TestClient {
             StringBuilder shown = new StringBuilder();
             s.setOutput(shown::append);
             s.EXEC("ci = 0");
-            Thread canceller2 = new Thread(() -> {
-                try {
-                    Thread.sleep(300);
-                    s.cancel();
-                } catch (Exception e) {
-                    check(false, "cancel: " + e);
-                }
-            });
-            canceller2.start();
+            Thread canceller2 = cancelSoon(s);
             expectError(() -> s.EXEC("while (ci < 1e9) { ci = ci + 1; disp(ci) }"), "interrupted",
                         "printing loop cancelled");
             canceller2.join();
