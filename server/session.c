@@ -46,7 +46,8 @@
  * texts), or a value's arrays, the value held until they are out.  The loop
  * reads no further request of a session while its reply waits, so one
  * reply at most is queued: a GET's value, which the session's limits
- * already count, and a few headers. */
+ * already count, and a few headers; before an EXEC's reply, the output it
+ * streamed while running (at most STREAM_QUEUED_MAX of it unread). */
 typedef struct reply_part {
     uint8_t *own;            /* a malloc'd copy, or NULL */
     const uint8_t *p;
@@ -302,16 +303,24 @@ static int finish_exec(session *S, int rc, const char *warnings)
  * poll, every 20 ms): a long loop shows its progress as it goes, as it does
  * embedded, the session holds 20 ms of it rather than the whole run's, and
  * an interrupt is not followed by everything the run printed.  silcd --mpi
- * queues its replies for rank 0's loop and sends the output with the reply. */
+ * cannot block rank 0 on one client: it queues the piece and writes what
+ * the socket takes now (the rest goes with the next poll or the reply);
+ * while more than STREAM_QUEUED_MAX waits unread, the output stays in out,
+ * as it did before streaming, rather than grow the queue too. */
+enum { STREAM_QUEUED_MAX = 4 << 20 };
+
 static int stream_output(void *user)
 {
     session *S = user;
     struct iovec iov;
-    if (S->queued || S->out.failed || !S->out.len) return 0;
+    if (S->out.failed || !S->out.len) return 0;
+    if (S->queued && srv_session_flush(S) < 0) return -1;
+    if (S->queued && S->q.bytes > STREAM_QUEUED_MAX) return 0;
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
     S->out.len = S->out.text_at = 0;
-    return send_parts(S, &iov, 1, NULL, 1);
+    if (send_parts(S, &iov, 1, NULL, 1)) return -1;
+    return S->queued && srv_session_flush(S) < 0 ? -1 : 0;
 }
 
 /* An EXEC runs against a snapshot (rolled back whole on a verdict) when a

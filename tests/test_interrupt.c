@@ -174,8 +174,11 @@ static void read_slowly(void *user, const char *text)
  * that reads the CANCEL, silcd first sends what the loop printed since the
  * last one).  Before, silcd sent the whole run's output after the
  * interrupt, and the REPL showed "interrupted" only once it had printed it
- * all. */
-static void check_output_cancelled(silc_context *ctx)
+ * all.  Under silcd --mpi on a loaded machine a statement can take longer
+ * than the 20 ms between polls (each one ends in an agreement between the
+ * ranks), and the poll that reads the CANCEL may follow `i = i + 1`, which
+ * printed nothing: there may be nothing to drop, so some_dropped is 0. */
+static void check_output_cancelled(silc_context *ctx, int some_dropped)
 {
     slow_reader r = {0, 0};
     int rc;
@@ -187,12 +190,12 @@ static void check_output_cancelled(silc_context *ctx)
           silc_context_errmsg(ctx));
     CHECK(r.before > 0, "output: nothing reached the callback while the loop ran (not streamed)");
     CHECK(r.after <= 1, "output: %d pieces reached the callback after silc_cancel returned", r.after);
-    CHECK(strstr(silc_context_warnings(ctx), "of the statement's output, still on the way from the server, "
-                                             "were not shown") != NULL,
+    CHECK(!some_dropped || strstr(silc_context_warnings(ctx), "of the statement's output, still on the way "
+                                                              "from the server, were not shown") != NULL,
           "output: no warning of the dropped output: '%s'", silc_context_warnings(ctx));
     CHECK_NEAR(scalar(ctx, "i"), 0, 0);
     printf("  remote printing loop: %d pieces shown before the cancel, %d after; %s", r.before, r.after,
-           silc_context_warnings(ctx));
+           *silc_context_warnings(ctx) ? silc_context_warnings(ctx) : "nothing dropped\n");
 }
 
 /* An iterative solve of lis-style (which asks host->cancelled() once an
@@ -306,6 +309,7 @@ int main(void)
             CHECK(0, "silc_open_remote %s: %s", server, silc_errmsg());
         } else {
             check_loop_cancelled(ctx, server);
+            check_output_cancelled(ctx, 0);
         }
         silc_close(&ctx);
         return check_done();
@@ -331,7 +335,7 @@ int main(void)
             CHECK(0, "silc_open_remote %s: %s", srv.url, silc_errmsg());
         } else {
             check_loop_cancelled(ctx, "remote");
-            check_output_cancelled(ctx);
+            check_output_cancelled(ctx, 1);
             /* After the cancels the session is in step (a CANCEL that
              * came late would have been answered by nothing). */
             CHECK(silc_exec(ctx, "q = 2") == 0, "after cancels: %s", silc_context_errmsg(ctx));

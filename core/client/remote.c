@@ -468,6 +468,10 @@ int rem_cancel(rem_conn *c)
     if (!c) return -1;
     if (!atomic_compare_exchange_strong(&c->exec_state, &state, EXEC_CANCELLING)) return 0;
     proto_encode_header(frame, PROTO_CANCEL, 0);
+    /* Output that arrives from now on is the backlog of a statement being
+     * stopped: marked before the frame goes, or the reader could show what
+     * the server sent in answer to it while this thread had not yet set it. */
+    atomic_store(&c->cancel_sent, 1);
     /* send() is async-signal-safe; proto_send polls and formats messages. */
     while (sent < sizeof frame) {
         ssize_t n = send(c->fd, frame + sent, sizeof frame - sent, MSG_NOSIGNAL);
@@ -475,7 +479,6 @@ int rem_cancel(rem_conn *c)
         else if (n < 0 && errno == EINTR) continue;
         else break; /* the connection is failing: the reply's read says so */
     }
-    atomic_store(&c->cancel_sent, 1);
     atomic_store(&c->exec_state, EXEC_AWAITING);
     errno = saved_errno; /* a signal handler must leave errno as it found it */
     return 0;

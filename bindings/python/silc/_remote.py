@@ -423,8 +423,8 @@ class RemoteSession:
         nothing when no exec is waiting for its reply."""
         with self._cancel_lock:
             if self._awaiting and self.sock is not None:
+                self._cancel_sent = True  # before the frame: what answers it is backlog
                 self.sock.sendall(_HEADER.pack(CANCEL, 0, 0))
-                self._cancel_sent = True
 
     def explain(self, statement):
         """What the statement would run and why, as text (nothing is run)."""

@@ -363,9 +363,9 @@ public final class SILC implements AutoCloseable {
             if (!awaitingExec || channel == null) return;
             ByteBuffer frame = ByteBuffer.allocate(16).order(ByteOrder.LITTLE_ENDIAN);
             frame.putInt(CANCEL).putInt(0).putLong(0).flip();
+            cancelSent = true; // before the frame: what answers it is backlog
             try {
                 while (frame.hasRemaining()) channel.write(frame);
-                cancelSent = true;
             } catch (IOException e) {
                 /* The EXEC's own read meets the broken connection and says so. */
                 throw new SILCException("cancel: cannot write to silc server " + url + ": " + e.getMessage(), e);
