@@ -9,7 +9,10 @@
  *   cholmod_l_factorize  into a copy of that analysis (or into the factor of
  *                        a dead value of the same pattern, given back to the
  *                        cache); the factor is an attachment of A;
- *   cholmod_l_solve      all right-hand sides at once.
+ *   the solve            a supernodal LL' factor (what CHOLMOD makes for
+ *                        all but the smallest matrices) is solved here by
+ *                        ch_super_solve, column by column, without BLAS;
+ *                        other factors by cholmod_l_solve.
  * A matrix that is not positive definite (CHOLMOD_NOT_POSDEF) returns
  * SILC_ENOTSPD and the dispatcher retries the list under the LU class.
  *
@@ -29,6 +32,7 @@
 typedef struct ch_factor {
     cholmod_factor *L;
     ss_symbolic *entry;         /* the analysis L was copied from, or NULL */
+    double *work;               /* n doubles for ch_super_solve, used under the lock */
     ss_factor_info info;
 } ch_factor;
 
@@ -47,6 +51,7 @@ static void ch_factor_free(void *p)
     if (F->L && F->entry) ss_sym_donate(SS_CHOLMOD, F->entry, F->L, ch_free_L);
     else if (F->L) ch_free_L(F->L);
     ss_sym_release(F->entry);
+    ss_host->free(F->work);
     ss_host->free(F);
 }
 
@@ -110,6 +115,67 @@ static int ch_fail(silc_call *call, const char *fn, int status)
     return ss_host->error(call, SILC_ELIB, "%s: failed (status %d)", fn, status);
 }
 
+/* L is solved by ch_super_solve (below) rather than cholmod_l_solve. */
+static int ch_solves_here(const cholmod_factor *L)
+{
+    return L->is_super && L->is_ll && L->xtype == CHOLMOD_REAL && L->dtype == CHOLMOD_DOUBLE &&
+           L->itype == CHOLMOD_LONG && L->Perm != NULL;
+}
+
+/*
+ * X = A^-1 B for the n x k column-major B (leading dimension n), with
+ * A(p, p) = L L' and L supernodal: w = B(p, j), L w = w, L' w = w,
+ * X(p, j) = w, one column at a time through w (n doubles).  X may be B.
+ *
+ * Why not cholmod_l_solve: with one or a few columns CHOLMOD solves each
+ * supernode with a dtrsv and a dgemv, two BLAS calls per supernode and
+ * sweep (20 000 calls a solve for the 5038 supernodes of the 200 x 200
+ * diffusion matrix), and OpenBLAS takes a lock and a buffer in each: in a
+ * profile of the diffusion loop 70 % of a step was in OpenBLAS and its
+ * mutexes, for a solve that is one pass over L each way.  These loops make
+ * the same pass (each supernode's columns stored as an nsrow x nscol
+ * column-major block whose first nscol rows are the diagonal block, the row
+ * indices in L->s), with no call and no lock per supernode
+ * (docs/backends.md, "The diffusion loop's solve").  Each column is solved
+ * alone, so a column's result does not depend on the others beside it.
+ */
+static void ch_super_solve(const cholmod_factor *L, const double *B, double *X, int64_t k, double *w)
+{
+    const SuiteSparse_long *perm = L->Perm, *super = L->super, *pi = L->pi, *px = L->px, *ls = L->s;
+    const double *lx = L->x;
+    int64_t n = (int64_t)L->n, nsuper = (int64_t)L->nsuper, s, i, j, c;
+    for (c = 0; c < k; c++) {
+        const double *b = B + c * n;
+        double *x = X + c * n;
+        for (i = 0; i < n; i++) w[i] = b[perm[i]];
+        for (s = 0; s < nsuper; s++) { /* L w = w, column by column */
+            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s];
+            const SuiteSparse_long *rows = ls + pi[s];
+            const double *blk = lx + px[s];
+            for (j = 0; j < nscol; j++) {
+                const double *col = blk + j * nsrow;
+                double t = w[k1 + j] / col[j];
+                w[k1 + j] = t;
+                for (i = j + 1; i < nscol; i++) w[k1 + i] -= col[i] * t;
+                for (i = nscol; i < nsrow; i++) w[rows[i]] -= col[i] * t;
+            }
+        }
+        for (s = nsuper - 1; s >= 0; s--) { /* L' w = w, last column first */
+            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s];
+            const SuiteSparse_long *rows = ls + pi[s];
+            const double *blk = lx + px[s];
+            for (j = nscol - 1; j >= 0; j--) {
+                const double *col = blk + j * nsrow;
+                double t = w[k1 + j];
+                for (i = nscol; i < nsrow; i++) t -= col[i] * w[rows[i]];
+                for (i = j + 1; i < nscol; i++) t -= col[i] * w[k1 + i];
+                w[k1 + j] = t / col[j];
+            }
+        }
+        for (i = 0; i < n; i++) x[perm[i]] = w[i];
+    }
+}
+
 /* For the condition estimate (A symmetric: A^{-T} = A^{-1}): the solution
  * and CHOLMOD's workspace are kept from one solve to the next
  * (cholmod_l_solve2), where cholmod_l_solve allocated and freed them on
@@ -127,8 +193,13 @@ static int ch_apply_inv(void *ctx, double *x, int t, int trans)
     int64_t n = (int64_t)e->F->L->n;
     int ok;
     (void)trans;
-    ch_dense(n, t, x, &B);
     ss_lock();
+    if (e->F->work) {
+        ch_super_solve(e->F->L, x, x, t, e->F->work);
+        ss_unlock();
+        return 0;
+    }
+    ch_dense(n, t, x, &B);
     ok = cholmod_l_solve2(CHOLMOD_A, e->F->L, &B, NULL, &e->X, NULL, &e->Y, &e->E, cc);
     ss_unlock();
     if (ok) memcpy(x, e->X->x, (size_t)(n * t) * sizeof(double));
@@ -226,6 +297,10 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
         ch_factor_free(F);
         return rc;
     }
+    if (ch_solves_here(L) && !(F->work = ss_host->alloc((size_t)L->n * sizeof(double)))) {
+        ch_factor_free(F);
+        return ss_nomem(call, "CHOLMOD solve work space");
+    }
     ss_pivot_ratio(&F->info);
     snprintf(F->info.method, sizeof F->info.method, "sparse Cholesky (CHOLMOD, %s, %s)",
              L->is_super ? "supernodal" : "simplicial", ch_ordering_name(L->ordering));
@@ -278,14 +353,25 @@ int ss_cholmod_solve(silc_call *call)
      * transposed solves are the same solves). */
     B = ss_rhs_dense(&b, &owned);
     if (!B) return ss_nomem(call, "CHOLMOD right-hand side");
-    ch_dense(n, k, B, &Bh);
-    ss_lock();
-    X = cholmod_l_solve(CHOLMOD_A, F->L, &Bh, cc);
-    status = cc->status;
-    ss_unlock();
-    if (owned) ss_host->free(B);
-    if (!X) return ch_fail(call, "cholmod_l_solve", status);
-    call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
+    if (F->work) { /* straight into the result: no CHOLMOD dense, no copy */
+        silc_view o;
+        if ((call->out = ss_host->dense_new_uninit(n, k))) {
+            ss_host->view(call->out, &o);
+            ss_lock();
+            ch_super_solve(F->L, B, o.val, k, F->work);
+            ss_unlock();
+        }
+        if (owned) ss_host->free(B);
+    } else {
+        ch_dense(n, k, B, &Bh);
+        ss_lock();
+        X = cholmod_l_solve(CHOLMOD_A, F->L, &Bh, cc);
+        status = cc->status;
+        ss_unlock();
+        if (owned) ss_host->free(B);
+        if (!X) return ch_fail(call, "cholmod_l_solve", status);
+        call->out = ss_dense_value(n, k, X->x, (int64_t)X->d);
+    }
     if (ss_cond_due(call, condest, &F->info)) {
         ch_est e = {F, NULL, NULL, NULL};
         ss_square_cond(call, condest, n, ch_apply_inv, &e, &F->info, NULL);

@@ -19,6 +19,10 @@
  *   - factor reuse (second solve with the same A), and a new value with the
  *     same pattern (A2 = 2 * A): the note says the symbolic analysis was
  *     reused; KLU refactors into the factors of a value that died (A = 3 * A);
+ *   - CHOLMOD's supernodal factor, solved by the plugin's own triangular
+ *     sweeps (cholmod.c, ch_super_solve): three exact columns at once, each
+ *     equal to its solve alone, and a Crank-Nicolson loop u = A \ (B * u)
+ *     whose u matches the reference backend's loop;
  *   - several and sparse right-hand sides; least squares (tall, inconsistent)
  *     and the minimum-norm (full row rank) or basic (deficient) solution of
  *     an underdetermined system.
@@ -240,6 +244,62 @@ static void test_multi_rhs(silc_context *c, const char *backend)
     free(X);
     free(B);
     silc_envelope_free(&A);
+}
+
+/* CHOLMOD's supernodal factor, which the plugin solves itself (ch_super_solve):
+ * the 80 x 80 Laplacian (6400 unknowns: CHOLMOD's rule picks supernodal) with
+ * three exact columns X0(:, j) = 1 + j + i/n, solved at once and one at a
+ * time; and 10 Crank-Nicolson steps u = A \ (B * u) (dt / h^2 = 40, as the
+ * diffusion example) against the same loop through the reference backend. */
+static void test_cholmod_supernodal(silc_context *c, silc_context *r)
+{
+    silc_envelope_t L;
+    int64_t k = 80, n = k * k, i, j;
+    double *X0 = malloc((size_t)(3 * n) * sizeof *X0), *B = malloc((size_t)(3 * n) * sizeof *B);
+    double *X, *x, *u, *ur, be, cond;
+    const char *in;
+    const char *loop = "I = sparse(1:6400, 1:6400, ones(6400, 1), 6400, 6400); A = I + 20 * L; Bm = I - 20 * L; "
+                       "u = ones(6400, 1); "
+                       "for s = 1:10 u = A \\ (Bm * u); end";
+    for (j = 0; j < 3; j++)
+        for (i = 0; i < n; i++) X0[j * n + i] = 1 + (double)j + (double)i / (double)n;
+    grid(&L, k, 0, 0);
+    for (j = 0; j < 3; j++) tl_csr_matvec(&L, X0 + j * n, B + j * n);
+    tl_put_checked(c, "L", &L);
+    tl_put_dense_checked(c, "B", n, 3, B);
+    CHECK(silc_exec(c, "X = L \\ B; x = L \\ B(:, 3)") == 0, "cholmod supernodal: %s", silc_context_errmsg(c));
+    in = tl_out_info(c, "X");
+    CHECK(tl_contains(in, "supernodal"), "cholmod: the 80 x 80 Laplacian was not factored supernodally:\n%s", in);
+    be = tl_out_number(in, "backward error: ");
+    cond = tl_out_number(in, "condition estimate: ");
+    CHECK(be >= 0 && be < 1e-14, "cholmod supernodal: backward error %g", be);
+    X = tl_get_dense_checked(c, "X", n, 3);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    if (X) CHECK(tl_rel_diff(X, X0, 3 * n) <= bound(n, cond), "cholmod supernodal: forward error %.3g (cond %.3g)",
+                 tl_rel_diff(X, X0, 3 * n), cond);
+    if (X && x) CHECK(memcmp(X + 2 * n, x, (size_t)n * sizeof *x) == 0,
+                      "cholmod supernodal: column 3 solved with the others differs from its solve alone");
+    free(X);
+    free(x);
+    /* The loop: L is the grid's 4-on-the-diagonal Laplacian (h = 1), so
+     * A = I + 20 L is Crank-Nicolson's matrix at dt / h^2 = 40. */
+    tl_put_checked(r, "L", &L);
+    CHECK(silc_exec(c, loop) == 0, "cholmod loop: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(r, loop) == 0, "reference loop: %s", silc_context_errmsg(r));
+    in = tl_out_info(c, "u");
+    CHECK(tl_contains(in, "suitesparse.cholmod") && tl_contains(in, "reused factorization: yes"),
+          "cholmod loop: the last step was not a reused CHOLMOD solve:\n%s", in);
+    u = tl_get_dense_checked(c, "u", n, 1);
+    ur = tl_get_dense_checked(r, "u", n, 1);
+    if (u && ur) CHECK(tl_rel_diff(u, ur, n) < 1e-12, "cholmod loop: u differs from the reference's by %.3g",
+                       tl_rel_diff(u, ur, n));
+    free(u);
+    free(ur);
+    silc_exec(c, "clear L B X x I A Bm u");
+    silc_exec(r, "clear L I A Bm u");
+    free(X0);
+    free(B);
+    silc_envelope_free(&L);
 }
 
 /* ---- shared matrices ------------------------------------------------------------ */
@@ -478,6 +538,7 @@ int main(void)
     test_multi_rhs(um, "suitesparse.umfpack");
     test_multi_rhs(kl, "suitesparse.klu");
     test_multi_rhs(ch, "suitesparse.cholmod");
+    test_cholmod_supernodal(ch, ref);
 
     printf("shared matrices (against the reference backend):\n");
     for (i = 0; i < sizeof spd / sizeof spd[0]; i++) test_shared(ch, ref, "suitesparse.cholmod", spd[i]);
