@@ -46,7 +46,10 @@
  * dt = 1e-3, N steps (--loop, default 100) from the example's initial block:
  * SILC with the default config, SILC with `tune on N` and tune.accuracy =
  * 1e-8 (a fresh session and wisdom file: the first run's whole cost), SciPy
- * with splu(A) once and N solves, Octave's loop of A \ (B*u).  Each row
+ * with splu(A) once and N solves, Octave's loop of A \ (B*u), and the
+ * baseline: CHOLMOD called directly (analysis and factorization once, then
+ * per step a CSR product and cholmod_l_solve2 reusing its work space; the
+ * factorization's CPU seconds in its second column).  Each row
  * prints sum(u) at the end (the tools agree to about 1e-10 relative) and
  * the last step's backward error.  --mumps-rows adds the loop with MUMPS
  * forced: double, single alone and single refined to 1e-8, each with
@@ -665,6 +668,89 @@ done:
     return rc;
 }
 
+/* The same loop with CHOLMOD called directly, what a C programmer holding
+ * CSR arrays would write: the plugin's settings (upper triangle of the
+ * symmetric CSR arrays, final_ll, CHOLMOD's ordering and supernodal rule),
+ * cholmod_l_analyze and cholmod_l_factorize once, then per step v = B u
+ * (a plain CSR loop) and cholmod_l_solve2 reusing its X, Y and E.  Timed
+ * from the analysis to the last step, as SILC's rows (which also start
+ * without a factorization); the factorization's own CPU seconds go to
+ * *factor_cpu.  The baseline that tells SILC's cost from CHOLMOD's. */
+static int direct_cholmod_diffusion(int64_t k, int steps, double out[D_N], double *factor_cpu)
+{
+    double h = diff2d_h(k), t0, c0, *u = NULL, *v = NULL, num = 0, den_a = 0, den_u = 0, den_v = 0;
+    silc_envelope_t A = {0}, B = {0};
+    cholmod_common cc;
+    cholmod_sparse S;
+    cholmod_dense V, *X = NULL, *Y = NULL, *E = NULL;
+    cholmod_factor *L = NULL;
+    int64_t n = k * k, i, p;
+    int step, rc = -1;
+    cholmod_l_start(&cc);
+    cc.final_ll = 1; /* as the plugin (ss_start) */
+    if (diff_shifted_laplacian(2, k, h, -DIFF_DT / 2, &A) || diff_shifted_laplacian(2, k, h, DIFF_DT / 2, &B) ||
+        !(u = malloc((size_t)n * sizeof *u)) || !(v = malloc((size_t)n * sizeof *v)))
+        goto done;
+    diff2d_initial(k, u);
+    memset(&S, 0, sizeof S);
+    S.nrow = S.ncol = (size_t)n;
+    S.nzmax = (size_t)A.nnz;
+    S.p = A.rowptr;
+    S.i = A.colind;
+    S.x = A.values;
+    S.stype = 1;
+    S.itype = CHOLMOD_LONG;
+    S.xtype = CHOLMOD_REAL;
+    S.dtype = CHOLMOD_DOUBLE;
+    S.sorted = S.packed = 1;
+    memset(&V, 0, sizeof V);
+    V.nrow = V.d = V.nzmax = (size_t)n;
+    V.ncol = 1;
+    V.x = v;
+    V.xtype = CHOLMOD_REAL;
+    V.dtype = CHOLMOD_DOUBLE;
+    t0 = tl_now();
+    c0 = cpu_now();
+    if (!(L = cholmod_l_analyze(&S, &cc)) || !cholmod_l_factorize(&S, L, &cc) || cc.status != CHOLMOD_OK) goto done;
+    *factor_cpu = cpu_now() - c0;
+    for (step = 0; step < steps; step++) {
+        for (i = 0; i < n; i++) {
+            double t = 0;
+            for (p = B.rowptr[i]; p < B.rowptr[i + 1]; p++) t += B.values[p] * u[B.colind[p]];
+            v[i] = t;
+        }
+        if (!cholmod_l_solve2(CHOLMOD_A, L, &V, NULL, &X, NULL, &Y, &E, &cc)) goto done;
+        memcpy(u, X->x, (size_t)n * sizeof *u);
+    }
+    out[D_WALL] = tl_now() - t0;
+    out[D_CPU] = cpu_now() - c0;
+    /* the last step's backward error, inf-norms, as the other tools' */
+    for (i = 0; i < n; i++) {
+        double t = 0, ra = 0;
+        for (p = A.rowptr[i]; p < A.rowptr[i + 1]; p++) t += A.values[p] * u[A.colind[p]], ra += fabs(A.values[p]);
+        num = fmax(num, fabs(v[i] - t));
+        den_a = fmax(den_a, ra);
+        den_u = fmax(den_u, fabs(u[i]));
+        den_v = fmax(den_v, fabs(v[i]));
+    }
+    out[D_BE] = num / (den_a * den_u + den_v);
+    out[D_SUM] = 0;
+    for (i = 0; i < n; i++) out[D_SUM] += u[i];
+    rc = 0;
+done:
+    if (rc) fprintf(stderr, "backends: direct CHOLMOD diffusion failed (status %d)\n", cc.status);
+    cholmod_l_free_dense(&X, &cc);
+    cholmod_l_free_dense(&Y, &cc);
+    cholmod_l_free_dense(&E, &cc);
+    cholmod_l_free_factor(&L, &cc);
+    cholmod_l_finish(&cc);
+    free(u);
+    free(v);
+    silc_envelope_free(&A);
+    silc_envelope_free(&B);
+    return rc;
+}
+
 static void diffusion_row(const char *who, const char *ran, const double r[D_N], const double silc[D_N])
 {
     printf("  %-40s %-22s %9.4f %9.4f %9.1e %17.12g %8.2f %8.2f\n", who, ran, r[D_WALL], r[D_CPU], r[D_BE],
@@ -698,8 +784,8 @@ static void bench_diffusion(const opts *o)
     enum { NFORCED = sizeof forced / sizeof forced[0] };
     int64_t k = o->grid_given ? o->grid : 200;
     int r, f, reps = o->reps > 0 ? o->reps : 3;
-    char setup[320], cmd[1024], script[512], wisdom[64], ran[2 + NFORCED][64] = {""};
-    double best[2 + NFORCED][D_N], res[D_N];
+    char setup[320], cmd[1024], script[512], wisdom[64], ran[2 + NFORCED][64] = {""}, dran[64];
+    double best[2 + NFORCED][D_N], res[D_N], direct[D_N] = {-1, 0, 0, 0}, factor_cpu = 0, fc = 0;
     for (f = 0; f < 2 + NFORCED; f++) best[f][D_WALL] = -1, best[f][D_BE] = best[f][D_SUM] = best[f][D_CPU] = 0;
     printf("\ndiffusion loop: %lld x %lld grid (%lld unknowns), Crank-Nicolson, dt = %g, %d steps\n",
            (long long)k, (long long)k, (long long)(k * k), DIFF_DT, o->loop);
@@ -717,6 +803,8 @@ static void bench_diffusion(const opts *o)
             memcpy(best[0], res, sizeof res), snprintf(ran[0], sizeof ran[0], "%s", rn);
         if (silc_diffusion(k, o->loop, setup, res, rn) == 0 && (best[1][0] < 0 || res[0] < best[1][0]))
             memcpy(best[1], res, sizeof res), snprintf(ran[1], sizeof ran[1], "%s", rn);
+        if (direct_cholmod_diffusion(k, o->loop, res, &fc) == 0 && (direct[0] < 0 || res[0] < direct[0]))
+            memcpy(direct, res, sizeof res), factor_cpu = fc;
         for (f = 0; o->mumps_rows && f < NFORCED; f++)
             if (silc_diffusion(k, o->loop, forced[f].setup, res, rn) == 0 &&
                 (best[2 + f][0] < 0 || res[0] < best[2 + f][0]))
@@ -725,6 +813,8 @@ static void bench_diffusion(const opts *o)
     remove(wisdom);
     diffusion_row("SILC, default config", ran[0], best[0], best[0]);
     diffusion_row("SILC, tune on, tune.accuracy = 1e-8", ran[1], best[1], best[0]);
+    snprintf(dran, sizeof dran, "factor %.3f s CPU", factor_cpu);
+    if (direct[0] >= 0) diffusion_row("direct CHOLMOD (analyze+factor, solve2)", dran, direct, best[0]);
     for (f = 0; o->mumps_rows && f < NFORCED; f++) diffusion_row(forced[f].who, ran[2 + f], best[2 + f], best[0]);
     if (o->scipy) {
         write_file(o->tmpdir, "diffusion.py", scipy_diffusion, script, sizeof script);

@@ -32,7 +32,7 @@
 typedef struct ch_factor {
     cholmod_factor *L;
     ss_symbolic *entry;         /* the analysis L was copied from, or NULL */
-    double *work;               /* n doubles for ch_super_solve, used under the lock */
+    double *work;               /* 2n doubles for ch_super_solve, used under the lock */
     ss_factor_info info;
 } ch_factor;
 
@@ -125,7 +125,8 @@ static int ch_solves_here(const cholmod_factor *L)
 /*
  * X = A^-1 B for the n x k column-major B (leading dimension n), with
  * A(p, p) = L L' and L supernodal: w = B(p, j), L w = w, L' w = w,
- * X(p, j) = w, one column at a time through w (n doubles).  X may be B.
+ * X(p, j) = w, one column at a time.  work holds 2n doubles: w, and t for
+ * a supernode's rows below its diagonal block.  X may be B.
  *
  * Why not cholmod_l_solve: with one or a few columns CHOLMOD solves each
  * supernode with a dtrsv and a dgemv, two BLAS calls per supernode and
@@ -133,43 +134,59 @@ static int ch_solves_here(const cholmod_factor *L)
  * diffusion matrix), and OpenBLAS takes a lock and a buffer in each: in a
  * profile of the diffusion loop 70 % of a step was in OpenBLAS and its
  * mutexes, for a solve that is one pass over L each way.  These loops make
- * the same pass (each supernode's columns stored as an nsrow x nscol
- * column-major block whose first nscol rows are the diagonal block, the row
- * indices in L->s), with no call and no lock per supernode
- * (docs/backends.md, "The diffusion loop's solve").  Each column is solved
- * alone, so a column's result does not depend on the others beside it.
+ * the same pass with no call and no lock per supernode.  A supernode's
+ * columns are an nsrow x nscol column-major block whose first nscol rows
+ * are the diagonal block; the row indices are in L->s.  Its rows below the
+ * diagonal block are updated through t, contiguous (the forward sweep sums
+ * the columns' contributions into t and scatters t once; the backward sweep
+ * gathers t once and takes dot products with it), not through one scattered
+ * update per entry: 20-30 % less time than entry by entry, as the BLAS
+ * form's dgemv does.  Each column of B is solved alone, so its result does
+ * not depend on the columns beside it (docs/backends.md, "The diffusion
+ * loop's solve").
  */
-static void ch_super_solve(const cholmod_factor *L, const double *B, double *X, int64_t k, double *w)
+static void ch_super_solve(const cholmod_factor *L, const double *B, double *X, int64_t k, double *work)
 {
     const SuiteSparse_long *perm = L->Perm, *super = L->super, *pi = L->pi, *px = L->px, *ls = L->s;
     const double *lx = L->x;
     int64_t n = (int64_t)L->n, nsuper = (int64_t)L->nsuper, s, i, j, c;
+    double *w = work, *t = work + n;
     for (c = 0; c < k; c++) {
         const double *b = B + c * n;
         double *x = X + c * n;
         for (i = 0; i < n; i++) w[i] = b[perm[i]];
-        for (s = 0; s < nsuper; s++) { /* L w = w, column by column */
-            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s];
-            const SuiteSparse_long *rows = ls + pi[s];
+        for (s = 0; s < nsuper; s++) { /* L w = w */
+            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s], below = nsrow - nscol;
+            const SuiteSparse_long *rows = ls + pi[s] + nscol;
             const double *blk = lx + px[s];
+            for (i = 0; i < below; i++) t[i] = 0;
             for (j = 0; j < nscol; j++) {
-                const double *col = blk + j * nsrow;
-                double t = w[k1 + j] / col[j];
-                w[k1 + j] = t;
-                for (i = j + 1; i < nscol; i++) w[k1 + i] -= col[i] * t;
-                for (i = nscol; i < nsrow; i++) w[rows[i]] -= col[i] * t;
+                const double *col = blk + j * nsrow, *sub = col + nscol;
+                double wj = w[k1 + j] / col[j];
+                w[k1 + j] = wj;
+                for (i = j + 1; i < nscol; i++) w[k1 + i] -= col[i] * wj;
+                for (i = 0; i < below; i++) t[i] += sub[i] * wj;
             }
+            for (i = 0; i < below; i++) w[rows[i]] -= t[i];
         }
         for (s = nsuper - 1; s >= 0; s--) { /* L' w = w, last column first */
-            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s];
-            const SuiteSparse_long *rows = ls + pi[s];
+            int64_t k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s], below = nsrow - nscol;
+            const SuiteSparse_long *rows = ls + pi[s] + nscol;
             const double *blk = lx + px[s];
+            for (i = 0; i < below; i++) t[i] = w[rows[i]];
             for (j = nscol - 1; j >= 0; j--) {
-                const double *col = blk + j * nsrow;
-                double t = w[k1 + j];
-                for (i = nscol; i < nsrow; i++) t -= col[i] * w[rows[i]];
-                for (i = j + 1; i < nscol; i++) t -= col[i] * w[k1 + i];
-                w[k1 + j] = t / col[j];
+                const double *col = blk + j * nsrow, *sub = col + nscol;
+                double d0 = 0, d1 = 0, d2 = 0, d3 = 0, wj; /* four sums: independent adds */
+                for (i = 0; i + 4 <= below; i += 4) {
+                    d0 += sub[i] * t[i];
+                    d1 += sub[i + 1] * t[i + 1];
+                    d2 += sub[i + 2] * t[i + 2];
+                    d3 += sub[i + 3] * t[i + 3];
+                }
+                for (; i < below; i++) d0 += sub[i] * t[i];
+                wj = w[k1 + j] - ((d0 + d1) + (d2 + d3));
+                for (i = j + 1; i < nscol; i++) wj -= col[i] * w[k1 + i];
+                w[k1 + j] = wj / col[j];
             }
         }
         for (i = 0; i < n; i++) x[perm[i]] = w[i];
@@ -236,7 +253,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
     cholmod_sparse A;
     cholmod_factor *L = NULL;
     ch_factor *F;
-    int sym_reused, status, rc;
+    int sym_reused, status, rc, serial;
     long long minor;
     *out = NULL;
     ch_sparse(a, &A);
@@ -276,7 +293,9 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
         L = Lc;
     }
     ss_lock();
+    serial = ss_serial_begin();
     cholmod_l_factorize(&A, L, cc);
+    ss_serial_end(serial);
     status = cc->status;
     minor = (long long)L->minor;
     F->L = L;
@@ -297,7 +316,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
         ch_factor_free(F);
         return rc;
     }
-    if (ch_solves_here(L) && !(F->work = ss_host->alloc((size_t)L->n * sizeof(double)))) {
+    if (ch_solves_here(L) && !(F->work = ss_host->alloc(2 * (size_t)L->n * sizeof(double)))) {
         ch_factor_free(F);
         return ss_nomem(call, "CHOLMOD solve work space");
     }
