@@ -22,7 +22,8 @@
  *   - CHOLMOD's supernodal factor, solved by the plugin's own triangular
  *     sweeps (cholmod.c, ch_super_solve): three exact columns at once, each
  *     equal to its solve alone, and a Crank-Nicolson loop u = A \ (B * u)
- *     whose u matches the reference backend's loop;
+ *     whose u matches the reference backend's loop, and no thread started
+ *     by CHOLMOD's OpenMP regions at SILC's thread count 1;
  *   - several and sparse right-hand sides; least squares (tall, inconsistent)
  *     and the minimum-norm (full row rank) or basic (deficient) solution of
  *     an underdetermined system.
@@ -30,6 +31,7 @@
  */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include <ctype.h>
+#include <dirent.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -246,17 +248,34 @@ static void test_multi_rhs(silc_context *c, const char *backend)
     silc_envelope_free(&A);
 }
 
+/* Threads of this process (CHOLMOD's OpenMP regions must not add any at
+ * SILC's thread count 1: ss_serial_begin). */
+static int tl_count_tasks(void)
+{
+    int count = 0;
+    DIR *d = opendir("/proc/self/task");
+    struct dirent *e;
+    if (!d) return -1;
+    while ((e = readdir(d)))
+        if (e->d_name[0] != '.') count++;
+    closedir(d);
+    return count;
+}
+
 /* CHOLMOD's supernodal factor, which the plugin solves itself (ch_super_solve):
  * the 80 x 80 Laplacian (6400 unknowns: CHOLMOD's rule picks supernodal) with
  * three exact columns X0(:, j) = 1 + j + i/n, solved at once and one at a
  * time; and 10 Crank-Nicolson steps u = A \ (B * u) (dt / h^2 = 40, as the
- * diffusion example) against the same loop through the reference backend. */
+ * diffusion example) against the same loop through the reference backend.
+ * It runs before any other CHOLMOD solve of the process: its factorizations
+ * are the first that could start OpenMP threads, and must start none. */
 static void test_cholmod_supernodal(silc_context *c, silc_context *r)
 {
     silc_envelope_t L;
     int64_t k = 80, n = k * k, i, j;
     double *X0 = malloc((size_t)(3 * n) * sizeof *X0), *B = malloc((size_t)(3 * n) * sizeof *B);
     double *X, *x, *u, *ur, be, cond;
+    int tasks;
     const char *in;
     const char *loop = "I = sparse(1:6400, 1:6400, ones(6400, 1), 6400, 6400); A = I + 20 * L; Bm = I - 20 * L; "
                        "u = ones(6400, 1); "
@@ -267,6 +286,7 @@ static void test_cholmod_supernodal(silc_context *c, silc_context *r)
     for (j = 0; j < 3; j++) tl_csr_matvec(&L, X0 + j * n, B + j * n);
     tl_put_checked(c, "L", &L);
     tl_put_dense_checked(c, "B", n, 3, B);
+    tasks = tl_count_tasks();
     CHECK(silc_exec(c, "X = L \\ B; x = L \\ B(:, 3)") == 0, "cholmod supernodal: %s", silc_context_errmsg(c));
     in = tl_out_info(c, "X");
     CHECK(tl_contains(in, "supernodal"), "cholmod: the 80 x 80 Laplacian was not factored supernodally:\n%s", in);
@@ -295,6 +315,8 @@ static void test_cholmod_supernodal(silc_context *c, silc_context *r)
                        tl_rel_diff(u, ur, n));
     free(u);
     free(ur);
+    CHECK(tl_count_tasks() == tasks, "cholmod: the factorizations at thread count 1 started %d more threads",
+          tl_count_tasks() - tasks);
     silc_exec(c, "clear L B X x I A Bm u");
     silc_exec(r, "clear L I A Bm u");
     free(X0);
@@ -526,6 +548,7 @@ int main(void)
     size_t i;
     if (!um || !kl || !ch || !qr || !ref) return check_done();
 
+    test_cholmod_supernodal(ch, ref);
     printf("generated systems (exact solutions):\n");
     test_generated(um, "suitesparse.umfpack", 0);
     test_generated(kl, "suitesparse.klu", 0);
@@ -538,7 +561,6 @@ int main(void)
     test_multi_rhs(um, "suitesparse.umfpack");
     test_multi_rhs(kl, "suitesparse.klu");
     test_multi_rhs(ch, "suitesparse.cholmod");
-    test_cholmod_supernodal(ch, ref);
 
     printf("shared matrices (against the reference backend):\n");
     for (i = 0; i < sizeof spd / sizeof spd[0]; i++) test_shared(ch, ref, "suitesparse.cholmod", spd[i]);
