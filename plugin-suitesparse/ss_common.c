@@ -69,12 +69,12 @@ void ss_set_omp_threads(int nthreads)
  * OpenMP regions of CHOLMOD_OMP_NUM_THREADS threads, a constant of its build
  * (4 in Debian's), whatever omp_set_num_threads or OMP_NUM_THREADS say.  So
  * with SILC's thread count at 1 a factorization still woke three more
- * threads, on this 2-core VM 70 ms of the 200 x 200 diffusion matrix's
- * 220 ms first solve in CPU time (docs/backends.md).  max-active-levels 0
- * makes every region run on the calling thread alone; the previous value is
- * given back at the end.  The setting is the process's: a region that
- * another thread of the program opens during the factorization runs
- * serially too (its result is the same).
+ * threads, on this 2-core VM about 70 ms of the 200 x 200 diffusion
+ * matrix's first solve (220-330 ms) in CPU time (docs/backends.md).
+ * max-active-levels 0 makes every region run on the calling thread alone;
+ * the previous value is given back at the end.  The setting is the
+ * process's: a region that another thread of the program opens during the
+ * factorization runs on one thread too (slower, for that while).
  */
 int ss_serial_begin(void)
 {
