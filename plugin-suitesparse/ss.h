@@ -68,6 +68,12 @@ void ss_finish(void);               /* frees caches, finishes the cholmod_common
 void ss_lock(void);                 /* guards the shared state below */
 void ss_unlock(void);
 cholmod_common *ss_cholmod_common(void); /* use only between ss_lock / ss_unlock */
+/* SILC's thread count (set_threads); with 1, ss_serial_begin .. ss_serial_end
+ * keep CHOLMOD's OpenMP regions, whose thread count its build fixed, on the
+ * calling thread (ss_common.c). */
+void ss_set_omp_threads(int nthreads);
+int ss_serial_begin(void);
+void ss_serial_end(int was);
 
 int ss_nomem(silc_call *call, const char *what);
 

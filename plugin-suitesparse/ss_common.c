@@ -11,6 +11,9 @@
 #include "ss.h"
 
 #include <math.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <pthread.h>
 #include <stdio.h>
 #include <stddef.h>
@@ -51,6 +54,46 @@ int ss_start(void)
      * and the .spd classes rely on Cholesky failing there. */
     ss_cc.final_ll = 1;
     return 0;
+}
+
+/* SILC's thread count for this plugin's libraries (set_threads). */
+static volatile int ss_threads = 1;
+
+void ss_set_omp_threads(int nthreads)
+{
+    ss_threads = nthreads;
+}
+
+/*
+ * CHOLMOD's supernodal factorization clears and fills its supernodes in
+ * OpenMP regions of CHOLMOD_OMP_NUM_THREADS threads, a constant of its build
+ * (4 in Debian's), whatever omp_set_num_threads or OMP_NUM_THREADS say.  So
+ * with SILC's thread count at 1 a factorization still woke three more
+ * threads, on this 2-core VM about 70 ms of the 200 x 200 diffusion
+ * matrix's first solve (220-330 ms) in CPU time (docs/backends.md).
+ * max-active-levels 0 makes every region run on the calling thread alone;
+ * the previous value is given back at the end.  The setting is the
+ * process's: a region that another thread of the program opens during the
+ * factorization runs on one thread too (slower, for that while).
+ */
+int ss_serial_begin(void)
+{
+#ifdef _OPENMP
+    int was = omp_get_max_active_levels();
+    if (ss_threads <= 1) omp_set_max_active_levels(0);
+    return was;
+#else
+    return 0;
+#endif
+}
+
+void ss_serial_end(int was)
+{
+#ifdef _OPENMP
+    omp_set_max_active_levels(was);
+#else
+    (void)was;
+#endif
 }
 
 void ss_finish(void)

@@ -14,7 +14,9 @@
  * Threads: UMFPACK, CHOLMOD and SPQR spend their time in BLAS, which is
  * OpenBLAS here (Debian's libblas.so.3 alternative).  set_threads finds
  * openblas_set_num_threads in the BLAS our libraries already loaded and calls
- * it; with another BLAS the call is a no-op.  KLU is sequential.
+ * it; with another BLAS the call is a no-op.  KLU is sequential.  CHOLMOD's
+ * own OpenMP regions have a thread count fixed at its build; at 1 thread
+ * they are kept on the calling thread (ss_serial_begin).
  */
 #include "ss.h"
 
@@ -102,6 +104,7 @@ static void ss_set_threads(int nthreads)
 {
     if (nthreads < 1) return;
     if (blas_set_threads) blas_set_threads(nthreads);
+    ss_set_omp_threads(nthreads);
 }
 
 static void ss_shutdown(void)

@@ -19,6 +19,11 @@
  *   - factor reuse (second solve with the same A), and a new value with the
  *     same pattern (A2 = 2 * A): the note says the symbolic analysis was
  *     reused; KLU refactors into the factors of a value that died (A = 3 * A);
+ *   - CHOLMOD's supernodal factor, solved by the plugin's own triangular
+ *     sweeps (cholmod.c, ch_super_solve): three exact columns at once, each
+ *     equal to its solve alone, and a Crank-Nicolson loop u = A \ (B * u)
+ *     whose u matches the reference backend's loop, and no thread started
+ *     by CHOLMOD's OpenMP regions at SILC's thread count 1;
  *   - several and sparse right-hand sides; least squares (tall, inconsistent)
  *     and the minimum-norm (full row rank) or basic (deficient) solution of
  *     an underdetermined system.
@@ -26,6 +31,7 @@
  */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include <ctype.h>
+#include <dirent.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -240,6 +246,82 @@ static void test_multi_rhs(silc_context *c, const char *backend)
     free(X);
     free(B);
     silc_envelope_free(&A);
+}
+
+/* Threads of this process (CHOLMOD's OpenMP regions must not add any at
+ * SILC's thread count 1: ss_serial_begin). */
+static int tl_count_tasks(void)
+{
+    int count = 0;
+    DIR *d = opendir("/proc/self/task");
+    struct dirent *e;
+    if (!d) return -1;
+    while ((e = readdir(d)))
+        if (e->d_name[0] != '.') count++;
+    closedir(d);
+    return count;
+}
+
+/* CHOLMOD's supernodal factor, which the plugin solves itself (ch_super_solve):
+ * the 80 x 80 Laplacian (6400 unknowns: CHOLMOD's rule picks supernodal) with
+ * three exact columns X0(:, j) = 1 + j + i/n, solved at once and one at a
+ * time; and 10 Crank-Nicolson steps u = A \ (B * u) (dt / h^2 = 40, as the
+ * diffusion example) against the same loop through the reference backend.
+ * It runs before any other CHOLMOD solve of the process: its factorizations
+ * are the first that could start OpenMP threads, and must start none. */
+static void test_cholmod_supernodal(silc_context *c, silc_context *r)
+{
+    silc_envelope_t L;
+    int64_t k = 80, n = k * k, i, j;
+    double *X0 = malloc((size_t)(3 * n) * sizeof *X0), *B = malloc((size_t)(3 * n) * sizeof *B);
+    double *X, *x, *u, *ur, be, cond;
+    int tasks;
+    const char *in;
+    const char *loop = "I = sparse(1:6400, 1:6400, ones(6400, 1), 6400, 6400); A = I + 20 * L; Bm = I - 20 * L; "
+                       "u = ones(6400, 1); "
+                       "for s = 1:10 u = A \\ (Bm * u); end";
+    for (j = 0; j < 3; j++)
+        for (i = 0; i < n; i++) X0[j * n + i] = 1 + (double)j + (double)i / (double)n;
+    grid(&L, k, 0, 0);
+    for (j = 0; j < 3; j++) tl_csr_matvec(&L, X0 + j * n, B + j * n);
+    tl_put_checked(c, "L", &L);
+    tl_put_dense_checked(c, "B", n, 3, B);
+    tasks = tl_count_tasks();
+    CHECK(silc_exec(c, "X = L \\ B; x = L \\ B(:, 3)") == 0, "cholmod supernodal: %s", silc_context_errmsg(c));
+    in = tl_out_info(c, "X");
+    CHECK(tl_contains(in, "supernodal"), "cholmod: the 80 x 80 Laplacian was not factored supernodally:\n%s", in);
+    be = tl_out_number(in, "backward error: ");
+    cond = tl_out_number(in, "condition estimate: ");
+    CHECK(be >= 0 && be < 1e-14, "cholmod supernodal: backward error %g", be);
+    X = tl_get_dense_checked(c, "X", n, 3);
+    x = tl_get_dense_checked(c, "x", n, 1);
+    if (X) CHECK(tl_rel_diff(X, X0, 3 * n) <= bound(n, cond), "cholmod supernodal: forward error %.3g (cond %.3g)",
+                 tl_rel_diff(X, X0, 3 * n), cond);
+    if (X && x) CHECK(memcmp(X + 2 * n, x, (size_t)n * sizeof *x) == 0,
+                      "cholmod supernodal: column 3 solved with the others differs from its solve alone");
+    free(X);
+    free(x);
+    /* The loop: L is the grid's 4-on-the-diagonal Laplacian (h = 1), so
+     * A = I + 20 L is Crank-Nicolson's matrix at dt / h^2 = 40. */
+    tl_put_checked(r, "L", &L);
+    CHECK(silc_exec(c, loop) == 0, "cholmod loop: %s", silc_context_errmsg(c));
+    CHECK(silc_exec(r, loop) == 0, "reference loop: %s", silc_context_errmsg(r));
+    in = tl_out_info(c, "u");
+    CHECK(tl_contains(in, "suitesparse.cholmod") && tl_contains(in, "reused factorization: yes"),
+          "cholmod loop: the last step was not a reused CHOLMOD solve:\n%s", in);
+    u = tl_get_dense_checked(c, "u", n, 1);
+    ur = tl_get_dense_checked(r, "u", n, 1);
+    if (u && ur) CHECK(tl_rel_diff(u, ur, n) < 1e-12, "cholmod loop: u differs from the reference's by %.3g",
+                       tl_rel_diff(u, ur, n));
+    free(u);
+    free(ur);
+    CHECK(tl_count_tasks() == tasks, "cholmod: the factorizations at thread count 1 started %d more threads",
+          tl_count_tasks() - tasks);
+    silc_exec(c, "clear L B X x I A Bm u");
+    silc_exec(r, "clear L I A Bm u");
+    free(X0);
+    free(B);
+    silc_envelope_free(&L);
 }
 
 /* ---- shared matrices ------------------------------------------------------------ */
@@ -466,6 +548,7 @@ int main(void)
     size_t i;
     if (!um || !kl || !ch || !qr || !ref) return check_done();
 
+    test_cholmod_supernodal(ch, ref);
     printf("generated systems (exact solutions):\n");
     test_generated(um, "suitesparse.umfpack", 0);
     test_generated(kl, "suitesparse.klu", 0);
