@@ -1011,8 +1011,11 @@ static void shape_start(const silc_value *v, silc_props *p)
  * GCC does not vectorize (a third of a dgesv's time at n = 1000 went to
  * them).  A column is one branch-free pass of max_abs_bits (its zeros, and
  * Inf or NaN as a magnitude at or above Inf's), then its outermost nonzeros
- * from either end.  A NaN counts as a nonzero, as c[i] != 0 says. */
-static void shape_pass_dense(const silc_value *v, silc_props *p)
+ * from either end.  A NaN counts as a nonzero, as c[i] != 0 says.  The
+ * largest magnitude it finds on the way fills the scan cache too (as
+ * shape_store does for CSR): the scaling hook's val_max_abs, asked right
+ * after, would otherwise read A a second time. */
+static void shape_pass_dense(silc_value *v, silc_props *p)
 {
     const int64_t m = v->m, n = v->n;
     int64_t nnz = 0, pos = 0;
@@ -1032,7 +1035,8 @@ static void shape_pass_dense(const silc_value *v, silc_props *p)
         if (last != j && last != first) shape_off_diagonal(p, last, j);
     }
     p->nnz = nnz;
-    p->has_nonfinite = top >= 0x7ff0000000000000ULL;
+    scan_from_bits(v, top);
+    p->has_nonfinite = v->scan_nonfinite;
     p->pos_diag = p->square && n > 0 && pos == n;
 }
 
