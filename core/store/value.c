@@ -1014,8 +1014,12 @@ static void shape_start(const silc_value *v, silc_props *p)
  * from either end.  A NaN counts as a nonzero, as c[i] != 0 says.  The
  * largest magnitude it finds on the way fills the scan cache too (as
  * shape_store does for CSR): the scaling hook's val_max_abs, asked right
- * after, would otherwise read A a second time. */
-static void shape_pass_dense(silc_value *v, silc_props *p)
+ * after, would otherwise read A a second time.
+ *
+ * With copy, each column is first copied there and read from the copy,
+ * which the copy has just put in L1: one read of v from memory serves both
+ * (val_shape_into). */
+static void shape_pass_dense(silc_value *v, silc_props *p, double *copy)
 {
     const int64_t m = v->m, n = v->n;
     int64_t nnz = 0, pos = 0;
@@ -1023,6 +1027,7 @@ static void shape_pass_dense(silc_value *v, silc_props *p)
     shape_start(v, p);
     for (int64_t j = 0; j < n; j++) {
         const double *c = v->val + j * m;
+        if (copy) c = memcpy(copy + j * m, c, (size_t)m * sizeof *c);
         int64_t zeros = 0, first, last;
         uint64_t mx = max_abs_bits(c, m, 1, &zeros);
         top = mx > top ? mx : top;
@@ -1411,7 +1416,7 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         shape_csr(v);
     if ((parts & SILC_PROPS_SHAPE) && !(parts & SILC_PROPS_NORMS) && !(v->props_have & SILC_PROPS_SHAPE) &&
         v->format == SILC_FMT_DENSE && v->field == SILC_FIELD_REAL) {
-        shape_pass_dense(v, p);
+        shape_pass_dense(v, p, NULL);
         v->props_have |= SILC_PROPS_SHAPE;
     }
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
@@ -1433,6 +1438,15 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         }
     }
     return p;
+}
+
+int val_shape_into(silc_value *v, double *copy)
+{
+    if (v->dist || v->format != SILC_FMT_DENSE || v->field != SILC_FIELD_REAL || (v->props_have & SILC_PROPS_SHAPE))
+        return -1;
+    shape_pass_dense(v, &v->props, copy);
+    v->props_have |= SILC_PROPS_SHAPE;
+    return 0;
 }
 
 const silc_props *val_props(const silc_value *v)
