@@ -752,7 +752,9 @@ int64_t val_attach_bytes(const silc_value *v)
  * backward error's residual pass sums as it goes; so a KLU solve of memplus
  * no longer pays for column sums it never reads (the properties took 4% of
  * it).  Plugins ask for the parts they read (host->props_part); a CSR value
- * made by silc_put has its shape from the copy (val_csr_fill_checked).
+ * made by silc_put has its shape from the copy (val_csr_fill_checked), and
+ * a dense one solved bare may get its shape in the pass that copies it for
+ * the backend's factorization (val_shape_into).
  *
  * The norms are first summed unscaled, which is exact enough and cannot
  * overflow or underflow harmfully while every |a| lies in
