@@ -167,9 +167,12 @@ static int solve_with(const char *mode, const double *a, int64_t m, int64_t n, c
         val_release(A), val_release(B);
         return -1;
     }
-    *Aout = A; /* the store holds it now */
+    val_release(A);
     val_release(B);
-    watched = A;
+    /* borrowed: the store holds it (a 1x1 one as the store's own scalar)
+     * until "A" is bound again */
+    *Aout = (silc_value *)api_lookup(E, "A", err, sizeof err);
+    watched = *Aout;
     watched_bytes = (size_t)(m * n) * sizeof(double);
     square_arrays = early_square_arrays = 0;
     rc = api_exec(E, "x = A \\ b", err, sizeof err);
