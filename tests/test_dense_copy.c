@@ -21,6 +21,10 @@
  *   - the copy is made exactly when the corners say so and the backend
  *     takes it: an array pool counting the n x n arrays sees the first one
  *     allocated before A's shape is known (the dispatcher's), and no second;
+ *   - the pass's kernel, which reads eight entries a step and then a tail,
+ *     gives brute force's answers with a special entry (the largest
+ *     magnitude, -0.0, a signed NaN with a payload, Inf, Inf and NaN in one
+ *     column, a lone subnormal) at every row of a 13-row column;
  *   - a NaN deep inside a general 300 x 300 A, and with b NaN as well, is
  *     refused naming A and its position, the message the default mode gives.
  */
@@ -131,8 +135,9 @@ static void check_store(const char *what, const double *a, int64_t m, int64_t n,
     {
         double want;
         memcpy(&want, &t->maxbits, sizeof want);
+        /* a NaN anywhere makes the max NaN; else it is the largest |a_ij|, Inf included */
         CHECK(val_has_nonfinite(v) == t->has_nonfinite &&
-                  (t->has_nonfinite ? !(val_max_abs(v) < INFINITY) : val_max_abs(v) == want),
+                  (isnan(want) ? isnan(val_max_abs(v)) : val_max_abs(v) == want),
               "%s: scan max %.17g nonfinite %d, truth %.17g %d", what, val_max_abs(v), val_has_nonfinite(v), want,
               t->has_nonfinite);
     }
@@ -313,6 +318,56 @@ static void edge_cases(void)
     }
 }
 
+/* The shape pass's kernel (value.c's max_abs_bits) reads a column eight
+ * entries a step in register pairs, then one by one: in 13-row columns one
+ * special entry is put at every row (every lane of the step, and the tail)
+ * of a middle column and of the last one, alone or with a second one three
+ * rows on, and the shape and the scan are compared with brute force. */
+static void kernel_lanes(void)
+{
+    enum { N = 13 };
+    const uint64_t nan_payload_bits = 0xfff0000000000123ULL; /* negative, quiet bit clear */
+    double nan_payload, *a = make(N, general);
+    memcpy(&nan_payload, &nan_payload_bits, sizeof nan_payload);
+    const struct {
+        const char *what;
+        double first, second; /* second 0: none */
+    } cases[] = {
+        {"largest magnitude, negative", -1e6, 0},
+        {"-0.0", -0.0, 0},
+        {"NaN with a payload and the sign", nan_payload, 0},
+        {"Inf", -INFINITY, 0},
+        {"Inf, then NaN", INFINITY, NAN},
+        {"NaN, then Inf", NAN, -INFINITY},
+        {"largest magnitude, then Inf", 1e300, INFINITY},
+    };
+    if (!a) return;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
+        for (int64_t j = 6; j < N; j += N - 1 - 6)
+            for (int64_t i = 0; i < N; i++) {
+                char what[160];
+                double *col = a + j * N, keep = col[i], keep2 = col[(i + 3) % N];
+                col[i] = cases[c].first;
+                if (cases[c].second != 0) col[(i + 3) % N] = cases[c].second;
+                snprintf(what, sizeof what, "%s at (%lld, %lld)", cases[c].what, (long long)i + 1,
+                         (long long)j + 1);
+                shape t = brute(a, N, N);
+                check_store(what, a, N, N, &t);
+                col[i] = keep, col[(i + 3) % N] = keep2;
+            }
+    /* a column of zeros but one subnormal, in every row: a nonzero, and the max when alone */
+    for (int64_t k = 0; k < N * N; k++) a[k] = 0;
+    for (int64_t i = 0; i < N; i++) {
+        char what[160];
+        a[i + 6 * N] = -0x1p-1074;
+        snprintf(what, sizeof what, "the only nonzero, subnormal, at (%lld, 7)", (long long)i + 1);
+        shape t = brute(a, N, N);
+        check_store(what, a, N, N, &t);
+        a[i + 6 * N] = 0;
+    }
+    free(a);
+}
+
 /* A NaN deep inside a general 300 x 300 A: the message names A and the
  * entry, whether or not the copy's pass found it, and comes before b's. */
 static void nan_inside(void)
@@ -347,6 +402,7 @@ int main(void)
     }
     val_set_array_pool(count_take, give_none);
     edge_cases();
+    kernel_lanes();
     nan_inside();
     val_set_array_pool(NULL, NULL);
     eng_destroy(&E);
