@@ -944,7 +944,7 @@ static inline double_pair pair_max(double_pair m, double_pair a)
 #if defined(__SSE2__)
     return (double_pair)_mm_max_pd((__m128d)m, (__m128d)a);
 #else
-    int64_pair up = a > m;
+    int64_pair up = (int64_pair)(a > m);
     return (double_pair)(((int64_pair)a & up) | ((int64_pair)m & ~up));
 #endif
 }
@@ -953,13 +953,14 @@ static inline double_pair pair_max(double_pair m, double_pair a)
  * number of stored zeros (-0.0 is one), in one branch-free pass.  Inf is
  * the largest magnitude it is; any NaN makes the answer a NaN pattern (above
  * Inf's), which is all scan_from_bits asks.  Eight entries a step in four
- * register pairs, two accumulators of each kind: the magnitude by masking the sign, a maxpd, a sum of the
- * magnitudes (NaN exactly when one of them is: they are never negative, so
- * Inf - Inf cannot occur, and an overflow gives Inf, not NaN), and
- * (x == 0) counted by subtracting its all-ones mask: 4.0 instructions an
- * entry of shape_pass_dense where the 64-bit integer maximum it replaced
- * took 7.9 (callgrind, docs/overhead.md).  Inlined with a constant count_zeros,
- * so each caller gets the loop it needs. */
+ * register pairs, two accumulators of each kind: the magnitude by masking
+ * the sign, a maxpd, a sum of the magnitudes (NaN exactly when one of them
+ * is: they are never negative, so Inf - Inf cannot occur, and an overflow
+ * gives Inf, not NaN), and (x == 0) counted by subtracting its all-ones
+ * mask.  4.0 instructions an entry of shape_pass_dense where the 64-bit
+ * integer maximum it replaced took 7.9 (callgrind, docs/overhead.md).
+ * Inlined with a constant count_zeros, so each caller gets the loop it
+ * needs. */
 static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros, int64_t *zeros)
 {
     const int64_pair magnitude = {INT64_MAX, INT64_MAX};
@@ -974,7 +975,10 @@ static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros,
         double_pair a3 = (double_pair)((int64_pair)load_pair(x + i + 6) & magnitude);
         m0 = pair_max(m0, pair_max(a0, a1)), m1 = pair_max(m1, pair_max(a2, a3));
         s0 += a0 + a1, s1 += a2 + a3;
-        if (count_zeros) z0 -= (a0 == zero) + (a1 == zero), z1 -= (a2 == zero) + (a3 == zero);
+        /* (the casts: Clang types a comparison's lanes long long, not int64_t) */
+        if (count_zeros)
+            z0 -= (int64_pair)(a0 == zero) + (int64_pair)(a1 == zero),
+                z1 -= (int64_pair)(a2 == zero) + (int64_pair)(a3 == zero);
     }
     m0 = pair_max(m0, m1);
     s0 += s1;
