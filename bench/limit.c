@@ -7,6 +7,8 @@
  *     limit spmv [max_nnz]                     (the SpMV rows up to max_nnz:
  *                                               `limit spmv 1e4` for profiling)
  *     limit --cpu ...                          (times by the thread's CPU clock)
+ *     limit bare [n] [solves]                  (SILC's bare dense solves alone,
+ *                                               untimed: for callgrind)
  *
  * --cpu: on a shared machine a process waits for a core for longer than a
  * 5 us product takes, and wall-clock ratios scatter by +-25 % at a load
@@ -275,6 +277,20 @@ static double median_difference(const double *a, const double *b, int reps)
     return bench_median(d, reps);
 }
 
+/* The bench's system: A random n x n with a dominant diagonal in a, b = A *
+ * ones in b, both also as envelopes, b PUT. */
+static int dense_system(int64_t n, double *a, double *b, silc_envelope_t *A, silc_envelope_t *be)
+{
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t i = 0; i < n; i++) a[i + j * n] = urand() - 0.5 + (i == j ? (double)n / 4 : 0);
+    for (int64_t i = 0; i < n; i++) {
+        double s = 0;
+        for (int64_t j = 0; j < n; j++) s += a[i + j * n];
+        b[i] = s;
+    }
+    return silc_envelope_dense(A, n, n, a) || silc_envelope_vector(be, n, b) || check(silc_put(ctx, "b", be), "PUT b");
+}
+
 static int dense_row(int64_t n, int reps)
 {
     size_t nn = (size_t)n * (size_t)n;
@@ -285,15 +301,7 @@ static int dense_row(int64_t n, int reps)
     silc_envelope_t A = {0}, be = {0};
     int rc = !a || !w || !b || !xb || !ipiv;
     if (rc) fprintf(stderr, "limit: out of memory\n");
-    for (int64_t j = 0; !rc && j < n; j++)
-        for (int64_t i = 0; i < n; i++) a[i + j * n] = urand() - 0.5 + (i == j ? (double)n / 4 : 0);
-    for (int64_t i = 0; !rc && i < n; i++) {
-        double s = 0;
-        for (int64_t j = 0; j < n; j++) s += a[i + j * n];
-        b[i] = s;
-    }
-    if (!rc) rc = silc_envelope_dense(&A, n, n, a) || silc_envelope_vector(&be, n, b);
-    if (!rc) rc = check(silc_put(ctx, "b", &be), "PUT b");
+    if (!rc) rc = dense_system(n, a, b, &A, &be);
     for (int r = -1; !rc && r < reps; r++) { /* r = -1: a warm-up, not counted */
         double t0, t, f = 0;
         /* dgesv on a copy made before the clock starts, then with the copy
@@ -341,6 +349,28 @@ static int dense_row(int64_t n, int reps)
     return rc || check(silc_exec(ctx, "clear A b x"), "clear") || check(silc_exec(ctx, mode_settings[FULL]), "set");
 }
 
+/* `limit bare n [solves]`: only SILC's bare solves of the dense part, each
+ * after a fresh PUT of A, nothing timed: what an instruction and cache
+ * profile of them needs (`valgrind --tool=callgrind --cache-sim=yes`,
+ * docs/overhead.md), without dgesv's and the other modes' runs. */
+static int bare_solves(int64_t n, int solves)
+{
+    size_t nn = (size_t)n * (size_t)n;
+    double *a = malloc(nn * sizeof *a), *b = malloc((size_t)n * sizeof *b), t, f;
+    silc_envelope_t A = {0}, be = {0};
+    int rc = !a || !b;
+    if (rc) fprintf(stderr, "limit: out of memory\n");
+    if (!rc) rc = dense_system(n, a, b, &A, &be) || check(silc_exec(ctx, mode_settings[BARE]), "set");
+    for (int r = 0; !rc && r < solves; r++) {
+        A.values[(size_t)r % (size_t)n * (size_t)(n + 1)] += 1e-3; /* a new A: no kept factorization */
+        rc = silc_solve_time(&A, &t, &f);
+    }
+    silc_envelope_free(&A);
+    silc_envelope_free(&be);
+    free(a), free(b);
+    return rc;
+}
+
 static int dense(int64_t max_n)
 {
     printf("\nDense solve x = A \\ b, A random n x n with a dominant diagonal (not symmetric); seconds (%s),\n"
@@ -366,13 +396,16 @@ int main(int argc, char **argv)
         argv++, argc--;
     }
     what = argc > 1 ? argv[1] : "all";
-    int spmv_only = !strcmp(what, "spmv");
+    int spmv_only = !strcmp(what, "spmv"), bare = !strcmp(what, "bare");
     double max_nnz = spmv_only && argc > 2 ? atof(argv[2]) : 1e6;
-    int64_t max_n = !spmv_only && argc > 2 ? atoll(argv[2]) : 3000;
+    int64_t max_n = !spmv_only && argc > 2 ? atoll(argv[2]) : bare ? 1000 : 3000;
+    int solves = bare && argc > 3 ? atoi(argv[3]) : 3;
     int rc;
-    if (argc > 3 || (strcmp(what, "all") && !spmv_only && strcmp(what, "dense")) || max_n < 1000 || max_nnz < 1e4) {
+    if (argc > 3 + bare || (strcmp(what, "all") && !spmv_only && !bare && strcmp(what, "dense")) ||
+        max_n < (bare ? 1 : 1000) || max_nnz < 1e4 || solves < 1) {
         fprintf(stderr, "usage: limit [--cpu] [dense|all] [max_dense_n >= 1000]\n"
-                        "       limit [--cpu] spmv [max_nnz >= 1e4]\n");
+                        "       limit [--cpu] spmv [max_nnz >= 1e4]\n"
+                        "       limit bare [n] [solves]\n");
         return 2;
     }
     if (silc_open(&ctx, NULL)) {
@@ -380,7 +413,8 @@ int main(int argc, char **argv)
         silc_close(&ctx);
         return 1;
     }
-    rc = (strcmp(what, "dense") && spmv(max_nnz)) || (strcmp(what, "spmv") && dense(max_n));
+    if (bare) rc = bare_solves(max_n, solves);
+    else rc = (strcmp(what, "dense") && spmv(max_nnz)) || (strcmp(what, "spmv") && dense(max_n));
     silc_close(&ctx);
     return rc ? 1 : 0;
 }

@@ -111,6 +111,12 @@ double complex lp_getz(const silc_view *A, int64_t i, int64_t j)
     return z[(A->ku + i - j) + j * A->ld];
 }
 
+double *lp_take_copy(silc_call *call, const silc_value *v)
+{
+    if (lp_host->struct_size < SILC_HOST_NEEDS(take_dense_copy) || !lp_host->take_dense_copy) return NULL;
+    return lp_host->take_dense_copy(call, v);
+}
+
 int lp_is_complex(const silc_value *v)
 {
     return lp_host->struct_size >= SILC_HOST_NEEDS(field) && lp_host->field(v) == SILC_FIELD_COMPLEX;
@@ -359,7 +365,8 @@ static int condest_off(const silc_call *call)
 static int solve_mixed(silc_call *call, int route, const silc_view *A, const silc_view *B)
 {
     lapack_int n = (lapack_int)A->n, nrhs = (lapack_int)B->n, iter = 0, info, *ipiv, *iwork;
-    double *a = lp_alloc((size_t)n * (size_t)n, sizeof(double));
+    double *given = lp_take_copy(call, call->in[0]); /* the host's copy of A, if it made one */
+    double *a = given ? given : lp_alloc((size_t)n * (size_t)n, sizeof(double));
     double *b = lp_alloc((size_t)n * (size_t)nrhs, sizeof(double));
     double *work = lp_alloc((size_t)n * (size_t)(nrhs > 4 ? nrhs : 4), sizeof(double));
     float *swork = lp_alloc((size_t)n * (size_t)(n + nrhs), sizeof(float));
@@ -375,7 +382,7 @@ static int solve_mixed(silc_call *call, int route, const silc_view *A, const sil
         goto done;
     }
     lp_host->view(out, &X);
-    memcpy(a, A->val, (size_t)n * (size_t)n * sizeof(double));
+    if (!given) memcpy(a, A->val, (size_t)n * (size_t)n * sizeof(double));
     rhs_copy(B, b, n, 0);
     info = chol ? LAPACKE_dsposv_work(LAPACK_COL_MAJOR, 'L', n, nrhs, a, n, b, n, X.val, n, work,
                                       swork, &iter)

@@ -67,6 +67,11 @@ typedef struct lp_factor {
     char note[160];
 } lp_factor;
 
+/* The host's copy of the real dense operand v, made in the read of v its
+ * checks did anyway (ABI 1.10, host->take_dense_copy), the caller's to
+ * factor in place and lp_free; NULL when there is none (or an older host):
+ * then copy v yourself. */
+double *lp_take_copy(silc_call *call, const silc_value *v);
 /* Memory through the host, with overflow checks.  NULL on failure. */
 void *lp_alloc(size_t count, size_t size);
 void lp_free(void *p);

@@ -30,21 +30,26 @@
 /* Scratch of the z*con estimators: 2n complex work then 2n doubles rwork. */
 #define LP_ZCON_DOUBLES(n) (6 * (n))
 
-/* A new factor of kind with a copy of the dense m x n matrix A in F->a. */
+/* A new factor of kind with a copy of the dense m x n matrix A (the view
+ * of call->in[0]) in F->a: the host's copy when it made one (lp_take_copy),
+ * else a memcpy. */
 static lp_factor *factor_with_copy(silc_call *call, int kind, const silc_view *A, int pivots)
 {
     lapack_int m = (lapack_int)A->m, n = (lapack_int)A->n;
     lp_factor *F = lp_factor_new(kind, m, n);
+    double *given;
     if (!F) return NULL;
     F->cplx = lp_is_complex(call->in[0]);
     F->ld = LP_LD(m);
-    F->a = lp_alloc((size_t)m * (size_t)n * (size_t)LP_W(F), sizeof(double));
+    given = F->cplx ? NULL : lp_take_copy(call, call->in[0]);
+    F->a = given ? given : lp_alloc((size_t)m * (size_t)n * (size_t)LP_W(F), sizeof(double));
     F->ipiv = pivots ? lp_alloc((size_t)LP_LD(n), sizeof(lapack_int)) : NULL;
     if (!F->a || (pivots && !F->ipiv)) {
         lp_factor_free(F);
         return NULL;
     }
-    if (m > 0 && n > 0) memcpy(F->a, A->val, (size_t)m * (size_t)n * (size_t)LP_W(F) * sizeof(double));
+    if (!given && m > 0 && n > 0)
+        memcpy(F->a, A->val, (size_t)m * (size_t)n * (size_t)LP_W(F) * sizeof(double));
     return F;
 }
 

@@ -29,7 +29,7 @@ extern "C" {
 #endif
 
 #define SILC_ABI_MAJOR 1
-#define SILC_ABI_MINOR 9
+#define SILC_ABI_MINOR 10
 
 /* Index type of CSR arrays.  Its width is part of the ABI (index_bytes). */
 typedef int64_t silc_index;
@@ -450,6 +450,18 @@ typedef struct silc_host_api {
     void *(*large_calloc)(size_t count, size_t size);
     void *(*large_realloc)(void *p, size_t bytes);
     void (*large_free)(void *p);
+
+    /* ABI 1.10: a copy of the dense real operand v's m*n entries
+     * (column-major, leading dimension m) that the host made in the same
+     * read of v as its own checks of v (the shape and NaN/Inf before a
+     * solve), now the plugin's: overwrite it (factor in place) and release
+     * it with host->free.  NULL when the host made none for v in this call
+     * (it makes one only for a square solve matrix whose class needs a
+     * factorization of all of it, once): then copy v yourself.  Taken
+     * instead of a memcpy, it spares a read of A from memory, which at
+     * n = 1000 is a few per cent of a dgesv.  Check struct_size >=
+     * SILC_HOST_NEEDS(take_dense_copy). */
+    double *(*take_dense_copy)(silc_call *call, const silc_value *v);
 } silc_host_api;
 
 /* ---- what a plugin provides ------------------------------------------------ */

@@ -140,6 +140,13 @@ void acc_pending_resolve(silc_engine *E, eng_pending *p, silc_report *r);
  * (one pass over it, not a scan and then the properties); else v is a
  * right-hand side and gets val_has_nonfinite's scan. */
 int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const char *name);
+/* 1 when the check of a solve's matrix A is better left to the dispatcher,
+ * which makes it for every solve before any backend runs, after the shape
+ * pass that may copy A for the backend on the way (dispatch.c's
+ * prepare_dense_copy): A whole, dense and real with its shape not known yet,
+ * and b finite (else A's check comes first, as its message does).  A caller
+ * that names the operands (eval.c) names A after the solve failed. */
+int refine_check_finite_later(const silc_engine *E, const silc_value *A, const silc_value *b);
 
 /* Steps a direct result that failed verification gets before the next
  * backend of the list is tried (the fallback chain, dispatch.c), unless

@@ -52,6 +52,12 @@
 
 /* ---- finite operands ------------------------------------------------------- */
 
+int refine_check_finite_later(const silc_engine *E, const silc_value *A, const silc_value *b)
+{
+    return E && !E->dist && A && b && !A->dist && A->format == SILC_FMT_DENSE && A->field == SILC_FIELD_REAL &&
+           !(A->props_have & SILC_PROPS_SHAPE) && !val_has_nonfinite(b);
+}
+
 int refine_check_finite(silc_engine *E, const silc_value *v, int matrix, const char *name)
 {
     silc_view w;

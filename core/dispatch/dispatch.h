@@ -166,12 +166,20 @@ const silc_host_api *host_api(void);
 int host_check_result(silc_call *call);
 /* The thread budget host->threads() reports; set by ld_set_threads. */
 void host_set_threads(int nthreads);
+/* A copy of a solve's dense A that dispatch.c made in its shape pass
+ * (val_shape_into), until a backend takes it (host->take_dense_copy) or
+ * the call ends and dispatch.c frees it. */
+typedef struct disp_dense_copy {
+    const silc_value *of;
+    double *array;                  /* val_array_alloc'd, as host->alloc's arrays */
+} disp_dense_copy;
 /* Per-call bookkeeping behind call->host_private. */
 typedef struct host_call_ctx {
     silc_engine *E;
     const ld_backend *backend;      /* backend running the call (options prefix) */
     int status;
     int collective;                 /* runs on the row blocks of every rank (dist.h) */
+    disp_dense_copy *copy;          /* NULL, or the solve's copy of A not taken yet */
     /* Last: a string, so a call's context zeroes what comes before it and
      * empties it (dispatch.c's walk; zeroing its 1 KB too wrote 17 cache
      * lines a call: docs/overhead.md, SpMV). */

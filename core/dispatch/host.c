@@ -306,6 +306,18 @@ static int h_cancelled(silc_call *call)
     return eng_cancel_pending(ctx->E, why, sizeof why);
 }
 
+/* The dispatcher's copy of v, if it made one for this call and no backend
+ * took it yet: the caller owns it from here (frees it with h_free). */
+static double *h_take_dense_copy(silc_call *call, const silc_value *v)
+{
+    host_call_ctx *ctx = call ? call->host_private : NULL;
+    double *array;
+    if (!ctx || !ctx->copy || ctx->copy->of != v) return NULL;
+    array = ctx->copy->array;
+    ctx->copy->array = NULL;
+    return array;
+}
+
 static const silc_host_api host_table = {
     SILC_ABI_MAJOR,
     SILC_ABI_MINOR,
@@ -351,6 +363,7 @@ static const silc_host_api host_table = {
     util_large_calloc,
     util_large_realloc,
     util_large_free,
+    h_take_dense_copy,
 };
 
 int host_check_result(silc_call *call)

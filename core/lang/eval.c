@@ -641,11 +641,18 @@ static int apply_binary(lang_ev *V, int op, operands *o, const silc_value *a,
         if (a->m != b->m)
             return shape_error(V, "needs as many rows in the right-hand side", op, o, a, b);
         /* NaN/Inf named by the user's operand text (refine.c; the dispatcher
-         * repeats the check with role names for every other route). */
-        if (refine_check_finite(V->E, a, 1, operand_name(V, o, 0)) ||
-            refine_check_finite(V->E, b, 0, operand_name(V, o, 1)))
-            return -1;
-        return ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
+         * repeats the check with role names for every other route).  A dense
+         * A not read yet is checked by the dispatcher, in the one read of A
+         * that also copies it for the backend, and named here if refused. */
+        {
+            int a_later = refine_check_finite_later(V->E, a, b), rc;
+            if ((!a_later && refine_check_finite(V->E, a, 1, operand_name(V, o, 0))) ||
+                refine_check_finite(V->E, b, 0, operand_name(V, o, 1)))
+                return -1;
+            rc = ev_run_op(V, SILC_OP_SOLVE, 0, a, b, 0, 0, o->what, out);
+            if (rc && a_later && refine_check_finite(V->E, a, 1, operand_name(V, o, 0))) return -1;
+            return rc;
+        }
     case TK_CARET:
         if (val_is_scalar(a) && val_is_scalar(b))
             return ev_run_op(V, SILC_OP_EWISE, SILC_EW_POW, a, b, 0, 0, o->what, out);

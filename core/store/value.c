@@ -19,6 +19,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "util.h"
 
@@ -752,7 +755,9 @@ int64_t val_attach_bytes(const silc_value *v)
  * backward error's residual pass sums as it goes; so a KLU solve of memplus
  * no longer pays for column sums it never reads (the properties took 4% of
  * it).  Plugins ask for the parts they read (host->props_part); a CSR value
- * made by silc_put has its shape from the copy (val_csr_fill_checked).
+ * made by silc_put has its shape from the copy (val_csr_fill_checked), and
+ * a dense one solved bare may get its shape in the pass that copies it for
+ * the backend's factorization (val_shape_into).
  *
  * The norms are first summed unscaled, which is exact enough and cannot
  * overflow or underflow harmfully while every |a| lies in
@@ -915,36 +920,82 @@ static inline uint64_t magnitude_bits(const double *x)
     return b & 0x7fffffffffffffffULL;
 }
 
+/* Two doubles as one SSE2 register (GCC's and Clang's vector extension: the
+ * build already requires a GCC-compatible compiler, CMakeLists.txt's flags).
+ * GCC 12 -O2 vectorizes neither a 64-bit integer maximum (no such
+ * instruction before SSE4.2) nor a floating-point one (IEEE compare-and-
+ * select is not a MAX_EXPR without -ffinite-math-only), so the kernel below
+ * says in pairs what it wants. */
+typedef double double_pair __attribute__((vector_size(16)));
+typedef int64_t int64_pair __attribute__((vector_size(16)));
+
+static inline double_pair load_pair(const double *x)
+{
+    double_pair v;
+    memcpy(&v, x, sizeof v); /* unaligned: a column starts anywhere */
+    return v;
+}
+
+/* The larger of each lane of m and a, for lanes that are not NaN (the
+ * caller detects NaN apart).  maxpd where SSE2 is the baseline; elsewhere a
+ * compare and a select, which the compiler lowers to what it has. */
+static inline double_pair pair_max(double_pair m, double_pair a)
+{
+#if defined(__SSE2__)
+    return (double_pair)_mm_max_pd((__m128d)m, (__m128d)a);
+#else
+    int64_pair up = (int64_pair)(a > m);
+    return (double_pair)(((int64_pair)a & up) | ((int64_pair)m & ~up));
+#endif
+}
+
 /* The largest |x_i| as its bit pattern, and with count_zeros also the
- * number of stored zeros, in one branch-free pass.  With the sign bit
- * cleared, the patterns of doubles order as their magnitudes do, with Inf
- * above every finite number and NaN above Inf, so one integer maximum
- * answers both "largest entry" and "any NaN or Inf".  On 17758 entries 5.1
- * us where a compare-and-branch loop took 8.2; with the zero count, 54 us on
- * memplus's 126150.  Inlined with a constant count_zeros, so each caller
- * gets the loop it needs. */
+ * number of stored zeros (-0.0 is one), in one branch-free pass.  Inf is
+ * the largest magnitude it is; any NaN makes the answer a NaN pattern (above
+ * Inf's), which is all scan_from_bits asks.  Eight entries a step in four
+ * register pairs, two accumulators of each kind: the magnitude by masking
+ * the sign, a maxpd, a sum of the magnitudes (NaN exactly when one of them
+ * is: they are never negative, so Inf - Inf cannot occur, and an overflow
+ * gives Inf, not NaN), and (x == 0) counted by subtracting its all-ones
+ * mask.  4.0 instructions an entry of shape_pass_dense where the 64-bit
+ * integer maximum it replaced took 7.9 (callgrind, docs/overhead.md).
+ * Inlined with a constant count_zeros, so each caller gets the loop it
+ * needs. */
 static inline uint64_t max_abs_bits(const double *x, int64_t n, int count_zeros, int64_t *zeros)
 {
-    uint64_t m0 = 0, m1 = 0, m2 = 0, m3 = 0, b[4];
-    int64_t z0 = 0, z1 = 0, z2 = 0, z3 = 0, i = 0;
-    for (; i + 4 <= n; i += 4) {
-        b[0] = magnitude_bits(x + i), b[1] = magnitude_bits(x + i + 1);
-        b[2] = magnitude_bits(x + i + 2), b[3] = magnitude_bits(x + i + 3);
-        if (count_zeros) z0 += b[0] == 0, z1 += b[1] == 0, z2 += b[2] == 0, z3 += b[3] == 0;
-        m0 = b[0] > m0 ? b[0] : m0;
-        m1 = b[1] > m1 ? b[1] : m1;
-        m2 = b[2] > m2 ? b[2] : m2;
-        m3 = b[3] > m3 ? b[3] : m3;
+    const int64_pair magnitude = {INT64_MAX, INT64_MAX};
+    const double_pair zero = {0, 0};
+    double_pair m0 = zero, m1 = zero, s0 = zero, s1 = zero;
+    int64_pair z0 = {0, 0}, z1 = z0;
+    int64_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        double_pair a0 = (double_pair)((int64_pair)load_pair(x + i) & magnitude);
+        double_pair a1 = (double_pair)((int64_pair)load_pair(x + i + 2) & magnitude);
+        double_pair a2 = (double_pair)((int64_pair)load_pair(x + i + 4) & magnitude);
+        double_pair a3 = (double_pair)((int64_pair)load_pair(x + i + 6) & magnitude);
+        m0 = pair_max(m0, pair_max(a0, a1)), m1 = pair_max(m1, pair_max(a2, a3));
+        s0 += a0 + a1, s1 += a2 + a3;
+        /* (the casts: Clang types a comparison's lanes long long, not int64_t) */
+        if (count_zeros)
+            z0 -= (int64_pair)(a0 == zero) + (int64_pair)(a1 == zero),
+                z1 -= (int64_pair)(a2 == zero) + (int64_pair)(a3 == zero);
     }
+    m0 = pair_max(m0, m1);
+    s0 += s1;
+    z0 += z1;
+    double top = m0[1] > m0[0] ? m0[1] : m0[0], total = s0[0] + s0[1];
+    int64_t z = z0[0] + z0[1];
     for (; i < n; i++) {
-        b[0] = magnitude_bits(x + i);
-        if (count_zeros) z0 += b[0] == 0;
-        m0 = b[0] > m0 ? b[0] : m0;
+        double a = fabs(x[i]);
+        top = a > top ? a : top;
+        total += a;
+        z += a == 0;
     }
-    if (count_zeros) *zeros = z0 + z1 + z2 + z3;
-    m0 = m1 > m0 ? m1 : m0;
-    m2 = m3 > m2 ? m3 : m2;
-    return m2 > m0 ? m2 : m0;
+    if (count_zeros) *zeros = z;
+    if (total != total) return 0x7ff8000000000000ULL; /* a NaN */
+    uint64_t bits;
+    memcpy(&bits, &top, sizeof bits);
+    return bits;
 }
 
 /* The shape and the norms of a dense value in one pass of short loops a
@@ -1011,8 +1062,15 @@ static void shape_start(const silc_value *v, silc_props *p)
  * GCC does not vectorize (a third of a dgesv's time at n = 1000 went to
  * them).  A column is one branch-free pass of max_abs_bits (its zeros, and
  * Inf or NaN as a magnitude at or above Inf's), then its outermost nonzeros
- * from either end.  A NaN counts as a nonzero, as c[i] != 0 says. */
-static void shape_pass_dense(const silc_value *v, silc_props *p)
+ * from either end.  A NaN counts as a nonzero, as c[i] != 0 says.  The
+ * largest magnitude it finds on the way fills the scan cache too (as
+ * shape_store does for CSR): the scaling hook's val_max_abs, asked right
+ * after, would otherwise read A a second time.
+ *
+ * With copy, each column is first copied there and read from the copy,
+ * which the copy has just put in L1: one read of v from memory serves both
+ * (val_shape_into). */
+static void shape_pass_dense(silc_value *v, silc_props *p, double *copy)
 {
     const int64_t m = v->m, n = v->n;
     int64_t nnz = 0, pos = 0;
@@ -1020,6 +1078,7 @@ static void shape_pass_dense(const silc_value *v, silc_props *p)
     shape_start(v, p);
     for (int64_t j = 0; j < n; j++) {
         const double *c = v->val + j * m;
+        if (copy) c = memcpy(copy + j * m, c, (size_t)m * sizeof *c);
         int64_t zeros = 0, first, last;
         uint64_t mx = max_abs_bits(c, m, 1, &zeros);
         top = mx > top ? mx : top;
@@ -1032,7 +1091,8 @@ static void shape_pass_dense(const silc_value *v, silc_props *p)
         if (last != j && last != first) shape_off_diagonal(p, last, j);
     }
     p->nnz = nnz;
-    p->has_nonfinite = top >= 0x7ff0000000000000ULL;
+    scan_from_bits(v, top);
+    p->has_nonfinite = v->scan_nonfinite;
     p->pos_diag = p->square && n > 0 && pos == n;
 }
 
@@ -1407,7 +1467,7 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         shape_csr(v);
     if ((parts & SILC_PROPS_SHAPE) && !(parts & SILC_PROPS_NORMS) && !(v->props_have & SILC_PROPS_SHAPE) &&
         v->format == SILC_FMT_DENSE && v->field == SILC_FIELD_REAL) {
-        shape_pass_dense(v, p);
+        shape_pass_dense(v, p, NULL);
         v->props_have |= SILC_PROPS_SHAPE;
     }
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
@@ -1429,6 +1489,15 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         }
     }
     return p;
+}
+
+int val_shape_into(silc_value *v, double *copy)
+{
+    if (v->dist || v->format != SILC_FMT_DENSE || v->field != SILC_FIELD_REAL || (v->props_have & SILC_PROPS_SHAPE))
+        return -1;
+    shape_pass_dense(v, &v->props, copy);
+    v->props_have |= SILC_PROPS_SHAPE;
+    return 0;
 }
 
 const silc_props *val_props(const silc_value *v)
