@@ -259,7 +259,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
     cholmod_sparse A;
     cholmod_factor *L = NULL;
     ch_factor *F;
-    int sym_reused, status, rc, serial;
+    int sym_reused, status, rc;
     long long minor;
     *out = NULL;
     ch_sparse(a, &A);
@@ -299,9 +299,7 @@ static int ch_factor_new(silc_call *call, const silc_view *a, void **out)
         L = Lc;
     }
     ss_lock();
-    serial = ss_serial_begin();
-    cholmod_l_factorize(&A, L, cc);
-    ss_serial_end(serial);
+    ss_cholmod_factorize(&A, L, cc);
     status = cc->status;
     minor = (long long)L->minor;
     F->L = L;

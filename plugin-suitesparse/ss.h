@@ -68,12 +68,12 @@ void ss_finish(void);               /* frees caches, finishes the cholmod_common
 void ss_lock(void);                 /* guards the shared state below */
 void ss_unlock(void);
 cholmod_common *ss_cholmod_common(void); /* use only between ss_lock / ss_unlock */
-/* SILC's thread count (set_threads); with 1, ss_serial_begin .. ss_serial_end
- * keep CHOLMOD's OpenMP regions, whose thread count its build fixed, on the
- * calling thread (ss_common.c). */
+/* SILC's thread count (set_threads); with 1, ss_cholmod_factorize keeps
+ * CHOLMOD's OpenMP regions, whose thread count its build fixed, on the
+ * calling thread (ss_common.c).  Call it under ss_lock, for every
+ * cholmod_l_factorize. */
 void ss_set_omp_threads(int nthreads);
-int ss_serial_begin(void);
-void ss_serial_end(int was);
+void ss_cholmod_factorize(cholmod_sparse *A, cholmod_factor *L, cholmod_common *cc);
 
 int ss_nomem(silc_call *call, const char *what);
 

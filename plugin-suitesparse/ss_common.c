@@ -76,23 +76,15 @@ void ss_set_omp_threads(int nthreads)
  * process's: a region that another thread of the program opens during the
  * factorization runs on one thread too (slower, for that while).
  */
-int ss_serial_begin(void)
+void ss_cholmod_factorize(cholmod_sparse *A, cholmod_factor *L, cholmod_common *cc)
 {
 #ifdef _OPENMP
     int was = omp_get_max_active_levels();
     if (ss_threads <= 1) omp_set_max_active_levels(0);
-    return was;
-#else
-    return 0;
-#endif
-}
-
-void ss_serial_end(int was)
-{
-#ifdef _OPENMP
+    cholmod_l_factorize(A, L, cc);
     omp_set_max_active_levels(was);
 #else
-    (void)was;
+    cholmod_l_factorize(A, L, cc);
 #endif
 }
 

@@ -502,11 +502,7 @@ static int chz_make(silc_call *call, const silc_view *a, void **out)
     A.sorted = 1, A.packed = 1;
     ss_lock();
     F->L = cholmod_l_analyze(&A, cc);
-    if (F->L) {
-        int serial = ss_serial_begin();
-        cholmod_l_factorize(&A, F->L, cc);
-        ss_serial_end(serial);
-    }
+    if (F->L) ss_cholmod_factorize(&A, F->L, cc);
     status = cc->status;
     if (F->L) minor = (long long)F->L->minor;
     F->info.rcond = F->L && status == CHOLMOD_OK ? cholmod_l_rcond(F->L, cc) : 0;

@@ -16,7 +16,7 @@
  * openblas_set_num_threads in the BLAS our libraries already loaded and calls
  * it; with another BLAS the call is a no-op.  KLU is sequential.  CHOLMOD's
  * own OpenMP regions have a thread count fixed at its build; at 1 thread
- * they are kept on the calling thread (ss_serial_begin).
+ * they are kept on the calling thread (ss_cholmod_factorize).
  */
 #include "ss.h"
 

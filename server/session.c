@@ -314,8 +314,7 @@ static int stream_output(void *user)
     session *S = user;
     struct iovec iov;
     if (S->out.failed || !S->out.len) return 0;
-    if (S->queued && srv_session_flush(S) < 0) return -1;
-    if (S->queued && S->q.bytes > STREAM_QUEUED_MAX) return 0;
+    if (S->queued && S->q.bytes > STREAM_QUEUED_MAX) return srv_session_flush(S) < 0 ? -1 : 0;
     iov.iov_base = S->out.p;
     iov.iov_len = S->out.len;
     S->out.len = S->out.text_at = 0;

@@ -249,7 +249,7 @@ static void test_multi_rhs(silc_context *c, const char *backend)
 }
 
 /* Threads of this process (CHOLMOD's OpenMP regions must not add any at
- * SILC's thread count 1: ss_serial_begin). */
+ * SILC's thread count 1: ss_cholmod_factorize). */
 static int tl_count_tasks(void)
 {
     int count = 0;

@@ -200,7 +200,8 @@ const silc_props *val_props_part(const silc_value *v, int parts);
  * computes it, with the scan cache) and a copy of its m*n entries into
  * copy, in one read of v: a solve's backend factors such a copy in place
  * (the dispatcher's factor copy, dispatch.c), and A is 8 MB at n = 1000.
- * -1 (nothing done) when v is not such a value or its shape is known. */
+ * copy NULL: the shape alone (val_props_part's pass for it).  -1 (nothing
+ * done) when v is not such a value or its shape is known. */
 int val_shape_into(silc_value *v, double *copy);
 /* Any NaN or Inf among the stored entries, and the largest |entry| (NaN if
  * any is NaN), from one cached scan: what a solve needs of its right-hand

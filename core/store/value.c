@@ -1465,11 +1465,8 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
     if ((parts & SILC_PROPS_SHAPE) && !(v->props_have & SILC_PROPS_SHAPE) && v->format == SILC_FMT_CSR &&
         v->field == SILC_FIELD_REAL)
         shape_csr(v);
-    if ((parts & SILC_PROPS_SHAPE) && !(parts & SILC_PROPS_NORMS) && !(v->props_have & SILC_PROPS_SHAPE) &&
-        v->format == SILC_FMT_DENSE && v->field == SILC_FIELD_REAL) {
-        shape_pass_dense(v, p, NULL);
-        v->props_have |= SILC_PROPS_SHAPE;
-    }
+    if ((parts & SILC_PROPS_SHAPE) && !(parts & SILC_PROPS_NORMS))
+        val_shape_into(v, NULL); /* a real dense value's shape alone; nothing for others or when known */
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
         int shape = !(v->props_have & SILC_PROPS_SHAPE);
         if (compute_norms(v, p, shape) == 0) v->props_have |= SILC_PROPS_NORMS;
