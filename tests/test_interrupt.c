@@ -153,7 +153,11 @@ static void check_loop_cancelled(silc_context *ctx, const char *where)
 
 /* The output callback of check_output_cancelled: reads slowly, as a
  * terminal does, counting the pieces that came before and after
- * silc_cancel returned. */
+ * silc_cancel returned.  It holds the first piece until silc_cancel has
+ * returned, so that what silcd streamed meanwhile (a piece a poll, every
+ * 20 ms) is surely still on its way then: a fast reader may take it all
+ * before the CANCEL and leave nothing to drop (the Java client's test saw
+ * that once in CI). */
 typedef struct slow_reader {
     int before, after;
 } slow_reader;
@@ -162,6 +166,12 @@ static void read_slowly(void *user, const char *text)
 {
     slow_reader *r = user;
     (void)text;
+    if (r->before + r->after == 0 && !atomic_load(&cancel_returned)) {
+        double t0 = util_now();
+        r->before++;
+        while (!atomic_load(&cancel_returned) && util_now() - t0 < 30) sleep_ms(5);
+        return;
+    }
     if (atomic_load(&cancel_returned)) r->after++;
     else r->before++;
     sleep_ms(5);
@@ -170,9 +180,9 @@ static void read_slowly(void *user, const char *text)
 /* Remote, a loop that shows a value every iteration: its output reaches
  * the callback while it runs (silcd streams it), and once silc_cancel has
  * returned at most the piece being handed over then: what is still on the
- * way is dropped, and a warning counts it (some always is: at the poll
- * that reads the CANCEL, silcd first sends what the loop printed since the
- * last one).  Before, silcd sent the whole run's output after the
+ * way is dropped, and a warning counts it (some always is: read_slowly
+ * holds the first piece until the CANCEL has gone out, and silcd streamed
+ * a piece at each poll meanwhile).  Before, silcd sent the whole run's output after the
  * interrupt, and the REPL showed "interrupted" only once it had printed it
  * all.  Under silcd --mpi on a loaded machine a statement can take longer
  * than the 20 ms between polls (each one ends in an agreement between the

@@ -229,9 +229,25 @@ def check_python(s, what, remote):
         # A loop that prints: its output streams while it runs, and what is
         # still on the way when the CANCEL goes out is dropped and counted
         # in a warning (as the C client does), not shown after the interrupt.
+        # The list holds the first piece until the CANCEL has gone out, as a
+        # slow terminal would: what silcd streamed meanwhile (a piece a
+        # poll, every 20 ms) is then surely on its way.  A fast reader may
+        # take everything before the CANCEL and leave nothing to drop.
         s.exec("i = 0")
-        out = []
-        t = threading.Timer(0.3 * SLOW, s.cancel)
+        cancel_out = threading.Event()
+
+        class SlowList(list):
+            def append(self, text):
+                if not self and not cancel_out.wait(30):
+                    fail("%s: printing loop: the CANCEL did not go out within 30 s" % what)
+                list.append(self, text)
+
+        def cancel_then_flag():
+            s.cancel()
+            cancel_out.set()
+
+        out = SlowList()
+        t = threading.Timer(0.3 * SLOW, cancel_then_flag)
         t.start()
         try:
             s.exec("while (i < 1e9) { i = i + 1; disp(i) }", out=out)

@@ -56,10 +56,16 @@ public final class TestClient {
     /* A thread that calls s.cancel() after 300 ms, as a user's Ctrl-C would
      * during a long EXEC; started, for the caller to join. */
     private static Thread cancelSoon(SILC s) {
+        return cancelSoon(s, new java.util.concurrent.CountDownLatch(1));
+    }
+
+    /* As above; sent counts down once the CANCEL has gone out. */
+    private static Thread cancelSoon(SILC s, java.util.concurrent.CountDownLatch sent) {
         Thread t = new Thread(() -> {
             try {
                 Thread.sleep(300);
                 s.cancel();
+                sent.countDown();
             } catch (Exception e) {
                 check(false, "cancel: " + e);
             }
@@ -318,10 +324,26 @@ public final class TestClient {
                   "the store as before the cancelled loop");
             // A loop that prints: what is still on its way when the CANCEL goes
             // out is dropped and counted in a warning, not shown afterwards.
+            // The output handler holds the first piece until the CANCEL has
+            // gone out, as a slow terminal would: what silcd streamed
+            // meanwhile (a piece a poll, every 20 ms) is then surely on its
+            // way. A fast reader may have taken everything before the CANCEL,
+            // leaving nothing to drop (CI saw that once).
             StringBuilder shown = new StringBuilder();
-            s.setOutput(shown::append);
+            java.util.concurrent.CountDownLatch cancelOut = new java.util.concurrent.CountDownLatch(1);
+            s.setOutput(text -> {
+                if (shown.length() == 0) {
+                    try {
+                        check(cancelOut.await(30, java.util.concurrent.TimeUnit.SECONDS),
+                              "the CANCEL went out within 30 s");
+                    } catch (InterruptedException e) {
+                        Thread.currentThread().interrupt();
+                    }
+                }
+                shown.append(text);
+            });
             s.EXEC("ci = 0");
-            Thread canceller2 = cancelSoon(s);
+            Thread canceller2 = cancelSoon(s, cancelOut);
             expectError(() -> s.EXEC("while (ci < 1e9) { ci = ci + 1; disp(ci) }"), "interrupted",
                         "printing loop cancelled");
             canceller2.join();
