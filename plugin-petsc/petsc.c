@@ -295,8 +295,50 @@ static int all_ranks(const psc_ranks *R, int flag)
 
 /* ---- the solver attachment ---------------------------------------------------- */
 
+/* The arrays A's Mat is built on, which PETSc does not copy
+ * (MatCreateSeqAIJWithArrays, MatCreateMPIAIJWithSplitArrays): they belong
+ * to the solver and are freed after its Mat.  On one process, this rank's
+ * rows of A with PetscInt indices (PetscInt is 32-bit in this build;
+ * solve_accepts and check_local saw that the counts fit) and va NULL: the
+ * values are A's own, borrowed, which is safe because the solver is an
+ * attachment of A (freed before A's arrays, val_release) and A is never
+ * changed in place while it has one (update_in_place); options that would
+ * make PETSc write into the Mat's values get a copy (csr_borrows).  On more,
+ * the rows split into the block of this rank's own columns (ia, ja local,
+ * va) and the rest (oi, oj global, oa), which PETSc's MATMPIAIJ keeps apart
+ * and whose oj it rewrites.  Before, MatSeqAIJSetPreallocationCSR and
+ * MatMPIAIJSetPreallocationCSR copied A entry by entry through
+ * MatSetValues: 66 ms of a 0.56 s one-shot CG + BoomerAMG solve at 500^2
+ * (docs/distributed.md). */
+typedef struct psc_csr {
+    void *block; /* the arrays below, one allocation (csr_build) */
+    PetscInt *ia, *ja, *oi, *oj;
+    double *va, *oa;
+} psc_csr;
+
+/* The arrays' block comes from the host's large-block allocator where it has
+ * one (ABI 1.9): from 4 MiB up on transparent huge pages, so that filling
+ * it takes a few page faults instead of one per 4 KiB (each ~6 us on this
+ * VM: 2,500 of them at 500^2 on two ranks).  Not counted against the value
+ * size limit, as PETSc's own copy was not. */
+static int large_blocks(void)
+{
+    return host->struct_size >= SILC_HOST_NEEDS(large_free);
+}
+
+static void csr_free(psc_csr *c)
+{
+    if (c->block) {
+        if (large_blocks()) host->large_free(c->block);
+        else host->free(c->block);
+    }
+    memset(c, 0, sizeof *c);
+}
+
+
 typedef struct psc_solver {
     Mat A;
+    psc_csr csr;         /* the arrays A is built on (freed after A) */
     KSP ksp;             /* NULL once cleared (solver_clear): not reusable */
     PetscOptions opts;   /* pushed as PETSc's default around every use of ksp */
     char *text;          /* the user's option string it was configured from */
@@ -326,6 +368,7 @@ static void solver_clear(psc_solver *S)
     S->ksp = NULL;
     S->A = NULL;
     S->opts = NULL;
+    csr_free(&S->csr); /* gone with A, or never to be used again */
 }
 
 static void solver_free(void *p)
@@ -346,52 +389,93 @@ static void solver_free(void *p)
         }                                                                                          \
     } while (0)
 
-/* This rank's rows of A as PetscInt arrays (PetscInt is 32-bit in this build;
- * solve_accepts and check_local saw that the counts fit).  Rank-local. */
-typedef struct psc_csr {
-    PetscInt *ia, *ja;
-} psc_csr;
-
-static int csr_indices(silc_call *call, const silc_view *a, psc_csr *c)
+/* Whether A's Mat may borrow A's values on one process: not when an option
+ * (the user's, PETSC_OPTIONS' or SILC's own, all in opts) asks PETSc to
+ * write into the operator -- a factorization in place (-pc_factor_in_place,
+ * also under a sub-solver's prefix) or a diagonal scaling of the system
+ * (-ksp_diagonal_scale) -- which would change the user's A. */
+static int csr_borrows(PetscOptions opts)
 {
-    int64_t k;
-    c->ia = host->alloc((size_t)(a->m + 1) * sizeof *c->ia);
-    c->ja = host->alloc((size_t)(a->nnz > 0 ? a->nnz : 1) * sizeof *c->ja);
-    if (!c->ia || !c->ja)
-        return psc_error(call, SILC_ENOMEM, "out of memory for %lld PetscInt indices",
-                         (long long)(a->nnz + a->m + 1));
-    for (k = 0; k <= a->m; k++) c->ia[k] = (PetscInt)a->rowptr[k];
-    for (k = 0; k < a->nnz; k++) c->ja[k] = (PetscInt)a->colind[k];
+    char *all = NULL;
+    int borrow;
+    if (PetscOptionsGetAll(opts, &all)) return 0;
+    borrow = all && !strstr(all, "in_place") && !strstr(all, "diagonal_scale");
+    PetscFree(all);
+    return borrow;
+}
+
+/* The arrays of this rank's rows of A for build_matrix (psc_csr).
+ * Rank-local. */
+static int csr_build(silc_call *call, const psc_ranks *R, const silc_view *a, int borrow, psc_csr *c)
+{
+    int64_t i, k, nd = 0, no, first = R->size > 1 ? R->layout.first_row : 0, last = first + a->m;
+    int split = R->size > 1;
+    size_t doubles, ints, bytes;
+    memset(c, 0, sizeof *c);
+    if (split)
+        for (k = 0; k < a->nnz; k++) nd += a->colind[k] >= first && a->colind[k] < last;
+    else
+        nd = a->nnz;
+    no = a->nnz - nd;
+    /* The doubles first, so that every array is aligned for its type. */
+    doubles = (size_t)(split || !borrow ? nd : 0) + (size_t)(split ? no : 0);
+    ints = (size_t)(a->m + 1) + (size_t)nd + (split ? (size_t)(a->m + 1) + (size_t)no : 0);
+    bytes = doubles * sizeof(double) + ints * sizeof(PetscInt);
+    c->block = large_blocks() ? host->large_alloc(bytes) : host->alloc(bytes);
+    if (!c->block)
+        return psc_error(call, SILC_ENOMEM, "out of memory for PETSc's copy of %lld rows (%lld entries)",
+                         (long long)a->m, (long long)a->nnz);
+    {
+        double *d = c->block;
+        PetscInt *p;
+        if (split || !borrow) c->va = d, d += nd;
+        if (split) c->oa = d, d += no;
+        p = (PetscInt *)d;
+        c->ia = p, p += a->m + 1;
+        c->ja = p, p += nd;
+        if (split) c->oi = p, p += a->m + 1, c->oj = p;
+    }
+    if (!split) {
+        for (i = 0; i <= a->m; i++) c->ia[i] = (PetscInt)a->rowptr[i];
+        for (k = 0; k < a->nnz; k++) c->ja[k] = (PetscInt)a->colind[k];
+        if (c->va) memcpy(c->va, a->val, (size_t)a->nnz * sizeof *c->va);
+        return SILC_OK;
+    }
+    c->ia[0] = c->oi[0] = 0;
+    for (i = 0, nd = no = 0; i < a->m; i++) {
+        for (k = a->rowptr[i]; k < a->rowptr[i + 1]; k++) {
+            int64_t col = a->colind[k];
+            if (col >= first && col < last) {
+                c->ja[nd] = (PetscInt)(col - first);
+                c->va[nd++] = a->val[k];
+            } else {
+                c->oj[no] = (PetscInt)col;
+                c->oa[no++] = a->val[k];
+            }
+        }
+        c->ia[i + 1] = (PetscInt)nd;
+        c->oi[i + 1] = (PetscInt)no;
+    }
     return SILC_OK;
 }
 
-static void csr_free(psc_csr *c)
-{
-    host->free(c->ia);
-    host->free(c->ja);
-    c->ia = c->ja = NULL;
-}
-
-/* A on R's communicator, PETSc copying the arrays: a MATSEQAIJ on one
- * process, else a MATMPIAIJ of which this rank holds the rows of a (columns
- * global; the diagonal block is square, as PETSc's vectors are split like
+/* A on R's communicator over c's arrays, which PETSc does not copy: a
+ * MATSEQAIJ on one process, else a MATMPIAIJ of which this rank holds the
+ * rows of a (the diagonal block is square, as PETSc's vectors are split like
  * the rows).  Collective. */
-static int build_matrix(silc_call *call, const psc_ranks *R, const silc_view *a, const psc_csr *c,
-                        int spd, Mat *out)
+static int build_matrix(silc_call *call, const psc_ranks *R, const silc_view *a, psc_csr *c, int spd,
+                        Mat *out)
 {
     Mat M = NULL;
     int rc = SILC_OK;
     PetscInt m = (PetscInt)a->m, n = (PetscInt)a->n;
     *out = NULL;
-    TRY(MatCreate(R->comm, &M), "MatCreate");
-    TRY(MatSetSizes(M, m, m, n, n), "MatSetSizes");
-    if (R->size > 1) {
-        TRY(MatSetType(M, MATMPIAIJ), "MatSetType");
-        TRY(MatMPIAIJSetPreallocationCSR(M, c->ia, c->ja, a->val), "MatMPIAIJSetPreallocationCSR");
-    } else {
-        TRY(MatSetType(M, MATSEQAIJ), "MatSetType");
-        TRY(MatSeqAIJSetPreallocationCSR(M, c->ia, c->ja, a->val), "MatSeqAIJSetPreallocationCSR");
-    }
+    if (R->size > 1)
+        TRY(MatCreateMPIAIJWithSplitArrays(R->comm, m, m, n, n, c->ia, c->ja, c->va, c->oi, c->oj, c->oa, &M),
+            "MatCreateMPIAIJWithSplitArrays");
+    else
+        TRY(MatCreateSeqAIJWithArrays(R->comm, m, n, c->ia, c->ja, c->va ? c->va : (double *)a->val, &M),
+            "MatCreateSeqAIJWithArrays");
     /* What the host knows about A helps GAMG (CG eigenvalue estimates), MUMPS
      * (SYM) and others.  The properties are global (the host computes those
      * of a distributed A collectively). */
@@ -675,13 +759,15 @@ static int log_view(silc_call *call, const psc_ranks *R, psc_solver *S)
  * preconditioner up (PETSc's options database pushed by the caller).
  * Collective. */
 static int solver_setup(silc_call *call, const psc_ranks *R, psc_solver *S, const silc_view *a,
-                        const psc_csr *csr)
+                        psc_csr *csr)
 {
     PC pc = NULL;
     PCFailedReason fr = PC_NOERROR;
     double t0 = host->now();
     int rc = SILC_OK;
     if ((rc = build_matrix(call, R, a, csr, S->spd, &S->A))) return rc;
+    S->csr = *csr; /* A's arrays now live as long as A */
+    memset(csr, 0, sizeof *csr);
     TRY(KSPCreate(R->comm, &S->ksp), "KSPCreate");
     TRY(PetscObjectSetOptions((PetscObject)S->ksp, S->opts), "PetscObjectSetOptions");
     TRY(KSPSetOperators(S->ksp, S->A, S->A), "KSPSetOperators");
@@ -966,7 +1052,7 @@ static int solve_run(silc_call *call)
     silc_view a, bv, o;
     silc_report *r = call->report;
     psc_ranks R;
-    psc_csr csr = {NULL, NULL};
+    psc_csr csr = {NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     psc_solver *S = NULL;
     silc_value *X = NULL;
     double *B = NULL, t0;
@@ -1028,7 +1114,7 @@ static int solve_run(silc_call *call)
         S->condest = condest != 0;
         S->cond_est = -1;
         if ((rc = psc_options_create(call, text, spd, &S->opts))) goto agreed;
-        if ((rc = csr_indices(call, &a, &csr))) goto agreed;
+        if ((rc = csr_build(call, &R, &a, csr_borrows(S->opts), &csr))) goto agreed;
     }
 agreed:
     if ((rc = agree(call, &R, rc))) goto done;

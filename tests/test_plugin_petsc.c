@@ -291,6 +291,38 @@ static void test_options(silc_context *cp)
     printf("not converged: %s\n", e);
 }
 
+/* PETSc's Mat is built on A's own values (no copy), so options that make
+ * PETSc write into its operator -- an in-place ILU(0), a diagonal scaling
+ * left unscaled -- must get a copy instead: after each solve, A holds
+ * exactly the entries PUT (A0, the same envelope PUT again, is separate
+ * arrays).  The plain options take the borrowed path and must solve. */
+static void test_operator_untouched(silc_context *cp, const silc_envelope_t *A, const double *ones, int64_t n)
+{
+    static const struct {
+        const char *opts;
+        int must_solve;
+    } cases[] = {
+        {"-ksp_type gmres -pc_type ilu -pc_factor_in_place -ksp_rtol 1e-10", 0},
+        {"-ksp_type cg -pc_type jacobi -ksp_diagonal_scale -ksp_rtol 1e-10", 0},
+        {"-ksp_type bcgs -pc_type ilu -ksp_rtol 1e-10", 1},
+    };
+    double *x = malloc((size_t)n * sizeof *x), d = -1;
+    CHECK(x && silc_put(cp, "A0", A) == 0, "put A0: %s", silc_context_errmsg(cp));
+    for (size_t i = 0; x && i < sizeof cases / sizeof cases[0]; i++) {
+        int rc = solve_with(cp, "xu", cases[i].opts);
+        CHECK(rc == 0 || !cases[i].must_solve, "%s: %s", cases[i].opts, silc_context_errmsg(cp));
+        if (rc == 0 && cases[i].must_solve) {
+            CHECK(tl_get_vec(cp, "xu", x, n) == 0, "get xu: %s", silc_context_errmsg(cp));
+            CHECK(tl_rel_diff(x, ones, n) <= 1e-6, "%s forward error %g", cases[i].opts, tl_rel_diff(x, ones, n));
+        }
+        CHECK(silc_exec(cp, "du = norm(A - A0, inf)") == 0 && tl_get_vec(cp, "du", &d, 1) == 0, "A - A0: %s",
+              silc_context_errmsg(cp));
+        CHECK(d == 0, "%s changed A: norm(A - A0, inf) = %g", cases[i].opts, d);
+    }
+    silc_exec(cp, "clear A0 xu du");
+    free(x);
+}
+
 static void test_multi_rhs(silc_context *cp, const double *ones, int64_t n)
 {
     silc_envelope_t e;
@@ -500,6 +532,7 @@ int main(void)
         test_iterative(cp, cr, ones, n, cond);
         test_direct(cp, ones, n, cond);
         test_options(cp);
+        test_operator_untouched(cp, &A, ones, n);
         test_multi_rhs(cp, ones, n);
         test_two_contexts(cp, cq, &A, ones, b);
         CHECK(put_system(cp, &A, ones, b) == 0, "put laplacian again");
