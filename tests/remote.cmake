@@ -61,7 +61,7 @@ if(SILC_CLANG AND NOT SILC_SANITIZE)
     set(_fz ${CMAKE_CURRENT_BINARY_DIR}/fuzz_frame_libfuzzer)
     set(_src ${CMAKE_CURRENT_LIST_DIR}/fuzz/fuzz_frame.c ${PROJECT_SOURCE_DIR}/core/client/protocol.c
              ${PROJECT_SOURCE_DIR}/core/store/envelope.c ${PROJECT_SOURCE_DIR}/core/store/value.c
-             ${PROJECT_SOURCE_DIR}/core/util/util.c)
+             ${PROJECT_SOURCE_DIR}/core/util/util.c ${PROJECT_SOURCE_DIR}/core/util/largealloc.c)
     list(TRANSFORM SILC_CORE_DIRS PREPEND -I OUTPUT_VARIABLE _core_inc)
     add_custom_command(OUTPUT ${_fz}
       COMMAND ${SILC_CLANG} -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined
