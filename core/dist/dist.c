@@ -786,7 +786,7 @@ static void norm_props(silc_value *v)
     const silc_props *bp = val_props_part(b, SILC_PROPS_NORMS);
     double mx[2] = {bp->norminf, bp->maxabs}, s, fro;
     int mirrored = (v->props_have & SILC_PROPS_SYMMETRY) && (v->props.symmetric || v->props.hermitian);
-    double *colsum = mirrored ? NULL : calloc((size_t)(v->n ? v->n : 1), sizeof *colsum);
+    double *colsum = mirrored ? NULL : util_large_calloc((size_t)(v->n ? v->n : 1), sizeof *colsum);
     int64_t i, j, wd = val_width(b);
     int nz, fin, pos;
     if (mirrored) {
@@ -808,7 +808,7 @@ static void norm_props(silc_value *v)
         v->props.norm1 = 0;
         for (j = 0; j < v->n; j++)
             if (!(colsum[j] <= v->props.norm1)) v->props.norm1 = colsum[j];
-        free(colsum);
+        util_large_free(colsum);
     }
     v->props.norminf = mx[0];
     v->props.maxabs = mx[1];
