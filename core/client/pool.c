@@ -33,7 +33,7 @@ enum { POOL_SLOTS = 8, POOL_IDLE_SECONDS = 30 };
 
 typedef struct slot {
     void *p;
-    size_t bytes; /* what the array can really hold (util_large_block_bytes or malloc_usable_size) */
+    size_t bytes; /* malloc_usable_size: what the array can really hold */
     time_t freed;
 } slot;
 
@@ -63,7 +63,7 @@ static time_t now_s(void)
 /* Frees slot i; under pool_lock. */
 static void drop(int i)
 {
-    util_large_free(slots[i].p); /* either kind of array (val_array_alloc) */
+    free(slots[i].p);
     pooled_bytes -= slots[i].bytes;
     slots[i].p = NULL;
     slots[i].bytes = 0;
@@ -101,9 +101,8 @@ static void *pool_take(size_t bytes)
  * arrays to make room: the newest is the likeliest to be asked for next. */
 static int pool_give(void *p)
 {
-    size_t bytes = util_large_block_bytes(p); /* a huge-page array, else malloc's */
+    size_t bytes = malloc_usable_size(p);
     time_t t;
-    if (!bytes) bytes = malloc_usable_size(p);
     int i, kept = 0;
     if (bytes < POOL_MIN_BYTES || bytes > cap_bytes) return 0;
     t = now_s();

@@ -65,7 +65,7 @@ static void *h_calloc(size_t count, size_t size)
 static void *h_realloc(void *p, size_t bytes)
 {
     if (h_too_big((double)bytes)) return NULL;
-    return util_large_realloc(p, bytes ? bytes : 1); /* p may be a huge-page array (val_array_alloc) */
+    return realloc(p, bytes ? bytes : 1);
 }
 
 static void h_free(void *p)

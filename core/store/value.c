@@ -48,13 +48,7 @@ void val_set_array_pool(void *(*take)(size_t bytes), int (*give)(void *p))
 }
 
 /* A pooled array is already mapped: zeroing it in place is far cheaper than
- * faulting in fresh pages, and an unset one costs nothing.  A fresh array of
- * UTIL_LARGE_MIN_BYTES (4 MiB) and more lies on transparent huge pages
- * (util_large_malloc), so that filling it takes a fault per 2 MiB instead
- * of one per 4 KiB: an SPMD program's silc_put_rows of a 500^2 Laplacian's
- * rows (20 MB) spent most of its 33 ms in 5,000 page faults, at ~6 us each
- * on this VM.  util_large_free and util_large_realloc take any pointer, so
- * arrays of either kind are freed and grown alike. */
+ * faulting in fresh pages, and an unset one costs nothing. */
 void *val_array_alloc(int64_t count, size_t size, int zero)
 {
     size_t bytes = (count > 0 ? (size_t)count : 1) * size;
@@ -63,12 +57,12 @@ void *val_array_alloc(int64_t count, size_t size, int zero)
         if (zero) memset(p, 0, bytes);
         return p;
     }
-    return zero ? util_large_calloc(bytes / size, size) : util_large_malloc(bytes);
+    return zero ? calloc(bytes / size, size) : malloc(bytes);
 }
 
 void val_array_free(void *p)
 {
-    if (p && !(pool_give && pool_give(p))) util_large_free(p);
+    if (p && !(pool_give && pool_give(p))) free(p);
 }
 
 /* The largest value this process makes (val_set_max_bytes).  Every size a
@@ -1332,7 +1326,7 @@ static int csr_symmetric(const silc_value *v)
     int64_t *next;
     int sym;
     if (!csr_symmetric_probe(v)) return 0;
-    next = util_large_malloc((size_t)(v->n ? v->n : 1) * sizeof *next); /* large: huge pages (val_array_alloc) */
+    next = util_large_malloc((size_t)(v->n ? v->n : 1) * sizeof *next); /* large: huge pages (compute_norms) */
     if (!next) return -1;
     sym = csr_symmetric_plain(v, next) || csr_symmetric_zeros(v, next);
     util_large_free(next);
@@ -1410,8 +1404,10 @@ static int compute_norms(const silc_value *v, silc_props *p, int shape)
     memset(&acc, 0, sizeof acc);
     acc.p = p;
     /* One sum per column and per row: 12 MB at a million unknowns, which on
-     * 4 KiB pages cost ~33 ms of first-touch faults on this VM (huge pages:
-     * val_array_alloc). */
+     * 4 KiB pages cost ~33 ms of first-touch faults on this VM.  Work arrays
+     * freed before the call returns, like a library's work space
+     * (util_large_malloc); values' own arrays stay malloc's (docs/overhead.md,
+     * "Values' arrays on huge pages"). */
     acc.colsum = util_large_malloc((size_t)(v->n ? v->n : 1) * sizeof(double));
     acc.rowsum = util_large_malloc((size_t)(v->m ? v->m : 1) * sizeof(double));
     props_start(v, &acc, shape, 1.0);

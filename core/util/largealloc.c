@@ -112,11 +112,6 @@ int util_large_owns(const void *p)
     return large_lookup(p, 0) != 0;
 }
 
-size_t util_large_block_bytes(const void *p)
-{
-    return large_lookup(p, 0);
-}
-
 size_t util_large_in_use(void)
 {
     size_t bytes;

@@ -137,8 +137,6 @@ void *util_large_realloc(void *p, size_t bytes);
 void util_large_free(void *p);
 /* 1 when p is a live block of the large allocator's own mappings. */
 int util_large_owns(const void *p);
-/* The bytes such a block can hold (whole huge pages); 0 for any other p. */
-size_t util_large_block_bytes(const void *p);
 /* The bytes the large allocator's own mappings hold now: memory that
  * glibc's mallinfo2 does not see, for whoever measures what a call kept. */
 size_t util_large_in_use(void);
