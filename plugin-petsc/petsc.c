@@ -318,8 +318,8 @@ typedef struct psc_csr {
 
 /* The arrays' block comes from the host's large-block allocator where it has
  * one (ABI 1.9): from 4 MiB up on transparent huge pages, so that filling
- * it takes a few page faults instead of one per 4 KiB (each ~6 us on this
- * VM: 2,500 of them at 500^2 on two ranks).  Not counted against the value
+ * it takes a few page faults instead of one per 4 KiB (each ~11 us on this
+ * VM: 2,100 of them per rank at 500^2 on two ranks).  Not counted against the value
  * size limit, as PETSc's own copy was not. */
 static int large_blocks(void)
 {
@@ -334,7 +334,6 @@ static void csr_free(psc_csr *c)
     }
     memset(c, 0, sizeof *c);
 }
-
 
 typedef struct psc_solver {
     Mat A;
