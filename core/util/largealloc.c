@@ -135,15 +135,21 @@ static int large_record(void *p, size_t len)
     return ok ? 0 : -1;
 }
 
-/* The entry of old becomes {now, len} (a block resized or moved). */
-static void large_rerecord(const void *old, void *now, size_t len)
+/* The entry of old becomes {now, len} (a block resized or moved); under
+ * large_lock. */
+static void large_rerecord_locked(const void *old, void *now, size_t len)
 {
     int i;
-    pthread_mutex_lock(&large_lock);
     if ((i = large_find(old)) >= 0) {
         large_mapped += len - large_blocks[i].len; /* modulo 2^N: a shrink subtracts */
         large_blocks[i] = (large_block){now, len};
     }
+}
+
+static void large_rerecord(const void *old, void *now, size_t len)
+{
+    pthread_mutex_lock(&large_lock);
+    large_rerecord_locked(old, now, len);
     pthread_mutex_unlock(&large_lock);
 }
 
@@ -178,17 +184,25 @@ static void large_unmap(void *p, size_t len)
     munmap(p, len);
 }
 
-/* Moves the len mapped bytes at p to a new mapping of newlen > len bytes:
- * the kernel moves the page tables (no copy, and huge pages stay huge).
- * NULL when there is no room, p untouched. */
+/* Moves the len mapped bytes at p to a new mapping of newlen > len bytes
+ * (the kernel moves the page tables: no copy, and huge pages stay huge) and
+ * re-records the block.  NULL when there is no room, p untouched.  The move
+ * unmaps p, so another thread's mmap may get p back at once: the move and
+ * the re-record are one step under large_lock, else that thread could
+ * record p while p's old entry is still there, and the re-record could
+ * take its entry for ours (test_largealloc's threads lost data that way,
+ * about 1 run in 100). */
 static void *large_grow(void *p, size_t len, size_t newlen)
 {
     void *q = large_map(newlen);
     if (!q) return NULL;
+    pthread_mutex_lock(&large_lock);
     if (mremap(p, len, len, MREMAP_MAYMOVE | MREMAP_FIXED, q) == MAP_FAILED) {
         memcpy(q, p, len);
         munmap(p, len);
     }
+    large_rerecord_locked(p, q, newlen);
+    pthread_mutex_unlock(&large_lock);
     return q;
 }
 #else
@@ -288,6 +302,5 @@ void *util_large_realloc(void *p, size_t bytes)
         errno = ENOMEM;
         return NULL;
     }
-    large_rerecord(p, q, newlen);
     return q;
 }
