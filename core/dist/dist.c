@@ -789,27 +789,21 @@ static void norm_props(silc_value *v)
     double *colsum = mirrored ? NULL : util_large_calloc((size_t)(v->n ? v->n : 1), sizeof *colsum);
     int64_t i, j, wd = val_width(b);
     int nz, fin, pos;
-    if (mirrored) {
-        reduce(D, mx, 2, 1);
-        v->props.norm1 = mx[0];
-    } else if (!colsum) {
-        die(D, "out of memory computing norms");
-    } else if (b->format == SILC_FMT_CSR) {
+    if (!mirrored && !colsum) die(D, "out of memory computing norms");
+    if (colsum && b->format == SILC_FMT_CSR) {
         for (i = 0; i < b->m; i++)
             for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++)
                 colsum[b->colind[j]] += entry_mod(b->val, j, wd, &nz, &fin, &pos);
-    } else {
+    } else if (colsum) {
         for (j = 0; j < b->n; j++)
             for (i = 0; i < b->m; i++) colsum[j] += entry_mod(b->val, i + j * b->m, wd, &nz, &fin, &pos);
     }
-    if (colsum) {
-        reduce(D, colsum, v->n, 0);
-        reduce(D, mx, 2, 1);
-        v->props.norm1 = 0;
-        for (j = 0; j < v->n; j++)
-            if (!(colsum[j] <= v->props.norm1)) v->props.norm1 = colsum[j];
-        util_large_free(colsum);
-    }
+    if (colsum) reduce(D, colsum, v->n, 0);
+    reduce(D, mx, 2, 1);
+    v->props.norm1 = mirrored ? mx[0] : 0;
+    for (j = 0; colsum && j < v->n; j++)
+        if (!(colsum[j] <= v->props.norm1)) v->props.norm1 = colsum[j];
+    util_large_free(colsum);
     v->props.norminf = mx[0];
     v->props.maxabs = mx[1];
     /* Frobenius: the largest rank's norm scales the others, so no square overflows. */
