@@ -556,10 +556,10 @@ static void factor_end(mumps_factor *F)
 {
     if (F->live && mpi_alive()) mumps_job(F, MUMPS_JOB_END);
     F->live = 0;
-    host->free(F->irn);
-    host->free(F->jcn);
-    host->free(F->a);
-    host->free(F->af);
+    silc_large_free_of(host, F->irn);
+    silc_large_free_of(host, F->jcn);
+    silc_large_free_of(host, F->a);
+    silc_large_free_of(host, F->af);
     host->free(F->yf);
     host->free(F->est_y0);
     F->irn = F->jcn = NULL;
@@ -612,9 +612,12 @@ static int build_triplets(const silc_view *v, int64_t row0, int lower, mumps_fac
     int w = ID_W(F);
     cap = v->format == SILC_FMT_CSR ? v->nnz : v->format == SILC_FMT_BAND ? v->ld * n : n * n;
     if (cap < 1) cap = 1;
-    F->irn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
-    F->jcn = host->alloc((size_t)cap * sizeof(MUMPS_INT));
-    F->a = host->alloc((size_t)cap * (size_t)w * sizeof(double));
+    /* 16 bytes an entry, kept as long as the factorization: 12 MB a rank
+     * at a million unknowns on two, whose first-touch page faults were
+     * half of this function (docs/distributed.md). */
+    F->irn = silc_large_alloc_of(host, (size_t)cap * sizeof(MUMPS_INT));
+    F->jcn = silc_large_alloc_of(host, (size_t)cap * sizeof(MUMPS_INT));
+    F->a = silc_large_alloc_of(host, (size_t)cap * (size_t)w * sizeof(double));
     if (!F->irn || !F->jcn || !F->a) return SILC_ENOMEM;
     if (v->format == SILC_FMT_CSR) {
         for (i = 0; i < v->m; i++)
@@ -954,7 +957,7 @@ static const char *to_single(mumps_factor *F, int64_t nnz)
         double x = ldexp(F->a[k], F->scale_a);
         if (x != 0 && fabs(x) < FLT_MIN) return "its entries span more than single precision's range";
     }
-    F->af = host->alloc((size_t)nnz * sizeof *F->af);
+    F->af = silc_large_alloc_of(host, (size_t)nnz * sizeof *F->af);
     if (!F->af) return "no memory for a single-precision copy";
     for (k = 0; k < nnz; k++) F->af[k] = (float)ldexp(F->a[k], F->scale_a);
     return NULL;
@@ -1064,7 +1067,7 @@ static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym
         mumps_job(F, MUMPS_JOB_END);
         memset(&F->id, 0, sizeof F->id);
         F->live = F->single = F->retries = 0;
-        host->free(F->af);
+        silc_large_free_of(host, F->af);
         F->af = NULL;
         F->fallback = "the single-precision LU was numerically singular";
         code = analyse_factor(F, (int)v->n, nnz, sym, s, &job);
@@ -1075,7 +1078,7 @@ static int factor_new(silc_call *call, solve_ctx *c, const silc_view *v, int sym
         return rc;
     }
     if (F->single) { /* MUMPS reads af from now on */
-        host->free(F->a);
+        silc_large_free_of(host, F->a);
         F->a = NULL;
     }
     /* LDL' of an SPD matrix has only positive pivots; INFOG(12) counts the negative ones. */

@@ -317,21 +317,12 @@ typedef struct psc_csr {
 } psc_csr;
 
 /* The arrays' block comes from the host's large-block allocator where it has
- * one (ABI 1.9): from 4 MiB up on transparent huge pages, so that filling
- * it takes a few page faults instead of one per 4 KiB (each ~11 us on this
- * VM: 2,100 of them per rank at 500^2 on two ranks).  Not counted against the value
- * size limit, as PETSc's own copy was not. */
-static int large_blocks(void)
-{
-    return host->struct_size >= SILC_HOST_NEEDS(large_free);
-}
-
+ * one (silc_large_alloc_of): filling it then takes a few page faults instead
+ * of one per 4 KiB (2,100 of them per rank at 500^2 on two ranks).  Not
+ * counted against the value size limit, as PETSc's own copy was not. */
 static void csr_free(psc_csr *c)
 {
-    if (c->block) {
-        if (large_blocks()) host->large_free(c->block);
-        else host->free(c->block);
-    }
+    if (c->block) silc_large_free_of(host, c->block);
     memset(c, 0, sizeof *c);
 }
 
@@ -420,7 +411,7 @@ static int csr_build(silc_call *call, const psc_ranks *R, const silc_view *a, in
     doubles = (size_t)(split || !borrow ? nd : 0) + (size_t)(split ? no : 0);
     ints = (size_t)(a->m + 1) + (size_t)nd + (split ? (size_t)(a->m + 1) + (size_t)no : 0);
     bytes = doubles * sizeof(double) + ints * sizeof(PetscInt);
-    c->block = large_blocks() ? host->large_alloc(bytes) : host->alloc(bytes);
+    c->block = silc_large_alloc_of(host, bytes);
     if (!c->block)
         return psc_error(call, SILC_ENOMEM, "out of memory for PETSc's copy of %lld rows (%lld entries)",
                          (long long)a->m, (long long)a->nnz);
