@@ -16,6 +16,9 @@
  *     NaN/Inf);
  *   - symmetry alone, then the norms, each agree with brute force, and so
  *     does val_props on a fresh copy that computes everything at once;
+ *   - val_row_norms (a distributed block's norms) gives the same
+ *     infinity and Frobenius norms and largest entry, no 1-norm, and
+ *     caches nothing;
  *   - the backward error's ||A||_inf, taken from the residual's pass when
  *     the norms are not known, equals the one from the properties;
  *   - silc_put's one-pass check refuses exactly what env_check refuses, with
@@ -219,6 +222,14 @@ static void check_matrix(const char *what, const silc_envelope_t *e)
               val_has_nonfinite(put), t.maxabs, t.has_nonfinite);
     }
     k = (double)(v->format == SILC_FMT_CSR ? v->rowptr[v->m] : v->m * v->n);
+    if (!t.has_nonfinite) { /* a distributed block's norms: no column sums, nothing cached */
+        silc_props rp;
+        int have = w->props_have, rc = val_row_norms(w, &rp); /* before CHECK reads rp */
+        CHECK(rc == 0 && isnan(rp.norm1) && close_to(rp.norminf, t.norminf, k) &&
+                  close_to(rp.normfro, t.normfro, k) && rp.maxabs == t.maxabs && w->props_have == have,
+              "%s: row norms 1 %.17g (NaN) inf %.17g/%.17g fro %.17g/%.17g max %.17g/%.17g, parts %d/%d", what,
+              rp.norm1, rp.norminf, t.norminf, rp.normfro, t.normfro, rp.maxabs, t.maxabs, w->props_have, have);
+    }
     p = val_props_part(v, SILC_PROPS_SHAPE);
     check_shape(what, p, &t);
     CHECK(v->format != SILC_FMT_CSR || v->props_have == SILC_PROPS_SHAPE,

@@ -772,7 +772,8 @@ static void shape_props(silc_value *v)
 }
 
 /* The norms of a distributed value: ||A||_inf and max|a_ij| from the
- * blocks' own, Frobenius scaled, and ||A||_1 from column sums over all the
+ * blocks' own (val_row_norms: one pass over the block's rows, no column
+ * sums of its own), Frobenius scaled, and ||A||_1 from column sums over all the
  * ranks -- an array of n sums per rank and a reduction of n doubles, the
  * most expensive property of all -- unless A is known symmetric or
  * hermitian (dist_props_hook asks that first), whose column sums are its
@@ -783,13 +784,17 @@ static void norm_props(silc_value *v)
 {
     dist_ctx *D = v->dist->ctx;
     const silc_value *b = v->dist->block;
-    const silc_props *bp = val_props_part(b, SILC_PROPS_NORMS);
-    double mx[2] = {bp->norminf, bp->maxabs}, s, fro;
+    silc_props bp;
+    double mx[3], s, fro;
     int mirrored = (v->props_have & SILC_PROPS_SYMMETRY) && (v->props.symmetric || v->props.hermitian);
     double *colsum = mirrored ? NULL : util_large_calloc((size_t)(v->n ? v->n : 1), sizeof *colsum);
     int64_t i, j, wd = val_width(b);
     int nz, fin, pos;
     if (!mirrored && !colsum) die(D, "out of memory computing norms");
+    val_row_norms(b, &bp); /* out of memory: norminf is the bound sum|a_ij| */
+    mx[0] = bp.norminf;
+    mx[1] = bp.maxabs;
+    mx[2] = bp.normfro;
     if (colsum && b->format == SILC_FMT_CSR) {
         for (i = 0; i < b->m; i++)
             for (j = b->rowptr[i]; j < b->rowptr[i + 1]; j++)
@@ -799,7 +804,7 @@ static void norm_props(silc_value *v)
             for (i = 0; i < b->m; i++) colsum[j] += entry_mod(b->val, i + j * b->m, wd, &nz, &fin, &pos);
     }
     if (colsum) reduce(D, colsum, v->n, 0);
-    reduce(D, mx, 2, 1);
+    reduce(D, mx, 3, 1);
     v->props.norm1 = mirrored ? mx[0] : 0;
     for (j = 0; colsum && j < v->n; j++)
         if (!(colsum[j] <= v->props.norm1)) v->props.norm1 = colsum[j];
@@ -807,9 +812,8 @@ static void norm_props(silc_value *v)
     v->props.norminf = mx[0];
     v->props.maxabs = mx[1];
     /* Frobenius: the largest rank's norm scales the others, so no square overflows. */
-    s = bp->normfro;
-    reduce(D, &s, 1, 1);
-    fro = s > 0 && isfinite(s) ? (bp->normfro / s) * (bp->normfro / s) : 0;
+    s = mx[2];
+    fro = s > 0 && isfinite(s) ? (bp.normfro / s) * (bp.normfro / s) : 0;
     reduce(D, &fro, 1, 0);
     v->props.normfro = s > 0 && isfinite(s) ? s * sqrt(fro) : s;
 }
@@ -1465,7 +1469,12 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
     dist_ctx *D = A->dist->ctx;
     silc_engine E0;
     const silc_value *xw, *a = A->dist->block, *b = B->dist->block;
-    double nR = 0, nA, nX, nB, be;
+    /* ||A||_inf from the properties when they hold it, else from the
+     * residual's pass over the rows (as backward_error_whole does): a
+     * distributed solve asks nothing else of A's norms, and their own pass
+     * would read the blocks once more (and sum their columns). */
+    double nA = (A->props_have & SILC_PROPS_NORMS) ? A->props.norminf : -1, nX, nB, be;
+    double red[2] = {0, 0}; /* max_i |r_i| over the columns, max_i sum_k |a_ik| */
     int64_t i, j, k = X->n, wa = val_width(A), wb = val_width(B), wx = val_width(X);
     memset(&E0, 0, sizeof E0);
     E0.dist = D;
@@ -1484,28 +1493,36 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
     }
     for (j = 0; j < k; j++)
         for (i = 0; i < a->m; i++) {
-            double r;
+            double r, ra = 0;
             int64_t p;
             if (wa == 1 && wb == 1 && wx == 1) { /* real: no complex arithmetic in the inner loop */
                 double s = b->val[i + j * b->m];
-                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) s -= a->val[p] * xw->val[a->colind[p] + j * xw->m];
+                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) {
+                    s -= a->val[p] * xw->val[a->colind[p] + j * xw->m];
+                    ra += fabs(a->val[p]);
+                }
                 r = fabs(s);
             } else { /* complex: |r| is the modulus, as backward_error_complex's infinity norm */
                 double complex s = entry_c(b->val, i + j * b->m, wb);
-                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++)
+                for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) {
                     s -= entry_c(a->val, p, wa) * entry_c(xw->val, a->colind[p] + j * xw->m, wx);
+                    ra += cabs(entry_c(a->val, p, wa));
+                }
                 r = cabs(s);
             }
-            if (!(r <= nR)) nR = r; /* NaN sticks */
+            if (!(r <= red[0])) red[0] = r; /* NaN sticks */
+            if (!(ra <= red[1])) red[1] = ra;
         }
     val_release(xbuf);
-    reduce(D, &nR, 1, 1);
-    nA = val_props_part(A, SILC_PROPS_NORMS)->norminf;
+    reduce(D, red, 2, 1);
+    /* The same on every rank, so all or none ask the properties (collective):
+     * a sum past DBL_MAX needs their scaled pass. */
+    if (nA < 0) nA = isfinite(red[1]) ? red[1] : val_props_part(A, SILC_PROPS_NORMS)->norminf;
     nX = val_max_abs(X);
     nB = val_max_abs(B);
-    if (isnan(nR) || isnan(nX)) be = NAN;
-    else if (nR == 0) be = 0;
-    else be = nR / (nA * nX + nB);
+    if (isnan(red[0]) || isnan(nX)) be = NAN;
+    else if (red[0] == 0) be = 0;
+    else be = red[0] / (nA * nX + nB);
     return be;
 }
 

@@ -196,6 +196,12 @@ const silc_props *val_props(const silc_value *v); /* computes and caches on firs
 /* Only some parts of the properties (SILC_PROPS_*, silc_plugin.h), each
  * computed and cached when first asked for (value.c says why). */
 const silc_props *val_props_part(const silc_value *v, int parts);
+/* The infinity norm, largest modulus and Frobenius norm of v into *p,
+ * without its column sums (p->norm1 = NaN) and without caching them: a
+ * distributed value's block, whose column sums span the ranks (dist.c
+ * reduces its own, and a symmetric value needs none).  Returns 0, or -1
+ * when memory ran short (then norminf is the upper bound sum|a_ij|). */
+int val_row_norms(const silc_value *v, silc_props *p);
 /* The shape part of a whole real dense v's properties (as val_props_part
  * computes it, with the scan cache) and a copy of its m*n entries into
  * copy, in one read of v: a solve's backend factors such a copy in place

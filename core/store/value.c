@@ -1394,10 +1394,11 @@ static void props_start(const silc_value *v, props_acc *acc, int structure, doub
 }
 
 /* Fills the norms, and the shape with them when shape is set (a format
- * other than CSR has no cheaper way to its shape).  Returns 0, or -1 when
- * memory ran short: then both operator norms are replaced by the upper
- * bound sum|a_ij| and the caller does not mark them known. */
-static int compute_norms(const silc_value *v, silc_props *p, int shape)
+ * other than CSR has no cheaper way to its shape).  cols = 0: no column
+ * sums, and norm1 = NaN (val_row_norms).  Returns 0, or -1 when memory ran
+ * short: then both operator norms are replaced by the upper bound
+ * sum|a_ij| and the caller does not mark them known. */
+static int compute_norms(const silc_value *v, silc_props *p, int shape, int cols)
 {
     props_acc acc;
     int exp2 = 0, rc = 0;
@@ -1408,7 +1409,7 @@ static int compute_norms(const silc_value *v, silc_props *p, int shape)
      * freed before the call returns, like a library's work space
      * (util_large_malloc); values' own arrays stay malloc's (docs/overhead.md,
      * "Values' arrays on huge pages"). */
-    acc.colsum = util_large_malloc((size_t)(v->n ? v->n : 1) * sizeof(double));
+    acc.colsum = cols ? util_large_malloc((size_t)(v->n ? v->n : 1) * sizeof(double)) : NULL;
     acc.rowsum = util_large_malloc((size_t)(v->m ? v->m : 1) * sizeof(double));
     props_start(v, &acc, shape, 1.0);
     int fast = 0; /* a fast pass gathered everything asked for */
@@ -1441,8 +1442,8 @@ static int compute_norms(const silc_value *v, silc_props *p, int shape)
             props_pass(v, &acc);
         }
     }
-    if (acc.colsum && acc.rowsum) {
-        p->norm1 = ldexp(max_of(acc.colsum, v->n), exp2);
+    if ((acc.colsum || !cols) && acc.rowsum) {
+        p->norm1 = cols ? ldexp(max_of(acc.colsum, v->n), exp2) : NAN;
         p->norminf = ldexp(max_of(acc.rowsum, v->m), exp2);
     } else {
         p->norm1 = p->norminf = ldexp(acc.total, exp2);
@@ -1474,7 +1475,7 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         val_shape_into(v, NULL); /* a real dense value's shape alone; nothing for others or when known */
     if ((parts & (SILC_PROPS_SHAPE | SILC_PROPS_NORMS)) & ~v->props_have) {
         int shape = !(v->props_have & SILC_PROPS_SHAPE);
-        if (compute_norms(v, p, shape) == 0) v->props_have |= SILC_PROPS_NORMS;
+        if (compute_norms(v, p, shape, 1) == 0) v->props_have |= SILC_PROPS_NORMS;
         v->props_have |= shape ? SILC_PROPS_SHAPE : 0;
     }
     if ((parts & SILC_PROPS_SYMMETRY) && !(v->props_have & SILC_PROPS_SYMMETRY)) {
@@ -1491,6 +1492,12 @@ const silc_props *val_props_part(const silc_value *cv, int parts)
         }
     }
     return p;
+}
+
+int val_row_norms(const silc_value *v, silc_props *p)
+{
+    memset(p, 0, sizeof *p); /* a NaN or Inf: the fast pass's sums see it and fall back */
+    return compute_norms(v, p, 0, 0);
 }
 
 int val_shape_into(silc_value *v, double *copy)
