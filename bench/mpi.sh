@@ -30,6 +30,10 @@
 # (it takes the program's triplets as they are).  The silcd server runs only while its
 # client runs (its idle ranks rest, but its start and end are not measured
 # here).  bench/mpi_wake.py measures what resting ranks add to a request.
+# A last table pairs each SILC one-shot row with its direct baseline round
+# by round (an SPMD row runs right before its baseline) and gives the median
+# and range of those ratios: on a shared host whose speed drifts within
+# minutes, the best of each row alone can come from different moments.
 set -u
 cd "$(dirname "$0")/.." || exit 1
 QUICK=0
@@ -147,18 +151,23 @@ for round in $(seq "$ROUNDS"); do
     # One process per method, as the direct rows: a solve that follows
     # another in the same process ran up to 1.6x slower here (hypre after
     # MUMPS or CHOLMOD at 1000^2, page faults and scheduler time in perf),
-    # which measures the process's history, not SILC.
-    for m in ${SILC_METHODS//,/ }; do
-      for n in $NS; do
-        record mpirun -np "$np" "$MPI_BIN" spmd -n "$n" -methods "$m"
-      done
-      [ "$LOOP" = 1 ] && record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
-    done
+    # which measures the process's history, not SILC.  Each SPMD one-shot
+    # row runs right before its direct baseline, so that the pair sees the
+    # same state of a shared host (its speed drifted 3.4-5.4 s for the same
+    # MUMPS factorization within minutes): the per-round ratios below pair them.
     for n in $NS; do
-      has_method petsc-mumps && direct "$np" mumps oneshot "$n" -method mumps
-      has_method mumps && direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky
-      has_method petsc-cg-hypre && direct "$np" cg-hypre oneshot "$n" -method cg-hypre
-      has_method mumps && direct "$np" dmumps oneshot "$n" -method dmumps
+      for m in ${SILC_METHODS//,/ }; do
+        record mpirun -np "$np" "$MPI_BIN" spmd -n "$n" -methods "$m"
+        case $m in
+          mumps) direct "$np" dmumps oneshot "$n" -method dmumps
+                 direct "$np" mumps-chol oneshot "$n" -method mumps -pc_type cholesky ;;
+          petsc-mumps) direct "$np" mumps oneshot "$n" -method mumps ;;
+          petsc-cg-hypre) direct "$np" cg-hypre oneshot "$n" -method cg-hypre ;;
+        esac
+      done
+    done
+    for m in ${SILC_METHODS//,/ }; do
+      [ "$LOOP" = 1 ] && record mpirun -np "$np" "$MPI_BIN" spmd -n "$LOOP_N" -steps "$STEPS" -methods "$m"
     done
     if [ "$LOOP" = 1 ]; then
       has_method petsc-mumps && direct "$np" mumps loop "$LOOP_N" -method mumps
@@ -200,6 +209,7 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     if (field($0, "kind") == "oneshot") {
       a = t + (field($0, "mode") == "direct" ? (field($0, "method") == "dmumps" ? 0 : field($0, "asm_s") + 0) : field($0, "put_s") + 0)
       if (!(k in tot) || a < tot[k]) tot[k] = a
+      rt[k, cnt[k]] = t; ra[k, cnt[k]] = a # this round, for the paired table
     }
     c = field($0, "cpu_s")
     if (c != "" && (!(k in cpu) || c + 0 < cpu[k])) { cpu[k] = c + 0; faults[k] = field($0, "faults"); sys[k] = field($0, "sys_s") }
@@ -219,6 +229,23 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
     if (mode == "embedded") return "(d) embedded SILC, default (CHOLMOD)"
     if (method == "dmumps") return "(c) direct MUMPS, dmumps_c (same ICNTLs as mumps)"
     return "(c) direct PETSc, " method
+  }
+  # "median [min-max]" of x[1..c] (sorted in place).
+  function spread3(x, c,   i, j, t) {
+    for (i = 2; i <= c; i++) for (j = i; j > 1 && x[j - 1] > x[j]; j--) { t = x[j]; x[j] = x[j - 1]; x[j - 1] = t }
+    return sprintf("%.2f [%.2f-%.2f]", c % 2 ? x[(c + 1) / 2] : (x[c / 2] + x[c / 2 + 1]) / 2, x[1], x[c])
+  }
+  # A SILC one-shot row against its direct row, round by round.
+  function paired(n, np, mode, method,   k, bk, i, c, xs, xa) {
+    k = "oneshot|" n "|" np "|" mode "|" method
+    bk = "oneshot|" n "|" np "|direct|" base_of(method, "oneshot")
+    if (!(k in cnt) || !(bk in cnt)) return
+    c = 0
+    for (i = 1; i <= cnt[k] && i <= cnt[bk]; i++) {
+      if (rt[bk, i] <= 0 || ra[bk, i] <= 0) continue
+      c++; xs[c] = rt[k, i] / rt[bk, i]; xa[c] = ra[k, i] / ra[bk, i]
+    }
+    if (c) printf "| %s | %s | %s | %s | %s | %d |\n", n, np, label(mode, method), spread3(xs, c), spread3(xa, c), c
   }
   function row(kind, n, np, mode, method,   k, b, bk, r, sp, L, note) {
     k = kind "|" n "|" np "|" mode "|" method
@@ -280,6 +307,18 @@ awk -v cores="$CORES" -v petsc="$PETSC" -v nps="$NPS" -v steps="$STEPS" -v parti
         for (m = 1; m <= 3; m++) row(K, n, np, "client", M[m])
         for (m = 1; m <= 3; m++) row(K, n, np, "spmd", M[m])
         if (np == 1) row(K, n, np, "embedded", "default")
+      }
+      if (K == "oneshot") {
+        print ""
+        print "Paired by round: each SPMD row runs right before its direct baseline (the client rows earlier in"
+        print "the round, while the server is up); median [range] of the per-round ratios:"
+        print ""
+        print "| n | np | mode, method | statement / direct | from arrays / direct | rounds |"
+        print "|---:|---:|---|---|---|---:|"
+        for (i = 1; i <= nn; i++) for (p = 1; p in P; p++) {
+          for (m = 1; m <= 3; m++) paired(order[i], P[p], "client", M[m])
+          for (m = 1; m <= 3; m++) paired(order[i], P[p], "spmd", M[m])
+        }
       }
     }
   }' "$RES"
