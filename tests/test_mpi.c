@@ -245,19 +245,16 @@ static void check_backward_error(silc_context *c, tl_capture *cap)
     ok = ok && get_whole(c, "xl", x, n) == 0;
     if (all_ok(ok)) {
         for (i = 0; i < n; i++) {
-            double r = 0, a = 0; /* b_i = sum_k a_ik (b = A * ones) */
+            double r = 0, a = 0, bi = 0; /* b_i = sum_k a_ik (b = A * ones) */
             for (k = A.rowptr[i]; k < A.rowptr[i + 1]; k++) {
                 r += A.values[k] * (1 - x[A.colind[k]]);
                 a += fabs(A.values[k]);
+                bi += A.values[k];
             }
             nR = fmax(nR, fabs(r));
             nA = fmax(nA, a);
-            nX = fmax(nX, fabs(x[i]));
-        }
-        for (i = 0; i < n; i++) {
-            double bi = 0;
-            for (k = A.rowptr[i]; k < A.rowptr[i + 1]; k++) bi += A.values[k];
             nB = fmax(nB, fabs(bi));
+            nX = fmax(nX, fabs(x[i]));
         }
         be = nR / (nA * nX + nB);
         CHECK(all_ok(be > 1e-12 && fabs(shown - be) <= 0.01 * be),

@@ -1491,7 +1491,8 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
     } else if (!(xw = dist_whole(&E0, X, 1))) {
         return -1;
     }
-    for (j = 0; j < k; j++)
+    for (j = 0; j < k; j++) {
+        int rows = nA < 0 && j == 0; /* the row sums: once, and only when not known */
         for (i = 0; i < a->m; i++) {
             double r, ra = 0;
             int64_t p;
@@ -1499,20 +1500,22 @@ double dist_backward_error(const silc_value *A, const silc_value *B, const silc_
                 double s = b->val[i + j * b->m];
                 for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) {
                     s -= a->val[p] * xw->val[a->colind[p] + j * xw->m];
-                    ra += fabs(a->val[p]);
+                    if (rows) ra += fabs(a->val[p]);
                 }
                 r = fabs(s);
             } else { /* complex: |r| is the modulus, as backward_error_complex's infinity norm */
                 double complex s = entry_c(b->val, i + j * b->m, wb);
                 for (p = a->rowptr[i]; p < a->rowptr[i + 1]; p++) {
-                    s -= entry_c(a->val, p, wa) * entry_c(xw->val, a->colind[p] + j * xw->m, wx);
-                    ra += cabs(entry_c(a->val, p, wa));
+                    double complex aij = entry_c(a->val, p, wa);
+                    s -= aij * entry_c(xw->val, a->colind[p] + j * xw->m, wx);
+                    if (rows) ra += cabs(aij);
                 }
                 r = cabs(s);
             }
             if (!(r <= red[0])) red[0] = r; /* NaN sticks */
             if (!(ra <= red[1])) red[1] = ra;
         }
+    }
     val_release(xbuf);
     reduce(D, red, 2, 1);
     /* The same on every rank, so all or none ask the properties (collective):
